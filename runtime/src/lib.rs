@@ -1,0 +1,24 @@
+//! nocdyn runtime.
+//!
+//! * [`math`]: the only float entry point of generated code (`sin_cos`, `sqrt`), std or `libm`.
+//! * [`model`] (feature `alloc`): the validated mechanism — bodies, joints, frames — that the
+//!   generator compiles and the generic runtime evaluates.
+//! * [`noc`] (feature `alloc`): the Natural Orthogonal Complement evaluated literally with nalgebra
+//!   (`T`, `Ṫ`, `M`, `W`, `I = TᵀMT`, `C = Tᵀ(MṪ+WMT)`): the first oracle.
+//! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
+//!   spatial (6-D) algebra, written from their own equations: the independent second route.
+#![no_std]
+
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod math;
+
+#[cfg(feature = "alloc")]
+pub mod model;
+#[cfg(feature = "alloc")]
+pub mod noc;
+#[cfg(feature = "alloc")]
+pub mod rnea;

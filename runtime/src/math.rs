@@ -1,0 +1,57 @@
+//! The math layer generated code calls: `sin_cos`, `sqrt`.
+//!
+//! With the `std` feature (and without `libm-force`) these are std's methods (LLVM intrinsics and
+//! the platform libm); otherwise the pure-Rust `libm` crate, which gives bit-identical results on
+//! every target. The two backends may differ by one ulp in sin/cos.
+
+/// `(sin x, cos x)`.
+#[inline(always)]
+pub fn sin_cos(x: f64) -> (f64, f64) {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.sin_cos()
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::sincos(x)
+    }
+}
+
+/// Square root.
+#[inline(always)]
+pub fn sqrt(x: f64) -> f64 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.sqrt()
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::sqrt(x)
+    }
+}
+
+/// `(sin x, cos x)` in single precision.
+#[inline(always)]
+pub fn sin_cos_f32(x: f32) -> (f32, f32) {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.sin_cos()
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::sincosf(x)
+    }
+}
+
+/// Square root in single precision.
+#[inline(always)]
+pub fn sqrt_f32(x: f32) -> f32 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.sqrt()
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::sqrtf(x)
+    }
+}
