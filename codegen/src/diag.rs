@@ -1,1 +1,295 @@
+//! Diagnostics: problems found in a spec, each with a severity, a message, the key path of the
+//! offending entry, its byte span in the source and an optional hint.
+//!
+//! [`Diagnostics`] owns the file name and the source text, so it renders itself (through
+//! `codespan-reporting`, colour-free and deterministic) wherever it ends up: the CLI, a build
+//! script's panic message, a `compile_error!` or a snapshot test.
 
+use std::fmt;
+use std::ops::Range;
+
+use codespan_reporting::diagnostic as cs;
+use codespan_reporting::files::SimpleFile;
+use codespan_reporting::term;
+
+/// How bad a [`Diagnostic`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    /// The spec is rejected.
+    Error,
+    /// The spec is accepted, but something was changed or looks suspicious.
+    Warning,
+}
+
+/// One problem in a spec.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// Error or warning.
+    pub severity: Severity,
+    /// What is wrong, one sentence, no trailing full stop.
+    pub message: String,
+    /// The key path of the offending entry, e.g. `joint "j3".axis` or `body[2].mass`.
+    pub key: Option<String>,
+    /// Byte range of the offending key or value in the source.
+    pub span: Option<Range<usize>>,
+    /// How to fix it, e.g. `did you mean "inertia"?`.
+    pub hint: Option<String>,
+}
+
+impl Diagnostic {
+    /// A new error with `message` and nothing else.
+    pub fn error(message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Error,
+            message: message.into(),
+            key: None,
+            span: None,
+            hint: None,
+        }
+    }
+
+    /// A new warning with `message` and nothing else.
+    pub fn warning(message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(message)
+        }
+    }
+
+    /// Sets the key path.
+    pub fn with_key(mut self, key: impl Into<String>) -> Self {
+        self.key = Some(key.into());
+        self
+    }
+
+    /// Sets the byte span (`None` leaves it unset).
+    pub fn with_span(mut self, span: impl Into<Option<Range<usize>>>) -> Self {
+        self.span = span.into();
+        self
+    }
+
+    /// Sets the hint.
+    pub fn with_hint(mut self, hint: impl Into<String>) -> Self {
+        self.hint = Some(hint.into());
+        self
+    }
+
+    /// `true` for [`Severity::Error`].
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+}
+
+/// The diagnostics of one source file, together with that file's name and text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostics {
+    file_name: String,
+    source: String,
+    list: Vec<Diagnostic>,
+}
+
+impl Diagnostics {
+    /// An empty list for the file `file_name` whose text is `source`.
+    pub fn new(file_name: &str, source: &str) -> Self {
+        Diagnostics {
+            file_name: file_name.to_owned(),
+            source: source.to_owned(),
+            list: Vec::new(),
+        }
+    }
+
+    /// Appends `d`.
+    pub fn push(&mut self, d: Diagnostic) {
+        self.list.push(d);
+    }
+
+    /// Appends `d` and returns it for further changes.
+    pub fn push_mut(&mut self, d: Diagnostic) -> &mut Diagnostic {
+        let i = self.list.len();
+        self.list.push(d);
+        &mut self.list[i]
+    }
+
+    /// Appends all diagnostics of `other` (whose file should be the same).
+    pub fn extend(&mut self, other: Diagnostics) {
+        self.list.extend(other.list);
+    }
+
+    /// `true` when at least one diagnostic is an error.
+    pub fn has_errors(&self) -> bool {
+        self.list.iter().any(Diagnostic::is_error)
+    }
+
+    /// Number of diagnostics (errors and warnings).
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// `true` when there are no diagnostics at all.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The diagnostics in order.
+    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.list.iter()
+    }
+
+    /// The file name given to [`Diagnostics::new`].
+    pub fn file_name(&self) -> &str {
+        &self.file_name
+    }
+
+    /// The source text given to [`Diagnostics::new`].
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Number of errors.
+    pub fn error_count(&self) -> usize {
+        self.list.iter().filter(|d| d.is_error()).count()
+    }
+
+    /// Stable sort by position in the source; diagnostics without a span go last.
+    pub fn sort_by_position(&mut self) {
+        self.list
+            .sort_by_key(|d| d.span.as_ref().map_or((1, 0, 0), |s| (0, s.start, s.end)));
+    }
+
+    /// Removes and returns the warnings, keeping the errors.
+    pub fn take_warnings(&mut self) -> Diagnostics {
+        let (errors, warnings) = std::mem::take(&mut self.list)
+            .into_iter()
+            .partition(Diagnostic::is_error);
+        self.list = errors;
+        Diagnostics {
+            file_name: self.file_name.clone(),
+            source: self.source.clone(),
+            list: warnings,
+        }
+    }
+
+    /// Colour-free rendering through `codespan-reporting`: for every diagnostic, its severity and
+    /// message, `file:line:column`, the source line with carets under the span labelled with the
+    /// key, and the hint. Deterministic (no colours, no absolute paths beyond the given name).
+    pub fn render(&self) -> String {
+        let file = SimpleFile::new(self.file_name.as_str(), self.source.as_str());
+        let config = term::Config {
+            chars: term::Chars::ascii(),
+            ..term::Config::default()
+        };
+        let mut out = String::new();
+        for d in &self.list {
+            let span = d.span.clone().map(|s| clamp_span(&self.source, s));
+            let mut notes = Vec::new();
+            let mut labels = Vec::new();
+            match (&span, &d.key) {
+                (Some(s), key) => {
+                    let mut label = cs::Label::primary((), s.clone());
+                    if let Some(k) = key {
+                        label = label.with_message(k);
+                    }
+                    labels.push(label);
+                }
+                (None, Some(k)) => notes.push(format!("in {}: {k}", self.file_name)),
+                (None, None) => notes.push(format!("in {}", self.file_name)),
+            }
+            if let Some(h) = &d.hint {
+                notes.push(format!("hint: {h}"));
+            }
+            let severity = match d.severity {
+                Severity::Error => cs::Severity::Error,
+                Severity::Warning => cs::Severity::Warning,
+            };
+            let diag = cs::Diagnostic::new(severity)
+                .with_message(&d.message)
+                .with_labels(labels)
+                .with_notes(notes.clone());
+            match term::emit_into_string(&config, &file, &diag) {
+                Ok(s) => out.push_str(&s),
+                Err(_) => {
+                    // Cannot happen with a clamped span; fall back to a plain line.
+                    let sev = match d.severity {
+                        Severity::Error => "error",
+                        Severity::Warning => "warning",
+                    };
+                    out.push_str(&format!("{sev}: {}\n", d.message));
+                    for n in &notes {
+                        out.push_str(&format!("  = {n}\n"));
+                    }
+                    out.push('\n');
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Clamps `span` into `source` and onto char boundaries (codespan-reporting rejects others).
+fn clamp_span(source: &str, span: Range<usize>) -> Range<usize> {
+    let fix = |mut i: usize| {
+        i = i.min(source.len());
+        while !source.is_char_boundary(i) {
+            i -= 1;
+        }
+        i
+    };
+    let start = fix(span.start);
+    let end = fix(span.end).max(start);
+    start..end
+}
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.render())
+    }
+}
+
+impl std::error::Error for Diagnostics {}
+
+impl<'a> IntoIterator for &'a Diagnostics {
+    type Item = &'a Diagnostic;
+    type IntoIter = std::slice::Iter<'a, Diagnostic>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.list.iter()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_location_key_and_hint() {
+        let src = "[mechanism]\nname = \"x\"\ninertai = 3\n";
+        let mut d = Diagnostics::new("arm.toml", src);
+        let start = src.find("inertai").unwrap();
+        d.push(
+            Diagnostic::error("unknown key \"inertai\"")
+                .with_key("mechanism.inertai")
+                .with_span(start..start + 7)
+                .with_hint("did you mean \"inertia\"?"),
+        );
+        d.push(Diagnostic::warning("no span here").with_key("body[0]"));
+        assert!(d.has_errors());
+        assert_eq!(d.len(), 2);
+        let r = d.render();
+        assert!(r.contains("arm.toml:3:1"), "{r}");
+        assert!(r.contains("^^^^^^^ mechanism.inertai"), "{r}");
+        assert!(r.contains("hint: did you mean \"inertia\"?"), "{r}");
+        assert!(r.contains("warning: no span here"), "{r}");
+        assert!(r.contains("in arm.toml: body[0]"), "{r}");
+        assert_eq!(r, d.to_string());
+    }
+
+    #[test]
+    fn out_of_range_spans_do_not_panic() {
+        let mut d = Diagnostics::new("x.toml", "é");
+        d.push(Diagnostic::error("m").with_span(1..100));
+        #[allow(clippy::reversed_empty_ranges)]
+        let reversed = 5..2;
+        d.push(Diagnostic::error("m").with_span(reversed));
+        let r = d.render();
+        assert!(r.contains("x.toml:1:"), "{r}");
+    }
+}

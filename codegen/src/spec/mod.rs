@@ -1,1 +1,160 @@
+//! The spec layer: mechanism descriptions (TOML, or URDF with the `urdf` feature) → a validated
+//! [`runtime::model::Model`], or [`Diagnostics`] pointing at every problem.
+//!
+//! Pipeline: a reader (`read_toml`, `urdf`) turns the text into the format-neutral `ir::Spec`,
+//! reporting syntax, key and type errors with spans; `lower` checks values and topology and
+//! lowers (stable topological order, fixed-joint merging, U/S expansion, DH frames) to the
+//! model. The format reference is `docs/spec.md`.
+//!
+//! This is the only module that knows TOML, XML or serde.
 
+mod angle;
+mod geom;
+mod ir;
+mod lower;
+mod read_toml;
+#[cfg(feature = "urdf")]
+mod urdf;
+
+#[cfg(test)]
+mod tests;
+
+use runtime::model::Model;
+
+use crate::diag::{Diagnostic, Diagnostics};
+
+/// Parse and validate a spec. The format is chosen by `file_name`'s extension: `.urdf` → URDF,
+/// anything else → TOML.
+///
+/// Pure: no I/O; `file_name` is only used for messages and the format choice. Never panics on
+/// any input. On success the warnings (e.g. an axis that was normalized) are returned beside
+/// the model; on failure all errors (and warnings) found, sorted by position.
+pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
+    let mut diags = Diagnostics::new(file_name, source);
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let mut d = Diagnostics::new(file_name, source);
+        let spec = if is_urdf(file_name) {
+            read_urdf(source, &mut d)
+        } else {
+            read_toml::read(source, &mut d)
+        };
+        let model = spec.and_then(|s| lower::lower(&s, &mut d));
+        (model, d)
+    }));
+    let model = match result {
+        Ok((model, d)) => {
+            diags.extend(d);
+            model
+        }
+        Err(_) => {
+            diags.push(
+                Diagnostic::error("internal error: the spec reader panicked")
+                    .with_hint("this is a bug in nocdyn; please report it with the input file"),
+            );
+            None
+        }
+    };
+    diags.sort_by_position();
+    match model {
+        Some(m) if !diags.has_errors() => Ok((m, diags)),
+        _ => {
+            if !diags.has_errors() {
+                diags.push(Diagnostic::error("the spec could not be read"));
+            }
+            Err(diags)
+        }
+    }
+}
+
+fn is_urdf(file_name: &str) -> bool {
+    file_name.to_ascii_lowercase().ends_with(".urdf")
+}
+
+#[cfg(feature = "urdf")]
+fn read_urdf(source: &str, diags: &mut Diagnostics) -> Option<ir::Spec> {
+    urdf::read(source, diags)
+}
+
+#[cfg(not(feature = "urdf"))]
+fn read_urdf(_source: &str, diags: &mut Diagnostics) -> Option<ir::Spec> {
+    diags.push(
+        Diagnostic::error("URDF input is not enabled in this build")
+            .with_hint("enable the \"urdf\" feature of the codegen crate"),
+    );
+    None
+}
+
+/// `true` when `s` matches `[a-z][a-z0-9_]*` (usable as a Rust module name).
+pub(crate) fn is_module_name(s: &str) -> bool {
+    s.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && s.chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// Maps any string to `[a-z][a-z0-9_]*`: lower-cased, other characters → `_`, runs of `_`
+/// collapsed, leading/trailing `_` trimmed, prefixed with `m_` when it would not start with a
+/// letter (`"mechanism"` when empty).
+pub(crate) fn sanitize_name(s: &str) -> String {
+    let mut out = String::new();
+    for c in s.chars() {
+        let c = c.to_ascii_lowercase();
+        let c = if c.is_ascii_lowercase() || c.is_ascii_digit() {
+            c
+        } else {
+            '_'
+        };
+        if !(c == '_' && out.ends_with('_')) {
+            out.push(c);
+        }
+    }
+    let out = out.trim_matches('_').to_owned();
+    match out.chars().next() {
+        None => "mechanism".into(),
+        Some(c) if c.is_ascii_lowercase() => out,
+        Some(_) => format!("m_{out}"),
+    }
+}
+
+/// `did you mean "x"?` for the candidate closest to `word`, when close enough.
+pub(crate) fn suggest_hint(word: &str, candidates: &[&str]) -> Option<String> {
+    closest(word, candidates).map(|c| format!("did you mean \"{c}\"?"))
+}
+
+/// The candidate with the smallest edit distance (transpositions count 1) to `word`, if that
+/// distance is at most a third of the word's length (at least 1); ties go to the first.
+pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let limit = (word.chars().count() / 3).max(1);
+    candidates
+        .iter()
+        .map(|c| (edit_distance(&word.to_lowercase(), &c.to_lowercase()), *c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+/// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let (n, m) = (a.len(), b.len());
+    let mut d = vec![vec![0usize; m + 1]; n + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, e) in d[0].iter_mut().enumerate() {
+        *e = j;
+    }
+    for i in 1..=n {
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = v;
+        }
+    }
+    d[n][m]
+}

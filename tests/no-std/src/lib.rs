@@ -1,5 +1,6 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
-//! panic handler. Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! panic handler that exports a C entry point for every generated function of every bundled
+//! mechanism. Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
@@ -7,3 +8,36 @@
 fn panic(_: &core::panic::PanicInfo) -> ! {
     loop {}
 }
+
+macro_rules! export {
+    ($($m:ident),* $(,)?) => {
+        $(
+            pub mod $m {
+                use mechanisms::$m as g;
+                /// Calls every generated function once; returns a checksum.
+                #[unsafe(no_mangle)]
+                pub extern "C" fn $m(q: &[f64; g::DOF], qd: &[f64; g::DOF], x: &[f64; g::DOF]) -> f64 {
+                    let m = g::mass_matrix(q);
+                    let c = g::coriolis(q, qd);
+                    let gr = g::gravity(q);
+                    let t = g::inverse_dynamics(q, qd, x);
+                    let a = match g::forward_dynamics(q, qd, x) {
+                        Ok(a) => a[0],
+                        Err(e) => e.value,
+                    };
+                    m[0][0] + c[0] + gr[0] + t[0] + a
+                }
+            }
+        )*
+    };
+}
+
+export!(
+    planar_2r,
+    puma560,
+    puma560_urdf,
+    stanford_arm,
+    gripper_tree,
+    chain7,
+    iiwa14
+);

@@ -1,0 +1,160 @@
+//! The optimized DAG of one function: dead-code removal, deterministic ordering and the
+//! operation count.
+//!
+//! Only nodes reachable from the function's outputs are kept (dead-code removal); they are put
+//! in depth-first post-order, operands in order and outputs in order, which depends on nothing
+//! but the graph — so the same spec always yields the same statements. `sin` and `cos` of one
+//! argument become a single `sin_cos` step.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use crate::sym::{ExprId, Graph, Node};
+
+/// Operation counts of one function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Multiplications.
+    pub mul: usize,
+    /// Negations.
+    pub neg: usize,
+    /// Divisions.
+    pub div: usize,
+    /// Square roots.
+    pub sqrt: usize,
+    /// `sin_cos` calls (one per joint angle used).
+    pub sin_cos: usize,
+    /// Pivot checks (comparisons).
+    pub cmp: usize,
+}
+
+impl OpCount {
+    /// Arithmetic operations: add + mul + neg + div + sqrt (trigonometry and comparisons apart).
+    pub fn flops(&self) -> usize {
+        self.add + self.mul + self.neg + self.div + self.sqrt
+    }
+}
+
+impl fmt::Display for OpCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} flops ({} add, {} mul, {} neg, {} div, {} sqrt), {} sin_cos, {} cmp",
+            self.flops(),
+            self.add,
+            self.mul,
+            self.neg,
+            self.div,
+            self.sqrt,
+            self.sin_cos,
+            self.cmp
+        )
+    }
+}
+
+/// One statement of a scheduled function.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// `let x{name} = <node>;`
+    Let { name: usize, node: ExprId },
+    /// `let (x{sin}, x{cos}) = sin_cos(<arg>);`
+    SinCos { sin: usize, cos: usize, arg: ExprId },
+    /// Pivot check of a `Guard` node: return `Err` unless the value exceeds the tolerance.
+    Check { node: ExprId },
+}
+
+/// How an operand is referred to in generated code.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Operand {
+    /// A `let` binding `x{n}`.
+    Var(usize),
+    /// A literal.
+    Const(f64),
+    /// `arg[index]`.
+    Input(crate::sym::Arg, u16),
+}
+
+/// A function's statements in order, with the name of every node it uses.
+#[derive(Clone, Debug, Default)]
+pub struct Schedule {
+    /// Statements.
+    pub steps: Vec<Step>,
+    names: HashMap<ExprId, usize>,
+    /// Operation count.
+    pub ops: OpCount,
+}
+
+impl Schedule {
+    /// How `id` is written in the function body (after its statement).
+    pub fn operand(&self, g: &Graph, id: ExprId) -> Operand {
+        match g.node(id) {
+            Node::Const(b) => Operand::Const(f64::from_bits(b)),
+            Node::Input(a, i) => Operand::Input(a, i),
+            Node::Guard { value, .. } => self.operand(g, value),
+            _ => Operand::Var(self.names[&id]),
+        }
+    }
+}
+
+/// Schedule the nodes that `roots` need.
+pub fn schedule(g: &Graph, roots: &[ExprId]) -> Schedule {
+    let mut s = Schedule::default();
+    let mut done: HashMap<ExprId, ()> = HashMap::new();
+    let mut next = 0usize;
+    let mut stack: Vec<(ExprId, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
+    while let Some((id, expanded)) = stack.pop() {
+        if done.contains_key(&id) {
+            continue;
+        }
+        if !expanded {
+            stack.push((id, true));
+            let ops: Vec<ExprId> = g.operands(id).collect();
+            for &o in ops.iter().rev() {
+                if !done.contains_key(&o) {
+                    stack.push((o, false));
+                }
+            }
+            continue;
+        }
+        done.insert(id, ());
+        match g.node(id) {
+            Node::Const(_) | Node::Input(..) => {}
+            Node::Sin(a) | Node::Cos(a) => {
+                // Name both halves of the pair at once.
+                let (sin, cos) = (next, next + 1);
+                next += 2;
+                s.steps.push(Step::SinCos { sin, cos, arg: a });
+                s.ops.sin_cos += 1;
+                for (node, name) in [(Node::Sin(a), sin), (Node::Cos(a), cos)] {
+                    if let Some(other) = g.lookup(node) {
+                        s.names.insert(other, name);
+                        done.insert(other, ());
+                    }
+                }
+            }
+            Node::Guard { .. } => {
+                s.steps.push(Step::Check { node: id });
+                s.ops.cmp += 1;
+            }
+            n => {
+                match n {
+                    Node::Add(..) | Node::Sub(..) => s.ops.add += 1,
+                    Node::Mul(..) => s.ops.mul += 1,
+                    Node::Div(..) => s.ops.div += 1,
+                    Node::Neg(..) => s.ops.neg += 1,
+                    Node::Sqrt(..) => s.ops.sqrt += 1,
+                    _ => {}
+                }
+                s.names.insert(id, next);
+                s.steps.push(Step::Let {
+                    name: next,
+                    node: id,
+                });
+                next += 1;
+            }
+        }
+    }
+    s
+}

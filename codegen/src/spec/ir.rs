@@ -1,0 +1,113 @@
+//! The format-neutral spec: what the TOML and URDF readers produce and [`super::lower`] turns
+//! into a [`runtime::model::Model`]. Values are already numbers (angles parsed, units SI);
+//! every entry keeps its key path and source span for diagnostics.
+
+use std::ops::Range;
+
+use runtime::model::{Mat3, Transform, Vec3};
+
+/// Byte range in the source.
+pub(crate) type Span = Option<Range<usize>>;
+
+/// A parsed, not yet validated mechanism.
+#[derive(Clone, Debug)]
+pub(crate) struct Spec {
+    pub name: String,
+    pub gravity: Vec3,
+    pub bodies: Vec<BodySpec>,
+    /// In the order in which they are to be numbered when already topological.
+    pub joints: Vec<JointSpec>,
+    /// Where to point whole-file diagnostics (e.g. "no movable joints").
+    pub anchor: Span,
+    /// Some joint could not be read far enough to know its parent or child (already reported):
+    /// don't report bodies as unattached, that would only echo the first error.
+    pub joints_incomplete: bool,
+}
+
+/// A rigid body, inertial data in its user frame `F`.
+#[derive(Clone, Debug)]
+pub(crate) struct BodySpec {
+    pub name: String,
+    /// Key path, e.g. `body "link2"`.
+    pub key: String,
+    /// Span of the body's name (or its element).
+    pub span: Span,
+    pub mass: f64,
+    pub mass_span: Span,
+    /// Mass centre in `F` (m).
+    pub com: Vec3,
+    /// Inertia about the mass centre in `F`'s axes (kg·m²), symmetric.
+    pub inertia: Mat3,
+    pub inertia_span: Span,
+}
+
+/// Joint kinds of the spec.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kind {
+    Revolute,
+    Prismatic,
+    Universal,
+    Spherical,
+    Fixed,
+}
+
+impl Kind {
+    pub fn word(self) -> &'static str {
+        match self {
+            Kind::Revolute => "revolute",
+            Kind::Prismatic => "prismatic",
+            Kind::Universal => "universal",
+            Kind::Spherical => "spherical",
+            Kind::Fixed => "fixed",
+        }
+    }
+}
+
+/// Denavit–Hartenberg parameters (m, rad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Dh {
+    pub a: f64,
+    pub alpha: f64,
+    pub d: f64,
+    pub theta: f64,
+}
+
+/// Where the joint frame is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Placement {
+    /// Pose of the joint frame in the parent body's user frame.
+    Origin(Transform),
+    /// Standard (distal) DH; the child's user frame is the distal DH frame.
+    Dh(Dh),
+    /// Modified (proximal, Craig) DH.
+    Mdh(Dh),
+}
+
+/// An axis as written, with where it was written.
+#[derive(Clone, Debug)]
+pub(crate) struct AxisSpec {
+    pub v: Vec3,
+    pub key: String,
+    pub span: Span,
+}
+
+/// A joint between two named bodies (`"base"` is the fixed world).
+#[derive(Clone, Debug)]
+pub(crate) struct JointSpec {
+    pub name: String,
+    /// Key path, e.g. `joint "j2"`.
+    pub key: String,
+    /// Span of the joint's name (or its element).
+    pub span: Span,
+    pub kind: Kind,
+    pub parent: String,
+    pub parent_span: Span,
+    pub child: String,
+    pub child_span: Span,
+    pub placement: Placement,
+    /// R/P: one axis; U: two; S and fixed: none (S uses x, y, z). Empty means the default.
+    pub axes: Vec<AxisSpec>,
+}
+
+/// The name of the fixed world in `parent`.
+pub(crate) const BASE: &str = "base";

@@ -1,0 +1,545 @@
+//! Validation and lowering of a [`Spec`] to a [`Model`]: value checks, name resolution,
+//! topology (every body the child of exactly one joint, no cycles), stable topological order,
+//! fixed-joint merging, U/S expansion and the DH frame bookkeeping.
+
+use std::collections::HashMap;
+
+use runtime::model::{Body, Joint, JointKind, Model, Transform, Vec3};
+
+use super::geom::{self, MassProps, compose};
+use super::ir::{BASE, BodySpec, JointSpec, Kind, Placement, Span, Spec};
+use super::suggest_hint;
+use crate::diag::{Diagnostic, Diagnostics};
+
+/// Validates `spec` and builds the model. Errors and warnings go to `diags`; `None` when there
+/// was any error.
+pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
+    let axes = check_values(spec, diags);
+    let topo = check_topology(spec, diags);
+    if diags.has_errors() {
+        return None;
+    }
+    let topo = topo?;
+    let model = build(spec, &topo, &axes, diags);
+    if diags.has_errors() {
+        None
+    } else {
+        Some(model)
+    }
+}
+
+/// Joint axes after validation: per joint, the unit axes of its revolutes/prismatic.
+type Axes = Vec<Vec<Vec3>>;
+
+/// Finite values, masses, inertias, axes. Returns the normalized axes per joint.
+fn check_values(spec: &Spec, diags: &mut Diagnostics) -> Axes {
+    for (k, g) in spec.gravity.iter().enumerate() {
+        if !g.is_finite() {
+            diags.push(
+                Diagnostic::error("gravity is not finite")
+                    .with_key(format!("mechanism.gravity[{k}]"))
+                    .with_span(spec.anchor.clone()),
+            );
+        }
+    }
+    for b in &spec.bodies {
+        check_body(b, diags);
+    }
+    spec.joints.iter().map(|j| joint_axes(j, diags)).collect()
+}
+
+fn check_body(b: &BodySpec, diags: &mut Diagnostics) {
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    if !b.mass.is_finite() {
+        diags.push(
+            Diagnostic::error("mass is not finite")
+                .with_key(format!("{}.mass", b.key))
+                .with_span(b.mass_span.clone()),
+        );
+    } else if b.mass < 0.0 {
+        diags.push(
+            Diagnostic::error(format!("negative mass {}", b.mass))
+                .with_key(format!("{}.mass", b.key))
+                .with_span(b.mass_span.clone())
+                .with_hint("a mass is in kg and must be >= 0 (0 for a massless body)"),
+        );
+    }
+    if !finite(&b.com) {
+        diags.push(
+            Diagnostic::error("mass centre is not finite")
+                .with_key(format!("{}.com", b.key))
+                .with_span(b.span.clone()),
+        );
+    }
+    if !b.inertia.iter().all(|r| finite(r)) {
+        diags.push(
+            Diagnostic::error("inertia is not finite")
+                .with_key(format!("{}.inertia", b.key))
+                .with_span(b.inertia_span.clone()),
+        );
+    } else if let Err((msg, hint)) = geom::check_inertia(&b.inertia) {
+        diags.push(
+            Diagnostic::error(msg)
+                .with_key(format!("{}.inertia", b.key))
+                .with_span(b.inertia_span.clone())
+                .with_hint(hint),
+        );
+    }
+}
+
+/// Validates and normalizes the axes of `j` (zero → error, non-unit → warning).
+fn joint_axes(j: &JointSpec, diags: &mut Diagnostics) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for a in &j.axes {
+        let n = geom::norm(&a.v);
+        if !a.v.iter().all(|x| x.is_finite()) {
+            diags.push(
+                Diagnostic::error("axis is not finite")
+                    .with_key(a.key.clone())
+                    .with_span(a.span.clone()),
+            );
+            out.push([0.0, 0.0, 1.0]);
+        } else if n < 1e-12 {
+            diags.push(
+                Diagnostic::error("zero-length axis")
+                    .with_key(a.key.clone())
+                    .with_span(a.span.clone())
+                    .with_hint("an axis is a direction in the joint frame, e.g. [0, 0, 1]"),
+            );
+            out.push([0.0, 0.0, 1.0]);
+        } else if n != 1.0 {
+            if (n - 1.0).abs() > 1e-9 {
+                diags.push(
+                    Diagnostic::warning(format!(
+                        "axis is not a unit vector (length {n}); normalized"
+                    ))
+                    .with_key(a.key.clone())
+                    .with_span(a.span.clone()),
+                );
+            }
+            out.push(a.v.map(|x| x / n));
+        } else {
+            out.push(a.v);
+        }
+    }
+    match j.kind {
+        Kind::Revolute | Kind::Prismatic if out.is_empty() => out.push([0.0, 0.0, 1.0]),
+        Kind::Universal => {
+            if out.is_empty() {
+                out = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+            }
+            if out.len() == 2 && geom::norm(&geom::cross(&out[0], &out[1])) < 1e-9 {
+                let (key, span) = j.axes.first().map_or((j.key.clone(), j.span.clone()), |a| {
+                    (a.key.clone(), a.span.clone())
+                });
+                diags.push(
+                    Diagnostic::error("the two axes of a universal joint are parallel")
+                        .with_key(key)
+                        .with_span(span)
+                        .with_hint("a universal joint needs two non-parallel axes, e.g. axes = [[1, 0, 0], [0, 1, 0]]"),
+                );
+            }
+        }
+        Kind::Spherical => out = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        _ => {}
+    }
+    out
+}
+
+/// Resolved topology.
+struct Topo {
+    /// Per joint: parent body index (`None` = base) and child body index.
+    parent: Vec<Option<usize>>,
+    child: Vec<usize>,
+    /// Joints in processing order (parents first, declared order where possible).
+    order: Vec<usize>,
+}
+
+fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
+    // Unique names.
+    let mut body_index: HashMap<&str, usize> = HashMap::new();
+    for (i, b) in spec.bodies.iter().enumerate() {
+        if b.name == BASE {
+            diags.push(
+                Diagnostic::error("a body cannot be named \"base\"")
+                    .with_key(format!("{}.name", b.key))
+                    .with_span(b.span.clone())
+                    .with_hint("\"base\" is the fixed world that the first joints attach to; it has no [[body]] entry"),
+            );
+        } else if let Some(&first) = body_index.get(b.name.as_str()) {
+            diags.push(
+                Diagnostic::error(format!("duplicate body name \"{}\"", b.name))
+                    .with_key(format!("{}.name", b.key))
+                    .with_span(b.span.clone())
+                    .with_hint(format!(
+                        "body names must be unique; the first \"{}\" is {}",
+                        b.name,
+                        position(diags.source(), &spec.bodies[first].span)
+                    )),
+            );
+        } else {
+            body_index.insert(&b.name, i);
+        }
+    }
+    let mut joint_index: HashMap<&str, usize> = HashMap::new();
+    for (i, j) in spec.joints.iter().enumerate() {
+        if let Some(&first) = joint_index.get(j.name.as_str()) {
+            diags.push(
+                Diagnostic::error(format!("duplicate joint name \"{}\"", j.name))
+                    .with_key(format!("{}.name", j.key))
+                    .with_span(j.span.clone())
+                    .with_hint(format!(
+                        "joint names must be unique; the first \"{}\" is {}",
+                        j.name,
+                        position(diags.source(), &spec.joints[first].span)
+                    )),
+            );
+        } else {
+            joint_index.insert(&j.name, i);
+        }
+    }
+
+    // Resolve parent and child.
+    let body_names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut parent = vec![None; spec.joints.len()];
+    let mut child = vec![usize::MAX; spec.joints.len()];
+    let mut child_of: Vec<Option<usize>> = vec![None; spec.bodies.len()];
+    let mut ok = true;
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if j.parent != BASE {
+            match body_index.get(j.parent.as_str()) {
+                Some(&b) => parent[ji] = Some(b),
+                None => {
+                    ok = false;
+                    let mut cands = body_names.clone();
+                    cands.push(BASE);
+                    diags.push(
+                        Diagnostic::error(format!("unknown parent body \"{}\"", j.parent))
+                            .with_key(format!("{}.parent", j.key))
+                            .with_span(j.parent_span.clone())
+                            .with_hint(suggest_hint(&j.parent, &cands).unwrap_or_else(|| {
+                                "the parent must be \"base\" or the name of a body".into()
+                            })),
+                    );
+                }
+            }
+        }
+        if j.child == BASE {
+            ok = false;
+            diags.push(
+                Diagnostic::error("the base cannot be a joint's child")
+                    .with_key(format!("{}.child", j.key))
+                    .with_span(j.child_span.clone())
+                    .with_hint("\"base\" is the fixed world; swap `parent` and `child`?"),
+            );
+            continue;
+        }
+        let Some(&c) = body_index.get(j.child.as_str()) else {
+            ok = false;
+            diags.push(
+                Diagnostic::error(format!("unknown child body \"{}\"", j.child))
+                    .with_key(format!("{}.child", j.key))
+                    .with_span(j.child_span.clone())
+                    .with_hint(
+                        suggest_hint(&j.child, &body_names)
+                            .unwrap_or_else(|| "the child must be the name of a body".into()),
+                    ),
+            );
+            continue;
+        };
+        child[ji] = c;
+        if let Some(first) = child_of[c] {
+            ok = false;
+            diags.push(
+                Diagnostic::error("closed chains are not supported yet (they arrive with the parallel-manipulator support)")
+                    .with_key(format!("{}.child", j.key))
+                    .with_span(j.child_span.clone())
+                    .with_hint(format!(
+                        "body \"{}\" is already the child of joint \"{}\"; in a tree every body is the child of exactly one joint",
+                        j.child, spec.joints[first].name
+                    )),
+            );
+        } else {
+            child_of[c] = Some(ji);
+        }
+    }
+    for (bi, b) in spec.bodies.iter().enumerate() {
+        if child_of[bi].is_none()
+            && !spec.joints_incomplete
+            && b.name != BASE
+            && body_index.get(b.name.as_str()) == Some(&bi)
+        {
+            ok = false;
+            diags.push(
+                Diagnostic::error(format!("body \"{}\" is not attached to anything", b.name))
+                    .with_key(b.key.clone())
+                    .with_span(b.span.clone())
+                    .with_hint(format!(
+                        "add a joint with child = \"{}\" (use kind = \"fixed\" for a rigid attachment)",
+                        b.name
+                    )),
+            );
+        }
+    }
+    if !ok {
+        return None;
+    }
+
+    // Cycles: follow parents from every joint; 0 = unseen, 1 = on the current walk, 2 = reaches base.
+    let mut state = vec![0u8; spec.joints.len()];
+    for start in 0..spec.joints.len() {
+        let mut walk = Vec::new();
+        let mut j = start;
+        loop {
+            match state[j] {
+                2 => break,
+                1 => {
+                    // Cycle: the part of `walk` from `j` on.
+                    let pos = walk.iter().position(|&x| x == j).unwrap_or(0);
+                    let cycle = &walk[pos..];
+                    let first = *cycle.iter().min().unwrap_or(&j);
+                    let mut names: Vec<String> = cycle
+                        .iter()
+                        .map(|&x| format!("\"{}\"", spec.joints[x].name))
+                        .collect();
+                    if let Some(f) = names.first().cloned() {
+                        names.push(f);
+                    }
+                    let js = &spec.joints[first];
+                    diags.push(
+                        Diagnostic::error(format!(
+                            "kinematic cycle: following the parents, joints {} never reach \"base\"",
+                            names.join(" → ")
+                        ))
+                        .with_key(format!("{}.parent", js.key))
+                        .with_span(js.parent_span.clone())
+                        .with_hint("every chain of parents must end at \"base\"; one of these joints needs another parent"),
+                    );
+                    ok = false;
+                    break;
+                }
+                _ => {}
+            }
+            state[j] = 1;
+            walk.push(j);
+            match parent[j] {
+                None => break,
+                Some(p) => match child_of[p] {
+                    Some(pj) => j = pj,
+                    None => break,
+                },
+            }
+        }
+        for &w in &walk {
+            state[w] = 2;
+        }
+    }
+    if !ok {
+        return None;
+    }
+
+    // Stable topological order: repeatedly the first declared joint whose parent is placed.
+    let n = spec.joints.len();
+    let mut placed = vec![false; n];
+    let mut body_placed = vec![false; spec.bodies.len()];
+    let mut order = Vec::with_capacity(n);
+    while order.len() < n {
+        let next = (0..n).find(|&j| !placed[j] && parent[j].is_none_or(|p| body_placed[p]))?;
+        placed[next] = true;
+        body_placed[child[next]] = true;
+        order.push(next);
+    }
+    Some(Topo {
+        parent,
+        child,
+        order,
+    })
+}
+
+/// `line:col` of a span's start, for hints.
+fn position(source: &str, span: &Span) -> String {
+    match span {
+        Some(s) => {
+            let before = &source[..s.start.min(source.len())];
+            let line = before.matches('\n').count() + 1;
+            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            format!("at line {line}, column {col}")
+        }
+        None => "earlier".into(),
+    }
+}
+
+/// Where a spec body ended up: the model body it is rigidly part of (`None` = base) and the
+/// pose of its user frame in that body's frame.
+#[derive(Clone, Copy)]
+struct Attach {
+    target: Option<usize>,
+    pose: Transform,
+}
+
+/// The model under construction.
+#[derive(Default)]
+struct Builder {
+    joints: Vec<Joint>,
+    body_names: Vec<String>,
+    parts: Vec<Vec<MassProps>>,
+    /// Names made up by the U/S expansion, with the span of the joint that made them.
+    generated: Vec<(String, Span)>,
+}
+
+impl Builder {
+    /// Adds a joint moving a new body; returns its index.
+    fn add(
+        &mut self,
+        name: String,
+        kind: JointKind,
+        origin: Transform,
+        axis: Vec3,
+        parent: Option<usize>,
+        body_name: String,
+    ) -> usize {
+        self.joints.push(Joint {
+            name,
+            kind,
+            parent,
+            origin,
+            axis,
+        });
+        self.body_names.push(body_name);
+        self.parts.push(Vec::new());
+        self.joints.len() - 1
+    }
+}
+
+fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Model {
+    let mut attach: Vec<Option<Attach>> = vec![None; spec.bodies.len()];
+    let mut m = Builder::default();
+    let base = Attach {
+        target: None,
+        pose: Transform::IDENTITY,
+    };
+
+    for &ji in &topo.order {
+        let j = &spec.joints[ji];
+        let body = &spec.bodies[topo.child[ji]];
+        let from = topo.parent[ji].and_then(|p| attach[p]).unwrap_or(base);
+        let (origin_user, offset) = match &j.placement {
+            Placement::Origin(t) => (*t, Transform::IDENTITY),
+            Placement::Dh(dh) => (geom::dh_origin(dh), geom::dh_offset(dh)),
+            Placement::Mdh(dh) => (geom::mdh_origin(dh), Transform::IDENTITY),
+        };
+        let origin = compose(&from.pose, &origin_user);
+        let props = MassProps {
+            mass: body.mass,
+            com: body.com,
+            inertia: body.inertia,
+        };
+        let ax = &axes[ji];
+        let child_attach = match j.kind {
+            Kind::Fixed => Attach {
+                target: from.target,
+                pose: compose(&origin, &offset),
+            },
+            Kind::Revolute | Kind::Prismatic => {
+                let kind = if j.kind == Kind::Revolute {
+                    JointKind::Revolute
+                } else {
+                    JointKind::Prismatic
+                };
+                let i = m.add(
+                    j.name.clone(),
+                    kind,
+                    origin,
+                    ax[0],
+                    from.target,
+                    body.name.clone(),
+                );
+                Attach {
+                    target: Some(i),
+                    pose: offset,
+                }
+            }
+            Kind::Universal | Kind::Spherical => {
+                let (suffixes, bodies): (&[&str], &[&str]) = if j.kind == Kind::Universal {
+                    (&["_1", "_2"], &["_cross"])
+                } else {
+                    (&["_x", "_y", "_z"], &["_x_body", "_y_body"])
+                };
+                let mut parent = from.target;
+                let mut o = origin;
+                for (k, sfx) in suffixes.iter().enumerate() {
+                    let bname = match bodies.get(k) {
+                        Some(b) => {
+                            let n = format!("{}{b}", j.name);
+                            m.generated.push((n.clone(), j.span.clone()));
+                            n
+                        }
+                        None => body.name.clone(),
+                    };
+                    let jname = format!("{}{sfx}", j.name);
+                    m.generated.push((jname.clone(), j.span.clone()));
+                    parent = Some(m.add(jname, JointKind::Revolute, o, ax[k], parent, bname));
+                    o = Transform::IDENTITY;
+                }
+                Attach {
+                    target: parent,
+                    pose: offset,
+                }
+            }
+        };
+        // The body's own mass goes into the model body it is now part of (none for the base).
+        if let Some(t) = child_attach.target {
+            m.parts[t].push(props.transformed(&child_attach.pose));
+        }
+        attach[topo.child[ji]] = Some(child_attach);
+    }
+
+    // Clashes of generated names with user names or with each other.
+    let user: Vec<&str> = spec
+        .bodies
+        .iter()
+        .map(|b| b.name.as_str())
+        .chain(spec.joints.iter().map(|j| j.name.as_str()))
+        .collect();
+    for (k, (name, span)) in m.generated.iter().enumerate() {
+        let again = m.generated[..k].iter().any(|(n, _)| n == name);
+        if user.contains(&name.as_str()) || again {
+            diags.push(
+                Diagnostic::error(format!(
+                    "the generated name \"{name}\" clashes with another name"
+                ))
+                .with_span(span.clone())
+                .with_hint("universal and spherical joints expand into revolutes named <joint>_1, <joint>_2 (body <joint>_cross) and <joint>_x, <joint>_y, <joint>_z (bodies <joint>_x_body, <joint>_y_body); rename the joint or the clashing entry"),
+            );
+        }
+    }
+
+    if m.joints.is_empty() {
+        diags.push(
+            Diagnostic::error("the mechanism has no movable joints")
+                .with_span(spec.anchor.clone())
+                .with_hint("add at least one revolute, prismatic, universal or spherical joint"),
+        );
+    }
+
+    let bodies = m
+        .body_names
+        .into_iter()
+        .zip(&m.parts)
+        .map(|(name, p)| {
+            let mp = MassProps::combine(p);
+            Body {
+                name,
+                mass: mp.mass,
+                com: mp.com,
+                inertia: mp.inertia,
+            }
+        })
+        .collect();
+    Model {
+        name: spec.name.clone(),
+        gravity: spec.gravity,
+        bodies,
+        joints: m.joints,
+    }
+}

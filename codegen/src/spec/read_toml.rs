@@ -1,0 +1,757 @@
+//! The TOML reader: spanned parse (`toml::de::DeTable`), then a hand-written walk over the
+//! tree that reports every unknown key (with a suggestion), missing key, wrong type, non-finite
+//! number and bad angle — all of them, not only the first — each at its exact span.
+
+use std::ops::Range;
+
+use runtime::model::{Mat3, Transform, Vec3};
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+use super::angle::{ANGLE_HINT, parse_angle};
+use super::ir::{AxisSpec, BodySpec, Dh, JointSpec, Kind, Placement, Spec};
+use super::{sanitize_name, suggest_hint};
+use crate::diag::{Diagnostic, Diagnostics};
+
+type Val<'i> = Spanned<DeValue<'i>>;
+
+const TOP_KEYS: &[&str] = &["mechanism", "body", "joint"];
+const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
+const BODY_KEYS: &[&str] = &["name", "mass", "com", "inertia", "inertia_rpy"];
+const INERTIA_KEYS: &[&str] = &["ixx", "iyy", "izz", "ixy", "ixz", "iyz"];
+const JOINT_KEYS: &[&str] = &[
+    "name", "kind", "parent", "child", "origin", "axis", "axes", "dh", "mdh",
+];
+const ORIGIN_KEYS: &[&str] = &["xyz", "rpy"];
+const DH_KEYS: &[&str] = &["a", "alpha", "d", "theta"];
+
+/// Common misnomers: (written, meant).
+const ALIASES: &[(&str, &str)] = &[
+    ("type", "kind"),
+    ("bodies", "body"),
+    ("link", "body"),
+    ("links", "body"),
+    ("joints", "joint"),
+    ("inertial", "inertia"),
+    ("center_of_mass", "com"),
+    ("centre_of_mass", "com"),
+    ("cog", "com"),
+    ("robot", "mechanism"),
+    ("g", "gravity"),
+];
+
+/// Reads a TOML spec. `None` when the file could not be read far enough to validate it.
+pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
+    let (root, errors) = DeTable::parse_recoverable(source);
+    if !errors.is_empty() {
+        // Report the first syntax error of each line; later ones on a line are mostly echoes.
+        let mut lines_seen = Vec::new();
+        for e in errors {
+            let line = e
+                .span()
+                .map(|s| source[..s.start.min(source.len())].matches('\n').count());
+            if line.is_some() && lines_seen.contains(&line) {
+                continue;
+            }
+            lines_seen.push(line);
+            diags.push(
+                Diagnostic::error(format!("TOML syntax error: {}", e.message().trim_end()))
+                    .with_span(e.span())
+                    .with_hint("see https://toml.io for the syntax"),
+            );
+        }
+        return None;
+    }
+    let root = root.into_inner();
+    let mut r = Reader {
+        diags,
+        joints_incomplete: false,
+    };
+    Some(r.spec(&root))
+}
+
+/// The walk's state. Entries with bad values are kept with placeholder values (the error is
+/// already reported and lowering stops before using them), so that names still resolve and one
+/// mistake does not cascade into "unknown body" errors.
+struct Reader<'d> {
+    diags: &'d mut Diagnostics,
+    joints_incomplete: bool,
+}
+
+/// What a value is, for "expected …, found …" messages.
+fn type_name(v: &DeValue<'_>) -> &'static str {
+    match v {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) => "an integer",
+        DeValue::Float(_) => "a float",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a date-time",
+        DeValue::Array(_) => "an array",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t Val<'i>> {
+    t.get(k)
+}
+
+/// The span of key `k` in `t`.
+fn key_span(t: &DeTable<'_>, k: &str) -> Option<Range<usize>> {
+    t.get_key_value(k).map(|(key, _)| key.span())
+}
+
+impl Reader<'_> {
+    fn err(&mut self, msg: impl Into<String>, key: &str, span: Range<usize>) -> &mut Diagnostic {
+        self.diags
+            .push_mut(Diagnostic::error(msg).with_key(key).with_span(span))
+    }
+
+    /// Reports keys of `t` not in `allowed`, with the closest allowed key as hint.
+    fn unknown_keys(&mut self, t: &DeTable<'_>, allowed: &[&str], path: &str) {
+        let mut keys: Vec<_> = t.iter().map(|(k, _)| k).collect();
+        keys.sort_by_key(|k| k.span().start);
+        for k in keys {
+            let name = k.get_ref().as_ref();
+            if allowed.contains(&name) {
+                continue;
+            }
+            let alias = ALIASES
+                .iter()
+                .find(|(w, m)| *w == name && allowed.contains(m))
+                .map(|(_, m)| format!("did you mean \"{m}\"?"));
+            let hint = alias
+                .or_else(|| suggest_hint(name, allowed))
+                .unwrap_or_else(|| {
+                    format!(
+                        "valid keys here: {}",
+                        allowed
+                            .iter()
+                            .map(|a| format!("\"{a}\""))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                });
+            let key = if path.is_empty() {
+                name.to_owned()
+            } else {
+                format!("{path}.{name}")
+            };
+            self.err(format!("unknown key \"{name}\""), &key, k.span())
+                .hint = Some(hint);
+        }
+    }
+
+    fn missing(&mut self, what: &str, path: &str, span: Range<usize>, hint: &str) {
+        let key = format!("{path}.{what}");
+        let d = self.err(format!("missing required key \"{what}\""), &key, span);
+        if !hint.is_empty() {
+            d.hint = Some(hint.to_owned());
+        }
+    }
+
+    fn type_error(&mut self, expected: &str, v: &Val<'_>, key: &str) {
+        let d = self.err(
+            format!("expected {expected}, found {}", type_name(v.get_ref())),
+            key,
+            v.span(),
+        );
+        if let DeValue::String(s) = v.get_ref()
+            && expected.contains("number")
+            && s.trim().parse::<f64>().is_ok()
+        {
+            d.hint = Some("write the number without quotes".into());
+        }
+    }
+
+    fn string(&mut self, v: &Val<'_>, key: &str) -> Option<String> {
+        match v.get_ref() {
+            DeValue::String(s) => Some(s.to_string()),
+            _ => {
+                self.type_error("a string", v, key);
+                None
+            }
+        }
+    }
+
+    fn table<'t, 'i>(&mut self, v: &'t Val<'i>, key: &str) -> Option<&'t DeTable<'i>> {
+        match v.get_ref() {
+            DeValue::Table(t) => Some(t),
+            _ => {
+                self.type_error("a table", v, key);
+                None
+            }
+        }
+    }
+
+    /// A finite number (integer or float).
+    fn number(&mut self, v: &Val<'_>, key: &str) -> Option<f64> {
+        let x = match v.get_ref() {
+            DeValue::Float(f) => f.as_str().parse::<f64>().ok(),
+            DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix())
+                .ok()
+                .map(|i| i as f64),
+            _ => {
+                self.type_error("a number", v, key);
+                return None;
+            }
+        };
+        match x {
+            Some(x) if x.is_finite() => Some(x),
+            Some(_) => {
+                self.err("value is not finite", key, v.span()).hint =
+                    Some("nan and inf are not allowed: every value must be a finite number".into());
+                None
+            }
+            None => {
+                self.err("number out of range", key, v.span());
+                None
+            }
+        }
+    }
+
+    /// An angle: a number in radians or an angle string.
+    fn angle(&mut self, v: &Val<'_>, key: &str) -> Option<f64> {
+        match v.get_ref() {
+            DeValue::String(s) => match parse_angle(s) {
+                Ok(a) => Some(a),
+                Err(e) => {
+                    self.err(format!("invalid angle {s:?}: {e}"), key, v.span())
+                        .hint = Some(ANGLE_HINT.into());
+                    None
+                }
+            },
+            DeValue::Float(_) | DeValue::Integer(_) => self.number(v, key),
+            _ => {
+                self.type_error("an angle (a number in radians or a string)", v, key);
+                None
+            }
+        }
+    }
+
+    /// `[x, y, z]` of numbers (`angles`: angle strings allowed).
+    fn triple(&mut self, v: &Val<'_>, key: &str, angles: bool) -> Option<Vec3> {
+        let DeValue::Array(a) = v.get_ref() else {
+            self.type_error("an array of three numbers", v, key);
+            return None;
+        };
+        if a.len() != 3 {
+            self.err(
+                format!(
+                    "expected an array of three numbers, found {} elements",
+                    a.len()
+                ),
+                key,
+                v.span(),
+            );
+            return None;
+        }
+        let mut out = [0.0; 3];
+        let mut ok = true;
+        for (k, e) in a.iter().enumerate() {
+            let ek = format!("{key}[{k}]");
+            let x = if angles {
+                self.angle(e, &ek)
+            } else {
+                self.number(e, &ek)
+            };
+            match x {
+                Some(x) => out[k] = x,
+                None => ok = false,
+            }
+        }
+        ok.then_some(out)
+    }
+
+    /// A name that must be an identifier-like string; returns it even when invalid (after the
+    /// error) so that references to it still resolve.
+    fn name(&mut self, t: &DeTable<'_>, path: &str, span: Range<usize>) -> Option<String> {
+        let Some(v) = get(t, "name") else {
+            self.missing("name", path, span, "");
+            return None;
+        };
+        let key = format!("{path}.name");
+        let n = self.string(v, &key)?;
+        let valid = n
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !valid {
+            self.err(format!("invalid name {n:?}"), &key, v.span()).hint = Some(
+                "names consist of ASCII letters, digits and `_`, and do not start with a digit"
+                    .into(),
+            );
+        }
+        Some(n)
+    }
+
+    fn spec(&mut self, root: &DeTable<'_>) -> Spec {
+        self.unknown_keys(root, TOP_KEYS, "");
+        let mut name = String::from("unnamed");
+        let mut gravity = [0.0, 0.0, -9.81];
+        let mut anchor = Some(0..0);
+        match get(root, "mechanism") {
+            None => {
+                self.err("missing [mechanism] table", "mechanism", 0..0)
+                    .hint = Some("start the file with [mechanism] and name = \"...\"".into());
+            }
+            Some(v) => {
+                if let Some(t) = self.table(v, "mechanism") {
+                    anchor = Some(v.span());
+                    self.unknown_keys(t, MECH_KEYS, "mechanism");
+                    match get(t, "name") {
+                        None => self.missing(
+                            "name",
+                            "mechanism",
+                            v.span(),
+                            "the name is used as a Rust module name, e.g. name = \"puma560\"",
+                        ),
+                        Some(nv) => {
+                            if let Some(n) = self.string(nv, "mechanism.name") {
+                                anchor = Some(nv.span());
+                                if !super::is_module_name(&n) {
+                                    self.err(
+                                        format!("invalid mechanism name {n:?}"),
+                                        "mechanism.name",
+                                        nv.span(),
+                                    )
+                                    .hint = Some(format!(
+                                        "the name is used as a Rust module name and must match [a-z][a-z0-9_]*, e.g. \"{}\"",
+                                        sanitize_name(&n)
+                                    ));
+                                }
+                                name = n;
+                            }
+                        }
+                    }
+                    if let Some(g) = get(t, "gravity")
+                        && let Some(g) = self.triple(g, "mechanism.gravity", false)
+                    {
+                        gravity = g;
+                    }
+                    if let Some(s) = get(t, "source") {
+                        self.string(s, "mechanism.source");
+                    }
+                }
+            }
+        }
+        let bodies = self
+            .entries(root, "body")
+            .into_iter()
+            .filter_map(|(i, t, span)| self.body(i, t, span))
+            .collect();
+        let joints = self
+            .entries(root, "joint")
+            .into_iter()
+            .filter_map(|(i, t, span)| self.joint(i, t, span))
+            .collect();
+        Spec {
+            name,
+            gravity,
+            bodies,
+            joints,
+            anchor,
+            joints_incomplete: self.joints_incomplete,
+        }
+    }
+
+    /// The tables of an array of tables `[[what]]`, with index and span.
+    fn entries<'t, 'i>(
+        &mut self,
+        root: &'t DeTable<'i>,
+        what: &str,
+    ) -> Vec<(usize, &'t DeTable<'i>, Range<usize>)> {
+        let Some(v) = get(root, what) else {
+            return Vec::new();
+        };
+        let DeValue::Array(a) = v.get_ref() else {
+            let span = key_span(root, what).unwrap_or(v.span());
+            self.err(
+                format!(
+                    "expected an array of tables [[{what}]], found {}",
+                    type_name(v.get_ref())
+                ),
+                what,
+                span,
+            )
+            .hint = Some(format!("write each entry under its own [[{what}]] header"));
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (i, e) in a.iter().enumerate() {
+            match e.get_ref() {
+                DeValue::Table(t) => out.push((i, t, e.span())),
+                _ => self.type_error("a table", e, &format!("{what}[{i}]")),
+            }
+        }
+        out
+    }
+
+    /// `body "name"` when the entry has a string name, else `body[i]`.
+    fn path(t: &DeTable<'_>, what: &str, i: usize) -> String {
+        match get(t, "name").map(|v| v.get_ref()) {
+            Some(DeValue::String(s)) => format!("{what} \"{s}\""),
+            _ => format!("{what}[{i}]"),
+        }
+    }
+
+    fn body(&mut self, i: usize, t: &DeTable<'_>, span: Range<usize>) -> Option<BodySpec> {
+        let path = Self::path(t, "body", i);
+        self.unknown_keys(t, BODY_KEYS, &path);
+        let name = self.name(t, &path, span.clone());
+        let name_span = get(t, "name").map_or(span.clone(), |v| v.span());
+        let mut mass_span = span.clone();
+        let mass = match get(t, "mass") {
+            None => {
+                self.missing(
+                    "mass",
+                    &path,
+                    span.clone(),
+                    "mass in kg; write mass = 0.0 for a massless body",
+                );
+                None
+            }
+            Some(v) => {
+                mass_span = v.span();
+                self.number(v, &format!("{path}.mass"))
+            }
+        };
+        let com = match get(t, "com") {
+            None => Some([0.0; 3]),
+            Some(v) => self.triple(v, &format!("{path}.com"), false),
+        };
+        let mut inertia_span = span.clone();
+        let inertia = match get(t, "inertia") {
+            None => Some([[0.0; 3]; 3]),
+            Some(v) => {
+                inertia_span = v.span();
+                self.inertia(v, &format!("{path}.inertia"))
+            }
+        };
+        let rpy = match get(t, "inertia_rpy") {
+            None => Some([0.0; 3]),
+            Some(v) => self.triple(v, &format!("{path}.inertia_rpy"), true),
+        };
+        let inertia = inertia
+            .zip(rpy)
+            .map(|(i, rpy)| super::geom::rotate_inertia(&runtime::model::rpy_to_matrix(rpy), &i));
+        Some(BodySpec {
+            name: name?,
+            key: path,
+            span: Some(name_span),
+            mass: mass.unwrap_or(0.0),
+            mass_span: Some(mass_span),
+            com: com.unwrap_or([0.0; 3]),
+            inertia: inertia.unwrap_or([[0.0; 3]; 3]),
+            inertia_span: Some(inertia_span),
+        })
+    }
+
+    fn inertia(&mut self, v: &Val<'_>, path: &str) -> Option<Mat3> {
+        let t = self.table(v, path)?;
+        self.unknown_keys(t, INERTIA_KEYS, path);
+        let mut x = [0.0; 6];
+        let mut ok = true;
+        for (k, name) in INERTIA_KEYS.iter().enumerate() {
+            match get(t, name) {
+                None if k < 3 => {
+                    self.missing(
+                        name,
+                        path,
+                        v.span(),
+                        "the moments ixx, iyy, izz are required; the products ixy, ixz, iyz default to 0",
+                    );
+                    ok = false;
+                }
+                None => {}
+                Some(e) => match self.number(e, &format!("{path}.{name}")) {
+                    Some(n) => x[k] = n,
+                    None => ok = false,
+                },
+            }
+        }
+        let [ixx, iyy, izz, ixy, ixz, iyz] = x;
+        ok.then_some([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    }
+
+    fn joint(&mut self, i: usize, t: &DeTable<'_>, span: Range<usize>) -> Option<JointSpec> {
+        let path = Self::path(t, "joint", i);
+        self.unknown_keys(t, JOINT_KEYS, &path);
+        let name = self.name(t, &path, span.clone());
+        let name_span = get(t, "name").map_or(span.clone(), |v| v.span());
+        let kind = match get(t, "kind") {
+            None => {
+                self.missing(
+                    "kind",
+                    &path,
+                    span.clone(),
+                    "kind = \"revolute\", \"prismatic\", \"universal\", \"spherical\" or \"fixed\"",
+                );
+                None
+            }
+            Some(v) => self.kind(v, &format!("{path}.kind")),
+        };
+        let mut end = |what: &str| -> Option<(String, Range<usize>)> {
+            match get(t, what) {
+                None => {
+                    self.missing(
+                        what,
+                        &path,
+                        span.clone(),
+                        if what == "parent" {
+                            "the parent is a body name or \"base\" (the fixed world)"
+                        } else {
+                            "the child is a body name"
+                        },
+                    );
+                    None
+                }
+                Some(v) => Some((self.string(v, &format!("{path}.{what}"))?, v.span())),
+            }
+        };
+        let parent = end("parent");
+        let child = end("child");
+
+        // Placement: at most one of origin, dh, mdh.
+        let mut present: Vec<(&str, &Val<'_>)> = ["origin", "dh", "mdh"]
+            .iter()
+            .filter_map(|k| get(t, k).map(|v| (*k, v)))
+            .collect();
+        present.sort_by_key(|(k, _)| key_span(t, k).map_or(0, |s| s.start));
+        let mut placement_ok = true;
+        if present.len() > 1 {
+            placement_ok = false;
+            for (k, _) in &present[1..] {
+                let ks = key_span(t, k).unwrap_or(span.clone());
+                self.err(
+                    format!(
+                        "a joint has one placement, but \"{}\" is also given",
+                        present[0].0
+                    ),
+                    &format!("{path}.{k}"),
+                    ks,
+                )
+                .hint = Some(
+                    "use exactly one of `origin` (+ `axis`), `dh` or `mdh` (or none for the identity)"
+                        .into(),
+                );
+            }
+        }
+        let placement = match present.first() {
+            None => Some(Placement::Origin(Transform::IDENTITY)),
+            Some(("origin", v)) => self.origin(v, &format!("{path}.origin")),
+            Some((k, v)) => {
+                let dh = self.dh(v, &format!("{path}.{k}"));
+                dh.map(|dh| {
+                    if *k == "dh" {
+                        Placement::Dh(dh)
+                    } else {
+                        Placement::Mdh(dh)
+                    }
+                })
+            }
+        };
+        let is_dh = matches!(present.first(), Some(("dh" | "mdh", _)));
+
+        // Axes, as the kind allows.
+        let mut axes = Vec::new();
+        let mut axes_ok = true;
+        let axis_v = get(t, "axis");
+        let axes_v = get(t, "axes");
+        if let Some(kind) = kind {
+            let wrong = |r: &mut Self, key: &str, msg: String, hint: &str| {
+                let ks = key_span(t, key).unwrap_or(span.clone());
+                r.err(msg, &format!("{path}.{key}"), ks).hint = Some(hint.to_owned());
+            };
+            if is_dh && !matches!(kind, Kind::Revolute | Kind::Prismatic | Kind::Fixed) {
+                let k = present[0].0;
+                wrong(
+                    self,
+                    k,
+                    format!("`{k}` placement is not allowed for a {} joint", kind.word()),
+                    "DH parameters describe revolute, prismatic or fixed joints; use `origin` (+ `axes`) here",
+                );
+                axes_ok = false;
+            }
+            match kind {
+                Kind::Revolute | Kind::Prismatic => {
+                    if axes_v.is_some() {
+                        wrong(
+                            self,
+                            "axes",
+                            format!(
+                                "`axes` is for universal joints, not a {} joint",
+                                kind.word()
+                            ),
+                            "use `axis = [x, y, z]`",
+                        );
+                        axes_ok = false;
+                    }
+                    if let Some(v) = axis_v {
+                        if is_dh {
+                            wrong(
+                                self,
+                                "axis",
+                                "`axis` cannot be combined with a DH placement".into(),
+                                "a DH joint moves about (or along) the z axis of its frame; remove `axis`",
+                            );
+                            axes_ok = false;
+                        } else {
+                            let key = format!("{path}.axis");
+                            match self.triple(v, &key, false) {
+                                Some(a) => axes.push(AxisSpec {
+                                    v: a,
+                                    key,
+                                    span: Some(v.span()),
+                                }),
+                                None => axes_ok = false,
+                            }
+                        }
+                    }
+                }
+                Kind::Universal => {
+                    if axis_v.is_some() {
+                        wrong(
+                            self,
+                            "axis",
+                            "a universal joint has two axes".into(),
+                            "use `axes = [[1, 0, 0], [0, 1, 0]]` (first rotation about axes[0], then about axes[1])",
+                        );
+                        axes_ok = false;
+                    }
+                    if let Some(v) = axes_v {
+                        let key = format!("{path}.axes");
+                        match v.get_ref() {
+                            DeValue::Array(a) if a.len() == 2 => {
+                                for (k, e) in a.iter().enumerate() {
+                                    let ek = format!("{key}[{k}]");
+                                    match self.triple(e, &ek, false) {
+                                        Some(x) => axes.push(AxisSpec {
+                                            v: x,
+                                            key: ek,
+                                            span: Some(e.span()),
+                                        }),
+                                        None => axes_ok = false,
+                                    }
+                                }
+                            }
+                            _ => {
+                                self.err(
+                                    "expected two axes, [[x, y, z], [x, y, z]]",
+                                    &key,
+                                    v.span(),
+                                );
+                                axes_ok = false;
+                            }
+                        }
+                    }
+                }
+                Kind::Spherical | Kind::Fixed => {
+                    for k in ["axis", "axes"] {
+                        if get(t, k).is_some() {
+                            wrong(
+                                self,
+                                k,
+                                format!("a {} joint takes no `{k}`", kind.word()),
+                                if kind == Kind::Spherical {
+                                    "a spherical joint rotates about x, then y, then z of its joint frame; orient it with `origin.rpy`"
+                                } else {
+                                    "remove it"
+                                },
+                            );
+                            axes_ok = false;
+                        }
+                    }
+                }
+            }
+        }
+        let (Some((parent, parent_span)), Some((child, child_span))) = (parent, child) else {
+            self.joints_incomplete = true;
+            return None;
+        };
+        Some(JointSpec {
+            name: name.unwrap_or(format!("joint[{i}]")),
+            key: path,
+            span: Some(name_span),
+            kind: kind.unwrap_or(Kind::Revolute),
+            parent,
+            parent_span: Some(parent_span),
+            child,
+            child_span: Some(child_span),
+            placement: placement
+                .filter(|_| placement_ok)
+                .unwrap_or(Placement::Origin(Transform::IDENTITY)),
+            axes: if axes_ok { axes } else { Vec::new() },
+        })
+    }
+
+    fn kind(&mut self, v: &Val<'_>, key: &str) -> Option<Kind> {
+        let s = self.string(v, key)?;
+        let k = match s.as_str() {
+            "revolute" | "R" => Kind::Revolute,
+            "prismatic" | "P" => Kind::Prismatic,
+            "universal" | "U" => Kind::Universal,
+            "spherical" | "S" => Kind::Spherical,
+            "fixed" => Kind::Fixed,
+            other => {
+                const ALL: &[&str] = &["revolute", "prismatic", "universal", "spherical", "fixed"];
+                let hint = match other {
+                    "continuous" => "use \"revolute\" (joint limits are not modelled)".to_owned(),
+                    "floating" | "planar" => format!(
+                        "{other} joints are not supported; model them as a chain of prismatic and revolute joints with massless bodies"
+                    ),
+                    _ => suggest_hint(&other.to_ascii_lowercase(), ALL).unwrap_or_else(|| {
+                        "kind is one of \"revolute\" (\"R\"), \"prismatic\" (\"P\"), \"universal\" (\"U\"), \"spherical\" (\"S\"), \"fixed\"".into()
+                    }),
+                };
+                self.err(format!("unknown joint kind {other:?}"), key, v.span())
+                    .hint = Some(hint);
+                return None;
+            }
+        };
+        Some(k)
+    }
+
+    fn origin(&mut self, v: &Val<'_>, path: &str) -> Option<Placement> {
+        let t = self.table(v, path)?;
+        self.unknown_keys(t, ORIGIN_KEYS, path);
+        let xyz = match get(t, "xyz") {
+            None => Some([0.0; 3]),
+            Some(e) => self.triple(e, &format!("{path}.xyz"), false),
+        };
+        let rpy = match get(t, "rpy") {
+            None => Some([0.0; 3]),
+            Some(e) => self.triple(e, &format!("{path}.rpy"), true),
+        };
+        Some(Placement::Origin(Transform::from_xyz_rpy(xyz?, rpy?)))
+    }
+
+    fn dh(&mut self, v: &Val<'_>, path: &str) -> Option<Dh> {
+        let t = self.table(v, path)?;
+        self.unknown_keys(t, DH_KEYS, path);
+        let mut x = [0.0; 4];
+        let mut ok = true;
+        for (k, name) in DH_KEYS.iter().enumerate() {
+            let key = format!("{path}.{name}");
+            let val = match get(t, name) {
+                None => {
+                    self.missing(
+                        name,
+                        path,
+                        v.span(),
+                        "DH parameters a (m), alpha (rad), d (m), theta (rad) are all required",
+                    );
+                    None
+                }
+                Some(e) if matches!(*name, "alpha" | "theta") => self.angle(e, &key),
+                Some(e) => self.number(e, &key),
+            };
+            match val {
+                Some(n) => x[k] = n,
+                None => ok = false,
+            }
+        }
+        let [a, alpha, d, theta] = x;
+        ok.then_some(Dh { a, alpha, d, theta })
+    }
+}
