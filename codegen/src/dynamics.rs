@@ -50,10 +50,56 @@ struct Link {
     h: Vec3,
     /// Inertia about the body-frame origin (body frame).
     j: Mat3,
-    /// Mass centre (body frame).
-    c: Vec3,
-    /// Inertia about the mass centre (body frame).
-    ic: Mat3,
+}
+
+impl Link {
+    /// Mass centre and inertia about it (body frame), when the (regrouped) mass is not zero.
+    fn centre(&self) -> Option<(Vec3, Mat3)> {
+        if self.mass == 0.0 {
+            return None;
+        }
+        let m = self.mass;
+        let c = [self.h[0] / m, self.h[1] / m, self.h[2] / m];
+        let cc = dot3(&c, &c);
+        let mut ic = self.j;
+        for r in 0..3 {
+            for s in 0..3 {
+                let delta = if r == s { cc } else { 0.0 };
+                ic[r][s] -= m * (delta - c[r] * c[s]);
+            }
+        }
+        for r in 0..3 {
+            for s in 0..r {
+                ic[r][s] = ic[s][r];
+            }
+        }
+        Some((c, ic))
+    }
+}
+
+fn dot3(a: &Vec3, b: &Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Inertial parameters `(m, h, J)` of a body (first moment `h` and inertia `J` about its frame
+/// origin), moved to a frame in which that body's frame has rotation `rot` and origin `p`:
+/// `h' = m p + R h`, `J' = R J Rᵀ + m (p·p 1 − p pᵀ) + 2 (p·Rh) 1 − Rh pᵀ − p (Rh)ᵀ`.
+fn transfer(rot: &Mat3, p: &Vec3, m: f64, h: &Vec3, j: &Mat3) -> (Vec3, Mat3) {
+    let rh = mat_vec(rot, h);
+    let rj = mat_mul(rot, &mat_mul(j, &transpose(rot)));
+    let pp = dot3(p, p);
+    let ph = dot3(p, &rh);
+    let mut jn = [[0.0; 3]; 3];
+    for r in 0..3 {
+        for s in r..3 {
+            let d = if r == s { 1.0 } else { 0.0 };
+            jn[r][s] =
+                rj[r][s] + m * (d * pp - p[r] * p[s]) + 2.0 * d * ph - rh[r] * p[s] - p[r] * rh[s];
+            jn[s][r] = jn[r][s];
+        }
+    }
+    let hn = [m * p[0] + rh[0], m * p[1] + rh[1], m * p[2] + rh[2]];
+    (hn, jn)
 }
 
 /// The tree with every joint axis turned onto `+z`.
@@ -155,13 +201,62 @@ impl Tree {
                 mass: m,
                 h: [m * c[0], m * c[1], m * c[2]],
                 j,
-                c,
-                ic,
             });
         }
-        Tree {
+        let mut tree = Tree {
             links,
             gravity: model.gravity,
+        };
+        tree.regroup();
+        tree
+    }
+
+    /// Lump into each parent the inertial parameters of its child that the child's joint motion
+    /// cannot reveal (Khalil & Kleinfinger 1987; Khalil & Dombre 2002, §9.4 / §12.5), from the
+    /// tips to the root; parameters lumped into the fixed base are dropped. The efforts of every
+    /// function are unchanged (they are linear in the inertial parameters, and the lumped part
+    /// has the same kinetic and potential energy on either side of the joint), but zeros appear
+    /// in the parameters and cost nothing.
+    /// * Revolute joint (axis `z` through the body origin): a body `(m, [0, 0, h_z],
+    ///   diag(A, A, 0))` is symmetric about the axis, so turning about it changes nothing: the
+    ///   mass, `h_z` and `A` (`J_yy` here, as Khalil's `YY_j`) move to the parent.
+    /// * Prismatic joint: the body does not turn relative to its parent, so its whole rotational
+    ///   inertia (a pure moment of inertia, `m = 0`, `h = 0`) moves to the parent.
+    fn regroup(&mut self) {
+        for i in (0..self.links.len()).rev() {
+            let l = &mut self.links[i];
+            let (m, h, j) = match l.kind {
+                JointKind::Revolute => {
+                    let a = l.j[1][1];
+                    let moved = (
+                        l.mass,
+                        [0.0, 0.0, l.h[2]],
+                        [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0; 3]],
+                    );
+                    l.mass = 0.0;
+                    l.h[2] = 0.0;
+                    l.j[0][0] -= a;
+                    l.j[1][1] = 0.0;
+                    moved
+                }
+                JointKind::Prismatic => {
+                    let moved = (0.0, [0.0; 3], l.j);
+                    l.j = [[0.0; 3]; 3];
+                    moved
+                }
+            };
+            let (rot, trans, parent) = (l.rot, l.trans, l.parent);
+            if let Some(p) = parent {
+                let (hn, jn) = transfer(&rot, &trans, m, &h, &j);
+                let lp = &mut self.links[p];
+                lp.mass += m;
+                for r in 0..3 {
+                    lp.h[r] += hn[r];
+                    for s in 0..3 {
+                        lp.j[r][s] += jn[r][s];
+                    }
+                }
+            }
         }
     }
 
@@ -537,21 +632,26 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         let ha = s.cross(h, a);
         let n_o = s.add3(jwd, gyro);
         let n_o = s.add3(n_o, ha);
-        let icm = s.cm(&l.ic);
-        let c = s.cv(&l.c);
-        let iwd = s.mat_vec(&icm, wd);
-        let gyro_c = s.gyro(&l.ic, w);
-        let cf = s.cross(c, f);
-        let n_c = s.add3(iwd, gyro_c);
-        let n_c = s.add3(n_c, cf);
-        let cost = |g: &Graph, n: &V3| {
-            let roots = [f[0], f[1], f[2], n[0], n[1], n[2]];
-            crate::schedule::schedule(g, &roots).ops.flops()
-        };
-        let nn = if cost(s.g, &n_c) < cost(s.g, &n_o) {
-            n_c
-        } else {
-            n_o
+        let nn = match l.centre() {
+            Some((lc, lic)) => {
+                let icm = s.cm(&lic);
+                let c = s.cv(&lc);
+                let iwd = s.mat_vec(&icm, wd);
+                let gyro_c = s.gyro(&lic, w);
+                let cf = s.cross(c, f);
+                let n_c = s.add3(iwd, gyro_c);
+                let n_c = s.add3(n_c, cf);
+                let cost = |g: &Graph, n: &V3| {
+                    let roots = [f[0], f[1], f[2], n[0], n[1], n[2]];
+                    crate::schedule::schedule(g, &roots).ops.flops()
+                };
+                if cost(s.g, &n_c) < cost(s.g, &n_o) {
+                    n_c
+                } else {
+                    n_o
+                }
+            }
+            None => n_o,
         };
         force.push(f);
         moment.push(nn);
