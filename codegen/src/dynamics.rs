@@ -26,23 +26,49 @@
 //!
 //! Gravity enters as an acceleration `−g` of the base (equivalent to `w_i^G = [0; m_i g]` on
 //! every body, and free).
+//!
+//! # Fewer operations, same efforts
+//! Every function is linear in the inertial parameters and invariant under the choice of body
+//! frames, which leaves room to make the generated code cheaper without changing a single
+//! output (beyond rounding). The tricks, after Khalil & Kleinfinger, "Minimum operations and
+//! minimum parameters of the dynamic models of tree structure robots", IEEE J. Robotics &
+//! Automation 3(6), 1987, and Khalil & Dombre, *Modeling, Identification and Control of
+//! Robots*, 2002, ch. 9 and 12:
+//! * **Regrouped (base) inertial parameters** (`Tree::regroup`): what a joint's motion cannot
+//!   reveal is lumped into the parent body — mass, axial first moment and one transverse moment
+//!   of inertia across a revolute joint, the whole rotational inertia across a prismatic one —
+//!   and dropped at the fixed base. Most masses become zero, so most body forces shrink to
+//!   `U h` with a two-component `h`.
+//! * **Free frame choices** (`Tree::choose`): any point of a joint axis can be the body origin
+//!   (Khalil's modified-DH freedom), the body axes can be turned about the joint axis, and a
+//!   constant turn of the joint frame can be moved into the joint angle (`sin_cos(q + γ)`, one
+//!   addition). A greedy search tries the choices that zero an offset coordinate, a rotation
+//!   entry, a first moment or a product of inertia, and keeps those that lower the operation
+//!   count of inverse dynamics plus mass matrix. Origins stay within the model's length scale.
+//! * **Per-body moment forms** (in [`inverse_dynamics`]): about the origin or the mass centre;
+//!   gyroscopic term from the products `ω_a ω_b` shared with `U`, or as `ω × (Jω)`; and the
+//!   axial inertia `J_zz` optionally apart, resolved in the joint frame where it needs no
+//!   rotation back to the parent. The cheapest by marginal operation count is kept.
 
 use runtime::model::{JointKind, Mat3, Model, Vec3, mat_mul, mat_vec, transpose};
 
-use crate::sym::{Arg, ExprId, Graph};
+use crate::sym::{Arg, ExprId, Graph, Node};
 
 /// A symbolic 3-vector.
 pub type V3 = [ExprId; 3];
 /// A symbolic 3×3 matrix (row-major).
 pub type M3 = [[ExprId; 3]; 3];
 
-/// One joint + body of the canonical tree (axis `+z` in the joint frame).
+/// One joint + body of the canonical tree (axis `+z` in the joint frame), with inertial
+/// parameters about the body-frame origin (possibly regrouped, see `Tree::regroup`).
 #[derive(Clone, Debug)]
 struct Link {
     kind: JointKind,
     parent: Option<usize>,
     /// Constant rotation of the joint frame (q = 0) in the parent body frame.
     rot: Mat3,
+    /// Joint angle offset: the joint turns by `Rz(q + phase)` (revolute).
+    phase: f64,
     /// Constant translation of the joint frame in the parent body frame.
     trans: Vec3,
     mass: f64,
@@ -50,6 +76,8 @@ struct Link {
     h: Vec3,
     /// Inertia about the body-frame origin (body frame).
     j: Mat3,
+    /// Mass and axial first moment that `Tree::regroup` moved to the parent.
+    lumped: (f64, f64),
 }
 
 impl Link {
@@ -60,46 +88,19 @@ impl Link {
         }
         let m = self.mass;
         let c = [self.h[0] / m, self.h[1] / m, self.h[2] / m];
-        let cc = dot3(&c, &c);
         let mut ic = self.j;
         for r in 0..3 {
-            for s in 0..3 {
-                let delta = if r == s { cc } else { 0.0 };
-                ic[r][s] -= m * (delta - c[r] * c[s]);
-            }
-        }
-        for r in 0..3 {
-            for s in 0..r {
-                ic[r][s] = ic[s][r];
+            for s in r..3 {
+                let mut terms = vec![self.j[r][s], m * c[r] * c[s]];
+                if r == s {
+                    terms.extend([-m * c[0] * c[0], -m * c[1] * c[1], -m * c[2] * c[2]]);
+                }
+                ic[r][s] = snapped_sum(&terms);
+                ic[s][r] = ic[r][s];
             }
         }
         Some((c, ic))
     }
-}
-
-fn dot3(a: &Vec3, b: &Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Inertial parameters `(m, h, J)` of a body (first moment `h` and inertia `J` about its frame
-/// origin), moved to a frame in which that body's frame has rotation `rot` and origin `p`:
-/// `h' = m p + R h`, `J' = R J Rᵀ + m (p·p 1 − p pᵀ) + 2 (p·Rh) 1 − Rh pᵀ − p (Rh)ᵀ`.
-fn transfer(rot: &Mat3, p: &Vec3, m: f64, h: &Vec3, j: &Mat3) -> (Vec3, Mat3) {
-    let rh = mat_vec(rot, h);
-    let rj = mat_mul(rot, &mat_mul(j, &transpose(rot)));
-    let pp = dot3(p, p);
-    let ph = dot3(p, &rh);
-    let mut jn = [[0.0; 3]; 3];
-    for r in 0..3 {
-        for s in r..3 {
-            let d = if r == s { 1.0 } else { 0.0 };
-            jn[r][s] =
-                rj[r][s] + m * (d * pp - p[r] * p[s]) + 2.0 * d * ph - rh[r] * p[s] - p[r] * rh[s];
-            jn[s][r] = jn[r][s];
-        }
-    }
-    let hn = [m * p[0] + rh[0], m * p[1] + rh[1], m * p[2] + rh[2]];
-    (hn, jn)
 }
 
 /// The tree with every joint axis turned onto `+z`.
@@ -107,6 +108,105 @@ fn transfer(rot: &Mat3, p: &Vec3, m: f64, h: &Vec3, j: &Mat3) -> (Vec3, Mat3) {
 pub struct Tree {
     links: Vec<Link>,
     gravity: Vec3,
+}
+
+/// A body in the canonical frames, before the origin choice: mass centre and inertia about it.
+#[derive(Clone, Debug)]
+struct Canonical {
+    kind: JointKind,
+    parent: Option<usize>,
+    rot: Mat3,
+    trans: Vec3,
+    mass: f64,
+    c: Vec3,
+    ic: Mat3,
+}
+
+/// The free choices of [`Tree::build`], per body: where its origin sits on its joint axis
+/// (a shift along `z` from the canonical origin) and, for a revolute joint, which of `J_xx`,
+/// `J_yy` the regrouping zeroes.
+#[derive(Clone, Debug, PartialEq)]
+struct Choice {
+    shift: Vec<f64>,
+    lump_xx: Vec<bool>,
+    /// Body axes turned about `z` by this angle.
+    turn: Vec<f64>,
+    /// Joint angle offset `γ` (revolute): the code evaluates `sin_cos(q + γ)` and the joint
+    /// frame's constant rotation absorbs `Rz(−γ)`.
+    phase: Vec<f64>,
+}
+
+/// `Rz(a)`, exact for multiples of π/2.
+fn rot_z(a: f64) -> Mat3 {
+    let (s, c) = runtime::model::exact_sin_cos(a);
+    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+}
+
+/// `a · b` with [`snapped_sum`] entries, and entries within rounding of ±1 made exact.
+fn snapped_mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for r in 0..3 {
+        for c in 0..3 {
+            let v = snapped_sum(&[a[r][0] * b[0][c], a[r][1] * b[1][c], a[r][2] * b[2][c]]);
+            m[r][c] = if (v.abs() - 1.0).abs() <= 4.0 * f64::EPSILON {
+                v.signum()
+            } else {
+                v
+            };
+        }
+    }
+    m
+}
+
+/// `a · v` with [`snapped_sum`] entries.
+fn snapped_mat_vec(a: &Mat3, v: &Vec3) -> Vec3 {
+    let mut r = [0.0; 3];
+    for (k, rk) in r.iter_mut().enumerate() {
+        *rk = snapped_sum(&[a[k][0] * v[0], a[k][1] * v[1], a[k][2] * v[2]]);
+    }
+    r
+}
+
+/// `Σ terms`, or exactly 0 when the sum is below the rounding level of its terms (a parameter
+/// that cancels analytically — an origin moved onto a mass centre, a product of inertia moved
+/// to zero — must become a structural zero, not a 1e-18 that costs a multiplication).
+fn snapped_sum(terms: &[f64]) -> f64 {
+    let sum: f64 = terms.iter().sum();
+    let mag: f64 = terms.iter().map(|t| t.abs()).sum();
+    if sum.abs() <= 32.0 * f64::EPSILON * mag {
+        0.0
+    } else {
+        sum
+    }
+}
+
+/// Inertial parameters `(m, h, J)` of a body (first moment `h` and inertia `J` about its frame
+/// origin) moved to a frame in which that body's frame has rotation `rot` and origin `p` (the
+/// parallel-axis theorem): `h' = m p + R h`, `J' = R J Rᵀ + m (p·p 1 − p pᵀ) + 2 (p·Rh) 1 − Rh pᵀ
+/// − p (Rh)ᵀ`; added to `(hp, jp)` with [`snapped_sum`].
+fn transfer_into(rot: &Mat3, p: &Vec3, m: f64, h: &Vec3, j: &Mat3, hp: &mut Vec3, jp: &mut Mat3) {
+    let rh = snapped_mat_vec(rot, h);
+    let rj = snapped_mat_mul(rot, &snapped_mat_mul(j, &transpose(rot)));
+    for r in 0..3 {
+        for s in r..3 {
+            let mut terms = vec![
+                jp[r][s],
+                rj[r][s],
+                -m * p[r] * p[s],
+                -rh[r] * p[s],
+                -p[r] * rh[s],
+            ];
+            if r == s {
+                for k in 0..3 {
+                    terms.push(m * p[k] * p[k]);
+                    terms.push(2.0 * p[k] * rh[k]);
+                }
+            }
+            jp[r][s] = snapped_sum(&terms);
+            jp[s][r] = jp[r][s];
+        }
+        hp[r] = snapped_sum(&[hp[r], m * p[r], rh[r]]);
+    }
 }
 
 /// A rotation `Q` with `Q e_z = a` (exact for ±coordinate axes).
@@ -153,16 +253,22 @@ fn frame_with_z_along(a: &Vec3) -> Mat3 {
 }
 
 impl Tree {
-    /// Canonicalize a validated model: each body frame `B_i` becomes `B_i Q_i` with
-    /// `Q_i e_z = axis_i`, so the motion is about (along) `+z`; origins and inertial data follow.
+    /// Canonicalize a validated model (each body frame `B_i` becomes `B_i Q_i` with
+    /// `Q_i e_z = axis_i`, so the motion is about (along) `+z`), then choose the body origins
+    /// on the joint axes and regroup the inertial parameters so that the generated code is
+    /// cheapest (see `Tree::choose`).
     pub fn new(model: &Model) -> Tree {
-        let n = model.dof();
+        let canon = Self::canonical(model);
+        Self::choose(&canon, model.gravity)
+    }
+
+    fn canonical(model: &Model) -> Vec<Canonical> {
         let qs: Vec<Mat3> = model
             .joints
             .iter()
             .map(|j| frame_with_z_along(&j.axis))
             .collect();
-        let mut links = Vec::with_capacity(n);
+        let mut links = Vec::with_capacity(model.dof());
         for (i, (joint, body)) in model.joints.iter().zip(&model.bodies).enumerate() {
             let qp = joint.parent.map(|p| transpose(&qs[p]));
             let (rot, trans) = match qp {
@@ -176,38 +282,75 @@ impl Tree {
                 ),
             };
             let qt = transpose(&qs[i]);
-            let c = mat_vec(&qt, &body.com);
-            let ic = mat_mul(&qt, &mat_mul(&body.inertia, &qs[i]));
-            let m = body.mass;
-            let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-            let mut j = [[0.0; 3]; 3];
-            for r in 0..3 {
-                for s in 0..3 {
-                    let delta = if r == s { cc } else { 0.0 };
-                    j[r][s] = ic[r][s] + m * (delta - c[r] * c[s]);
-                }
-            }
-            // Keep the stored inertia exactly symmetric.
-            for r in 0..3 {
-                for s in 0..r {
-                    j[r][s] = j[s][r];
-                }
-            }
-            links.push(Link {
+            links.push(Canonical {
                 kind: joint.kind,
                 parent: joint.parent,
                 rot,
                 trans,
+                mass: body.mass,
+                c: mat_vec(&qt, &body.com),
+                ic: mat_mul(&qt, &mat_mul(&body.inertia, &qs[i])),
+            });
+        }
+        links
+    }
+
+    /// The tree for one [`Choice`]: body origins moved along their axes, then regrouped.
+    fn build(canon: &[Canonical], gravity: Vec3, choice: &Choice) -> Tree {
+        let mut links = Vec::with_capacity(canon.len());
+        for (i, b) in canon.iter().enumerate() {
+            let d = choice.shift[i];
+            // New origin o + d e_z: the joint frame moves by d along its axis (R e_z d in the
+            // parent), the parent's own shift moves the other way.
+            let dp = b.parent.map_or(0.0, |p| choice.shift[p]);
+            let trans = [
+                snapped_sum(&[b.trans[0], b.rot[0][2] * d]),
+                snapped_sum(&[b.trans[1], b.rot[1][2] * d]),
+                snapped_sum(&[b.trans[2], b.rot[2][2] * d, -dp]),
+            ];
+            let c = [b.c[0], b.c[1], snapped_sum(&[b.c[2], -d])];
+            // Turned axes: parent axes by Rz(β_p), own by Rz(β_i), joint phase γ_i:
+            // rot' = Rz(β_p)ᵀ rot Rz(β_i − γ_i); trans' = Rz(β_p)ᵀ trans; c' = Rz(β_i)ᵀ c.
+            let tp = transpose(&rot_z(b.parent.map_or(0.0, |p| choice.turn[p])));
+            let phase = match b.kind {
+                JointKind::Revolute => choice.phase[i],
+                JointKind::Prismatic => 0.0,
+            };
+            let rot = snapped_mat_mul(
+                &tp,
+                &snapped_mat_mul(&b.rot, &rot_z(choice.turn[i] - phase)),
+            );
+            let trans = snapped_mat_vec(&tp, &trans);
+            let ti = rot_z(choice.turn[i]);
+            let c = snapped_mat_vec(&transpose(&ti), &c);
+            let ic = snapped_mat_mul(&transpose(&ti), &snapped_mat_mul(&b.ic, &ti));
+            let m = b.mass;
+            // Inertia about the origin: I_c + m (c·c 1 − c cᵀ).
+            let mut j = ic;
+            for r in 0..3 {
+                for s in r..3 {
+                    let mut terms = vec![ic[r][s], -m * c[r] * c[s]];
+                    if r == s {
+                        terms.extend([m * c[0] * c[0], m * c[1] * c[1], m * c[2] * c[2]]);
+                    }
+                    j[r][s] = snapped_sum(&terms);
+                    j[s][r] = j[r][s];
+                }
+            }
+            links.push(Link {
+                kind: b.kind,
+                parent: b.parent,
+                rot,
+                phase,
+                trans,
                 mass: m,
                 h: [m * c[0], m * c[1], m * c[2]],
                 j,
+                lumped: (0.0, 0.0),
             });
         }
-        let mut tree = Tree {
-            links,
-            gravity: model.gravity,
-        };
-        tree.regroup();
+        let mut tree = Tree { links, gravity };
+        tree.regroup(&choice.lump_xx);
         tree
     }
 
@@ -219,24 +362,26 @@ impl Tree {
     /// in the parameters and cost nothing.
     /// * Revolute joint (axis `z` through the body origin): a body `(m, [0, 0, h_z],
     ///   diag(A, A, 0))` is symmetric about the axis, so turning about it changes nothing: the
-    ///   mass, `h_z` and `A` (`J_yy` here, as Khalil's `YY_j`) move to the parent.
+    ///   mass, `h_z` and `A` (`J_yy`, Khalil's `YY_j`, or `J_xx`) move to the parent.
     /// * Prismatic joint: the body does not turn relative to its parent, so its whole rotational
     ///   inertia (a pure moment of inertia, `m = 0`, `h = 0`) moves to the parent.
-    fn regroup(&mut self) {
+    fn regroup(&mut self, lump_xx: &[bool]) {
         for i in (0..self.links.len()).rev() {
             let l = &mut self.links[i];
             let (m, h, j) = match l.kind {
                 JointKind::Revolute => {
-                    let a = l.j[1][1];
+                    let (keep, zero) = if lump_xx[i] { (1, 0) } else { (0, 1) };
+                    let a = l.j[zero][zero];
                     let moved = (
                         l.mass,
                         [0.0, 0.0, l.h[2]],
                         [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0; 3]],
                     );
+                    l.lumped = (l.mass, l.h[2]);
                     l.mass = 0.0;
                     l.h[2] = 0.0;
-                    l.j[0][0] -= a;
-                    l.j[1][1] = 0.0;
+                    l.j[keep][keep] = snapped_sum(&[l.j[keep][keep], -a]);
+                    l.j[zero][zero] = 0.0;
                     moved
                 }
                 JointKind::Prismatic => {
@@ -247,17 +392,224 @@ impl Tree {
             };
             let (rot, trans, parent) = (l.rot, l.trans, l.parent);
             if let Some(p) = parent {
-                let (hn, jn) = transfer(&rot, &trans, m, &h, &j);
                 let lp = &mut self.links[p];
                 lp.mass += m;
-                for r in 0..3 {
-                    lp.h[r] += hn[r];
-                    for s in 0..3 {
-                        lp.j[r][s] += jn[r][s];
-                    }
+                transfer_into(&rot, &trans, m, &h, &j, &mut lp.h, &mut lp.j);
+            }
+        }
+    }
+
+    /// Operation count that `Tree::choose` minimizes: inverse dynamics plus mass matrix (the
+    /// other functions are parts or consumers of these).
+    fn cost(&self) -> usize {
+        let mut g = Graph::new();
+        let all = Terms {
+            velocity: true,
+            acceleration: true,
+            gravity: true,
+        };
+        let id = inverse_dynamics(&mut g, self, all);
+        let mm: Vec<ExprId> = mass_matrix(&mut g, self).concat();
+        // Each function is scheduled on its own, so count each cone separately.
+        let count = |roots: &[ExprId]| {
+            let mut p = Paid::default();
+            p.pay(&g, roots);
+            p.0.iter()
+                .enumerate()
+                .filter(|&(k, &b)| b && is_flop(g.node(ExprId(k as u32))))
+                .count()
+        };
+        count(&id) + count(&mm)
+    }
+
+    /// Greedy search over the [`Choice`]s (the frame freedom of Khalil's modified DH
+    /// convention: any point of a joint axis can be a body origin and the body axes can turn
+    /// about it, and the kinetic energy does not care): body by body from the tips, try
+    /// origins that zero a coordinate of a joint offset or a product of inertia, turns that
+    /// zero a coordinate of a first moment, child offset or child axis (or diagonalize `J`'s xy
+    /// block), joint phases that make a joint rotation sparser, and the other `J_xx`/`J_yy`
+    /// lump; keep whatever lowers [`Tree::cost`].
+    fn choose(canon: &[Canonical], gravity: Vec3) -> Tree {
+        let n = canon.len();
+        let mut choice = Choice {
+            shift: vec![0.0; n],
+            lump_xx: vec![false; n],
+            turn: vec![0.0; n],
+            phase: vec![0.0; n],
+        };
+        // Origins stay within the model's own length scale (a far origin would make the
+        // parameters cancel against each other and cost accuracy).
+        let norm = |v: &Vec3| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let reach = canon
+            .iter()
+            .map(|b| norm(&b.trans).max(norm(&b.c)))
+            .fold(0.0, f64::max);
+        let mut best = Self::build(canon, gravity, &choice);
+        let mut best_cost = best.cost();
+        // Choices already tried (exact keys: the same choice always costs the same).
+        let key = |c: &Choice| -> Vec<u64> {
+            let bits = |v: &Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let mut k = bits(&c.shift);
+            k.extend(bits(&c.turn));
+            k.extend(bits(&c.phase));
+            k.extend(c.lump_xx.iter().map(|&b| b as u64));
+            k
+        };
+        let mut tried: rustc_hash::FxHashSet<Vec<u64>> = Default::default();
+        tried.insert(key(&choice));
+        // One sweep from the tips: each body decided once, in the same context whatever follows
+        // it, so that a chain of n + 1 joints costs a chain of n plus one joint (repeated sweeps
+        // find a little more but make the count of a growing chain erratic).
+        for i in (0..n).rev() {
+            for cand in best.candidates(&choice, i) {
+                if cand.shift[i].abs() > reach || !tried.insert(key(&cand)) {
+                    continue;
+                }
+                let t = Self::build(canon, gravity, &cand);
+                let c = t.cost();
+                if c < best_cost {
+                    best = t;
+                    best_cost = c;
+                    choice = cand;
                 }
             }
         }
+        best
+    }
+
+    /// Move the origins of the children of `i` whose axes are parallel to `i`'s by `d` along
+    /// that common direction (recursively), so that their offsets do not change when `i`'s
+    /// origin moves by `d`. `false` when there is no such child.
+    fn shift_parallel_children(&self, choice: &mut Choice, i: usize, d: f64) -> bool {
+        let mut any = false;
+        for (k, c) in self.links.iter().enumerate() {
+            let z = c.rot[2][2];
+            if c.parent == Some(i) && (z == 1.0 || z == -1.0) {
+                choice.shift[k] += z * d;
+                self.shift_parallel_children(choice, k, z * d);
+                any = true;
+            }
+        }
+        any
+    }
+
+    /// Alternative choices for body `i`, from the current tree.
+    fn candidates(&self, choice: &Choice, i: usize) -> Vec<Choice> {
+        let l = &self.links[i];
+        let mut deltas = Vec::new();
+        // Zero a coordinate of the body's own offset in its parent.
+        for k in 0..3 {
+            if l.rot[k][2] != 0.0 && l.trans[k] != 0.0 {
+                deltas.push(-l.trans[k] / l.rot[k][2]);
+            }
+        }
+        // Zero the axial coordinate of a child's offset.
+        for c in &self.links {
+            if c.parent == Some(i) && c.trans[2] != 0.0 {
+                deltas.push(c.trans[2]);
+            }
+        }
+        // Put the origin level with the mass centre of what is lumped into the parent.
+        if l.lumped.0 != 0.0 && l.lumped.1 != 0.0 {
+            deltas.push(l.lumped.1 / l.lumped.0);
+        }
+        // Zero a product of inertia J_xz or J_yz (it changes by d h_x, d h_y).
+        for k in 0..2 {
+            if l.h[k] != 0.0 && l.j[k][2] != 0.0 {
+                deltas.push(-l.j[k][2] / l.h[k]);
+            }
+        }
+        let mut out = Vec::new();
+        for d in deltas {
+            if d.is_finite() {
+                let mut c = choice.clone();
+                c.shift[i] += d;
+                out.push(c.clone());
+                // The same, with the subtree of parallel axes moved along (their offsets kept).
+                if self.shift_parallel_children(&mut c, i, d) {
+                    out.push(c);
+                }
+            }
+        }
+        if l.kind == JointKind::Revolute {
+            let mut c = choice.clone();
+            c.lump_xx[i] = !c.lump_xx[i];
+            out.push(c);
+            // Joint phase: make the joint frame's rotation sparser (zero an entry of its x or
+            // y column), or drop the phase.
+            let r = &l.rot;
+            let mut turns = Vec::new();
+            for k in 0..3 {
+                if r[k][0] != 0.0 && r[k][1] != 0.0 {
+                    // (Zeroing r[k][1] instead only swaps the roles of x and y.)
+                    turns.push((-r[k][0]).atan2(r[k][1]));
+                }
+            }
+            for a in turns {
+                let mut c = choice.clone();
+                c.phase[i] -= a;
+                out.push(c);
+            }
+            if choice.phase[i] != 0.0 {
+                let mut c = choice.clone();
+                c.phase[i] = 0.0;
+                out.push(c);
+            }
+        }
+        // Body axes turned about z to zero a coordinate of a 2-vector in the xy plane: the first
+        // moment, a child's offset or a child's axis; or to diagonalize J's xy block.
+        let mut vs: Vec<[f64; 2]> = vec![[l.h[0], l.h[1]]];
+        for c in &self.links {
+            if c.parent == Some(i) {
+                vs.push([c.trans[0], c.trans[1]]);
+                for k in 0..3 {
+                    vs.push([c.rot[0][k], c.rot[1][k]]);
+                }
+            }
+        }
+        let mut turns = Vec::new();
+        for v in vs {
+            if v[0] != 0.0 && v[1] != 0.0 {
+                turns.push(v[1].atan2(v[0]));
+            }
+        }
+        if l.j[0][1] != 0.0 {
+            turns.push(0.5 * (2.0 * l.j[0][1]).atan2(l.j[0][0] - l.j[1][1]));
+        }
+        for a in turns {
+            let mut c = choice.clone();
+            c.turn[i] += a;
+            out.push(c.clone());
+            if l.kind == JointKind::Revolute {
+                // The same with the joint frame's rotation kept (the phase follows).
+                c.phase[i] += a;
+                out.push(c);
+            }
+        }
+        // A child's axis turned into the xz plane of this body and the child's joint phase
+        // chosen with it: the child's joint rotation becomes `Ry(α)` (the two moves of the DH
+        // convention; either alone may not pay).
+        for (k, ch) in self.links.iter().enumerate() {
+            let z = [ch.rot[0][2], ch.rot[1][2]];
+            if ch.parent != Some(i)
+                || ch.kind != JointKind::Revolute
+                || (z[0] == 0.0 && z[1] == 0.0)
+            {
+                continue;
+            }
+            let a = z[1].atan2(z[0]);
+            let r = snapped_mat_mul(&transpose(&rot_z(a)), &ch.rot);
+            // Child's x axis along this body's y (its x and z components zero).
+            let b = (-r[0][0]).atan2(r[0][1]);
+            let mut c = choice.clone();
+            c.turn[i] += a;
+            if l.kind == JointKind::Revolute {
+                c.phase[i] += a;
+            }
+            c.phase[k] -= b;
+            out.push(c);
+        }
+        out
     }
 
     /// Number of joints.
@@ -284,7 +636,11 @@ impl<'a> Sym<'a> {
             let qi = g.input(Arg::Q, i);
             q.push(qi);
             sc.push(match l.kind {
-                JointKind::Revolute => Some((g.sin(qi), g.cos(qi))),
+                JointKind::Revolute => {
+                    let k = g.constant(l.phase);
+                    let a = g.add(qi, k);
+                    Some((g.sin(a), g.cos(a)))
+                }
                 JointKind::Prismatic => None,
             });
         }
@@ -405,6 +761,13 @@ impl<'a> Sym<'a> {
         out
     }
 
+    /// Gyroscopic moment `ω × (I ω)` formed as written: `Iω`, then the cross product.
+    fn gyro_cross(&mut self, inertia: &Mat3, w: V3) -> V3 {
+        let im = self.cm(inertia);
+        let iw = self.mat_vec(&im, w);
+        self.cross(w, iw)
+    }
+
     /// `Rz(q_i)ᵀ v` (revolute), `v` (prismatic).
     fn rz_t(&mut self, i: usize, v: V3) -> V3 {
         match self.sc[i] {
@@ -515,6 +878,60 @@ impl<'a> Sym<'a> {
     }
 }
 
+/// Nodes already needed (their cost is sunk), indexed by node id.
+#[derive(Default)]
+struct Paid(Vec<bool>);
+
+impl Paid {
+    fn contains(&self, id: ExprId) -> bool {
+        self.0.get(id.0 as usize).copied().unwrap_or(false)
+    }
+    /// Add the cone of `roots`.
+    fn pay(&mut self, g: &Graph, roots: &[ExprId]) {
+        if self.0.len() < g.len() {
+            self.0.resize(g.len(), false);
+        }
+        let mut stack: Vec<ExprId> = roots.to_vec();
+        while let Some(id) = stack.pop() {
+            if !self.0[id.0 as usize] {
+                self.0[id.0 as usize] = true;
+                stack.extend(g.operands(id));
+            }
+        }
+    }
+}
+
+/// `true` for the nodes that [`crate::schedule::OpCount::flops`] counts.
+fn is_flop(n: Node) -> bool {
+    matches!(
+        n,
+        Node::Add(..)
+            | Node::Sub(..)
+            | Node::Mul(..)
+            | Node::Div(..)
+            | Node::Neg(..)
+            | Node::Sqrt(..)
+    )
+}
+
+/// Arithmetic operations (as counted by [`crate::schedule::OpCount::flops`]) that `roots` need
+/// beyond the nodes in `paid`: the marginal cost of a choice.
+fn marginal_flops(g: &Graph, roots: &[ExprId], paid: &Paid) -> usize {
+    let mut seen: rustc_hash::FxHashSet<ExprId> = Default::default();
+    let mut stack: Vec<ExprId> = roots.to_vec();
+    let mut flops = 0;
+    while let Some(id) = stack.pop() {
+        if paid.contains(id) || !seen.insert(id) {
+            continue;
+        }
+        if is_flop(g.node(id)) {
+            flops += 1;
+        }
+        stack.extend(g.operands(id));
+    }
+    flops
+}
+
 /// Which generalized-force terms an inverse-dynamics sweep includes.
 #[derive(Clone, Copy, Debug)]
 pub struct Terms {
@@ -560,6 +977,9 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
     let mut omega: Vec<V3> = Vec::with_capacity(n);
     let mut omegad: Vec<V3> = Vec::with_capacity(n);
     let mut acc: Vec<V3> = Vec::with_capacity(n);
+    // ω and ω̇ resolved in the joint frame (the body frame before the joint's own rotation).
+    let mut omega_j: Vec<V3> = Vec::with_capacity(n);
+    let mut omegad_j: Vec<V3> = Vec::with_capacity(n);
     for i in 0..n {
         let l = &tree.links[i];
         let (wp, wdp, ap) = match l.parent {
@@ -574,18 +994,28 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
                 let up = s.mat_vec(&u, p);
                 let ao = s.add3(ap, up);
                 let a = s.child_frame(i, ao);
-                let w_in = s.child_frame(i, wp);
-                let wd_in = s.child_frame(i, wdp);
-                // ω_i = ω_p + e q̇; ω̇_i = ω̇_p + e q̈ + ω_p × e q̇ (e = +z).
-                let w = [w_in[0], w_in[1], s.g.add(w_in[2], qd[i])];
-                let x = s.g.mul(w_in[1], qd[i]);
-                let y = s.g.mul(w_in[0], qd[i]);
-                let wd = [
-                    s.g.add(wd_in[0], x),
-                    s.g.sub(wd_in[1], y),
-                    s.g.add(wd_in[2], qdd[i]),
-                ];
-                (w, wd, a)
+                // ω_i = ω_p + e q̇; ω̇_i = ω̇_p + e q̈ + ω_p × e q̇ (e = +z), in either frame.
+                let r0 = s.cm(&l.rot);
+                let mut frames = [(wp, wdp); 2];
+                for (k, fr) in frames.iter_mut().enumerate() {
+                    let (mut w_in, mut wd_in) = (s.mat_t_vec(&r0, wp), s.mat_t_vec(&r0, wdp));
+                    if k == 0 {
+                        w_in = s.rz_t(i, w_in);
+                        wd_in = s.rz_t(i, wd_in);
+                    }
+                    let w = [w_in[0], w_in[1], s.g.add(w_in[2], qd[i])];
+                    let x = s.g.mul(w_in[1], qd[i]);
+                    let y = s.g.mul(w_in[0], qd[i]);
+                    let wd = [
+                        s.g.add(wd_in[0], x),
+                        s.g.sub(wd_in[1], y),
+                        s.g.add(wd_in[2], qdd[i]),
+                    ];
+                    *fr = (w, wd);
+                }
+                omega_j.push(frames[1].0);
+                omegad_j.push(frames[1].1);
+                (frames[0].0, frames[0].1, a)
             }
             JointKind::Prismatic => {
                 let w = s.child_frame(i, wp);
@@ -604,6 +1034,8 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
                 let cor = [s.g.scale(2.0, x), s.g.scale(-2.0, y), qdd[i]];
                 let a = s.add3(ap_in, ur);
                 let a = s.add3(a, cor);
+                omega_j.push(w);
+                omegad_j.push(wd);
                 (w, wd, a)
             }
         };
@@ -614,58 +1046,103 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
     // Body wrenches M_i ṫ_i + W_i M_i t_i − w_i^G (eq. 12), about the body-frame origin.
     let mut force: Vec<V3> = Vec::with_capacity(n);
     let mut moment: Vec<V3> = Vec::with_capacity(n);
+    let mut extra_moment: Vec<V3> = Vec::with_capacity(n);
+    // Nodes already needed by the wrenches chosen so far (their cost is sunk).
+    let mut paid = Paid::default();
     for i in 0..n {
         let l = &tree.links[i];
         let m = s.c(l.mass);
         let h = s.cv(&l.h);
-        let jm = s.cm(&l.j);
         let (w, wd, a) = (omega[i], omegad[i], acc[i]);
         let ma = s.scale3(m, a);
         let u = s.u_matrix(w, wd);
         let uh = s.mat_vec(&u, h);
         let f = s.add3(ma, uh);
-        // Moment about the origin, two equivalent forms; keep the cheaper one for this body:
+        // Moment about the origin, equivalent forms; keep the cheapest for this body:
         // J ω̇ + ω × Jω + h × a (inertia about the origin), or
-        // I_c ω̇ + ω × I_c ω + c × f (about the mass centre, then moved).
-        let jwd = s.mat_vec(&jm, wd);
-        let gyro = s.gyro(&l.j, w);
+        // I_c ω̇ + ω × I_c ω + c × f (about the mass centre, then moved);
+        // the gyroscopic term either from the shared products ω_a ω_b ([`Sym::gyro`]) or as
+        // ω × (Jω) (cheaper for a full inertia tensor); and the axial moment of inertia
+        // `diag(0, 0, J_zz)` either with the rest or apart, in the joint frame: it is
+        // unchanged by the joint's rotation, so its moment needs no rotation back to the
+        // parent (`extra`, added after the rotation).
+        let (wj, wdj) = (omega_j[i], omegad_j[i]);
+        let mut tensors: Vec<(Mat3, Option<V3>)> = vec![(l.j, None)];
+        if let Some((lc, lic)) = l.centre() {
+            let c = s.cv(&lc);
+            let cf = s.cross(c, f);
+            tensors.push((lic, Some(cf)));
+        }
         let ha = s.cross(h, a);
-        let n_o = s.add3(jwd, gyro);
-        let n_o = s.add3(n_o, ha);
-        let nn = match l.centre() {
-            Some((lc, lic)) => {
-                let icm = s.cm(&lic);
-                let c = s.cv(&lc);
-                let iwd = s.mat_vec(&icm, wd);
-                let gyro_c = s.gyro(&lic, w);
-                let cf = s.cross(c, f);
-                let n_c = s.add3(iwd, gyro_c);
-                let n_c = s.add3(n_c, cf);
-                let cost = |g: &Graph, n: &V3| {
-                    let roots = [f[0], f[1], f[2], n[0], n[1], n[2]];
-                    crate::schedule::schedule(g, &roots).ops.flops()
-                };
-                if cost(s.g, &n_c) < cost(s.g, &n_o) {
-                    n_c
+        let mut forms: Vec<(V3, V3)> = Vec::new();
+        for (tensor, moved) in tensors {
+            let mut splits = vec![(tensor, 0.0)];
+            if l.kind == JointKind::Revolute && tensor[2][2] != 0.0 {
+                let mut rest = tensor;
+                rest[2][2] = 0.0;
+                splits.push((rest, tensor[2][2]));
+            }
+            for (rest, axial) in splits {
+                let extra = if axial != 0.0 {
+                    let ax = [[0.0; 3], [0.0; 3], [0.0, 0.0, axial]];
+                    let g = s.gyro_cross(&ax, wj);
+                    [g[0], g[1], s.g.scale(axial, wdj[2])]
                 } else {
-                    n_o
+                    s.zero3()
+                };
+                let rm = s.cm(&rest);
+                let iwd = s.mat_vec(&rm, wd);
+                let last = match moved {
+                    Some(cf) => cf,
+                    None => ha,
+                };
+                for cross_form in [false, true] {
+                    let gyro = if cross_form {
+                        s.gyro_cross(&rest, w)
+                    } else {
+                        s.gyro(&rest, w)
+                    };
+                    let nb = s.add3(iwd, gyro);
+                    forms.push((s.add3(nb, last), extra));
                 }
             }
-            None => n_o,
-        };
+        }
+        let mut best = usize::MAX;
+        let mut choice = forms[0];
+        for &(nb, extra) in &forms {
+            let rotated = s.rz(i, nb);
+            let rotated = s.add3(rotated, extra);
+            let roots = [f[0], f[1], f[2], rotated[0], rotated[1], rotated[2]];
+            let c = marginal_flops(s.g, &roots, &paid);
+            if c < best {
+                best = c;
+                choice = (nb, extra);
+            }
+        }
+        let (nb, extra) = choice;
+        paid.pay(
+            s.g,
+            &[
+                f[0], f[1], f[2], nb[0], nb[1], nb[2], extra[0], extra[1], extra[2],
+            ],
+        );
         force.push(f);
-        moment.push(nn);
+        moment.push(choice.0);
+        extra_moment.push(choice.1);
     }
     // Backward sweep: Tᵀ w, accumulated from the tips (eq. 24).
     let mut tau = vec![zero; n];
     for i in (0..n).rev() {
         tau[i] = match tree.links[i].kind {
-            JointKind::Revolute => moment[i][2],
+            JointKind::Revolute => s.g.add(moment[i][2], extra_moment[i][2]),
             JointKind::Prismatic => force[i][2],
         };
         if let Some(p) = tree.links[i].parent {
             let f = s.parent_frame(i, force[i]);
-            let nn = s.parent_frame(i, moment[i]);
+            let nn = s.rz(i, moment[i]);
+            let nn = s.add3(nn, extra_moment[i]);
+            let r0 = s.cm(&tree.links[i].rot);
+            let nn = s.mat_vec(&r0, nn);
             let off = s.offset(i);
             let pf = s.cross(off, f);
             let nn = s.add3(nn, pf);

@@ -6,7 +6,7 @@
 //!    with file, line, column and key);
 //! 2. [`dynamics`]: the model → NOC quantities as nodes of a hash-consed expression DAG
 //!    ([`sym`]; constants folded and shared subexpressions merged as nodes are built);
-//! 3. [`schedule`]: per function, dead-code removal, deterministic order, operation count;
+//! 3. [`schedule`](mod@schedule): per function, dead-code removal, deterministic order, operation count;
 //! 4. [`emit`]: Rust tokens → `syn::File` → prettyplease text.
 //!
 //! [`compile`] runs them all; the CLI, build scripts and the proc macro are thin adapters.

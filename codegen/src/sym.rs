@@ -164,6 +164,10 @@ impl Graph {
             }
             _ => {}
         }
+        if a == b {
+            // x + x = 2x (and 2·(c·x) folds into one product).
+            return self.scale(2.0, a);
+        }
         match (self.node(a), self.node(b)) {
             (Node::Neg(x), Node::Neg(y)) => {
                 let s = self.add(x, y);

@@ -1,1 +1,122 @@
-fn main() {}
+//! Generated dynamics vs the runtime oracles, per call.
+//!
+//! For the PUMA 560 (`mechanisms::puma560`) and the 7-joint iiwa transcription
+//! (`mechanisms::chain7`): inverse dynamics and mass matrix, each generated / runtime NOC
+//! (`runtime::noc`, nalgebra, literal `TᵀMT`) / runtime Newton–Euler (`runtime::rnea`: RNEA and
+//! CRBA in spatial algebra); forward dynamics generated / runtime NOC (there is no RNEA forward
+//! dynamics). Inputs are fixed pseudo-random states behind `black_box`.
+//!
+//! ```text
+//! cargo bench -p tests --bench dynamics
+//! ```
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use runtime::model::Model;
+use tests::{random_state, rel_err, rng};
+
+/// One bundled mechanism: its spec (for the runtime model) and its generated module.
+macro_rules! bench_mechanism {
+    ($fn_name:ident, $module:ident, $spec_file:literal, $seed:expr) => {
+        fn $fn_name(c: &mut Criterion) {
+            use mechanisms::$module as generated;
+            const N: usize = generated::DOF;
+            let name = stringify!($module);
+            let src = include_str!(concat!("../../mechanisms/specs/", $spec_file));
+            let (model, _warnings): (Model, _) =
+                codegen::spec::load($spec_file, src).unwrap_or_else(|d| panic!("{}", d.render()));
+            assert_eq!(model.dof(), N);
+
+            let (q, qd, qdd) = random_state(&mut rng($seed), N);
+            let q: [f64; N] = q.try_into().unwrap();
+            let qd: [f64; N] = qd.try_into().unwrap();
+            let qdd: [f64; N] = qdd.try_into().unwrap();
+            let tau = generated::inverse_dynamics(&q, &qd, &qdd);
+
+            // Like-for-like: all routes agree at the benchmarked state.
+            let noc = runtime::noc::inverse_dynamics(&model, &q, &qd, &qdd);
+            let rnea = runtime::rnea::inverse_dynamics(&model, &q, &qd, &qdd);
+            assert!(rel_err(&tau, noc.as_slice()) < 1e-9, "{name}: ID vs NOC");
+            assert!(rel_err(&tau, rnea.as_slice()) < 1e-9, "{name}: ID vs RNEA");
+            let fd = generated::forward_dynamics(&q, &qd, &tau).expect("regular state");
+            assert!(rel_err(&fd, &qdd) < 1e-6, "{name}: FD(ID(q̈)) vs q̈");
+
+            let mut g = c.benchmark_group(format!("{name}/inverse_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| {
+                    generated::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd))
+                })
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    runtime::noc::inverse_dynamics(
+                        black_box(&model),
+                        black_box(&q),
+                        black_box(&qd),
+                        black_box(&qdd),
+                    )
+                })
+            });
+            g.bench_function("runtime_rnea", |b| {
+                b.iter(|| {
+                    runtime::rnea::inverse_dynamics(
+                        black_box(&model),
+                        black_box(&q),
+                        black_box(&qd),
+                        black_box(&qdd),
+                    )
+                })
+            });
+            g.finish();
+
+            let mut g = c.benchmark_group(format!("{name}/mass_matrix"));
+            g.bench_function("generated", |b| {
+                b.iter(|| generated::mass_matrix(black_box(&q)))
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| runtime::noc::mass_matrix(black_box(&model), black_box(&q)))
+            });
+            g.bench_function("runtime_rnea", |b| {
+                b.iter(|| runtime::rnea::mass_matrix(black_box(&model), black_box(&q)))
+            });
+            g.finish();
+
+            let mut g = c.benchmark_group(format!("{name}/forward_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| {
+                    generated::forward_dynamics(black_box(&q), black_box(&qd), black_box(&tau))
+                })
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    runtime::noc::forward_dynamics(
+                        black_box(&model),
+                        black_box(&q),
+                        black_box(&qd),
+                        black_box(&tau),
+                    )
+                })
+            });
+            g.finish();
+        }
+    };
+}
+
+bench_mechanism!(puma560, puma560, "puma560.toml", 560);
+bench_mechanism!(chain7, chain7, "chain7.toml", 7);
+
+fn config() -> Criterion {
+    Criterion::default()
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_millis(500))
+        .sample_size(30)
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = puma560, chain7
+}
+criterion_main!(benches);

@@ -96,28 +96,28 @@ fn counts(model: &Model) -> (OpCount, OpCount) {
     (get("inverse_dynamics"), get("mass_matrix"))
 }
 
-/// `(n, ID flops, MM flops)` for n = N_MIN..=N_MAX, printed as a table.
+/// `(n, ID flops, MM flops)` for n = N_MIN..=N_MAX, printed as a table (in one piece, so that
+/// parallel tests do not interleave).
 fn table(label: &str, model: impl Fn(usize) -> Model) -> Vec<(usize, f64, f64)> {
-    eprintln!("\n{label}");
-    eprintln!(
-        "| {:>2} | {:>8} | {:>10} | {:>8} | {:>9} | {:>10} |",
+    let mut t = format!(
+        "\n{label}\n| {:>2} | {:>8} | {:>10} | {:>8} | {:>11} | {:>10} |\n|---:|---:|---:|---:|---:|---:|\n",
         "n", "ID flops", "ID flops/n", "MM flops", "MM flops/n²", "MM /entry"
     );
-    eprintln!("|---:|---:|---:|---:|---:|---:|");
     let mut rows = Vec::new();
     for n in N_MIN..=N_MAX {
         let (id, mm) = counts(&model(n));
         let (id, mm) = (id.flops() as f64, mm.flops() as f64);
         let nf = n as f64;
         let entries = nf * (nf + 1.0) / 2.0;
-        eprintln!(
-            "| {n:>2} | {id:>8} | {:>10.1} | {mm:>8} | {:>11.2} | {:>10.2} |",
+        t += &format!(
+            "| {n:>2} | {id:>8} | {:>10.1} | {mm:>8} | {:>11.2} | {:>10.2} |\n",
             id / nf,
             mm / (nf * nf),
             mm / entries
         );
         rows.push((n, id, mm));
     }
+    eprint!("{t}");
     rows
 }
 
@@ -160,120 +160,142 @@ fn min(it: impl Iterator<Item = f64>) -> f64 {
     it.fold(f64::INFINITY, f64::min)
 }
 
-/// Inverse dynamics is linear in n.
-fn check_linear_id(label: &str, rows: &[(usize, f64, f64)]) {
+type Row = (usize, f64, f64);
+
+/// Inverse dynamics is linear in n: the criteria it violates (empty: none).
+fn linear_id_violations(label: &str, rows: &[Row]) -> Vec<String> {
+    let mut bad = Vec::new();
     let asym: Vec<_> = rows.iter().filter(|r| r.0 >= N_ASYMPTOTIC).collect();
-    // 1. Flops per joint stay flat.
-    let per_joint = || asym.iter().map(|r| r.1 / r.0 as f64);
-    let (hi, lo) = (max(per_joint()), min(per_joint()));
-    assert!(
-        hi <= 1.15 * lo,
-        "{label}: ID flops/joint not flat for n ≥ {N_ASYMPTOTIC}: {lo:.1} … {hi:.1}"
-    );
-    // 2. The cost of one more joint does not grow with n: the increments of the upper half of
-    //    the range are at most 1.25× the largest increment of the lower half (O(n²): ≈ 2×).
-    let inc: Vec<(usize, f64)> = asym.windows(2).map(|w| (w[0].0, w[1].1 - w[0].1)).collect();
     let mid = (N_ASYMPTOTIC + N_MAX) / 2;
+    // 1. Flops per joint level off: over the upper half of the range they vary by ≤ 15 %
+    //    (O(n²): +50 % from n = 8 to n = 12). The lower half is not flat: the joints next to the
+    //    fixed base are cheaper (zero base twist, constant base-frame quantities fold), so
+    //    flops/n rises towards the per-joint increment from below.
+    let per_joint = || asym.iter().filter(|r| r.0 >= mid).map(|r| r.1 / r.0 as f64);
+    let (hi, lo) = (max(per_joint()), min(per_joint()));
+    if hi > 1.15 * lo {
+        bad.push(format!(
+            "{label}: ID flops/joint not flat for n ≥ {mid}: {lo:.1} … {hi:.1}"
+        ));
+    }
+    // 2. The cost of one more joint does not grow with n: the increments of the upper half of
+    //    the range are at most 1.25× the largest increment of the lower half (O(n²): ≈ 1.5×).
+    let inc: Vec<(usize, f64)> = asym.windows(2).map(|w| (w[0].0, w[1].1 - w[0].1)).collect();
     let early = max(inc.iter().filter(|d| d.0 < mid).map(|d| d.1));
     let late = max(inc.iter().filter(|d| d.0 >= mid).map(|d| d.1));
-    eprintln!("{label}: ID increments {inc:?}");
-    assert!(
-        early > 0.0 && late <= 1.25 * early,
-        "{label}: ID increment grows with n: ≤ {early} below n = {mid}, up to {late} above"
-    );
-    // 3. A quadratic fit has a negligible n² term: over the whole range it adds < 5 % of the
-    //    linear term's contribution.
+    eprintln!("{label}: ID increments flops(n+1) − flops(n): {inc:?}");
+    if !(early > 0.0 && late <= 1.25 * early) {
+        bad.push(format!(
+            "{label}: ID increment grows with n: ≤ {early} below n = {mid}, up to {late} above"
+        ));
+    }
+    // 3. A quadratic fit has a negligible n² term: at n = N_MAX it adds < 5 % of the linear
+    //    term's per-joint cost.
     let pts: Vec<(f64, f64)> = asym.iter().map(|r| (r.0 as f64, r.1)).collect();
     let [c0, c1, c2] = quadratic_fit(&pts);
-    eprintln!("{label}: ID ≈ {c0:.1} + {c1:.2} n + {c2:.3} n²");
-    assert!(
-        c1 > 0.0 && c2.abs() * N_MAX as f64 <= 0.05 * c1,
-        "{label}: ID flops not linear: fit {c0:.1} + {c1:.2} n + {c2:.3} n²"
-    );
+    eprintln!("{label}: ID fit ≈ {c0:.1} + {c1:.2} n + {c2:.3} n²");
+    if !(c1 > 0.0 && c2.abs() * N_MAX as f64 <= 0.05 * c1) {
+        bad.push(format!(
+            "{label}: ID flops not linear: fit {c0:.1} + {c1:.2} n + {c2:.3} n²"
+        ));
+    }
+    bad
 }
 
-/// The mass matrix is at most quadratic in n.
-fn check_quadratic_mm(label: &str, rows: &[(usize, f64, f64)]) {
-    let per_n2 = |r: &(usize, f64, f64)| r.2 / (r.0 * r.0) as f64;
-    let per_entry = |r: &(usize, f64, f64)| r.2 / (r.0 * (r.0 + 1) / 2) as f64;
+/// The mass matrix is at most quadratic in n: the criteria it violates (empty: none).
+fn quadratic_mm_violations(label: &str, rows: &[Row]) -> Vec<String> {
+    let mut bad = Vec::new();
+    let per_n2 = |r: &&Row| r.2 / (r.0 * r.0) as f64;
+    let per_entry_per_n = |r: &&Row| r.2 / (r.0 * (r.0 + 1) / 2) as f64 / r.0 as f64;
     let asym: Vec<_> = rows.iter().filter(|r| r.0 >= N_ASYMPTOTIC).collect();
     let mid = (N_ASYMPTOTIC + N_MAX) / 2;
-    // 1. flops / n² bounded: the largest value in the upper half of the range is at most 1.25×
-    //    the largest in the lower half (O(n³): ≈ 2×).
-    let early = max(asym.iter().filter(|r| r.0 <= mid).map(|r| per_n2(r)));
-    let late = max(asym.iter().filter(|r| r.0 > mid).map(|r| per_n2(r)));
-    assert!(
-        late <= 1.25 * early,
-        "{label}: MM flops/n² grows: ≤ {early:.2} up to n = {mid}, up to {late:.2} above"
-    );
+    let lower = || asym.iter().filter(|r| r.0 <= mid);
+    let upper = || asym.iter().filter(|r| r.0 > mid);
+    // 1. flops / n² bounded: the largest value in the upper half of the range is at most 1.2×
+    //    the largest in the lower half (O(n³): 1.5×).
+    let (early, late) = (max(lower().map(per_n2)), max(upper().map(per_n2)));
+    if late > 1.2 * early {
+        bad.push(format!(
+            "{label}: MM flops/n² grows: ≤ {early:.2} up to n = {mid}, up to {late:.2} above"
+        ));
+    }
     // 2. Flops per entry grow at most linearly: (flops/entry)/n does not increase from the lower
-    //    to the upper half of the range (O(n⁴) overall would double it).
-    let e_early = max(asym
-        .iter()
-        .filter(|r| r.0 <= mid)
-        .map(|r| per_entry(r) / r.0 as f64));
-    let e_late = max(asym
-        .iter()
-        .filter(|r| r.0 > mid)
-        .map(|r| per_entry(r) / r.0 as f64));
-    assert!(
-        e_late <= 1.1 * e_early,
-        "{label}: MM flops/entry grows faster than n: {e_early:.3}·n up to n = {mid}, {e_late:.3}·n above"
+    //    to the upper half of the range by more than 10 % (O(n⁴) overall: 1.5×).
+    let (early, late) = (
+        max(lower().map(per_entry_per_n)),
+        max(upper().map(per_entry_per_n)),
     );
-    // 3. The second differences (the n² coefficient, doubled) do not grow: a cubic would make
-    //    them rise linearly.
+    if late > 1.1 * early {
+        bad.push(format!(
+            "{label}: MM flops/entry grows faster than n: {early:.3}·n up to n = {mid}, \
+             {late:.3}·n above"
+        ));
+    }
+    // 3. The second differences (twice the n² coefficient) do not grow: a cubic makes them rise
+    //    linearly in n.
     let d2: Vec<(usize, f64)> = asym
         .windows(3)
         .map(|w| (w[1].0, w[2].2 - 2.0 * w[1].2 + w[0].2))
         .collect();
-    eprintln!("{label}: MM second differences {d2:?}");
-    let s_early = max(d2.iter().filter(|d| d.0 <= mid).map(|d| d.1));
-    let s_late = max(d2.iter().filter(|d| d.0 > mid).map(|d| d.1));
-    assert!(
-        s_late <= 1.25 * s_early.max(1.0),
-        "{label}: MM second differences grow (cubic?): ≤ {s_early} up to n = {mid}, {s_late} above"
-    );
+    eprintln!("{label}: MM second differences: {d2:?}");
+    let early = max(d2.iter().filter(|d| d.0 <= mid).map(|d| d.1));
+    let late = max(d2.iter().filter(|d| d.0 > mid).map(|d| d.1));
+    if late > 1.25 * early.max(1.0) {
+        bad.push(format!(
+            "{label}: MM second differences grow (cubic?): ≤ {early} up to n = {mid}, \
+             {late} above"
+        ));
+    }
+    bad
 }
+
+fn check(label: &str, model: impl Fn(usize) -> Model) {
+    let rows = table(label, model);
+    let mut bad = linear_id_violations(label, &rows);
+    bad.extend(quadratic_mm_violations(label, &rows));
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+// One seed for every n: the (n+1)-joint chain is the n-joint chain plus one link (the models
+// draw their links in order), so the increments measure one more joint and nothing else.
 
 #[test]
 fn generic_chain_inverse_dynamics_is_linear_and_mass_matrix_quadratic() {
-    let label = "generic n-R chain (random axes, origins, inertias)";
-    let rows = table(label, |n| generic_chain(0xC0DE + n as u64, n));
-    check_linear_id(label, &rows);
-    check_quadratic_mm(label, &rows);
+    check("generic n-R chain (random axes, origins, inertias)", |n| {
+        generic_chain(0xC0DE, n)
+    });
 }
 
 #[test]
 fn dh_chain_inverse_dynamics_is_linear_and_mass_matrix_quadratic() {
-    let label = "DH-like n-R chain (z axes, twists 0/±π/2)";
-    let rows = table(label, |n| dh_chain(0xD4 + n as u64, n));
-    check_linear_id(label, &rows);
-    check_quadratic_mm(label, &rows);
+    check("DH-like n-R chain (z axes, twists 0/±π/2)", |n| {
+        dh_chain(0xD4, n)
+    });
 }
 
-/// The checks themselves reject wrong growth (guards against assertions that cannot fail).
+/// The criteria reject wrong growth: each can fail.
 #[test]
-fn checks_reject_superlinear_and_supercubic_growth() {
-    let ns = N_MIN..=N_MAX;
-    let linear: Vec<_> = ns
-        .clone()
-        .map(|n| {
-            (
-                n,
-                150.0 * n as f64 - 40.0,
-                30.0 * (n * n) as f64 + 60.0 * n as f64,
-            )
-        })
-        .collect();
-    check_linear_id("synthetic linear", &linear);
-    check_quadratic_mm("synthetic quadratic", &linear);
-    let quadratic_id: Vec<_> = ns
-        .clone()
-        .map(|n| (n, 150.0 * n as f64 + 12.0 * (n * n) as f64, 0.0))
-        .collect();
-    assert!(std::panic::catch_unwind(|| check_linear_id("O(n²) ID", &quadratic_id)).is_err());
-    let cubic_mm: Vec<_> = ns
-        .map(|n| (n, 0.0, 30.0 * (n * n) as f64 + 4.0 * (n * n * n) as f64))
-        .collect();
-    assert!(std::panic::catch_unwind(|| check_quadratic_mm("O(n³) MM", &cubic_mm)).is_err());
+fn criteria_reject_superlinear_id_and_supercubic_mm() {
+    let rows = |id: fn(f64) -> f64, mm: fn(f64) -> f64| -> Vec<Row> {
+        (N_MIN..=N_MAX)
+            .map(|n| (n, id(n as f64), mm(n as f64)))
+            .collect()
+    };
+    // Linear ID with a cheap base, quadratic MM: accepted.
+    let good = rows(|n| 222.0 * n - 278.0, |n| 30.0 * n * n + 60.0 * n - 100.0);
+    assert_eq!(linear_id_violations("linear", &good), Vec::<String>::new());
+    assert_eq!(
+        quadratic_mm_violations("quadratic", &good),
+        Vec::<String>::new()
+    );
+    // O(n²) inverse dynamics (a modest n² term beside a large linear one): all three criteria.
+    let quadratic_id = rows(|n| 150.0 * n + 12.0 * n * n, |_| 0.0);
+    assert_eq!(linear_id_violations("O(n²) ID", &quadratic_id).len(), 3);
+    // O(n³) mass matrix: flops/n² and the second differences.
+    let cubic_mm = rows(|_| 0.0, |n| 30.0 * n * n + 4.0 * n * n * n);
+    let v = quadratic_mm_violations("O(n³) MM", &cubic_mm);
+    assert_eq!(v.len(), 2, "{v:?}");
+    // O(n⁴) mass matrix: all three.
+    let quartic_mm = rows(|_| 0.0, |n| 30.0 * n * n + n * n * n * n);
+    assert_eq!(quadratic_mm_violations("O(n⁴) MM", &quartic_mm).len(), 3);
 }
