@@ -770,32 +770,28 @@ impl<'a> Sym<'a> {
 
     /// `Rz(q_i)ᵀ v` (revolute), `v` (prismatic).
     fn rz_t(&mut self, i: usize, v: V3) -> V3 {
-        match self.sc[i] {
-            Some((s, c)) => {
-                let a = self.g.mul(c, v[0]);
-                let b = self.g.mul(s, v[1]);
-                let x = self.g.add(a, b);
-                let a = self.g.mul(c, v[1]);
-                let b = self.g.mul(s, v[0]);
-                let y = self.g.sub(a, b);
-                [x, y, v[2]]
-            }
-            None => v,
-        }
+        self.rotate_z(i, v, true)
     }
     /// `Rz(q_i) v` (revolute), `v` (prismatic).
     fn rz(&mut self, i: usize, v: V3) -> V3 {
-        match self.sc[i] {
-            Some((s, c)) => {
-                let a = self.g.mul(c, v[0]);
-                let b = self.g.mul(s, v[1]);
-                let x = self.g.sub(a, b);
-                let a = self.g.mul(s, v[0]);
-                let b = self.g.mul(c, v[1]);
-                let y = self.g.add(a, b);
-                [x, y, v[2]]
-            }
-            None => v,
+        self.rotate_z(i, v, false)
+    }
+    /// `Rz(q_i) v`, or `Rz(q_i)ᵀ v` when `transpose`; the identity for prismatic joints.
+    fn rotate_z(&mut self, i: usize, v: V3, transpose: bool) -> V3 {
+        let Some((s, c)) = self.sc[i] else { return v };
+        // Nodes are created in a fixed order (ids decide operand order in the output).
+        let cv0 = self.g.mul(c, v[0]);
+        let sv1 = self.g.mul(s, v[1]);
+        if transpose {
+            let x = self.g.add(cv0, sv1);
+            let cv1 = self.g.mul(c, v[1]);
+            let sv0 = self.g.mul(s, v[0]);
+            [x, self.g.sub(cv1, sv0), v[2]]
+        } else {
+            let x = self.g.sub(cv0, sv1);
+            let sv0 = self.g.mul(s, v[0]);
+            let cv1 = self.g.mul(c, v[1]);
+            [x, self.g.add(sv0, cv1), v[2]]
         }
     }
     /// Parent-frame components → body-`i` components.
