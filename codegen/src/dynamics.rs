@@ -944,24 +944,14 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
     let n = tree.dof();
     let mut s = Sym::new(g, tree);
     let zero = s.g.zero();
-    let qd: Vec<ExprId> = (0..n)
-        .map(|i| {
-            if terms.velocity {
-                s.g.input(Arg::Qd, i)
-            } else {
-                zero
-            }
-        })
-        .collect();
-    let qdd: Vec<ExprId> = (0..n)
-        .map(|i| {
-            if terms.acceleration {
-                s.g.input(Arg::Qdd, i)
-            } else {
-                zero
-            }
-        })
-        .collect();
+    // `arg[i]` for every joint when the term is on, else structural zeros.
+    let inputs = |g: &mut Graph, arg: Arg, on: bool| -> Vec<ExprId> {
+        (0..n)
+            .map(|i| if on { g.input(arg, i) } else { zero })
+            .collect()
+    };
+    let qd = inputs(s.g, Arg::Qd, terms.velocity);
+    let qdd = inputs(s.g, Arg::Qdd, terms.acceleration);
     let a0 = if terms.gravity {
         let gv = tree.gravity;
         s.cv(&[-gv[0], -gv[1], -gv[2]])
