@@ -20,6 +20,32 @@ pub enum Shape {
     Matrix,
     /// `Result<[f64; DOF], Singular>`.
     FallibleVector,
+    /// `Result<…, Singular>` of one part or a tuple of parts, in output order.
+    Fallible(Vec<Part>),
+}
+
+/// One part of a [`Shape::Fallible`] result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// `[f64; DOF]`.
+    Vector,
+    /// `[[f64; DOF]; DOF]`, row-major.
+    Matrix,
+}
+
+impl Part {
+    fn len(self, dof: usize) -> usize {
+        match self {
+            Part::Vector => dof,
+            Part::Matrix => dof * dof,
+        }
+    }
+    fn ty(self) -> TokenStream {
+        match self {
+            Part::Vector => quote!([f64; DOF]),
+            Part::Matrix => quote!([[f64; DOF]; DOF]),
+        }
+    }
 }
 
 /// One function to emit.
@@ -34,8 +60,14 @@ pub struct Function<'a> {
     pub outputs: Vec<ExprId>,
     /// Return shape.
     pub shape: Shape,
+    /// Degrees of freedom (the length of a [`Part::Vector`]).
+    pub dof: usize,
     /// Its schedule.
     pub schedule: Schedule,
+    /// `pub` (else a private kernel of a public wrapper).
+    pub public: bool,
+    /// Guards name a `Site` (parallel mechanisms) instead of a pivot (trees).
+    pub sites: bool,
 }
 
 fn float_lit(v: f64) -> TokenStream {
@@ -66,7 +98,8 @@ fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
     }
 }
 
-fn math_call(cfg: &Config, f: &str, x: TokenStream) -> TokenStream {
+/// A call of the math backend's `f` (`sin_cos`, `sqrt`, `atan2`) on the argument tokens `x`.
+pub(crate) fn math_call(cfg: &Config, f: &str, x: TokenStream) -> TokenStream {
     let f = Ident::new(f, Span::call_site());
     match &cfg.math {
         MathBackend::Libm => {
@@ -104,6 +137,7 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                     index,
                 } = g.node(node)
                 else {
+                    stmts.push(TokenStream::new());
                     continue;
                 };
                 let (v, t, sc) = (
@@ -111,14 +145,44 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                     operand(g, s, tol),
                     operand(g, s, scale),
                 );
-                let i = Literal::usize_unsuffixed(index as usize);
-                quote! {
-                    if !(#v > #t) {
-                        return Err(Singular {
-                            pivot: #i,
-                            value: #v,
-                            condition_estimate: if #v > 0.0 { #sc / #v } else { f64::INFINITY },
-                        });
+                let two_sided = index & crate::sym::TWO_SIDED != 0;
+                let code = index & !crate::sym::TWO_SIDED;
+                let test = if two_sided {
+                    quote!(#v > #t || #v < -#t)
+                } else {
+                    quote!(#v > #t)
+                };
+                let magnitude = if two_sided {
+                    quote!(if #v < 0.0 { -#v } else { #v })
+                } else {
+                    quote!(#v)
+                };
+                let at = if f.sites {
+                    site_tokens(runtime::parallel::Site::from_code(code))
+                } else {
+                    let i = Literal::usize_unsuffixed(code as usize);
+                    quote!(pivot: #i)
+                };
+                if two_sided {
+                    quote! {
+                        if !(#test) {
+                            let a = #magnitude;
+                            return Err(Singular {
+                                #at,
+                                value: #v,
+                                condition_estimate: if a > 0.0 { #sc / a } else { f64::INFINITY },
+                            });
+                        }
+                    }
+                } else {
+                    quote! {
+                        if !(#test) {
+                            return Err(Singular {
+                                #at,
+                                value: #v,
+                                condition_estimate: if #v > 0.0 { #sc / #v } else { f64::INFINITY },
+                            });
+                        }
                     }
                 }
             }
@@ -146,13 +210,44 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                         quote!(-#a)
                     }
                     Node::Sqrt(a) => math_call(cfg, "sqrt", operand(g, s, a)),
-                    _ => continue,
+                    Node::Atan2(a, b) => {
+                        let (a, b) = (operand(g, s, a), operand(g, s, b));
+                        math_call(cfg, "atan2", quote!(#a, #b))
+                    }
+                    _ => {
+                        stmts.push(TokenStream::new());
+                        continue;
+                    }
                 };
                 quote!(let #x = #e;)
             }
         };
         stmts.push(st);
     }
+    let stmts = chunked(g, s, &f.outputs, stmts);
+    // Parallel modules: a NaN or infinite input is an error, not a NaN result.
+    let checks: Vec<TokenStream> = if f.sites {
+        f.args
+            .iter()
+            .map(|a| {
+                let a = Ident::new(a.name(), Span::call_site());
+                quote! {
+                    for v in #a.iter() {
+                        if !v.is_finite() {
+                            return Err(Singular {
+                                site: Site::Input,
+                                value: *v,
+                                condition_estimate: f64::INFINITY,
+                            });
+                        }
+                    }
+                }
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let stmts: Vec<TokenStream> = checks.into_iter().chain(stmts).collect();
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| operand(g, s, o)).collect();
     let ret = match f.shape {
         Shape::Vector => quote!([#(#outs),*]),
@@ -162,24 +257,153 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
             let rows: Vec<TokenStream> = outs.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
             quote!([#(#rows),*])
         }
+        Shape::Fallible(ref parts) => {
+            let n = f.dof;
+            let mut rest = &outs[..];
+            let mut items = Vec::new();
+            for p in parts {
+                let (now, later) = rest.split_at(p.len(n).min(rest.len()));
+                rest = later;
+                items.push(match p {
+                    Part::Vector => quote!([#(#now),*]),
+                    Part::Matrix => {
+                        let rows: Vec<TokenStream> =
+                            now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
+                        quote!([#(#rows),*])
+                    }
+                });
+            }
+            if items.len() == 1 {
+                quote!(Ok(#(#items)*))
+            } else {
+                quote!(Ok((#(#items),*)))
+            }
+        }
     };
     quote! { #(#stmts)* #ret }
 }
 
-fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
+/// Statements per block beyond which a function body is split into blocks.
+const CHUNK: usize = 512;
+
+/// Variables a step defines and uses.
+fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
+    let var_of = |id: ExprId| match s.operand(g, id) {
+        Operand::Var(n) => Some(n),
+        _ => None,
+    };
+    match *step {
+        Step::SinCos { sin, cos, arg } => (vec![sin, cos], var_of(arg).into_iter().collect()),
+        Step::Check { node } => (vec![], g.operands(node).filter_map(var_of).collect()),
+        Step::Let { name, node } => (vec![name], g.operands(node).filter_map(var_of).collect()),
+    }
+}
+
+/// Long bodies as a sequence of blocks, each yielding the variables later blocks use:
+/// `let (x7, x9) = { …; (x7, x9) };`. Every `let` opens a lexical scope in the debug
+/// information, and rustc's LLVM backend recurses once per nested scope: thousands of `let`s in
+/// one block overflow its stack. Blocks keep the nesting depth near `CHUNK` plus the number of
+/// blocks. Short bodies are left as they are.
+fn chunked(
+    g: &Graph,
+    s: &Schedule,
+    outputs: &[ExprId],
+    stmts: Vec<TokenStream>,
+) -> Vec<TokenStream> {
+    if stmts.len() <= 4 * CHUNK {
+        return stmts;
+    }
+    let vars: Vec<(Vec<usize>, Vec<usize>)> =
+        s.steps.iter().map(|st| step_vars(g, s, st)).collect();
+    let mut last_use: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for (i, (_, uses)) in vars.iter().enumerate() {
+        for &u in uses {
+            last_use.insert(u, i);
+        }
+    }
+    for &o in outputs {
+        if let Operand::Var(n) = s.operand(g, o) {
+            last_use.insert(n, usize::MAX);
+        }
+    }
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < stmts.len() {
+        let end = (start + CHUNK).min(stmts.len());
+        let mut live: Vec<usize> = vars[start..end]
+            .iter()
+            .flat_map(|(defs, _)| defs.iter().copied())
+            .filter(|d| last_use.get(d).is_some_and(|&u| u >= end))
+            .collect();
+        live.sort_unstable();
+        let body = &stmts[start..end];
+        let names: Vec<Ident> = live.iter().map(|&n| var(n)).collect();
+        out.push(match names.len() {
+            0 => quote! { { #(#body)* } },
+            1 => {
+                let v = &names[0];
+                quote! { let #v = { #(#body)* #v }; }
+            }
+            _ => quote! { let (#(#names),*) = { #(#body)* (#(#names),*) }; },
+        });
+        start = end;
+    }
+    out
+}
+
+/// `site: Site::…` of a guard in a parallel module.
+fn site_tokens(site: runtime::parallel::Site) -> TokenStream {
+    use runtime::parallel::Site as S;
+    match site {
+        S::MassMatrix(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::MassMatrix(#i))
+        }
+        S::Leg(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Leg(#i))
+        }
+        S::Reach(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Reach(#i))
+        }
+        S::Actuation(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Actuation(#i))
+        }
+        S::Platform => quote!(site: Site::Platform),
+        S::Input => quote!(site: Site::Input),
+    }
+}
+
+/// The tokens of one function.
+pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
     let name = Ident::new(f.name, Span::call_site());
     let args: Vec<TokenStream> = f
         .args
         .iter()
         .map(|a| {
+            let len = if *a == Arg::X {
+                quote!(NX)
+            } else {
+                quote!(DOF)
+            };
             let a = Ident::new(a.name(), Span::call_site());
-            quote!(#a: &[f64; DOF])
+            quote!(#a: &[f64; #len])
         })
         .collect();
-    let ret = match f.shape {
+    let ret = match &f.shape {
         Shape::Vector => quote!([f64; DOF]),
         Shape::Matrix => quote!([[f64; DOF]; DOF]),
         Shape::FallibleVector => quote!(Result<[f64; DOF], Singular>),
+        Shape::Fallible(parts) => {
+            let tys: Vec<TokenStream> = parts.iter().map(|p| p.ty()).collect();
+            if tys.len() == 1 {
+                quote!(Result<#(#tys)*, Singular>)
+            } else {
+                quote!(Result<(#(#tys),*), Singular>)
+            }
+        }
     };
     let docs = f.doc.iter().map(|d| {
         let d = format!(" {d}");
@@ -187,13 +411,14 @@ fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
     });
     let ops = format!(" Cost per call: {}.", f.schedule.ops);
     let body = body(g, cfg, f);
+    let vis = if f.public { quote!(pub) } else { quote!() };
     quote! {
         #(#docs)*
         #[doc = ""]
         #[doc = #ops]
         #[inline]
         #[allow(unused_variables, clippy::all)]
-        pub fn #name(#(#args),*) -> #ret {
+        #vis fn #name(#(#args),*) -> #ret {
             #body
         }
     }
@@ -240,6 +465,11 @@ pub fn module(
         #singular
         #(#fns)*
     };
+    render(header, tokens)
+}
+
+/// Header comment lines, then the items `tokens` pretty-printed.
+pub(crate) fn render(header: &[String], tokens: TokenStream) -> String {
     let file: syn::File = match syn::parse2(tokens) {
         Ok(f) => f,
         // The tokens are built from a closed grammar above; a parse failure is a generator bug.
@@ -258,14 +488,28 @@ pub fn module(
 
 /// The op-count table (markdown) of a set of functions.
 pub fn stats_table(rows: &[(String, OpCount)], dof: usize) -> Vec<String> {
+    // The `atan2` column appears only when some function calls it (parallel mechanisms with
+    // revolute actuators), so tree tables keep their shape.
+    let atan2 = rows.iter().any(|(_, c)| c.atan2 > 0);
+    let (h1, h2) = if atan2 {
+        (" atan2 |", "---:|")
+    } else {
+        ("", "")
+    };
     let mut v = vec![
-        "| function | flops | flops/joint | add | mul | neg | div | sqrt | sin_cos | cmp |"
-            .to_string(),
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|".to_string(),
+        format!(
+            "| function | flops | flops/joint | add | mul | neg | div | sqrt | sin_cos | cmp |{h1}"
+        ),
+        format!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|{h2}"),
     ];
     for (name, c) in rows {
+        let extra = if atan2 {
+            format!(" {} |", c.atan2)
+        } else {
+            String::new()
+        };
         v.push(format!(
-            "| {name} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |{extra}",
             c.flops(),
             c.flops() as f64 / dof.max(1) as f64,
             c.add,

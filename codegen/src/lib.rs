@@ -36,6 +36,7 @@ pub mod build_script;
 pub mod diag;
 pub mod dynamics;
 pub mod emit;
+pub mod parallel;
 pub mod schedule;
 pub mod spec;
 pub mod sym;
@@ -93,8 +94,15 @@ pub fn compile(
     source: &str,
     cfg: &Config,
 ) -> Result<Generated, diag::Diagnostics> {
-    let (model, warnings) = spec::load(file_name, source)?;
-    let mut out = generate(&model, cfg);
+    let (mechanism, warnings) = spec::load_mechanism(file_name, source)?;
+    let mut out = match mechanism {
+        spec::Mechanism::Tree(model) => generate(&model, cfg),
+        spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg).map_err(|msg| {
+            let mut d = diag::Diagnostics::new(file_name, source);
+            d.push(diag::Diagnostic::error(msg).with_key("platform"));
+            d
+        })?,
+    };
     out.warnings = warnings;
     Ok(out)
 }
@@ -244,6 +252,9 @@ pub fn generate(model: &Model, cfg: &Config) -> Generated {
                 outputs,
                 shape,
                 schedule,
+                dof: n,
+                public: true,
+                sites: false,
             }
         })
         .collect();

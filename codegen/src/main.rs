@@ -55,12 +55,22 @@ fn main() -> ExitCode {
     };
     let name = cli.spec.to_string_lossy().into_owned();
     if cli.check {
-        return match codegen::spec::load(&name, &source) {
-            Ok((model, warnings)) => {
+        return match codegen::spec::load_mechanism(&name, &source) {
+            Ok((mechanism, warnings)) => {
                 if !warnings.is_empty() {
                     eprint!("{}", warnings.render());
                 }
-                eprintln!("{}: ok ({} joints)", name, model.dof());
+                match mechanism {
+                    codegen::spec::Mechanism::Tree(model) => {
+                        eprintln!("{}: ok ({} joints)", name, model.dof())
+                    }
+                    codegen::spec::Mechanism::Parallel(model) => eprintln!(
+                        "{}: ok (parallel, {} legs, {} DOF)",
+                        name,
+                        model.legs.len(),
+                        model.dof()
+                    ),
+                }
                 ExitCode::SUCCESS
             }
             Err(d) => {

@@ -28,6 +28,8 @@ pub struct OpCount {
     pub sin_cos: usize,
     /// Pivot checks (comparisons).
     pub cmp: usize,
+    /// `atan2` calls (parallel mechanisms: revolute actuator angles).
+    pub atan2: usize,
 }
 
 impl OpCount {
@@ -50,7 +52,11 @@ impl fmt::Display for OpCount {
             self.sqrt,
             self.sin_cos,
             self.cmp
-        )
+        )?;
+        if self.atan2 > 0 {
+            write!(f, ", {} atan2", self.atan2)?;
+        }
+        Ok(())
     }
 }
 
@@ -145,6 +151,7 @@ pub fn schedule(g: &Graph, roots: &[ExprId]) -> Schedule {
                     Node::Div(..) => s.ops.div += 1,
                     Node::Neg(..) => s.ops.neg += 1,
                     Node::Sqrt(..) => s.ops.sqrt += 1,
+                    Node::Atan2(..) => s.ops.atan2 += 1,
                     _ => {}
                 }
                 s.names.insert(id, next);

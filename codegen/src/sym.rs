@@ -30,6 +30,12 @@ pub enum Arg {
     Qdd,
     /// Joint efforts.
     Tau,
+    /// Platform coordinates (parallel mechanisms): `[f64; NX]`.
+    X,
+    /// Platform speeds (parallel mechanisms).
+    U,
+    /// Platform speed rates (parallel mechanisms).
+    Ud,
 }
 
 impl Arg {
@@ -40,6 +46,9 @@ impl Arg {
             Arg::Qd => "qd",
             Arg::Qdd => "qdd",
             Arg::Tau => "tau",
+            Arg::X => "x",
+            Arg::U => "u",
+            Arg::Ud => "ud",
         }
     }
 }
@@ -67,9 +76,13 @@ pub enum Node {
     Sin(ExprId),
     /// `cos a`.
     Cos(ExprId),
+    /// `atan2(a, b)`: the angle of the point `(b, a)`.
+    Atan2(ExprId, ExprId),
     /// Pivot `index` of a factorization: the operand when it is `> tol` (a node), else the
     /// function returns `Err(Singular)`; `scale` is the matrix diagonal entry the pivot came from
-    /// (for the condition estimate).
+    /// (for the condition estimate). With [`TWO_SIDED`] set in `index` the test is
+    /// `|value| > tol`; the rest of `index` is a site code (`runtime::parallel::Site::code`;
+    /// for trees the pivot).
     Guard {
         value: ExprId,
         tol: ExprId,
@@ -77,6 +90,9 @@ pub enum Node {
         index: u16,
     },
 }
+
+/// Flag in a guard's `index`: the test is `|value| > tol`.
+pub const TWO_SIDED: u16 = 0x8000;
 
 /// The expression DAG.
 #[derive(Default, Clone)]
@@ -310,6 +326,14 @@ impl Graph {
         }
     }
 
+    /// `atan2(a, b)`.
+    pub fn atan2(&mut self, a: ExprId, b: ExprId) -> ExprId {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(y), Some(x)) => self.constant(y.atan2(x)),
+            _ => self.intern(Node::Atan2(a, b)),
+        }
+    }
+
     /// A checked pivot (see [`Node::Guard`]).
     pub fn guard(&mut self, value: ExprId, tol: ExprId, scale: ExprId, index: usize) -> ExprId {
         self.intern(Node::Guard {
@@ -324,9 +348,11 @@ impl Graph {
     pub fn operands(&self, id: ExprId) -> impl Iterator<Item = ExprId> {
         let ops: [Option<ExprId>; 3] = match self.node(id) {
             Node::Const(_) | Node::Input(..) => [None, None, None],
-            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
-                [Some(a), Some(b), None]
-            }
+            Node::Add(a, b)
+            | Node::Sub(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Atan2(a, b) => [Some(a), Some(b), None],
             Node::Neg(a) | Node::Sqrt(a) | Node::Sin(a) | Node::Cos(a) => [Some(a), None, None],
             Node::Guard {
                 value, tol, scale, ..
@@ -365,12 +391,16 @@ impl Graph {
                 Node::Sqrt(a) => v(a).sqrt(),
                 Node::Sin(a) => v(a).sin(),
                 Node::Cos(a) => v(a).cos(),
-                Node::Guard { value, tol, .. } => {
-                    if v(value) > v(tol) {
-                        v(value)
+                Node::Atan2(a, b) => v(a).atan2(v(b)),
+                Node::Guard {
+                    value, tol, index, ..
+                } => {
+                    let ok = if index & TWO_SIDED != 0 {
+                        v(value).abs() > v(tol)
                     } else {
-                        f64::NAN
-                    }
+                        v(value) > v(tol)
+                    };
+                    if ok { v(value) } else { f64::NAN }
                 }
             };
             val[id.0 as usize] = Some(r);

@@ -1,8 +1,11 @@
-//! Rendered diagnostics of every bad spec in `tests/data/bad/` (one file per kind of error),
-//! as insta snapshots; and the good specs (including every complete example in
-//! `docs/spec.md`) load without warnings.
+//! Rendered diagnostics of every bad spec in `tests/data/bad/` (one file per kind of error) and
+//! of every bad parallel spec in `tests/data/bad_parallel/` (read with `load_mechanism`), as
+//! insta snapshots; and the good specs (including every complete example in `docs/spec.md` and
+//! the bundled parallel specs in `mechanisms/specs/`) load without warnings.
 
 use std::path::Path;
+
+use codegen::spec::Mechanism;
 
 /// Loads `path` under its bare file name (no absolute paths in snapshots) and renders the
 /// diagnostics; a bad spec must fail.
@@ -38,6 +41,76 @@ fn bad_urdf_specs() {
     insta::glob!("data/bad", "*.urdf", |path| {
         insta::assert_snapshot!(render_bad(path));
     });
+}
+
+/// As [`render_bad`], through `load_mechanism` (trees and parallel mechanisms).
+fn render_bad_mechanism(path: &Path) -> String {
+    let name = path.file_name().unwrap().to_str().unwrap();
+    let source = std::fs::read_to_string(path).unwrap();
+    match codegen::spec::load_mechanism(name, &source) {
+        Ok((m, warnings)) => panic!(
+            "{name} was accepted ({}), warnings:\n{}",
+            m.name(),
+            warnings.render()
+        ),
+        Err(diags) => {
+            assert!(diags.has_errors());
+            for d in diags.iter() {
+                assert!(d.span.is_some(), "{name}: diagnostic without a span: {d:?}");
+            }
+            diags.render()
+        }
+    }
+}
+
+#[test]
+fn bad_parallel_specs() {
+    insta::glob!("data/bad_parallel", "*.toml", |path| {
+        insta::assert_snapshot!(render_bad_mechanism(path));
+    });
+}
+
+fn load_clean_mechanism(name: &str, source: &str) -> Mechanism {
+    match codegen::spec::load_mechanism(name, source) {
+        Ok((m, warnings)) => {
+            assert!(warnings.is_empty(), "{name}:\n{}", warnings.render());
+            m
+        }
+        Err(e) => panic!("{name}:\n{}", e.render()),
+    }
+}
+
+/// The bundled parallel specs and the good parallel test specs load as parallel mechanisms
+/// whose `validate()` passes.
+#[test]
+fn good_parallel_specs_load_and_validate() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut n = 0;
+    for dir in [
+        root.join("tests/data/good_parallel"),
+        root.join("../mechanisms/specs"),
+    ] {
+        let mut entries: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        entries.sort();
+        for path in entries {
+            let name = path.file_name().unwrap().to_str().unwrap().to_owned();
+            let source = std::fs::read_to_string(&path).unwrap();
+            let Mechanism::Parallel(m) = load_clean_mechanism(&name, &source) else {
+                // The bundled folder also holds trees.
+                continue;
+            };
+            m.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+            // `load` refuses it, pointing at the [platform] table.
+            let e = codegen::spec::load(&name, &source).unwrap_err();
+            assert!(e.render().contains("parallel mechanism"), "{}", e.render());
+            n += 1;
+        }
+    }
+    assert!(n >= 5, "found {n} parallel specs");
 }
 
 fn load_clean(name: &str, source: &str) -> runtime::model::Model {
@@ -86,21 +159,36 @@ fn puma560_example_lowers_as_documented() {
 }
 
 /// Every ```toml block of docs/spec.md that starts with `[mechanism]` is a complete, valid
-/// spec.
+/// spec (a tree, or a parallel mechanism whose `validate()` passes); there is at least one of
+/// each.
 #[test]
 fn examples_in_docs_load_without_warnings() {
     let doc = include_str!("../../docs/spec.md");
     let mut n = 0;
+    let mut parallel = 0;
     let mut rest = doc;
     while let Some(start) = rest.find("```toml\n") {
         let body = &rest[start + 8..];
         let end = body.find("```").unwrap();
         let block = &body[..end];
         if block.trim_start().starts_with("[mechanism]") {
-            load_clean(&format!("docs/spec.md example {n}"), block);
+            let name = format!("docs/spec.md example {n}");
+            match load_clean_mechanism(&name, block) {
+                Mechanism::Tree(_) => {
+                    load_clean(&name, block);
+                }
+                Mechanism::Parallel(m) => {
+                    m.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+                    parallel += 1;
+                }
+            }
             n += 1;
         }
         rest = &body[end + 3..];
     }
-    assert!(n >= 1, "no complete example found in docs/spec.md");
+    assert!(n >= 2, "no complete example found in docs/spec.md");
+    assert!(
+        parallel >= 1,
+        "no complete parallel example found in docs/spec.md"
+    );
 }

@@ -5,6 +5,8 @@
 //!   generator compiles and the generic runtime evaluates.
 //! * [`noc`] (feature `alloc`): the Natural Orthogonal Complement evaluated literally with nalgebra
 //!   (`T`, `Ṫ`, `M`, `W`, `I = TᵀMT`, `C = Tᵀ(MṪ+WMT)`): the first oracle.
+//! * [`parallel`] (feature `alloc`): simple-platform parallel manipulators — the model, leg
+//!   kinematics and the NOC in actuator space, generic over the scalar so the generator reuses it.
 //! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
 //!   spatial (6-D) algebra, written from their own equations: the independent second route.
 #![no_std]
@@ -20,5 +22,7 @@ pub mod math;
 pub mod model;
 #[cfg(feature = "alloc")]
 pub mod noc;
+#[cfg(feature = "alloc")]
+pub mod parallel;
 #[cfg(feature = "alloc")]
 pub mod rnea;

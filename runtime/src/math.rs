@@ -55,3 +55,16 @@ pub fn sqrt_f32(x: f32) -> f32 {
         libm::sqrtf(x)
     }
 }
+
+/// `atan2(y, x)`: the angle of the point `(x, y)`, in `(−π, π]`.
+#[inline(always)]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        y.atan2(x)
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::atan2(y, x)
+    }
+}

@@ -6,6 +6,9 @@
 //! CRBA in spatial algebra); forward dynamics generated / runtime NOC (there is no RNEA forward
 //! dynamics). Inputs are fixed pseudo-random states behind `black_box`.
 //!
+//! For the Gough–Stewart platform and the Agile Eye (parallel): inverse and forward dynamics,
+//! generated vs the runtime evaluator `runtime::parallel::noc`.
+//!
 //! ```text
 //! cargo bench -p tests --bench dynamics
 //! ```
@@ -107,6 +110,72 @@ macro_rules! bench_mechanism {
 bench_mechanism!(puma560, puma560, "puma560.toml", 560);
 bench_mechanism!(chain7, chain7, "chain7.toml", 7);
 
+/// A bundled parallel mechanism: generated vs the runtime evaluator (`runtime::parallel::noc`,
+/// the same equations in `f64` with `Vec`s), for inverse and forward dynamics.
+macro_rules! bench_parallel {
+    ($fn_name:ident, $module:ident) => {
+        fn $fn_name(c: &mut Criterion) {
+            use mechanisms::$module as generated;
+            use runtime::parallel::noc::{self, Plan};
+            const NX: usize = generated::NX;
+            const N: usize = generated::DOF;
+            let name = stringify!($module);
+            let model = tests::pkm::model(name);
+            let plan = Plan::new(&model).expect("valid model");
+            let home = tests::pkm::home_x(&model);
+            let (angle, reach) = match model.motion {
+                runtime::parallel::PlatformMotion::Pose => (0.1, 0.02 * model.size()),
+                runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
+            };
+            let (x, u, ud) =
+                tests::pkm::random_state(&plan, &home, &mut rng(N as u64), angle, reach);
+            let x: [f64; NX] = x.try_into().unwrap();
+            let u: [f64; N] = u.try_into().unwrap();
+            let ud: [f64; N] = ud.try_into().unwrap();
+            let tau = generated::inverse_dynamics(&x, &u, &ud).expect("regular state");
+            let reference = noc::inverse_dynamics(&plan, &x, &u, &ud).expect("regular state");
+            assert!(rel_err(&tau, &reference) < 1e-9, "{name}: ID vs runtime");
+
+            let mut g = c.benchmark_group(format!("{name}/inverse_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| generated::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    noc::inverse_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&ud),
+                    )
+                })
+            });
+            g.finish();
+
+            let mut g = c.benchmark_group(format!("{name}/forward_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| {
+                    generated::forward_dynamics(black_box(&x), black_box(&u), black_box(&tau))
+                })
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    noc::forward_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&tau),
+                    )
+                })
+            });
+            g.finish();
+        }
+    };
+}
+
+bench_parallel!(gough_stewart, gough_stewart);
+bench_parallel!(agile_eye, agile_eye);
+
 fn config() -> Criterion {
     Criterion::default()
         .measurement_time(Duration::from_secs(2))
@@ -117,6 +186,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7
+    targets = puma560, chain7, gough_stewart, agile_eye
 }
 criterion_main!(benches);

@@ -1,6 +1,11 @@
 //! Shared helpers for nocdyn's integration tests: random models and states, error norms.
 #![allow(clippy::needless_range_loop)]
 
+
+pub mod pkm;
+
+pub mod lagrange;
+
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use runtime::model::{Body, Joint, JointKind, Model, Transform, rpy_to_matrix};
 

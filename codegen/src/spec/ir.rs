@@ -22,6 +22,36 @@ pub(crate) struct Spec {
     /// Some joint could not be read far enough to know its parent or child (already reported):
     /// don't report bodies as unattached, that would only echo the first error.
     pub joints_incomplete: bool,
+    /// The `[platform]` table: present for a parallel mechanism (TOML only).
+    pub platform: Option<PlatformSpec>,
+}
+
+/// How a parallel mechanism's platform moves (`platform.coordinates`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Coordinates {
+    /// Six DOF: position and orientation.
+    Pose,
+    /// Three DOF: orientation about a fixed centre (a spherical mechanism).
+    Orientation,
+}
+
+/// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`
+/// (the error is already reported).
+#[derive(Clone, Debug)]
+pub(crate) struct PlatformSpec {
+    /// Span of the `platform` key of the `[platform]` header (whole-platform diagnostics).
+    pub span: Span,
+    /// The moving platform: a body name.
+    pub body: Option<String>,
+    pub body_span: Span,
+    pub coordinates: Option<Coordinates>,
+    pub coordinates_span: Span,
+    /// The platform frame's pose in the base frame at home (identity by default).
+    pub home: Transform,
+    pub home_span: Span,
+    /// Orientation platforms: the fixed centre (base frame, m), if written.
+    pub centre: Option<Vec3>,
+    pub centre_span: Span,
 }
 
 /// A rigid body, inertial data in its user frame `F`.
@@ -100,6 +130,8 @@ pub(crate) struct JointSpec {
     /// Span of the joint's name (or its element).
     pub span: Span,
     pub kind: Kind,
+    /// Span of the `kind` value (or of the joint's element).
+    pub kind_span: Span,
     pub parent: String,
     pub parent_span: Span,
     pub child: String,
@@ -107,6 +139,13 @@ pub(crate) struct JointSpec {
     pub placement: Placement,
     /// R/P: one axis; U: two; S and fixed: none (S uses x, y, z). Empty means the default.
     pub axes: Vec<AxisSpec>,
+    /// Parallel mechanisms: `actuated = true`, with the span of the `actuated` key.
+    pub actuated: bool,
+    pub actuated_span: Span,
+    /// Parallel mechanisms, joints into the platform: the joint frame in the platform frame.
+    pub child_origin: Option<Transform>,
+    /// Span of the `child_origin` key, when written.
+    pub child_origin_span: Span,
 }
 
 /// The name of the fixed world in `parent`.

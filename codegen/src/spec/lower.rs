@@ -11,28 +11,68 @@ use super::ir::{BASE, BodySpec, JointSpec, Kind, Placement, Span, Spec};
 use super::suggest_hint;
 use crate::diag::{Diagnostic, Diagnostics};
 
-/// Validates `spec` and builds the model. Errors and warnings go to `diags`; `None` when there
-/// was any error.
+/// Validates `spec` (a tree: no `[platform]`) and builds the model. Errors and warnings go to
+/// `diags`; `None` when there was any error.
 pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
     let axes = check_values(spec, diags);
-    let topo = check_topology(spec, diags);
+    check_no_parallel_keys(spec, diags);
+    let topo = check_topology(spec, diags, &Skip::none(spec));
     if diags.has_errors() {
         return None;
     }
     let topo = topo?;
-    let model = build(spec, &topo, &axes, diags);
+    let built = build(spec, &topo, &axes, diags);
     if diags.has_errors() {
         None
     } else {
-        Some(model)
+        Some(built.model)
+    }
+}
+
+/// `actuated` and `child_origin` belong to parallel mechanisms only.
+fn check_no_parallel_keys(spec: &Spec, diags: &mut Diagnostics) {
+    for j in &spec.joints {
+        if j.actuated {
+            diags.push(
+                Diagnostic::error("`actuated` is only for parallel mechanisms")
+                    .with_key(format!("{}.actuated", j.key))
+                    .with_span(j.actuated_span.clone().or(j.span.clone()))
+                    .with_hint("this spec has no [platform] table, so it is a tree, in which every joint is actuated; remove `actuated` (or add a [platform] table)"),
+            );
+        }
+        if j.child_origin.is_some() {
+            diags.push(
+                Diagnostic::error("`child_origin` is only for joints into the platform of a parallel mechanism")
+                    .with_key(format!("{}.child_origin", j.key))
+                    .with_span(j.child_origin_span.clone().or(j.span.clone()))
+                    .with_hint("this spec has no [platform] table, so it is a tree; remove `child_origin` (the child's frame is the joint frame)"),
+            );
+        }
     }
 }
 
 /// Joint axes after validation: per joint, the unit axes of its revolutes/prismatic.
-type Axes = Vec<Vec<Vec3>>;
+pub(super) type Axes = Vec<Vec<Vec3>>;
+
+/// Joints and bodies that the tree checks and the tree lowering leave out (a parallel
+/// mechanism's joints into the platform, and the platform with what is fixed to it).
+pub(super) struct Skip {
+    pub joint: Vec<bool>,
+    pub body: Vec<bool>,
+}
+
+impl Skip {
+    /// Nothing skipped (a tree).
+    pub(super) fn none(spec: &Spec) -> Skip {
+        Skip {
+            joint: vec![false; spec.joints.len()],
+            body: vec![false; spec.bodies.len()],
+        }
+    }
+}
 
 /// Finite values, masses, inertias, axes. Returns the normalized axes per joint.
-fn check_values(spec: &Spec, diags: &mut Diagnostics) -> Axes {
+pub(super) fn check_values(spec: &Spec, diags: &mut Diagnostics) -> Axes {
     for (k, g) in spec.gravity.iter().enumerate() {
         if !g.is_finite() {
             diags.push(
@@ -147,15 +187,18 @@ fn joint_axes(j: &JointSpec, diags: &mut Diagnostics) -> Vec<Vec3> {
 }
 
 /// Resolved topology.
-struct Topo {
+pub(super) struct Topo {
     /// Per joint: parent body index (`None` = base) and child body index.
-    parent: Vec<Option<usize>>,
-    child: Vec<usize>,
-    /// Joints in processing order (parents first, declared order where possible).
-    order: Vec<usize>,
+    pub parent: Vec<Option<usize>>,
+    pub child: Vec<usize>,
+    /// Joints in processing order (parents first, declared order where possible); skipped
+    /// joints are left out.
+    pub order: Vec<usize>,
 }
 
-fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
+/// Names, references and the tree structure. Joints and bodies in `skip` are resolved (their
+/// names and bodies must exist) but take no part in the tree rules.
+pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) -> Option<Topo> {
     // Unique names.
     let mut body_index: HashMap<&str, usize> = HashMap::new();
     for (i, b) in spec.bodies.iter().enumerate() {
@@ -248,16 +291,41 @@ fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
             continue;
         };
         child[ji] = c;
-        if let Some(first) = child_of[c] {
+        if skip.joint[ji] {
+            continue;
+        }
+        if skip.body[c] {
             ok = false;
             diags.push(
+                Diagnostic::error(format!(
+                    "body \"{}\" is part of the platform and cannot be the child of joint \"{}\"",
+                    j.child, j.name
+                ))
+                .with_key(format!("{}.child", j.key))
+                .with_span(j.child_span.clone())
+                .with_hint("the platform and the bodies fixed to it are reached only through the joints into the platform (with `child_origin`) and the fixed joints hanging from it"),
+            );
+            continue;
+        }
+        if let Some(first) = child_of[c] {
+            ok = false;
+            let d = if skip.body.iter().any(|s| *s) {
+                // A parallel mechanism: only the platform closes loops.
+                Diagnostic::error("only the platform may be the child of several joints: other closed loops are not supported")
+                    .with_hint(format!(
+                        "body \"{}\" is already the child of joint \"{}\"; the loops of a simple-platform mechanism close at the platform, every other body is the child of exactly one joint",
+                        j.child, spec.joints[first].name
+                    ))
+            } else {
                 Diagnostic::error("closed chains are not supported yet (they arrive with the parallel-manipulator support)")
-                    .with_key(format!("{}.child", j.key))
-                    .with_span(j.child_span.clone())
                     .with_hint(format!(
                         "body \"{}\" is already the child of joint \"{}\"; in a tree every body is the child of exactly one joint",
                         j.child, spec.joints[first].name
-                    )),
+                    ))
+            };
+            diags.push(
+                d.with_key(format!("{}.child", j.key))
+                    .with_span(j.child_span.clone()),
             );
         } else {
             child_of[c] = Some(ji);
@@ -265,6 +333,7 @@ fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
     }
     for (bi, b) in spec.bodies.iter().enumerate() {
         if child_of[bi].is_none()
+            && !skip.body[bi]
             && !spec.joints_incomplete
             && b.name != BASE
             && body_index.get(b.name.as_str()) == Some(&bi)
@@ -287,7 +356,7 @@ fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
 
     // Cycles: follow parents from every joint; 0 = unseen, 1 = on the current walk, 2 = reaches base.
     let mut state = vec![0u8; spec.joints.len()];
-    for start in 0..spec.joints.len() {
+    for start in (0..spec.joints.len()).filter(|&j| !skip.joint[j]) {
         let mut walk = Vec::new();
         let mut j = start;
         loop {
@@ -340,10 +409,11 @@ fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
 
     // Stable topological order: repeatedly the first declared joint whose parent is placed.
     let n = spec.joints.len();
-    let mut placed = vec![false; n];
+    let mut placed = skip.joint.clone();
     let mut body_placed = vec![false; spec.bodies.len()];
-    let mut order = Vec::with_capacity(n);
-    while order.len() < n {
+    let active = skip.joint.iter().filter(|s| !**s).count();
+    let mut order = Vec::with_capacity(active);
+    while order.len() < active {
         let next = (0..n).find(|&j| !placed[j] && parent[j].is_none_or(|p| body_placed[p]))?;
         placed[next] = true;
         body_placed[child[next]] = true;
@@ -357,7 +427,7 @@ fn check_topology(spec: &Spec, diags: &mut Diagnostics) -> Option<Topo> {
 }
 
 /// `line:col` of a span's start, for hints.
-fn position(source: &str, span: &Span) -> String {
+pub(super) fn position(source: &str, span: &Span) -> String {
     match span {
         Some(s) => {
             let before = &source[..s.start.min(source.len())];
@@ -372,9 +442,18 @@ fn position(source: &str, span: &Span) -> String {
 /// Where a spec body ended up: the model body it is rigidly part of (`None` = base) and the
 /// pose of its user frame in that body's frame.
 #[derive(Clone, Copy)]
-struct Attach {
-    target: Option<usize>,
-    pose: Transform,
+pub(super) struct Attach {
+    pub target: Option<usize>,
+    pub pose: Transform,
+}
+
+/// The lowered tree with the bookkeeping the parallel lowering needs.
+pub(super) struct Built {
+    pub model: Model,
+    /// Per spec body: where it ended up (`None` for skipped bodies).
+    pub attach: Vec<Option<Attach>>,
+    /// Per model joint: the spec joint it comes from.
+    pub spec_joint: Vec<usize>,
 }
 
 /// The model under construction.
@@ -383,35 +462,35 @@ struct Builder {
     joints: Vec<Joint>,
     body_names: Vec<String>,
     parts: Vec<Vec<MassProps>>,
+    /// Per joint: the spec joint it comes from.
+    spec_joint: Vec<usize>,
     /// Names made up by the U/S expansion, with the span of the joint that made them.
     generated: Vec<(String, Span)>,
 }
 
 impl Builder {
-    /// Adds a joint moving a new body; returns its index.
-    fn add(
-        &mut self,
-        name: String,
-        kind: JointKind,
-        origin: Transform,
-        axis: Vec3,
-        parent: Option<usize>,
-        body_name: String,
-    ) -> usize {
-        self.joints.push(Joint {
-            name,
-            kind,
-            parent,
-            origin,
-            axis,
-        });
+    /// Adds `joint` moving a new body named `body_name`; `spec_joint` is the spec joint it
+    /// comes from. Returns its index.
+    fn add(&mut self, joint: Joint, body_name: String, spec_joint: usize) -> usize {
+        self.spec_joint.push(spec_joint);
+        self.joints.push(joint);
         self.body_names.push(body_name);
         self.parts.push(Vec::new());
         self.joints.len() - 1
     }
 }
 
-fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Model {
+/// The placement of a joint: the joint frame in the parent's user frame, and (standard DH) the
+/// pose of the child's user frame in the joint frame after the motion.
+pub(super) fn placement_frames(p: &Placement) -> (Transform, Transform) {
+    match p {
+        Placement::Origin(t) => (*t, Transform::IDENTITY),
+        Placement::Dh(dh) => (geom::dh_origin(dh), geom::dh_offset(dh)),
+        Placement::Mdh(dh) => (geom::mdh_origin(dh), Transform::IDENTITY),
+    }
+}
+
+pub(super) fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Built {
     let mut attach: Vec<Option<Attach>> = vec![None; spec.bodies.len()];
     let mut m = Builder::default();
     let base = Attach {
@@ -423,11 +502,7 @@ fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Mode
         let j = &spec.joints[ji];
         let body = &spec.bodies[topo.child[ji]];
         let from = topo.parent[ji].and_then(|p| attach[p]).unwrap_or(base);
-        let (origin_user, offset) = match &j.placement {
-            Placement::Origin(t) => (*t, Transform::IDENTITY),
-            Placement::Dh(dh) => (geom::dh_origin(dh), geom::dh_offset(dh)),
-            Placement::Mdh(dh) => (geom::mdh_origin(dh), Transform::IDENTITY),
-        };
+        let (origin_user, offset) = placement_frames(&j.placement);
         let origin = compose(&from.pose, &origin_user);
         let props = MassProps {
             mass: body.mass,
@@ -447,12 +522,15 @@ fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Mode
                     JointKind::Prismatic
                 };
                 let i = m.add(
-                    j.name.clone(),
-                    kind,
-                    origin,
-                    ax[0],
-                    from.target,
+                    Joint {
+                        name: j.name.clone(),
+                        kind,
+                        parent: from.target,
+                        origin,
+                        axis: ax[0],
+                    },
                     body.name.clone(),
+                    ji,
                 );
                 Attach {
                     target: Some(i),
@@ -478,7 +556,14 @@ fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Mode
                     };
                     let jname = format!("{}{sfx}", j.name);
                     m.generated.push((jname.clone(), j.span.clone()));
-                    parent = Some(m.add(jname, JointKind::Revolute, o, ax[k], parent, bname));
+                    let joint = Joint {
+                        name: jname,
+                        kind: JointKind::Revolute,
+                        parent,
+                        origin: o,
+                        axis: ax[k],
+                    };
+                    parent = Some(m.add(joint, bname, ji));
                     o = Transform::IDENTITY;
                 }
                 Attach {
@@ -536,10 +621,14 @@ fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnostics) -> Mode
             }
         })
         .collect();
-    Model {
-        name: spec.name.clone(),
-        gravity: spec.gravity,
-        bodies,
-        joints: m.joints,
+    Built {
+        model: Model {
+            name: spec.name.clone(),
+            gravity: spec.gravity,
+            bodies,
+            joints: m.joints,
+        },
+        attach,
+        spec_joint: m.spec_joint,
     }
 }

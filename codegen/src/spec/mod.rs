@@ -1,10 +1,12 @@
 //! The spec layer: mechanism descriptions (TOML, or URDF with the `urdf` feature) → a validated
-//! [`runtime::model::Model`], or [`Diagnostics`] pointing at every problem.
+//! [`runtime::model::Model`] (a tree) or [`runtime::parallel::ParallelModel`] (a TOML spec with a
+//! `[platform]` table), or [`Diagnostics`] pointing at every problem.
 //!
 //! Pipeline: a reader (`read_toml`, `urdf`) turns the text into the format-neutral `ir::Spec`,
 //! reporting syntax, key and type errors with spans; `lower` checks values and topology and
 //! lowers (stable topological order, fixed-joint merging, U/S expansion, DH frames) to the
-//! model. The format reference is `docs/spec.md`.
+//! model; `parallel` lowers a parallel mechanism with the same machinery and splits it into
+//! legs. The format reference is `docs/spec.md`.
 //!
 //! This is the only module that knows TOML, XML or serde.
 
@@ -12,6 +14,7 @@ mod angle;
 mod geom;
 mod ir;
 mod lower;
+mod parallel;
 mod read_toml;
 #[cfg(feature = "urdf")]
 mod urdf;
@@ -20,16 +23,77 @@ mod urdf;
 mod tests;
 
 use runtime::model::Model;
+use runtime::parallel::ParallelModel;
 
 use crate::diag::{Diagnostic, Diagnostics};
 
-/// Parse and validate a spec. The format is chosen by `file_name`'s extension: `.urdf` → URDF,
-/// anything else → TOML.
+/// A validated mechanism: a kinematic tree, or a simple-platform parallel manipulator.
+// Built once per spec; boxing the larger variant would only complicate matching on it.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+pub enum Mechanism {
+    /// A serial chain or tree (no `[platform]` table; every URDF).
+    Tree(Model),
+    /// A parallel manipulator (a TOML spec with a `[platform]` table).
+    Parallel(ParallelModel),
+}
+
+impl Mechanism {
+    /// The mechanism's name (`mechanism.name`).
+    pub fn name(&self) -> &str {
+        match self {
+            Mechanism::Tree(m) => &m.name,
+            Mechanism::Parallel(m) => &m.name,
+        }
+    }
+}
+
+/// Parse and validate a tree spec. The format is chosen by `file_name`'s extension: `.urdf` →
+/// URDF, anything else → TOML. A parallel mechanism (a TOML spec with a `[platform]` table) is
+/// an error here: read it with [`load_mechanism`].
 ///
 /// Pure: no I/O; `file_name` is only used for messages and the format choice. Never panics on
 /// any input. On success the warnings (e.g. an axis that was normalized) are returned beside
 /// the model; on failure all errors (and warnings) found, sorted by position.
 pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
+    let (mechanism, mut diags, platform) = load_any(file_name, source);
+    if let Some(span) = platform {
+        diags.push(
+            Diagnostic::error("this spec describes a parallel mechanism (it has a [platform] table), which cannot be loaded as a tree")
+                .with_key("platform")
+                .with_span(span)
+                .with_hint("read it with codegen::spec::load_mechanism, which returns a ParallelModel; code generation for parallel mechanisms is not available yet"),
+        );
+    }
+    finish(mechanism, diags).and_then(|(m, d)| match m {
+        Mechanism::Tree(m) => Ok((m, d)),
+        // Unreachable: a parallel spec got an error above.
+        Mechanism::Parallel(_) => Err(d),
+    })
+}
+
+/// Parse and validate a spec of either kind: a tree (as [`load`]) or, for a TOML spec with a
+/// `[platform]` table, a parallel mechanism (see `docs/spec.md`, "Parallel mechanisms").
+///
+/// Pure and panic-free like [`load`]; on success the warnings are returned beside the
+/// mechanism, on failure all errors (and warnings) found, sorted by position.
+pub fn load_mechanism(
+    file_name: &str,
+    source: &str,
+) -> Result<(Mechanism, Diagnostics), Diagnostics> {
+    let (mechanism, diags, _) = load_any(file_name, source);
+    finish(mechanism, diags)
+}
+
+/// Reads and lowers; also returns the span of the `[platform]` header for a parallel spec.
+fn load_any(
+    file_name: &str,
+    source: &str,
+) -> (
+    Option<Mechanism>,
+    Diagnostics,
+    Option<std::ops::Range<usize>>,
+) {
     let mut diags = Diagnostics::new(file_name, source);
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let mut d = Diagnostics::new(file_name, source);
@@ -38,24 +102,40 @@ pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagn
         } else {
             read_toml::read(source, &mut d)
         };
-        let model = spec.and_then(|s| lower::lower(&s, &mut d));
-        (model, d)
+        let platform = spec
+            .as_ref()
+            .and_then(|s| s.platform.as_ref())
+            .map(|p| p.span.clone().unwrap_or(0..0));
+        let mechanism = spec.and_then(|s| {
+            if s.platform.is_some() {
+                parallel::lower_parallel(&s, &mut d).map(Mechanism::Parallel)
+            } else {
+                lower::lower(&s, &mut d).map(Mechanism::Tree)
+            }
+        });
+        (mechanism, d, platform)
     }));
-    let model = match result {
-        Ok((model, d)) => {
+    match result {
+        Ok((mechanism, d, platform)) => {
             diags.extend(d);
-            model
+            (mechanism, diags, platform)
         }
         Err(_) => {
             diags.push(
                 Diagnostic::error("internal error: the spec reader panicked")
                     .with_hint("this is a bug in nocdyn; please report it with the input file"),
             );
-            None
+            (None, diags, None)
         }
-    };
+    }
+}
+
+fn finish(
+    mechanism: Option<Mechanism>,
+    mut diags: Diagnostics,
+) -> Result<(Mechanism, Diagnostics), Diagnostics> {
     diags.sort_by_position();
-    match model {
+    match mechanism {
         Some(m) if !diags.has_errors() => Ok((m, diags)),
         _ => {
             if !diags.has_errors() {

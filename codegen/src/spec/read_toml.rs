@@ -9,18 +9,31 @@ use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 use super::angle::{ANGLE_HINT, parse_angle};
-use super::ir::{AxisSpec, BodySpec, Dh, JointSpec, Kind, Placement, Spec};
+use super::ir::{
+    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Placement, PlatformSpec, Spec,
+};
 use super::{sanitize_name, suggest_hint};
 use crate::diag::{Diagnostic, Diagnostics};
 
 type Val<'i> = Spanned<DeValue<'i>>;
 
-const TOP_KEYS: &[&str] = &["mechanism", "body", "joint"];
+const TOP_KEYS: &[&str] = &["mechanism", "platform", "body", "joint"];
+const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
 const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
 const BODY_KEYS: &[&str] = &["name", "mass", "com", "inertia", "inertia_rpy"];
 const INERTIA_KEYS: &[&str] = &["ixx", "iyy", "izz", "ixy", "ixz", "iyz"];
 const JOINT_KEYS: &[&str] = &[
-    "name", "kind", "parent", "child", "origin", "axis", "axes", "dh", "mdh",
+    "name",
+    "kind",
+    "parent",
+    "child",
+    "origin",
+    "axis",
+    "axes",
+    "dh",
+    "mdh",
+    "actuated",
+    "child_origin",
 ];
 const ORIGIN_KEYS: &[&str] = &["xyz", "rpy"];
 const DH_KEYS: &[&str] = &["a", "alpha", "d", "theta"];
@@ -38,6 +51,9 @@ const ALIASES: &[(&str, &str)] = &[
     ("cog", "com"),
     ("robot", "mechanism"),
     ("g", "gravity"),
+    ("center", "centre"),
+    ("actuator", "actuated"),
+    ("active", "actuated"),
 ];
 
 /// Reads a TOML spec. `None` when the file could not be read far enough to validate it.
@@ -168,6 +184,16 @@ impl Reader<'_> {
             DeValue::String(s) => Some(s.to_string()),
             _ => {
                 self.type_error("a string", v, key);
+                None
+            }
+        }
+    }
+
+    fn boolean(&mut self, v: &Val<'_>, key: &str) -> Option<bool> {
+        match v.get_ref() {
+            DeValue::Boolean(b) => Some(*b),
+            _ => {
+                self.type_error("a boolean (true or false)", v, key);
                 None
             }
         }
@@ -335,6 +361,10 @@ impl Reader<'_> {
                 }
             }
         }
+        let platform = get(root, "platform").and_then(|v| {
+            let span = key_span(root, "platform").unwrap_or(v.span());
+            self.platform(v, span)
+        });
         let bodies = self
             .entries(root, "body")
             .into_iter()
@@ -352,7 +382,85 @@ impl Reader<'_> {
             joints,
             anchor,
             joints_incomplete: self.joints_incomplete,
+            platform,
         }
+    }
+
+    /// The `[platform]` table of a parallel mechanism.
+    /// `Some` whenever the key is present, so that the spec is treated as a parallel one (a
+    /// platform that could not be read has no body, and lowering stops early).
+    fn platform(&mut self, v: &Val<'_>, span: Range<usize>) -> Option<PlatformSpec> {
+        let mut p = PlatformSpec {
+            span: Some(span.clone()),
+            body: None,
+            body_span: Some(span.clone()),
+            coordinates: None,
+            coordinates_span: Some(span.clone()),
+            home: Transform::IDENTITY,
+            home_span: Some(span.clone()),
+            centre: None,
+            centre_span: Some(span.clone()),
+        };
+        let Some(t) = self.table(v, "platform") else {
+            return Some(p);
+        };
+        self.unknown_keys(t, PLATFORM_KEYS, "platform");
+        match get(t, "body") {
+            None => self.missing(
+                "body",
+                "platform",
+                span.clone(),
+                "the moving platform is one of the [[body]] entries: body = \"<its name>\"",
+            ),
+            Some(b) => {
+                p.body_span = Some(b.span());
+                p.body = self.string(b, "platform.body");
+            }
+        }
+        match get(t, "coordinates") {
+            None => self.missing(
+                "coordinates",
+                "platform",
+                span.clone(),
+                "coordinates = \"pose\" (6 DOF) or \"orientation\" (3 DOF about a fixed centre)",
+            ),
+            Some(c) => {
+                p.coordinates_span = Some(c.span());
+                if let Some(s) = self.string(c, "platform.coordinates") {
+                    p.coordinates = match s.as_str() {
+                        "pose" => Some(Coordinates::Pose),
+                        "orientation" => Some(Coordinates::Orientation),
+                        other => {
+                            let hint = suggest_hint(
+                                &other.to_ascii_lowercase(),
+                                &["pose", "orientation"],
+                            )
+                            .unwrap_or_else(|| {
+                                "coordinates is \"pose\" (position and orientation, 6 DOF) or \"orientation\" (rotation about a fixed centre, 3 DOF)".into()
+                            });
+                            self.err(
+                                format!("unknown platform coordinates {other:?}"),
+                                "platform.coordinates",
+                                c.span(),
+                            )
+                            .hint = Some(hint);
+                            None
+                        }
+                    };
+                }
+            }
+        }
+        if let Some(h) = get(t, "home") {
+            p.home_span = Some(h.span());
+            if let Some(Placement::Origin(x)) = self.origin(h, "platform.home") {
+                p.home = x;
+            }
+        }
+        if let Some(c) = get(t, "centre") {
+            p.centre_span = Some(c.span());
+            p.centre = self.triple(c, "platform.centre", false);
+        }
+        Some(p)
     }
 
     /// The tables of an array of tables `[[what]]`, with index and span.
@@ -479,6 +587,7 @@ impl Reader<'_> {
         self.unknown_keys(t, JOINT_KEYS, &path);
         let name = self.name(t, &path, span.clone());
         let name_span = get(t, "name").map_or(span.clone(), |v| v.span());
+        let kind_span = get(t, "kind").map_or(name_span.clone(), |v| v.span());
         let kind = match get(t, "kind") {
             None => {
                 self.missing(
@@ -665,6 +774,22 @@ impl Reader<'_> {
                 }
             }
         }
+        let mut actuated = false;
+        let actuated_span = key_span(t, "actuated");
+        if let Some(v) = get(t, "actuated") {
+            actuated = self
+                .boolean(v, &format!("{path}.actuated"))
+                .unwrap_or(false);
+        }
+        let child_origin_span = key_span(t, "child_origin");
+        let child_origin = match get(t, "child_origin") {
+            None => None,
+            Some(v) => match self.origin(v, &format!("{path}.child_origin")) {
+                Some(Placement::Origin(x)) => Some(x),
+                // Already reported; keep a placeholder so that "missing" is not reported too.
+                _ => Some(Transform::IDENTITY),
+            },
+        };
         let (Some((parent, parent_span)), Some((child, child_span))) = (parent, child) else {
             self.joints_incomplete = true;
             return None;
@@ -674,6 +799,7 @@ impl Reader<'_> {
             key: path,
             span: Some(name_span),
             kind: kind.unwrap_or(Kind::Revolute),
+            kind_span: Some(kind_span),
             parent,
             parent_span: Some(parent_span),
             child,
@@ -682,6 +808,10 @@ impl Reader<'_> {
                 .filter(|_| placement_ok)
                 .unwrap_or(Placement::Origin(Transform::IDENTITY)),
             axes: if axes_ok { axes } else { Vec::new() },
+            actuated,
+            actuated_span,
+            child_origin,
+            child_origin_span,
         })
     }
 

@@ -656,3 +656,375 @@ fn load_never_panics_on_mutated_input() {
         }
     }
 }
+
+/// Parallel mechanisms: the bundled specs, the leg split, frames of leg ends, closure.
+mod parallel_specs {
+    use runtime::model::{JointKind, Transform, mat_vec};
+    use runtime::parallel::{LegEnd, LegKind, ParallelModel, PlatformMotion, leg_home_poses};
+
+    use super::super::{Mechanism, load, load_mechanism};
+    use super::{assert_vec, close};
+
+    fn load_parallel(name: &str, src: &str) -> ParallelModel {
+        match load_mechanism(name, src) {
+            Ok((Mechanism::Parallel(m), w)) => {
+                assert!(w.is_empty(), "unexpected warnings:\n{}", w.render());
+                m
+            }
+            Ok((Mechanism::Tree(_), _)) => panic!("{name} loaded as a tree"),
+            Err(e) => panic!("{}", e.render()),
+        }
+    }
+
+    fn errors(name: &str, src: &str) -> String {
+        match load_mechanism(name, src) {
+            Ok(_) => panic!("{name} was accepted"),
+            Err(e) => e.render(),
+        }
+    }
+
+    const GS: &str = include_str!("../../../mechanisms/specs/gough_stewart.toml");
+    const SPECS: [(&str, &str); 4] = [
+        ("gough_stewart.toml", GS),
+        (
+            "sliding_hexapod.toml",
+            include_str!("../../../mechanisms/specs/sliding_hexapod.toml"),
+        ),
+        (
+            "rus_hexapod.toml",
+            include_str!("../../../mechanisms/specs/rus_hexapod.toml"),
+        ),
+        (
+            "agile_eye.toml",
+            include_str!("../../../mechanisms/specs/agile_eye.toml"),
+        ),
+    ];
+
+    #[test]
+    fn bundled_parallel_specs_load_and_validate() {
+        let expect = [
+            (LegKind::Ups, 6, 3),
+            (LegKind::Pus, 6, 3),
+            (LegKind::Rus, 6, 3),
+            (LegKind::SphericalRr, 3, 2),
+        ];
+        for ((name, src), (kind, legs, joints)) in SPECS.into_iter().zip(expect) {
+            let m = load_parallel(name, src);
+            let kinds = m.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(kinds, vec![kind; legs], "{name}");
+            assert_eq!(m.dof(), legs, "{name}");
+            for leg in &m.legs {
+                assert_eq!(leg.joints.len(), joints, "{name}");
+                assert_eq!(leg.bodies.len(), joints, "{name}");
+                assert_eq!(leg.joints[0].parent, None);
+                for (k, j) in leg.joints.iter().enumerate().skip(1) {
+                    assert_eq!(j.parent, Some(k - 1), "{name}");
+                }
+                // Non-trivial leg inertia.
+                assert!(
+                    leg.bodies.iter().map(|b| b.mass).sum::<f64>() > 0.0,
+                    "{name}"
+                );
+            }
+            // `load` refuses a parallel spec and says why.
+            let e = load(name, src).unwrap_err().render();
+            assert!(e.contains("parallel mechanism"), "{e}");
+        }
+    }
+
+    /// The Gough–Stewart spec against Tsai's numbers (pkm-literature.md), independently of the
+    /// runtime's closure check.
+    #[test]
+    fn gough_stewart_matches_tsai_data() {
+        let m = load_parallel("gough_stewart.toml", GS);
+        let base = [
+            [-2.12, 1.374, 0.0],
+            [-2.38, 1.224, 0.0],
+            [-2.38, -1.224, 0.0],
+            [-2.12, -1.374, 0.0],
+            [0.0, -0.15, 0.0],
+            [0.0, 0.15, 0.0],
+        ];
+        let plat = [
+            [0.17, 0.595, -0.4],
+            [-0.6, 0.15, -0.4],
+            [-0.6, -0.15, -0.4],
+            [0.17, -0.595, -0.4],
+            [0.43, -0.445, -0.4],
+            [0.43, 0.445, -0.4],
+        ];
+        assert_eq!(m.motion, PlatformMotion::Pose);
+        assert_eq!(m.home.translation, [-1.5, 0.0, 1.0]);
+        assert_eq!(m.home.rotation, Transform::IDENTITY.rotation);
+        assert_eq!(m.platform.mass, 1.5);
+        assert_eq!(m.platform.com, [0.0; 3]);
+        assert_eq!(m.gravity, [0.0, 0.0, -9.81]);
+        for (i, leg) in m.legs.iter().enumerate() {
+            let n = i + 1;
+            assert_eq!(leg.name, format!("s{n}"));
+            let names: Vec<&str> = leg.joints.iter().map(|j| j.name.as_str()).collect();
+            assert_eq!(
+                names,
+                [format!("u{n}_1"), format!("u{n}_2"), format!("p{n}")]
+            );
+            let kinds: Vec<JointKind> = leg.joints.iter().map(|j| j.kind).collect();
+            use JointKind::{Prismatic as P, Revolute as R};
+            assert_eq!(kinds, [R, R, P]);
+            assert_eq!(leg.actuated, 2);
+            assert_eq!(leg.actuated_name, format!("p{n}"));
+            // The U's cross is massless, the cylinder and the piston weigh 0.1 kg each.
+            let masses: Vec<f64> = leg.bodies.iter().map(|b| b.mass).collect();
+            assert_eq!(masses, [0.0, 0.1, 0.1]);
+            assert!(close(leg.bodies[1].inertia[0][0], 1.0 / 160.0, 1e-15));
+            // The U centre is the base point, the S centre the platform point.
+            assert_eq!(leg.joints[0].origin.translation, base[i]);
+            let LegEnd::Spherical {
+                on_leg,
+                on_platform,
+            } = leg.end
+            else {
+                panic!("leg {n} does not end in a spherical joint");
+            };
+            assert_eq!(on_platform, plat[i]);
+            let poses = leg_home_poses(leg);
+            let tip = poses[2].apply(&on_leg);
+            assert_vec(&tip, &m.home.apply(&plat[i]), 1e-14);
+            // The leg's direction at home is the prismatic axis (z of the U frame); the U axes
+            // are perpendicular to it and to each other.
+            let dir = [
+                tip[0] - base[i][0],
+                tip[1] - base[i][1],
+                tip[2] - base[i][2],
+            ];
+            let e: Vec<[f64; 3]> = poses
+                .iter()
+                .zip(&leg.joints)
+                .map(|(x, j)| mat_vec(&x.rotation, &j.axis))
+                .collect();
+            let len = super::super::geom::norm(&dir);
+            assert_vec(&e[2], &dir.map(|x| x / len), 1e-14);
+            let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            assert!(dot(&e[0], &e[1]).abs() < 1e-15);
+            assert!(dot(&e[0], &e[2]).abs() < 1e-15);
+            assert!(dot(&e[1], &e[2]).abs() < 1e-15);
+            // Piston mass centre 0.5 m from the platform joint.
+            assert!(close(on_leg[2] - leg.bodies[2].com[2], 0.5, 1e-14));
+        }
+    }
+
+    /// Moving the platform's home by 1 mm (or turning it by a few mrad) opens every loop: each
+    /// leg gets its own closure diagnostic, at its joint into the platform.
+    #[test]
+    fn perturbed_home_breaks_every_loop() {
+        for (name, src) in SPECS {
+            let m = load_parallel(name, src);
+            let (from, to) = if name == "agile_eye.toml" {
+                (
+                    "home = { xyz = [0.0, 0.0, 0.0] }",
+                    "home = { xyz = [0.0, 0.0, 0.0], rpy = [0.001, 0.002, 0.003] }",
+                )
+            } else {
+                let h = m.home.translation;
+                let old = format!("home = {{ xyz = [{:?}, {:?}, {:?}] }}", h[0], h[1], h[2]);
+                let new = format!(
+                    "home = {{ xyz = [{:?}, {:?}, {:?}] }}",
+                    h[0],
+                    h[1],
+                    h[2] + 0.001
+                );
+                assert!(src.contains(&old), "{name}: {old}");
+                (
+                    Box::leak(old.into_boxed_str()) as &str,
+                    Box::leak(new.into_boxed_str()) as &str,
+                )
+            };
+            let bad = src.replace(from, to);
+            let e = errors(name, &bad);
+            assert_eq!(
+                e.matches("the loop does not close at home").count(),
+                m.dof(),
+                "{name}:\n{e}"
+            );
+            for leg in &m.legs {
+                assert!(e.contains(&format!("^ joint \"{}\"", leg.name)), "{e}");
+            }
+        }
+    }
+
+    /// The leg end is expressed in the last leg body's model frame, also when the lowering
+    /// re-expresses that body's frame (standard DH) or merges a body into it (fixed joint).
+    #[test]
+    fn leg_end_follows_body_frame_changes() {
+        let m0 = load_parallel("gough_stewart.toml", GS);
+        let LegEnd::Spherical { on_leg, .. } = m0.legs[0].end else {
+            panic!()
+        };
+        let len = on_leg[2];
+        let s_line = format!("origin = {{ xyz = [0.0, 0.0, {len:?}] }}");
+        assert!(GS.contains(&s_line));
+        let p1 = "child = \"piston1\"\naxis = [0.0, 0.0, 1.0]\n";
+        assert!(GS.contains(p1));
+
+        // 1. The prismatic joint placed with standard DH: the piston's user frame is the distal
+        //    frame Rz(0.5)·Tz(0.2)·Rx(0.3); the S centre written in that frame.
+        let (a, d, th) = (0.3f64, 0.2, 0.5);
+        let z = len - d;
+        let s_dh = format!(
+            "origin = {{ xyz = [0.0, {:?}, {:?}] }}",
+            z * a.sin(),
+            z * a.cos()
+        );
+        let dh = GS.replacen(
+            p1,
+            &format!("child = \"piston1\"\ndh = {{ a = 0.0, alpha = {a:?}, d = {d:?}, theta = {th:?} }}\n"),
+            1,
+        );
+        let good = dh.replacen(&s_line, &s_dh, 1);
+        let m = load_parallel("dh.toml", &good);
+        m.validate().unwrap();
+        let tip = |m: &ParallelModel| {
+            let leg = &m.legs[0];
+            let LegEnd::Spherical { on_leg, .. } = leg.end else {
+                panic!()
+            };
+            leg_home_poses(leg)[2].apply(&on_leg)
+        };
+        assert_vec(&tip(&m), &tip(&m0), 1e-12);
+        // Leaving the S centre as it was (now read in the distal frame) moves it off the
+        // prismatic axis.
+        let e = errors("dh.toml", &dh);
+        assert!(
+            e.contains("leg s1 (U, P, S): the prismatic axis must lie on the line"),
+            "{e}"
+        );
+        // With alpha = 0 it stays on the axis, 0.2 m too far out: the loop does not close.
+        let e = errors(
+            "dh0.toml",
+            &dh.replace(&format!("alpha = {a:?}"), "alpha = 0.0"),
+        );
+        assert!(e.contains("leg s1: the loop does not close at home"), "{e}");
+
+        // 2. A rod end fixed to the piston, 0.1 m further along and turned; the S joint hangs
+        //    from it, the payload hangs from the platform.
+        let rod_end = format!(
+            "[[body]]\nname = \"rod_end\"\nmass = 0.05\ncom = [0.0, 0.0, 0.01]\n\n\
+             [[joint]]\nname = \"end_weld\"\nkind = \"fixed\"\nparent = \"piston1\"\nchild = \"rod_end\"\n\
+             origin = {{ xyz = [0.0, 0.0, {:?}], rpy = [\"pi/2\", 0.0, 0.0] }}\n\n\
+             [[body]]\nname = \"payload\"\nmass = 0.5\ncom = [0.0, 0.0, 0.05]\n\n\
+             [[joint]]\nname = \"clamp\"\nkind = \"fixed\"\nparent = \"platform\"\nchild = \"payload\"\n\
+             origin = {{ xyz = [0.0, 0.0, 0.1] }}\n",
+            len - 0.1
+        );
+        // In the rod end's frame (x rotated by 90°), the piston's +z is the rod end's +y.
+        let src =
+            GS.replacen(
+                &format!("{s_line}\n"),
+                "origin = { xyz = [0.0, 0.1, 0.0] }\n",
+                1,
+            )
+            .replacen(
+                "parent = \"piston1\"\nchild = \"platform\"",
+                "parent = \"rod_end\"\nchild = \"platform\"",
+                1,
+            ) + "\n"
+                + &rod_end;
+        let m = load_parallel("rod_end.toml", &src);
+        m.validate().unwrap();
+        assert_vec(&tip(&m), &tip(&m0), 1e-12);
+        // The rod end's mass is in the piston, the payload's in the platform.
+        assert!(close(m.legs[0].bodies[2].mass, 0.15, 1e-15));
+        assert!(close(m.platform.mass, 2.0, 1e-15));
+        assert!(close(m.platform.com[2], 0.5 * 0.15 / 2.0, 1e-15));
+    }
+
+    /// Deterministic mutations of valid parallel specs never panic `load_mechanism`.
+    #[test]
+    fn load_mechanism_never_panics_on_mutated_input() {
+        let alphabet: &[&str] = &[
+            "\"",
+            "[",
+            "]",
+            "{",
+            "}",
+            "=",
+            ",",
+            "\n",
+            "nan",
+            "-",
+            "0",
+            " ",
+            "\"base\"",
+            "#",
+            "[[joint]]",
+            "\"platform\"",
+            "\"camera\"",
+            "true",
+            "actuated = true\n",
+            "child_origin = {}\n",
+            "[platform]\n",
+            "\"S\"",
+            "\"R\"",
+            "\"U\"",
+            "\"fixed\"",
+        ];
+        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut rand = |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as usize
+        };
+        for (name, seed) in [SPECS[0], SPECS[3]] {
+            for _ in 0..150 {
+                let mut s = seed.to_owned();
+                for _ in 0..1 + rand(4) {
+                    let mut at = rand(s.len() + 1);
+                    while !s.is_char_boundary(at) {
+                        at -= 1;
+                    }
+                    match rand(3) {
+                        0 => s.insert_str(at, alphabet[rand(alphabet.len())]),
+                        1 => {
+                            let mut end = (at + rand(40)).min(s.len());
+                            while !s.is_char_boundary(end) {
+                                end -= 1;
+                            }
+                            s.replace_range(at..end, "");
+                        }
+                        _ => {
+                            // Swap two names of the same kind of entry.
+                            s = s.replacen("\"piston2\"", "\"piston3\"", 1);
+                        }
+                    }
+                }
+                if let Err(e) = load_mechanism(name, &s) {
+                    let r = e.render();
+                    assert!(!r.contains("internal error"), "panicked on:\n{s}\n{r}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn agile_eye_legs() {
+        let m = load_parallel("agile_eye.toml", SPECS[3].1);
+        assert_eq!(m.motion, PlatformMotion::Orientation { centre: [0.0; 3] });
+        let uwv = [
+            ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+            ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+            ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
+        ];
+        for (leg, (u, w, v)) in m.legs.iter().zip(uwv) {
+            assert_eq!(leg.actuated, 0);
+            assert_eq!(leg.joints[0].axis, u);
+            assert_eq!(leg.joints[1].axis, w);
+            assert_eq!(
+                leg.end,
+                LegEnd::Revolute {
+                    on_leg: v,
+                    on_platform: v
+                }
+            );
+        }
+    }
+}

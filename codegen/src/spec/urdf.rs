@@ -568,12 +568,17 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
             key,
             span: name_span(&joint_tags, i),
             kind,
+            kind_span: attr_span(&joint_tags, i, &[], "type").or_else(|| name_span(&joint_tags, i)),
             parent: end(&j.parent.link),
             parent_span: attr_span(&joint_tags, i, &["parent"], "link"),
             child: j.child.link.clone(),
             child_span: attr_span(&joint_tags, i, &["child"], "link"),
             placement: Placement::Origin(Transform::from_xyz_rpy(j.origin.xyz.0, j.origin.rpy.0)),
             axes,
+            actuated: false,
+            actuated_span: None,
+            child_origin: None,
+            child_origin_span: None,
         });
     }
 
@@ -607,5 +612,6 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         joints,
         anchor: Some(robot_span),
         joints_incomplete: false,
+        platform: None,
     })
 }

@@ -1,0 +1,677 @@
+//! Parallel mechanisms: the runtime's evaluator ([`runtime::parallel::noc`], written over
+//! [`Real`]) run on a symbolic scalar, so that every operation becomes a node of the
+//! hash-consed DAG ([`crate::sym`]): constants fold, structural zeros vanish and common
+//! subexpressions are shared exactly as for trees. The DAG kernels are then wrapped by a few
+//! fixed templates (the partially pivoted LU of the actuation matrix, Newton's forward
+//! kinematics) into the module's public functions.
+
+use std::cell::RefCell;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
+use runtime::model::JointKind;
+use runtime::parallel::noc::{self, Plan};
+use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular, Site};
+
+use crate::emit::{self, Function, Part, Shape};
+use crate::schedule::{OpCount, schedule};
+use crate::sym::{Arg, ExprId, Graph, TWO_SIDED};
+use crate::{Config, Generated, MathBackend, VERSION};
+
+thread_local! {
+    /// The graph the symbolic scalars of the current generation write to.
+    static GRAPH: RefCell<Graph> = RefCell::new(Graph::new());
+}
+
+fn with<T>(f: impl FnOnce(&mut Graph) -> T) -> T {
+    GRAPH.with(|c| f(&mut c.borrow_mut()))
+}
+
+/// A symbolic scalar: a node of the thread's current graph.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Sx(ExprId);
+
+macro_rules! binop {
+    ($tr:ident, $m:ident, $g:ident) => {
+        impl $tr for Sx {
+            type Output = Sx;
+            fn $m(self, o: Sx) -> Sx {
+                Sx(with(|g| g.$g(self.0, o.0)))
+            }
+        }
+    };
+}
+binop!(Add, add, add);
+binop!(Sub, sub, sub);
+binop!(Mul, mul, mul);
+binop!(Div, div, div);
+
+impl Neg for Sx {
+    type Output = Sx;
+    fn neg(self) -> Sx {
+        Sx(with(|g| g.neg(self.0)))
+    }
+}
+
+impl Real for Sx {
+    fn c(v: f64) -> Sx {
+        Sx(with(|g| g.constant(v)))
+    }
+    fn sqrt(self) -> Sx {
+        Sx(with(|g| g.sqrt(self.0)))
+    }
+    fn atan2(self, x: Sx) -> Sx {
+        Sx(with(|g| g.atan2(self.0, x.0)))
+    }
+    fn check(
+        value: Sx,
+        threshold: Sx,
+        scale: Sx,
+        site: Site,
+        two_sided: bool,
+    ) -> Result<Sx, Singular> {
+        let consts = with(|g| (g.as_const(value.0), g.as_const(threshold.0)));
+        if let (Some(v), Some(t)) = consts {
+            // Decided at generation time.
+            return f64::check(
+                v,
+                t,
+                with(|g| g.as_const(scale.0)).unwrap_or(1.0),
+                site,
+                two_sided,
+            )
+            .map(|_| value);
+        }
+        let code = site.code() | if two_sided { TWO_SIDED } else { 0 };
+        Ok(Sx(with(|g| {
+            g.guard(value.0, threshold.0, scale.0, code as usize)
+        })))
+    }
+}
+
+fn inputs(arg: Arg, n: usize) -> Vec<Sx> {
+    (0..n).map(|i| Sx(with(|g| g.input(arg, i)))).collect()
+}
+
+fn ids(v: &[Sx]) -> Vec<ExprId> {
+    v.iter().map(|s| s.0).collect()
+}
+
+fn flat(m: &[Vec<Sx>]) -> Vec<ExprId> {
+    m.iter().flatten().map(|s| s.0).collect()
+}
+
+/// The DAG kernels of a parallel mechanism.
+pub struct Kernels {
+    /// The shared DAG.
+    pub graph: Graph,
+    /// Actuated joint positions `q(x)`.
+    pub inverse_kinematics: Vec<ExprId>,
+    /// `A u`.
+    pub actuator_rates: Vec<ExprId>,
+    /// `A` (row-major) then `f = I u̇ + C u − γ`.
+    pub id_parts: Vec<ExprId>,
+    /// `I`, row-major.
+    pub mass_matrix: Vec<ExprId>,
+    /// `A` then `I`.
+    pub inertia_parts: Vec<ExprId>,
+    /// `u̇`.
+    pub forward_dynamics: Vec<ExprId>,
+    /// `q(x)` then `A`.
+    pub fk_parts: Vec<ExprId>,
+}
+
+/// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
+/// input: a structural singularity).
+pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
+    with(|g| *g = Graph::new());
+    let r = build(plan);
+    let graph = with(std::mem::take);
+    r.map(|k| Kernels { graph, ..k })
+}
+
+fn build(plan: &Plan) -> Result<Kernels, Singular> {
+    let n = plan.dof();
+    let x = inputs(Arg::X, plan.nx());
+    let u = inputs(Arg::U, n);
+    let ud = inputs(Arg::Ud, n);
+    let tau = inputs(Arg::Tau, n);
+    let (pl, legs) = noc::kinematics(plan, &x)?;
+    let q = noc::actuated_positions(plan, &legs);
+    let a = noc::actuation_matrix(plan, &legs);
+    let rates: Vec<Sx> = a
+        .iter()
+        .map(|row| {
+            row.iter()
+                .zip(&u)
+                .fold(Sx::c(0.0), |s, (&aij, &uj)| s + aij * uj)
+        })
+        .collect();
+    let f = noc::generalized_force(plan, &pl, &legs, &u, &ud, true);
+    let i = noc::generalized_inertia(plan, &pl, &legs);
+    let fd = noc::forward_dynamics_generic(plan, &x, &u, &tau)?;
+    let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
+    Ok(Kernels {
+        graph: Graph::new(),
+        inverse_kinematics: ids(&q),
+        actuator_rates: ids(&rates),
+        id_parts: cat(flat(&a), ids(&f)),
+        mass_matrix: flat(&i),
+        inertia_parts: cat(flat(&a), flat(&i)),
+        forward_dynamics: ids(&fd),
+        fk_parts: cat(ids(&q), flat(&a)),
+    })
+}
+
+/// Operation count of the emitted `lu_solve::<N>` (column scaling, partial pivoting, one
+/// right-hand side).
+pub fn lu_ops(n: usize) -> OpCount {
+    let mut c = OpCount::default();
+    // Column scaling: norms, reciprocals, products.
+    c.mul += 2 * n * n;
+    c.add += n * n;
+    c.sqrt += n;
+    c.div += n;
+    for k in 0..n {
+        let rows = n - k - 1;
+        c.cmp += rows + 2;
+        c.div += 1;
+        c.mul += rows * (1 + (n - k) + 1);
+        c.add += rows * ((n - k) + 1);
+    }
+    c.mul += n * (n - 1) / 2 + n;
+    c.add += n * (n - 1) / 2;
+    c.div += n;
+    c
+}
+
+fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
+    OpCount {
+        add: a.add + b.add * times,
+        mul: a.mul + b.mul * times,
+        neg: a.neg + b.neg * times,
+        div: a.div + b.div * times,
+        sqrt: a.sqrt + b.sqrt * times,
+        sin_cos: a.sin_cos + b.sin_cos * times,
+        cmp: a.cmp + b.cmp * times,
+        atan2: a.atan2 + b.atan2 * times,
+    }
+}
+
+/// Generate the module of a parallel mechanism.
+pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String> {
+    let plan = Plan::new(model)?;
+    let k = kernels(&plan).map_err(|e| {
+        format!("the mechanism is singular for every input ({e}); check the leg geometry")
+    })?;
+    let g = &k.graph;
+    let n = plan.dof();
+    let nx = plan.nx();
+    let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
+    let coords = match plan.motion {
+        PlatformMotion::Pose => {
+            "`x = [px, py, pz, qw, qx, qy, qz]` (platform frame origin, m, and unit quaternion, base frame); `u = [ω; v]` (rad/s; m/s of the platform frame origin, base-frame components)"
+        }
+        PlatformMotion::Orientation { .. } => {
+            "`x = [qw, qx, qy, qz]` (unit quaternion of the platform about the fixed centre, base frame); `u = ω` (rad/s, base-frame components)"
+        }
+    };
+    let make = |name: &'static str,
+                doc: Vec<String>,
+                args: Vec<Arg>,
+                outputs: Vec<ExprId>,
+                shape: Shape,
+                public: bool| Function {
+        name,
+        doc,
+        args,
+        schedule: schedule(g, &outputs),
+        outputs,
+        shape,
+        dof: n,
+        public,
+        sites: true,
+    };
+    let functions = [
+        make(
+            "inverse_kinematics",
+            vec![format!(
+                "Actuated joint positions `q(x)` (rad or m, in `ACTUATOR_NAMES` order) by closed-form leg inverse kinematics. {coords}. `Err` when a leg cannot reach the platform (`Site::Reach`) or is singular (`Site::Leg`)."
+            )],
+            vec![Arg::X],
+            k.inverse_kinematics.clone(),
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        make(
+            "actuator_rates",
+            vec!["Actuator rates `q̇ = A u` (rad/s or m/s); `Err` at a leg singularity.".into()],
+            vec![Arg::X, Arg::U],
+            k.actuator_rates.clone(),
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        make(
+            "id_parts",
+            vec!["Kernel of `inverse_dynamics`: the actuation matrix `A` and the generalized force `f = I u̇ + C u − γ`.".into()],
+            vec![Arg::X, Arg::U, Arg::Ud],
+            k.id_parts.clone(),
+            fallible(&[Part::Matrix, Part::Vector]),
+            false,
+        ),
+        make(
+            "mass_matrix",
+            vec!["Generalized inertia `I = TᵀMT` of the speeds `u` (symmetric positive definite away from singularities; kg·m², kg·m, kg).".into()],
+            vec![Arg::X],
+            k.mass_matrix.clone(),
+            fallible(&[Part::Matrix]),
+            true,
+        ),
+        make(
+            "inertia_parts",
+            vec!["Kernel of `actuator_mass_matrix`: `A` and `I`.".into()],
+            vec![Arg::X],
+            k.inertia_parts.clone(),
+            fallible(&[Part::Matrix, Part::Matrix]),
+            false,
+        ),
+        make(
+            "forward_dynamics",
+            vec!["Speed rates `u̇` with `I u̇ = Aᵀ τ − (C u − γ)` for the actuator efforts `tau` (N or N·m); `Err` at a leg singularity or when a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
+            vec![Arg::X, Arg::U, Arg::Tau],
+            k.forward_dynamics.clone(),
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        make(
+            "fk_parts",
+            vec!["Kernel of `forward_kinematics`: `q(x)` and `A(x)`.".into()],
+            vec![Arg::X],
+            k.fk_parts.clone(),
+            fallible(&[Part::Vector, Part::Matrix]),
+            false,
+        ),
+    ];
+    let ops = |name: &str| {
+        functions
+            .iter()
+            .find(|f| f.name == name)
+            .map(|f| f.schedule.ops)
+            .unwrap_or_default()
+    };
+    let lu = lu_ops(n);
+    let stats: Vec<(String, OpCount)> = vec![
+        ("inverse_kinematics".into(), ops("inverse_kinematics")),
+        ("actuator_rates".into(), ops("actuator_rates")),
+        ("inverse_dynamics".into(), plus(ops("id_parts"), lu, 1)),
+        ("mass_matrix".into(), ops("mass_matrix")),
+        (
+            "actuator_mass_matrix".into(),
+            plus(ops("inertia_parts"), lu, 2 * n),
+        ),
+        ("forward_dynamics".into(), ops("forward_dynamics")),
+        (
+            "forward_kinematics (per Newton step)".into(),
+            plus(ops("fk_parts"), lu, 1),
+        ),
+    ];
+    let mut header = vec![
+        format!(
+            "@generated by nocdyn codegen {VERSION} from mechanism `{}` — do not edit.",
+            model.name
+        ),
+        format!(
+            "Parallel mechanism: {} legs ({}); NX = {nx} position coordinates, DOF = {n}. Units: SI (m, kg, s, rad, N, N·m).",
+            plan.legs.len(),
+            plan.legs
+                .iter()
+                .map(|l| l.kind.word())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        match &cfg.math {
+            MathBackend::Libm => {
+                "Math backend: the `libm` crate (sin/cos, sqrt, atan2); otherwise core only.".into()
+            }
+            MathBackend::Std => "Math backend: std.".into(),
+            MathBackend::Runtime(p) => format!("Math backend: `{p}::math` (nocdyn runtime)."),
+        },
+        "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
+    ];
+    header.extend(emit::stats_table(&stats, n));
+    let fns: Vec<TokenStream> = functions
+        .iter()
+        .map(|f| emit::function(g, cfg, f))
+        .collect();
+    let names: Vec<&str> = model
+        .legs
+        .iter()
+        .map(|l| l.actuated_name.as_str())
+        .collect();
+    let revolute: Vec<bool> = plan
+        .legs
+        .iter()
+        .map(|l| l.joints[l.actuated] == JointKind::Revolute)
+        .collect();
+    let items = templates(cfg, &plan, &names, &revolute);
+    let nx_lit = Literal::usize_unsuffixed(nx);
+    let n_lit = Literal::usize_unsuffixed(n);
+    let tokens = quote! {
+        /// Number of position coordinates `x`.
+        pub const NX: usize = #nx_lit;
+        /// Degrees of freedom: speeds `u`, actuators.
+        pub const DOF: usize = #n_lit;
+        /// The actuated joints, in the order of `q` and `tau`.
+        pub const ACTUATOR_NAMES: [&str; DOF] = [#(#names),*];
+        #items
+        #(#fns)*
+    };
+    let code = emit::render(&header, tokens);
+    Ok(Generated {
+        code,
+        stats,
+        dof: n,
+        warnings: crate::diag::Diagnostics::new("", ""),
+    })
+}
+
+/// The fixed items of every parallel module: error types, the LU of `A`, and the public
+/// functions that wrap the DAG kernels.
+fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> TokenStream {
+    let sqrt = emit::math_call(cfg, "sqrt", quote!(s));
+    let sqrt_n = emit::math_call(cfg, "sqrt", quote!(n));
+    let sqrt_a = emit::math_call(cfg, "sqrt", quote!(a2));
+    let sin_cos = emit::math_call(cfg, "sin_cos", quote!(0.5 * a));
+    let leg_tol = noc::LEG_TOLERANCE;
+    let act_tol = noc::ACTUATION_TOLERANCE;
+    let fk_tol = noc::FK_TOLERANCE;
+    let fk_max = noc::FK_MAX_ITERATIONS;
+    let (qi, has_p) = match plan.motion {
+        PlatformMotion::Pose => (3usize, true),
+        PlatformMotion::Orientation { .. } => (0usize, false),
+    };
+    let qi = Literal::usize_unsuffixed(qi);
+    let translate = if has_p {
+        quote! {
+            for i in 0..3 {
+                out[i] += du[3 + i];
+            }
+        }
+    } else {
+        quote!()
+    };
+    let act_tol_lit = Literal::f64_unsuffixed(act_tol);
+    let fk_tol_lit = Literal::f64_unsuffixed(fk_tol);
+    let fk_max_lit = Literal::usize_unsuffixed(fk_max);
+    let leg_doc = format!(
+        " Leg `k`'s Jacobian is singular: `|det J| ≤ {leg_tol:e} · ∏‖columns‖` (a leg, type-I, singularity)."
+    );
+    let act_doc = format!(
+        " Pivot `i` of the actuation matrix `A` (columns scaled to unit norm, partial pivoting) is `≤ {act_tol:e}` times the largest pivot: a parallel (type-II) singularity."
+    );
+    quote! {
+        /// Where an evaluation failed.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Site {
+            /// Pivot `i` of the generalized inertia's `LDLᵀ` (forward dynamics).
+            MassMatrix(usize),
+            #[doc = #leg_doc]
+            Leg(usize),
+            /// Leg `k` cannot reach the platform: the pose is outside the workspace.
+            Reach(usize),
+            #[doc = #act_doc]
+            Actuation(usize),
+            /// The platform quaternion is zero (or not finite).
+            Platform,
+            /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite.
+            Input,
+        }
+
+        /// A configuration where the method fails, or a non-finite input: never a NaN result.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Singular {
+            /// Which matrix, leg or pivot.
+            pub site: Site,
+            /// The determinant, pivot or discriminant that failed its test.
+            pub value: f64,
+            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
+            pub condition_estimate: f64,
+        }
+
+        /// Forward kinematics did not converge.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct NoConvergence {
+            /// Newton iterations made.
+            pub iterations: usize,
+            /// The last residual `max |q(x) − q|` (m or rad).
+            pub residual: f64,
+        }
+
+        /// Which actuators are revolute (angles are compared modulo 2π).
+        const REVOLUTE: [bool; DOF] = [#(#revolute),*];
+
+        /// Solve `a x = b` (or `aᵀ x = b`) by LU with partial pivoting after scaling the columns
+        /// to unit norm; `Err(Site::Actuation)` when a pivot is not above the tolerance.
+        #[allow(clippy::all)]
+        fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF], transpose: bool) -> Result<[f64; DOF], Singular> {
+            let mut m = [[0.0; DOF]; DOF];
+            for i in 0..DOF {
+                for j in 0..DOF {
+                    m[i][j] = if transpose { a[j][i] } else { a[i][j] };
+                }
+            }
+            let mut sc = [1.0; DOF];
+            for j in 0..DOF {
+                let mut s = 0.0;
+                for i in 0..DOF {
+                    s += m[i][j] * m[i][j];
+                }
+                let s = #sqrt;
+                if s > 0.0 {
+                    sc[j] = 1.0 / s;
+                    for i in 0..DOF {
+                        m[i][j] *= sc[j];
+                    }
+                }
+            }
+            let mut x = *b;
+            let mut pmax: f64 = 0.0;
+            for k in 0..DOF {
+                let mut p = k;
+                let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
+                for i in k + 1..DOF {
+                    let v = if m[i][k] < 0.0 { -m[i][k] } else { m[i][k] };
+                    if v > best {
+                        best = v;
+                        p = i;
+                    }
+                }
+                m.swap(k, p);
+                x.swap(k, p);
+                if !(best > 0.0 && best < f64::INFINITY) {
+                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: f64::INFINITY });
+                }
+                if best > pmax {
+                    pmax = best;
+                }
+                if !(best > #act_tol_lit * pmax) {
+                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: pmax / best });
+                }
+                let inv = 1.0 / m[k][k];
+                for i in k + 1..DOF {
+                    let f = m[i][k] * inv;
+                    if f != 0.0 {
+                        for j in k..DOF {
+                            m[i][j] -= f * m[k][j];
+                        }
+                        x[i] -= f * x[k];
+                    }
+                }
+            }
+            for i in (0..DOF).rev() {
+                let mut s = x[i];
+                for j in i + 1..DOF {
+                    s -= m[i][j] * x[j];
+                }
+                x[i] = s / m[i][i];
+            }
+            for j in 0..DOF {
+                x[j] *= sc[j];
+            }
+            Ok(x)
+        }
+
+        /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
+        /// the platform motion `(x, u, ud)`; `Err` at a leg or parallel singularity.
+        #[inline]
+        pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+            let (a, f) = id_parts(x, u, ud)?;
+            lu_solve(&a, &f, true)
+        }
+
+        /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
+        #[allow(clippy::all)]
+        pub fn actuator_mass_matrix(x: &[f64; NX]) -> Result<[[f64; DOF]; DOF], Singular> {
+            let (a, i) = inertia_parts(x)?;
+            let mut b = [[0.0; DOF]; DOF];
+            for j in 0..DOF {
+                let mut e = [0.0; DOF];
+                e[j] = 1.0;
+                let c = lu_solve(&a, &e, false)?;
+                for r in 0..DOF {
+                    let mut s = 0.0;
+                    for k in 0..DOF {
+                        s += i[r][k] * c[k];
+                    }
+                    b[r][j] = s;
+                }
+            }
+            let mut out = [[0.0; DOF]; DOF];
+            for j in 0..DOF {
+                let mut col = [0.0; DOF];
+                for r in 0..DOF {
+                    col[r] = b[r][j];
+                }
+                let c = lu_solve(&a, &col, true)?;
+                for r in 0..DOF {
+                    out[r][j] = c[r];
+                }
+            }
+            for r in 0..DOF {
+                for c in r + 1..DOF {
+                    let m = 0.5 * (out[r][c] + out[c][r]);
+                    out[r][c] = m;
+                    out[c][r] = m;
+                }
+            }
+            Ok(out)
+        }
+
+        /// `x` moved by the small motion `du` (rotation vector, then translation; base frame).
+        #[allow(clippy::all)]
+        fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+            let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
+            let a = #sqrt_a;
+            let (s, c) = #sin_cos;
+            let k = if a > 1e-300 { s / a } else { 0.5 };
+            let d = [c, k * du[0], k * du[1], k * du[2]];
+            let i = #qi;
+            let q = [x[i], x[i + 1], x[i + 2], x[i + 3]];
+            let r = [
+                d[0] * q[0] - d[1] * q[1] - d[2] * q[2] - d[3] * q[3],
+                d[0] * q[1] + d[1] * q[0] + d[2] * q[3] - d[3] * q[2],
+                d[0] * q[2] - d[1] * q[3] + d[2] * q[0] + d[3] * q[1],
+                d[0] * q[3] + d[1] * q[2] - d[2] * q[1] + d[3] * q[0],
+            ];
+            let n = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
+            let n = #sqrt_n;
+            let mut out = *x;
+            for j in 0..4 {
+                out[i + j] = r[j] / n;
+            }
+            #translate
+            out
+        }
+
+        /// The residual `q − q(x)` (angles wrapped to (−π, π]), its max norm, and `A(x)`.
+        #[allow(clippy::all)]
+        fn fk_residual(q: &[f64; DOF], x: &[f64; NX]) -> Option<([f64; DOF], f64, [[f64; DOF]; DOF])> {
+            let (qx, a) = fk_parts(x).ok()?;
+            let mut r = [0.0; DOF];
+            let mut m: f64 = 0.0;
+            for i in 0..DOF {
+                let mut d = q[i] - qx[i];
+                if REVOLUTE[i] {
+                    let t = 2.0 * core::f64::consts::PI;
+                    while d > core::f64::consts::PI {
+                        d -= t;
+                    }
+                    while d <= -core::f64::consts::PI {
+                        d += t;
+                    }
+                }
+                r[i] = d;
+                let ad = if d < 0.0 { -d } else { d };
+                if !(ad <= m) {
+                    m = ad;
+                }
+            }
+            if m < f64::INFINITY { Some((r, m, a)) } else { None }
+        }
+
+        /// Forward kinematics: the platform coordinates whose actuated joint positions are `q`,
+        /// by Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it
+        /// does not reduce the residual), at most 50 iterations, converged when
+        /// `max |q(x) − q| ≤ 1e-12 · (1 + max |q|)`. The result's quaternion is unit.
+        #[allow(clippy::all)]
+        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
+            let mut qmax: f64 = 0.0;
+            for v in q {
+                let a = if *v < 0.0 { -*v } else { *v };
+                if a > qmax {
+                    qmax = a;
+                }
+            }
+            let tol = #fk_tol_lit * (1.0 + qmax);
+            let mut x = retract(guess, &[0.0; DOF]);
+            let Some(mut cur) = fk_residual(q, &x) else {
+                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
+            };
+            for it in 0..#fk_max_lit {
+                if cur.1 <= tol {
+                    return Ok(x);
+                }
+                let Ok(du) = lu_solve(&cur.2, &cur.0, false) else {
+                    return Err(NoConvergence { iterations: it, residual: cur.1 });
+                };
+                let mut step = 1.0;
+                let mut moved = false;
+                for _ in 0..20 {
+                    let mut d = [0.0; DOF];
+                    for i in 0..DOF {
+                        d[i] = du[i] * step;
+                    }
+                    let xn = retract(&x, &d);
+                    if let Some(r) = fk_residual(q, &xn) {
+                        if r.1 < cur.1 {
+                            x = xn;
+                            cur = r;
+                            moved = true;
+                            break;
+                        }
+                    }
+                    step *= 0.5;
+                }
+                if !moved {
+                    return Err(NoConvergence { iterations: it + 1, residual: cur.1 });
+                }
+            }
+            if cur.1 <= tol {
+                Ok(x)
+            } else {
+                Err(NoConvergence { iterations: #fk_max_lit, residual: cur.1 })
+            }
+        }
+    }
+}

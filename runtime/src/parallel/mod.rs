@@ -1,0 +1,370 @@
+//! Simple-platform parallel manipulators: a moving platform carried by legs, each leg a serial
+//! chain from the base to the platform (noc-method.md, "Simple-platform parallel manipulators";
+//! the lecture's eqs. 49–72).
+//!
+//! # The model
+//! * The platform's independent coordinates are its pose ([`PlatformMotion::Pose`]:
+//!   `x = [px, py, pz, qw, qx, qy, qz]`, `u = [ω; v]`) or its orientation about a fixed centre
+//!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`). Base-frame components;
+//!   `v` is the velocity of the platform frame's origin.
+//! * Leg `J` is a serial chain of one-DOF joints (U joints arrive expanded into two revolutes with
+//!   a massless body between them) whose last body meets the platform in a spherical joint (pose)
+//!   or a revolute joint (orientation). The leg's joints and bodies follow [`Model`]'s conventions:
+//!   `joints[k]` moves `bodies[k]`, its origin is given in the frame of `bodies[k − 1]` (the base
+//!   frame for `k = 0`), and at home every leg joint is at zero.
+//! * Exactly one joint per leg is actuated; the actuated coordinates `q` are in leg order.
+//!
+//! [`Model`]: crate::model::Model
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use crate::model::{Body, Joint, JointKind, Transform, Vec3, mat_vec};
+
+pub mod noc;
+pub mod real;
+
+pub use noc::{NoConvergence, Plan};
+pub use real::{Real, Singular, Site};
+
+/// How the platform moves and which coordinates describe it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlatformMotion {
+    /// Six DOF. `x = [px, py, pz, qw, qx, qy, qz]`: the platform frame's origin (m) and unit
+    /// quaternion in the base frame; `u = [ω; v]`: angular velocity (rad/s) and velocity of the
+    /// platform frame's origin (m/s).
+    Pose,
+    /// Three DOF: rotation about the platform frame's origin, which stays at `centre` (base
+    /// frame, m). `x = [qw, qx, qy, qz]`, `u = ω`.
+    Orientation {
+        /// The fixed centre of rotation (base frame, m).
+        centre: Vec3,
+    },
+}
+
+impl PlatformMotion {
+    /// Number of position coordinates `x`.
+    pub fn nx(&self) -> usize {
+        match self {
+            PlatformMotion::Pose => 7,
+            PlatformMotion::Orientation { .. } => 4,
+        }
+    }
+    /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
+    pub fn dof(&self) -> usize {
+        match self {
+            PlatformMotion::Pose => 6,
+            PlatformMotion::Orientation { .. } => 3,
+        }
+    }
+}
+
+/// How a leg's last body meets the platform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LegEnd {
+    /// A spherical joint: the point `on_leg` (last leg body's frame, m) coincides with the point
+    /// `on_platform` (platform frame, m).
+    Spherical {
+        /// The joint centre in the last leg body's frame.
+        on_leg: Vec3,
+        /// The joint centre in the platform frame.
+        on_platform: Vec3,
+    },
+    /// A revolute joint whose axis passes through the centre of an orientation mechanism: the
+    /// unit direction `on_leg` (last leg body's frame) coincides with `on_platform` (platform
+    /// frame).
+    Revolute {
+        /// The axis direction in the last leg body's frame.
+        on_leg: Vec3,
+        /// The axis direction in the platform frame.
+        on_platform: Vec3,
+    },
+}
+
+/// One leg: a serial chain of one-DOF joints from the base to the platform.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Leg {
+    /// Name (from the spec; the name of the joint that meets the platform).
+    pub name: String,
+    /// Joints from the base outwards; `joints[k]` moves `bodies[k]`. Their `parent` fields are
+    /// `None` for `k = 0` and `Some(k − 1)` otherwise (indices into this leg).
+    pub joints: Vec<Joint>,
+    /// The leg's bodies (massless ones allowed).
+    pub bodies: Vec<Body>,
+    /// Index into `joints` of the actuated joint.
+    pub actuated: usize,
+    /// Name of the actuated joint (as in the spec).
+    pub actuated_name: String,
+    /// How the last body meets the platform.
+    pub end: LegEnd,
+}
+
+/// A validated simple-platform parallel manipulator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParallelModel {
+    /// Mechanism name (a Rust identifier-friendly string).
+    pub name: String,
+    /// Gravitational acceleration in the base frame (m/s²).
+    pub gravity: Vec3,
+    /// The platform's coordinates.
+    pub motion: PlatformMotion,
+    /// The platform's inertial data in the platform frame.
+    pub platform: Body,
+    /// The platform frame's pose in the base frame at home (every leg joint at zero).
+    pub home: Transform,
+    /// The legs.
+    pub legs: Vec<Leg>,
+}
+
+/// The leg types with closed-form inverse kinematics, recognised from the joint geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LegKind {
+    /// U (two revolutes with intersecting axes) at the base, then a prismatic joint along the
+    /// line from the U centre to the spherical joint: UPS.
+    Ups,
+    /// A prismatic joint from the base, then U, then a fixed-length link to the S joint: PUS.
+    Pus,
+    /// A revolute joint from the base (crank), then U, then a fixed-length link to S: RUS.
+    Rus,
+    /// Two revolutes then the revolute to the platform, all axes through the centre of an
+    /// orientation mechanism: spherical RRR.
+    SphericalRr,
+}
+
+impl LegKind {
+    /// The usual name (`"UPS"`, …).
+    pub fn word(self) -> &'static str {
+        match self {
+            LegKind::Ups => "UPS",
+            LegKind::Pus => "PUS",
+            LegKind::Rus => "RUS",
+            LegKind::SphericalRr => "spherical RRR",
+        }
+    }
+}
+
+/// Length tolerance of the geometric checks (m), relative to the mechanism's size.
+pub const GEOMETRY_TOLERANCE: f64 = 1e-9;
+
+impl ParallelModel {
+    /// Number of position coordinates.
+    pub fn nx(&self) -> usize {
+        self.motion.nx()
+    }
+    /// Degrees of freedom (= number of actuators = number of legs).
+    pub fn dof(&self) -> usize {
+        self.motion.dof()
+    }
+
+    /// The typical length of the mechanism (m): the largest distance of a joint origin or the
+    /// home platform origin from the base origin, at least 1 mm. Tolerances scale with it.
+    pub fn size(&self) -> f64 {
+        let mut s: f64 = 1e-3;
+        let n = |v: &Vec3| libm::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        s = s.max(n(&self.home.translation));
+        for leg in &self.legs {
+            for pose in leg_home_poses(leg) {
+                s = s.max(n(&pose.translation));
+            }
+        }
+        s
+    }
+
+    /// Check the structure the evaluators rely on: one leg per DOF, one actuator per leg, leg
+    /// ends that match the platform motion, a recognised leg type, and loops that close at home.
+    /// Returns each leg's type. The messages name the leg.
+    pub fn validate(&self) -> Result<Vec<LegKind>, String> {
+        if self.legs.len() != self.dof() {
+            return Err(format!(
+                "the platform has {} degrees of freedom but there are {} legs (one actuated leg per degree of freedom is required)",
+                self.dof(),
+                self.legs.len()
+            ));
+        }
+        let tol = GEOMETRY_TOLERANCE * self.size();
+        let mut kinds = Vec::with_capacity(self.legs.len());
+        for leg in &self.legs {
+            let kind = classify(self, leg, tol)?;
+            check_closure(self, leg, tol)?;
+            kinds.push(kind);
+        }
+        Ok(kinds)
+    }
+}
+
+/// Poses (base frame) of the leg's bodies at home, joints at zero.
+pub fn leg_home_poses(leg: &Leg) -> Vec<Transform> {
+    let mut out: Vec<Transform> = Vec::with_capacity(leg.joints.len());
+    let mut x = Transform::IDENTITY;
+    for j in &leg.joints {
+        x = x.compose(&j.origin);
+        out.push(x);
+    }
+    out
+}
+
+fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: &Vec3, b: &Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn norm(a: &Vec3) -> f64 {
+    libm::sqrt(dot(a, a))
+}
+
+/// Distance between the lines `p + s·e` and `q + t·f` (unit directions); `None` when parallel.
+fn line_distance(p: &Vec3, e: &Vec3, q: &Vec3, f: &Vec3) -> Option<f64> {
+    let n = cross(e, f);
+    let nn = norm(&n);
+    if nn < 1e-9 {
+        return None;
+    }
+    Some(dot(&sub(q, p), &n).abs() / nn)
+}
+
+/// Home axis (unit, base frame) and point of each leg joint.
+fn home_axes(leg: &Leg) -> Vec<(Vec3, Vec3)> {
+    leg_home_poses(leg)
+        .iter()
+        .zip(&leg.joints)
+        .map(|(x, j)| (mat_vec(&x.rotation, &j.axis), x.translation))
+        .collect()
+}
+
+fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
+    use JointKind::{Prismatic as P, Revolute as R};
+    let kinds: Vec<JointKind> = leg.joints.iter().map(|j| j.kind).collect();
+    let ax = home_axes(leg);
+    let name = &leg.name;
+    let meet = |a: usize, b: usize| -> bool {
+        matches!(line_distance(&ax[a].1, &ax[a].0, &ax[b].1, &ax[b].0), Some(d) if d <= tol)
+    };
+    if leg.actuated >= leg.joints.len() {
+        return Err(format!("leg {name}: no actuated joint"));
+    }
+    let kind = match (m.motion, leg.end, kinds.as_slice()) {
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, P]) => {
+            if !meet(0, 1) {
+                return Err(format!(
+                    "leg {name} (U, P, S): the two revolute axes of the U joint do not intersect"
+                ));
+            }
+            // The prismatic axis must run through the U centre towards the S centre.
+            let tip = leg_tip_home(leg);
+            let u = ax[1].1;
+            let d = sub(&tip, &u);
+            let e = ax[2].0;
+            let off = cross(&d, &e);
+            if norm(&off) > tol {
+                return Err(format!(
+                    "leg {name} (U, P, S): the prismatic axis must lie on the line from the U centre to the S centre"
+                ));
+            }
+            LegKind::Ups
+        }
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [P, R, R]) => {
+            if !meet(1, 2) {
+                return Err(format!(
+                    "leg {name} (P, U, S): the two revolute axes of the U joint do not intersect"
+                ));
+            }
+            LegKind::Pus
+        }
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, R]) => {
+            if !meet(1, 2) {
+                return Err(format!(
+                    "leg {name} (R, U, S): the two revolute axes of the U joint do not intersect"
+                ));
+            }
+            LegKind::Rus
+        }
+        (PlatformMotion::Orientation { centre }, LegEnd::Revolute { .. }, [R, R]) => {
+            for (k, (e, p)) in ax.iter().enumerate() {
+                let off = cross(&sub(&centre, p), e);
+                if norm(&off) > tol {
+                    return Err(format!(
+                        "leg {name}: the axis of its joint {} does not pass through the centre of rotation",
+                        leg.joints[k].name
+                    ));
+                }
+            }
+            LegKind::SphericalRr
+        }
+        (PlatformMotion::Pose, LegEnd::Revolute { .. }, _) => {
+            return Err(format!(
+                "leg {name}: a 6-DOF platform needs legs that end in a spherical joint"
+            ));
+        }
+        (PlatformMotion::Orientation { .. }, LegEnd::Spherical { .. }, _) => {
+            return Err(format!(
+                "leg {name}: an orientation platform needs legs that end in a revolute joint"
+            ));
+        }
+        _ => {
+            let word: Vec<&str> = kinds
+                .iter()
+                .map(|k| if *k == R { "R" } else { "P" })
+                .collect();
+            return Err(format!(
+                "leg {name}: joints {} are not a supported leg type (supported: UPS, PUS, RUS for a 6-DOF platform; RRR with every axis through the centre for an orientation platform)",
+                word.join("-")
+            ));
+        }
+    };
+    Ok(kind)
+}
+
+/// The leg's end point at home in the base frame (spherical end), or the last body's origin.
+fn leg_tip_home(leg: &Leg) -> Vec3 {
+    let poses = leg_home_poses(leg);
+    let last = poses.last().copied().unwrap_or(Transform::IDENTITY);
+    match leg.end {
+        LegEnd::Spherical { on_leg, .. } => last.apply(&on_leg),
+        LegEnd::Revolute { .. } => last.translation,
+    }
+}
+
+fn check_closure(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<(), String> {
+    let poses = leg_home_poses(leg);
+    let last = poses.last().copied().unwrap_or(Transform::IDENTITY);
+    match leg.end {
+        LegEnd::Spherical {
+            on_leg,
+            on_platform,
+        } => {
+            let a = last.apply(&on_leg);
+            let b = m.home.apply(&on_platform);
+            let d = norm(&sub(&a, &b));
+            if d > tol {
+                return Err(format!(
+                    "leg {}: the loop does not close at home: the spherical joint's centre is {:?} m on the leg but {:?} m on the platform ({:.3e} m apart)",
+                    leg.name, a, b, d
+                ));
+            }
+        }
+        LegEnd::Revolute {
+            on_leg,
+            on_platform,
+        } => {
+            let a = mat_vec(&last.rotation, &on_leg);
+            let b = mat_vec(&m.home.rotation, &on_platform);
+            let d = norm(&sub(&a, &b));
+            if d > 1e-9 {
+                return Err(format!(
+                    "leg {}: the loop does not close at home: the last revolute axis is {:?} on the leg but {:?} on the platform",
+                    leg.name, a, b
+                ));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,1365 @@
+//! The NOC of a simple-platform parallel manipulator in actuator space (noc-method.md,
+//! "Simple-platform parallel manipulators"; the lecture's eqs. 49–72), written once over
+//! [`Real`] so that the runtime (`f64`) and the generator (symbolic) evaluate the same
+//! equations.
+//!
+//! # How one evaluation goes
+//! 1. The platform pose from `x` (rotation from the quaternion, normalized on the fly).
+//! 2. Per leg, in the leg's own frame `L` (the home frame of its first joint, so that its axes
+//!    are usually coordinate axes): closed-form inverse kinematics by the Paden–Kahan
+//!    subproblems (UPS: the leg length, then the U by "two intersecting axes"; PUS and RUS: the
+//!    first joint from the fixed rod length, then the U; spherical RRR: the first two joints by
+//!    two intersecting axes), the joints kept as `(sin, cos)` pairs and lengths, never angles.
+//! 3. The leg Jacobian `J_J` (3 × 3: the S centre's velocity for a leg ending in S, the
+//!    platform's angular velocity for a spherical leg) and its inverse by the adjugate, checked
+//!    against [`LEG_TOLERANCE`]: `θ̇_J = J_J⁻¹ G u` with `G` mapping `u` to the end point's
+//!    velocity — the lecture's `L_J = J_J⁻¹ T`, one small solve per leg, never a system over
+//!    all loops.
+//! 4. Joint accelerations `θ̈_J = J_J⁻¹ (ṫ_end − J̇_J θ̇_J)`; leg body twists and twist rates from
+//!    the joint rates and accelerations (columns of `T` and `Ṫ`).
+//! 5. One Newton–Euler wrench per body, `w = M ṫ + W M t − w^G` (eq. 12), projected:
+//!    leg bodies to the leg joints (`τ_J = T_Jᵀ w`), then to the end point by `y = J_J⁻ᵀ τ_J`,
+//!    then to `u` by `Gᵀ y`; the platform's wrench directly. The sum is the generalized force
+//!    `f = I u̇ + C u − γ` of the speeds `u`.
+//! 6. Actuator efforts `τ = A⁻ᵀ f` where `q̇ = A u` stacks the actuated rows of the `J_J⁻¹ G`
+//!    (eqs. 66–72); [`lu_solve`] factorizes `A` with partial pivoting.
+
+// Index loops read like the equations; negated float comparisons make NaN fail the test.
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::collapsible_if
+)]
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::real::{Real, Singular, Site};
+use super::{LegEnd, LegKind, ParallelModel, PlatformMotion};
+use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+
+/// Leg-Jacobian threshold: a leg is singular when `|det J_J| ≤ LEG_TOLERANCE · ∏‖columns‖`
+/// (the Hadamard ratio; its inverse, reported as the condition estimate, grows like the
+/// condition number of `J_J`).
+pub const LEG_TOLERANCE: f64 = 1e-8;
+/// Actuation-matrix threshold: `A` (columns scaled to unit norm) is singular when a pivot of its
+/// partially pivoted LU is `≤ ACTUATION_TOLERANCE` times the largest pivot; the condition
+/// estimate is the ratio of the largest to the smallest pivot.
+pub const ACTUATION_TOLERANCE: f64 = 1e-8;
+/// Generalized-inertia threshold of forward dynamics: pivot `i` of `LDLᵀ` must exceed
+/// `PIVOT_TOLERANCE` times the diagonal entry it came from (as for trees).
+pub const PIVOT_TOLERANCE: f64 = 1e-12;
+
+type V<R> = [R; 3];
+type M<R> = [[R; 3]; 3];
+
+fn cv<R: Real>(v: &Vec3) -> V<R> {
+    [R::c(v[0]), R::c(v[1]), R::c(v[2])]
+}
+fn cm<R: Real>(m: &Mat3) -> M<R> {
+    [cv(&m[0]), cv(&m[1]), cv(&m[2])]
+}
+fn add<R: Real>(a: V<R>, b: V<R>) -> V<R> {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn sub<R: Real>(a: V<R>, b: V<R>) -> V<R> {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn scale<R: Real>(s: R, a: V<R>) -> V<R> {
+    [s * a[0], s * a[1], s * a[2]]
+}
+fn dot<R: Real>(a: V<R>, b: V<R>) -> R {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross<R: Real>(a: V<R>, b: V<R>) -> V<R> {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn mv<R: Real>(m: &M<R>, v: V<R>) -> V<R> {
+    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}
+fn mtv<R: Real>(m: &M<R>, v: V<R>) -> V<R> {
+    [
+        m[0][0] * v[0] + m[1][0] * v[1] + m[2][0] * v[2],
+        m[0][1] * v[0] + m[1][1] * v[1] + m[2][1] * v[2],
+        m[0][2] * v[0] + m[1][2] * v[1] + m[2][2] * v[2],
+    ]
+}
+fn mm<R: Real>(a: &M<R>, b: &M<R>) -> M<R> {
+    let col = |j: usize| [b[0][j], b[1][j], b[2][j]];
+    let (c0, c1, c2) = (col(0), col(1), col(2));
+    [
+        [dot(a[0], c0), dot(a[0], c1), dot(a[0], c2)],
+        [dot(a[1], c0), dot(a[1], c1), dot(a[1], c2)],
+        [dot(a[2], c0), dot(a[2], c1), dot(a[2], c2)],
+    ]
+}
+fn zero3<R: Real>() -> V<R> {
+    [R::c(0.0); 3]
+}
+fn ident<R: Real>() -> M<R> {
+    let (o, z) = (R::c(1.0), R::c(0.0));
+    [[o, z, z], [z, o, z], [z, z, o]]
+}
+
+/// Rotation by the angle whose `(sin, cos)` is `(s, c)` about the unit `axis` (Rodrigues:
+/// `c·1 + s·[e]× + (1 − c)·e eᵀ`).
+fn rot<R: Real>(e: &Vec3, s: R, c: R) -> M<R> {
+    let v = R::c(1.0) - c;
+    let e_ = cv::<R>(e);
+    let mut m = [[R::c(0.0); 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let mut x = v * R::c(e[i] * e[j]);
+            if i == j {
+                x = x + c;
+            }
+            m[i][j] = x;
+        }
+    }
+    // s·[e]×
+    m[0][1] = m[0][1] - s * e_[2];
+    m[0][2] = m[0][2] + s * e_[1];
+    m[1][0] = m[1][0] + s * e_[2];
+    m[1][2] = m[1][2] - s * e_[0];
+    m[2][0] = m[2][0] - s * e_[1];
+    m[2][1] = m[2][1] + s * e_[0];
+    m
+}
+
+/// The constant data of one leg, resolved in the leg frame `L`.
+#[derive(Clone, Debug)]
+pub struct LegPlan {
+    /// Leg type.
+    pub kind: LegKind,
+    /// The leg frame `L` in the base frame (the home frame of the first joint).
+    pub frame: Transform,
+    /// Joint kinds.
+    pub joints: Vec<JointKind>,
+    /// Home joint axes (unit, `L`).
+    pub axes: Vec<Vec3>,
+    /// Home joint points (on the axes, `L`).
+    pub points: Vec<Vec3>,
+    /// Home body poses in `L`.
+    pub homes: Vec<Transform>,
+    /// Body inertial data: mass, mass centre (body frame), inertia (body frame).
+    pub bodies: Vec<(f64, Vec3, Mat3)>,
+    /// Index of the actuated joint.
+    pub actuated: usize,
+    /// Spherical end: the S centre at home (`L`); revolute end: the end axis at home (`L`).
+    pub end_home: Vec3,
+    /// The end point (S centre) or end axis in the platform frame.
+    pub end_platform: Vec3,
+    /// The U centre at home (`L`) (the orientation centre for a spherical leg).
+    pub u_centre: Vec3,
+    /// Fixed length: UPS the home distance U centre → S centre; PUS, RUS the rod length.
+    pub length: f64,
+    /// Branch of the two-intersecting-axes subproblem (±1), from the home configuration.
+    pub sigma_u: f64,
+    /// Branch of the first joint's subproblem (PUS, RUS) or the prismatic direction (UPS).
+    pub sigma_first: f64,
+}
+
+/// The constant data of a whole mechanism: what the evaluators need, prepared once.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Platform motion.
+    pub motion: PlatformMotion,
+    /// Gravity (base frame).
+    pub gravity: Vec3,
+    /// Platform mass, mass centre, inertia (platform frame).
+    pub platform: (f64, Vec3, Mat3),
+    /// Legs.
+    pub legs: Vec<LegPlan>,
+}
+
+fn sub3(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot3(a: &Vec3, b: &Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross3(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The point of line `(p, e)` closest to line `(q, f)` (the intersection when they meet).
+fn meet(p: &Vec3, e: &Vec3, q: &Vec3, f: &Vec3) -> Vec3 {
+    // p + s e = q + t f (least squares): [e·e −e·f; e·f −f·f][s t]ᵀ = [(q−p)·e; (q−p)·f]
+    let w = dot3(e, f);
+    let d = sub3(q, p);
+    let (de, df) = (dot3(&d, e), dot3(&d, f));
+    let den = 1.0 - w * w;
+    let s = if den.abs() < 1e-300 {
+        0.0
+    } else {
+        (de - w * df) / den
+    };
+    [p[0] + s * e[0], p[1] + s * e[1], p[2] + s * e[2]]
+}
+
+fn sign(x: f64) -> f64 {
+    if x < 0.0 { -1.0 } else { 1.0 }
+}
+
+impl Plan {
+    /// Prepare `model` (validating it first).
+    pub fn new(model: &ParallelModel) -> Result<Plan, alloc::string::String> {
+        let kinds = model.validate()?;
+        let mut legs = Vec::with_capacity(model.legs.len());
+        for (leg, kind) in model.legs.iter().zip(kinds) {
+            let first = leg.joints[0].origin;
+            // Home poses relative to L (the first joint's frame), composed from the joint
+            // origins directly so that exact placements stay exact.
+            let mut homes: Vec<Transform> = Vec::with_capacity(leg.joints.len());
+            let mut h = Transform::IDENTITY;
+            for (j, joint) in leg.joints.iter().enumerate() {
+                if j > 0 {
+                    h = h.compose(&joint.origin);
+                }
+                homes.push(h);
+            }
+            let axes: Vec<Vec3> = homes
+                .iter()
+                .zip(&leg.joints)
+                .map(|(h, j)| mat_vec(&h.rotation, &j.axis))
+                .collect();
+            let points: Vec<Vec3> = homes.iter().map(|h| h.translation).collect();
+            let last = *homes.last().unwrap_or(&Transform::IDENTITY);
+            let (end_home, end_platform) = match leg.end {
+                LegEnd::Spherical {
+                    on_leg,
+                    on_platform,
+                } => (last.apply(&on_leg), on_platform),
+                LegEnd::Revolute {
+                    on_leg,
+                    on_platform,
+                } => (mat_vec(&last.rotation, &on_leg), on_platform),
+            };
+            let (ui, uj) = match kind {
+                LegKind::Ups | LegKind::SphericalRr => (0, 1),
+                LegKind::Pus | LegKind::Rus => (1, 2),
+            };
+            let u_centre = meet(&points[ui], &axes[ui], &points[uj], &axes[uj]);
+            let (e1, e2) = (axes[ui], axes[uj]);
+            let k = cross3(&e1, &e2);
+            let mut plan = LegPlan {
+                kind,
+                frame: first,
+                joints: leg.joints.iter().map(|j| j.kind).collect(),
+                axes: axes.clone(),
+                points,
+                homes,
+                bodies: leg
+                    .bodies
+                    .iter()
+                    .map(|b| (b.mass, b.com, b.inertia))
+                    .collect(),
+                actuated: leg.actuated,
+                end_home,
+                end_platform,
+                u_centre,
+                length: 0.0,
+                sigma_u: 1.0,
+                sigma_first: 1.0,
+            };
+            match kind {
+                LegKind::Ups => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    plan.sigma_first = sign(dot3(&d, &axes[2]));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                }
+                LegKind::Pus => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    // s = e·d − σ √(…) = 0 at home.
+                    plan.sigma_first = sign(dot3(&axes[0], &d));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                }
+                LegKind::Rus => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                    // Pick the crank branch that reproduces θ = 0 at home.
+                    let mut best = (f64::INFINITY, 1.0);
+                    for s in [1.0, -1.0] {
+                        plan.sigma_first = s;
+                        if let Ok((sn, cs)) = rus_crank::<f64>(&plan, end_home, 0) {
+                            let err = sn.abs() + (cs - 1.0).abs();
+                            if err < best.0 {
+                                best = (err, s);
+                            }
+                        }
+                    }
+                    plan.sigma_first = best.1;
+                }
+                LegKind::SphericalRr => {
+                    plan.sigma_u = sign(dot3(&end_home, &k));
+                }
+            }
+            legs.push(plan);
+        }
+        Ok(Plan {
+            motion: model.motion,
+            gravity: model.gravity,
+            platform: (
+                model.platform.mass,
+                model.platform.com,
+                model.platform.inertia,
+            ),
+            legs,
+        })
+    }
+
+    /// Degrees of freedom.
+    pub fn dof(&self) -> usize {
+        self.motion.dof()
+    }
+    /// Position coordinates.
+    pub fn nx(&self) -> usize {
+        self.motion.nx()
+    }
+}
+
+/// The platform's pose from `x`.
+#[derive(Clone, Copy, Debug)]
+pub struct Platform<R> {
+    /// Rotation (platform → base).
+    pub rot: M<R>,
+    /// Origin of the platform frame (base frame).
+    pub origin: V<R>,
+}
+
+/// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`); the quaternion need not
+/// be unit (it is normalized), but it must not be zero.
+pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> {
+    let (origin, q) = match plan.motion {
+        PlatformMotion::Pose => ([x[0], x[1], x[2]], [x[3], x[4], x[5], x[6]]),
+        PlatformMotion::Orientation { centre } => (cv(&centre), [x[0], x[1], x[2], x[3]]),
+    };
+    let [w, a, b, c] = q;
+    let n = w * w + a * a + b * b + c * c;
+    let n = R::check(n, R::c(0.0), R::c(1.0), Site::Platform, false)?;
+    let s = R::c(2.0) / n;
+    let one = R::c(1.0);
+    let rot = [
+        [
+            one - s * (b * b + c * c),
+            s * (a * b - w * c),
+            s * (a * c + w * b),
+        ],
+        [
+            s * (a * b + w * c),
+            one - s * (a * a + c * c),
+            s * (b * c - w * a),
+        ],
+        [
+            s * (a * c - w * b),
+            s * (b * c + w * a),
+            one - s * (a * a + b * b),
+        ],
+    ];
+    Ok(Platform { rot, origin })
+}
+
+/// Paden–Kahan subproblem 2: `(sin, cos)` of `θ1, θ2` with `R(e1, θ1)·R(e2, θ2)·p = q`
+/// (`e1`, `e2` unit, intersecting; `|p| = |q|`), on the branch `sigma`.
+fn two_axes<R: Real>(
+    e1: &Vec3,
+    e2: &Vec3,
+    p: V<R>,
+    q: V<R>,
+    sigma: f64,
+    leg: usize,
+) -> Result<[(R, R); 2], Singular> {
+    let w = dot3(e1, e2);
+    let k = cross3(e1, e2);
+    let kk = dot3(&k, &k);
+    let den = 1.0 / (w * w - 1.0);
+    let e2p = dot(cv(e2), p);
+    let e1q = dot(cv(e1), q);
+    let alpha = (R::c(w) * e2p - e1q) * R::c(den);
+    let beta = (R::c(w) * e1q - e2p) * R::c(den);
+    let pp = dot(p, p);
+    let g2 = (pp - alpha * alpha - beta * beta - R::c(2.0 * w) * alpha * beta) * R::c(1.0 / kk);
+    // γ² < 0: the target is out of reach; γ² ≈ 0 (within 1e-12 of |p|²): the boundary of the
+    // leg's workspace, where its Jacobian is singular.
+    let g2 = R::check(g2, R::c(-1e-12) * pp, pp, Site::Reach(leg), false)?;
+    let g2 = R::check(g2, R::c(0.0), pp, Site::Leg(leg), false)?;
+    let gamma = R::c(sigma) * g2.sqrt();
+    let c = add(
+        add(scale(alpha, cv(e1)), scale(beta, cv(e2))),
+        scale(gamma, cv(&k)),
+    );
+    // θ2 turns p about e2 onto c.
+    let pperp = sub(p, scale(e2p, cv(e2)));
+    let cperp = sub(c, scale(e2p, cv(e2)));
+    let n2 = dot(pperp, pperp);
+    let s2 = dot(cross(cv(e2), pperp), cperp) / n2;
+    let c2 = dot(pperp, cperp) / n2;
+    // θ1 turns c about e1 onto q.
+    let cq = sub(c, scale(e1q, cv(e1)));
+    let qq = sub(q, scale(e1q, cv(e1)));
+    let n1 = dot(cq, cq);
+    let n1 = R::check(n1, R::c(0.0), pp, Site::Leg(leg), false)?;
+    let s1 = dot(cross(cv(e1), cq), qq) / n1;
+    let c1 = dot(cq, qq) / n1;
+    Ok([(s1, c1), (s2, c2)])
+}
+
+/// RUS: `(sin, cos)` of the crank angle that puts the U centre at the rod length from `a` (`L`).
+fn rus_crank<R: Real>(plan: &LegPlan, a: V<R>, leg: usize) -> Result<(R, R), Singular> {
+    let e0 = plan.axes[0];
+    let o0 = plan.points[0];
+    let r = sub3(&plan.u_centre, &o0);
+    let rpar = dot3(&e0, &r);
+    let rperp = [
+        r[0] - rpar * e0[0],
+        r[1] - rpar * e0[1],
+        r[2] - rpar * e0[2],
+    ];
+    let er = cross3(&e0, &rperp);
+    let d = sub(a, cv(&o0));
+    let kk = (dot(d, d) + R::c(dot3(&r, &r) - plan.length * plan.length)) * R::c(0.5)
+        - R::c(rpar) * dot(d, cv(&e0));
+    let aa = dot(d, cv(&rperp));
+    let bb = dot(d, cv(&er));
+    let rho2 = aa * aa + bb * bb;
+    let disc = rho2 - kk * kk;
+    let disc = R::check(disc, R::c(0.0), rho2, Site::Reach(leg), false)?;
+    let sq = R::c(plan.sigma_first) * disc.sqrt();
+    let c = (aa * kk - bb * sq) / rho2;
+    let s = (bb * kk + aa * sq) / rho2;
+    Ok((s, c))
+}
+
+/// A joint's position: `(sin, cos)` for a revolute, the displacement for a prismatic joint.
+#[derive(Clone, Copy, Debug)]
+pub enum JointPos<R> {
+    /// Revolute.
+    R(R, R),
+    /// Prismatic.
+    P(R),
+}
+
+/// The kinematic state of one leg at a configuration, resolved in its frame `L`.
+#[derive(Clone, Debug)]
+pub struct LegKin<R> {
+    /// Joint positions.
+    pub q: Vec<JointPos<R>>,
+    /// Current joint axes.
+    pub e: Vec<V<R>>,
+    /// Current joint points.
+    pub o: Vec<V<R>>,
+    /// Body rotations (body → `L`).
+    pub rot: Vec<M<R>>,
+    /// Body mass centres.
+    pub com: Vec<V<R>>,
+    /// End point (spherical end) or end axis (revolute end).
+    pub end: V<R>,
+    /// Rows of `J_J⁻¹` (the adjugate rows divided by the determinant).
+    pub jinv: [V<R>; 3],
+    /// Base-frame rotation of `L` (constant).
+    pub frame: M<R>,
+    /// The end point relative to the platform origin, base frame (spherical end; zero else).
+    pub arm: V<R>,
+}
+
+/// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`.
+pub fn leg_kinematics<R: Real>(
+    plan: &Plan,
+    k: usize,
+    pl: &Platform<R>,
+) -> Result<LegKin<R>, Singular> {
+    let lp = &plan.legs[k];
+    let fr: M<R> = cm(&lp.frame.rotation);
+    let ft: V<R> = cv(&lp.frame.translation);
+    let n = lp.joints.len();
+    // The end target in L.
+    let (target, arm) = match lp.kind {
+        LegKind::SphericalRr => {
+            let axis = mv(&pl.rot, cv(&lp.end_platform));
+            (mtv(&fr, axis), zero3())
+        }
+        _ => {
+            let arm = mv(&pl.rot, cv(&lp.end_platform));
+            let a = add(pl.origin, arm);
+            (mtv(&fr, sub(a, ft)), arm)
+        }
+    };
+    // Closed-form inverse kinematics.
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(n);
+    match lp.kind {
+        LegKind::Ups => {
+            let r = sub(target, cv(&lp.u_centre));
+            let rr = dot(r, r);
+            let rr = R::check(rr, R::c(0.0), R::c(1.0), Site::Reach(k), false)?;
+            let rho = rr.sqrt();
+            let d = R::c(lp.sigma_first) * (rho - R::c(lp.length));
+            let dir = scale(R::c(1.0) / rho, r);
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
+            let [a, b] = two_axes(&lp.axes[0], &lp.axes[1], cv(&p), dir, lp.sigma_u, k)?;
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+            q.push(JointPos::P(d));
+        }
+        LegKind::Pus => {
+            let e0 = lp.axes[0];
+            let dd = sub(target, cv(&lp.u_centre));
+            let t = dot(cv(&e0), dd);
+            let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
+            let disc = R::check(
+                disc,
+                R::c(0.0),
+                R::c(lp.length * lp.length),
+                Site::Reach(k),
+                false,
+            )?;
+            let s = t - R::c(lp.sigma_first) * disc.sqrt();
+            let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+            let qv = sub(target, u);
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k)?;
+            q.push(JointPos::P(s));
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+        LegKind::Rus => {
+            let (s0, c0) = rus_crank(lp, target, k)?;
+            let r0 = rot(&lp.axes[0], s0, c0);
+            let o0 = cv(&lp.points[0]);
+            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+            // The rod direction in the crank's home frame.
+            let qv = mtv(&r0, sub(target, u));
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k)?;
+            q.push(JointPos::R(s0, c0));
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+        LegKind::SphericalRr => {
+            let [a, b] = two_axes(
+                &lp.axes[0],
+                &lp.axes[1],
+                cv(&lp.end_home),
+                target,
+                lp.sigma_u,
+                k,
+            )?;
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+    }
+    // Product of exponentials from the home configuration: D = Π exp(ξ_j θ_j), x ↦ G x + t.
+    let mut g: M<R> = ident();
+    let mut t: V<R> = zero3();
+    let mut e = Vec::with_capacity(n);
+    let mut o = Vec::with_capacity(n);
+    let mut rots = Vec::with_capacity(n);
+    let mut coms = Vec::with_capacity(n);
+    for j in 0..n {
+        let ej = mv(&g, cv(&lp.axes[j]));
+        let oj = add(mv(&g, cv(&lp.points[j])), t);
+        match q[j] {
+            JointPos::R(s, c) => {
+                g = mm(&g, &rot(&lp.axes[j], s, c));
+                t = sub(oj, mv(&g, cv(&lp.points[j])));
+            }
+            JointPos::P(d) => {
+                t = add(t, scale(d, ej));
+            }
+        }
+        let h = &lp.homes[j];
+        rots.push(mm(&g, &cm(&h.rotation)));
+        let (_, com, _) = lp.bodies[j];
+        let ch = h.apply(&com);
+        coms.push(add(mv(&g, cv(&ch)), t));
+        e.push(ej);
+        o.push(oj);
+    }
+    let end = match lp.kind {
+        LegKind::SphericalRr => target,
+        _ => add(mv(&g, cv(&lp.end_home)), t),
+    };
+    // Jacobian columns and their adjugate.
+    let cols: Vec<V<R>> = match lp.kind {
+        LegKind::SphericalRr => vec![e[0], e[1], end],
+        _ => (0..n)
+            .map(|j| match lp.joints[j] {
+                JointKind::Revolute => cross(e[j], sub(end, o[j])),
+                JointKind::Prismatic => e[j],
+            })
+            .collect(),
+    };
+    let r0 = cross(cols[1], cols[2]);
+    let r1 = cross(cols[2], cols[0]);
+    let r2 = cross(cols[0], cols[1]);
+    let det = dot(cols[0], r0);
+    let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
+    let det = R::check(det, R::c(LEG_TOLERANCE) * hn, hn, Site::Leg(k), true)?;
+    let id = R::c(1.0) / det;
+    Ok(LegKin {
+        q,
+        e,
+        o,
+        rot: rots,
+        com: coms,
+        end,
+        jinv: [scale(id, r0), scale(id, r1), scale(id, r2)],
+        frame: fr,
+        arm,
+    })
+}
+
+/// The legs' kinematics at `x`.
+pub fn kinematics<R: Real>(
+    plan: &Plan,
+    x: &[R],
+) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    let pl = platform(plan, x)?;
+    let mut legs = Vec::with_capacity(plan.legs.len());
+    for k in 0..plan.legs.len() {
+        legs.push(leg_kinematics(plan, k, &pl)?);
+    }
+    Ok((pl, legs))
+}
+
+/// Actuated joint positions (rad or m) of the legs, in leg order.
+pub fn actuated_positions<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<R> {
+    plan.legs
+        .iter()
+        .zip(legs)
+        .map(|(lp, lk)| match lk.q[lp.actuated] {
+            JointPos::R(s, c) => s.atan2(c),
+            JointPos::P(d) => d,
+        })
+        .collect()
+}
+
+/// The end point's (or end axis's) velocity map: `v_end = G u` in the base frame, as rows.
+fn end_velocity<R: Real>(plan: &Plan, lk: &LegKin<R>, u: &[R]) -> V<R> {
+    match plan.motion {
+        PlatformMotion::Pose => {
+            let w = [u[0], u[1], u[2]];
+            let v = [u[3], u[4], u[5]];
+            add(v, cross(w, lk.arm))
+        }
+        PlatformMotion::Orientation { .. } => [u[0], u[1], u[2]],
+    }
+}
+
+/// The actuation matrix `A` (`q̇ = A u`), row-major `DOF × DOF`.
+pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>> {
+    plan.legs
+        .iter()
+        .zip(legs)
+        .map(|(lp, lk)| {
+            // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a.
+            let g = mv(&lk.frame, lk.jinv[lp.actuated]);
+            match plan.motion {
+                PlatformMotion::Pose => {
+                    let m = cross(lk.arm, g);
+                    vec![m[0], m[1], m[2], g[0], g[1], g[2]]
+                }
+                PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
+            }
+        })
+        .collect()
+}
+
+/// The generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`) of the speeds `u`.
+pub fn generalized_force<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    let dof = plan.dof();
+    let mut f: Vec<R> = vec![R::c(0.0); dof];
+    let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
+    let w = [u[0], u[1], u[2]];
+    let wd = [ud[0], ud[1], ud[2]];
+    for (lp, lk) in plan.legs.iter().zip(legs) {
+        let n = lp.joints.len();
+        // End velocity and acceleration (base frame), then in L.
+        let (v_end, a_end) = match plan.motion {
+            PlatformMotion::Pose => {
+                let v = [u[3], u[4], u[5]];
+                let a = [ud[3], ud[4], ud[5]];
+                let v_end = add(v, cross(w, lk.arm));
+                let a_end = add(add(a, cross(wd, lk.arm)), cross(w, cross(w, lk.arm)));
+                (v_end, a_end)
+            }
+            PlatformMotion::Orientation { .. } => (w, wd),
+        };
+        let _ = end_velocity::<R>;
+        let v_l = mtv(&lk.frame, v_end);
+        let a_l = mtv(&lk.frame, a_end);
+        // Joint rates θ̇ = J⁻¹ v_end.
+        let qd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], v_l)).collect();
+        // Angular velocities of the bodies (ω_j after joint j) and the end.
+        let mut om: Vec<V<R>> = Vec::with_capacity(n);
+        let mut acc = zero3::<R>();
+        for j in 0..n {
+            if lp.joints[j] == JointKind::Revolute {
+                acc = add(acc, scale(qd[j], lk.e[j]));
+            }
+            om.push(acc);
+        }
+        let om_before = |j: usize| if j == 0 { zero3::<R>() } else { om[j - 1] };
+        // Velocity of a point x of body k: Σ_{j≤k} θ̇_j col_j(x).
+        let point_vel = |k: usize, x: V<R>| -> V<R> {
+            let mut v = zero3::<R>();
+            for j in 0..=k {
+                let c = match lp.joints[j] {
+                    JointKind::Revolute => cross(lk.e[j], sub(x, lk.o[j])),
+                    JointKind::Prismatic => lk.e[j],
+                };
+                v = add(v, scale(qd[j], c));
+            }
+            v
+        };
+        // Velocities of the joint points (each joint point moves with the body before it).
+        let o_vel: Vec<V<R>> = (0..n)
+            .map(|j| {
+                if j == 0 {
+                    zero3()
+                } else {
+                    point_vel(j - 1, lk.o[j])
+                }
+            })
+            .collect();
+        // Bias acceleration (θ̈ = 0) of a point x of body k with velocity xd: Σ θ̇_j d/dt col_j.
+        let point_bias = |k: usize, x: V<R>, xd: V<R>| -> V<R> {
+            let mut b = zero3::<R>();
+            for j in 0..=k {
+                let ed = cross(om_before(j), lk.e[j]);
+                let c = match lp.joints[j] {
+                    JointKind::Revolute => add(
+                        cross(ed, sub(x, lk.o[j])),
+                        cross(lk.e[j], sub(xd, o_vel[j])),
+                    ),
+                    JointKind::Prismatic => ed,
+                };
+                b = add(b, scale(qd[j], c));
+            }
+            b
+        };
+        let ang_bias = |k: usize| -> V<R> {
+            let mut b = zero3::<R>();
+            for j in 0..=k {
+                if lp.joints[j] == JointKind::Revolute {
+                    b = add(b, scale(qd[j], cross(om_before(j), lk.e[j])));
+                }
+            }
+            b
+        };
+        // Joint accelerations θ̈ = J⁻¹ (a_end − J̇ θ̇).
+        let bias_end = match lp.kind {
+            LegKind::SphericalRr => {
+                // ω_P = θ̇0 e0 + θ̇1 e1 + θ̇2 e_end; e_end turns with body 1.
+                add(ang_bias(n - 1), scale(qd[2], cross(om[n - 1], lk.end)))
+            }
+            _ => point_bias(n - 1, lk.end, v_l),
+        };
+        let rhs = sub(a_l, bias_end);
+        let qdd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], rhs)).collect();
+        // Body wrenches (about each mass centre) and the leg's joint efforts.
+        let g_l = mtv(&lk.frame, cv::<R>(&g_world));
+        let mut force = zero3::<R>();
+        let mut moment0 = zero3::<R>(); // about the origin of L
+        let mut tau: Vec<R> = vec![R::c(0.0); 3];
+        for k in (0..n).rev() {
+            let (mass, _, inertia) = lp.bodies[k];
+            let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
+            if !massless {
+                let c = lk.com[k];
+                let cd = point_vel(k, c);
+                let mut a = point_bias(k, c, cd);
+                let mut wdot = ang_bias(k);
+                for j in 0..=k {
+                    let col = match lp.joints[j] {
+                        JointKind::Revolute => {
+                            wdot = add(wdot, scale(qdd[j], lk.e[j]));
+                            cross(lk.e[j], sub(c, lk.o[j]))
+                        }
+                        JointKind::Prismatic => lk.e[j],
+                    };
+                    a = add(a, scale(qdd[j], col));
+                }
+                let nk = euler(&lk.rot[k], &inertia, om[k], wdot);
+                let fk = scale(R::c(mass), sub(a, g_l));
+                force = add(force, fk);
+                moment0 = add(moment0, add(nk, cross(c, fk)));
+            }
+            let mo = sub(moment0, cross(lk.o[k], force));
+            tau[k] = match lp.joints[k] {
+                JointKind::Revolute => dot(lk.e[k], mo),
+                JointKind::Prismatic => dot(lk.e[k], force),
+            };
+        }
+        // End force (or moment) y = J⁻ᵀ τ, to the base frame, then Gᵀ y.
+        let y_l = add(
+            add(scale(tau[0], lk.jinv[0]), scale(tau[1], lk.jinv[1])),
+            scale(tau[2], lk.jinv[2]),
+        );
+        let y = mv(&lk.frame, y_l);
+        match plan.motion {
+            PlatformMotion::Pose => {
+                let m = cross(lk.arm, y);
+                for i in 0..3 {
+                    f[i] = f[i] + m[i];
+                    f[3 + i] = f[3 + i] + y[i];
+                }
+            }
+            PlatformMotion::Orientation { .. } => {
+                for i in 0..3 {
+                    f[i] = f[i] + y[i];
+                }
+            }
+        }
+    }
+    // The platform.
+    let (mass, com, inertia) = plan.platform;
+    let r = mv(&pl.rot, cv::<R>(&com));
+    let (a0,) = match plan.motion {
+        PlatformMotion::Pose => ([ud[3], ud[4], ud[5]],),
+        PlatformMotion::Orientation { .. } => (zero3::<R>(),),
+    };
+    let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
+    let fp = scale(R::c(mass), sub(a, cv(&g_world)));
+    let np = add(euler(&pl.rot, &inertia, w, wd), cross(r, fp));
+    for i in 0..3 {
+        f[i] = f[i] + np[i];
+    }
+    if let PlatformMotion::Pose = plan.motion {
+        for i in 0..3 {
+            f[3 + i] = f[3 + i] + fp[i];
+        }
+    }
+    f
+}
+
+/// Euler's equation `I ω̇ + ω × I ω` (eq. 12's rotational row) for a body with rotation `rot`
+/// and inertia `inertia` (body frame), in the frame `rot` maps to. An isotropic inertia `c·1`
+/// needs no rotation: the moment is `c ω̇`.
+fn euler<R: Real>(rot: &M<R>, inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
+    let c = inertia[0][0];
+    let isotropic = inertia[1][1] == c
+        && inertia[2][2] == c
+        && inertia[0][1] == 0.0
+        && inertia[0][2] == 0.0
+        && inertia[1][2] == 0.0
+        && inertia[1][0] == 0.0
+        && inertia[2][0] == 0.0
+        && inertia[2][1] == 0.0;
+    if isotropic {
+        return scale(R::c(c), wd);
+    }
+    let wb = mtv(rot, w);
+    let ab = mtv(rot, wd);
+    let ib = cm::<R>(inertia);
+    let nb = add(mv(&ib, ab), cross(wb, mv(&ib, wb)));
+    mv(rot, nb)
+}
+
+/// The generalized inertia `I = TᵀMT` of the speeds `u` (exactly symmetric): column `j` is the
+/// generalized force of `u = 0`, `u̇ = e_j` without gravity.
+pub fn generalized_inertia<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+) -> Vec<Vec<R>> {
+    let n = plan.dof();
+    let zero = vec![R::c(0.0); n];
+    let cols: Vec<Vec<R>> = (0..n)
+        .map(|j| {
+            let mut e = vec![R::c(0.0); n];
+            e[j] = R::c(1.0);
+            generalized_force(plan, pl, legs, &zero, &e, false)
+        })
+        .collect();
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| if i <= j { cols[j][i] } else { cols[i][j] })
+                .collect()
+        })
+        .collect()
+}
+
+/// Solve `m x = b` for a symmetric positive definite `m` by `LDLᵀ` (no pivoting), each pivot
+/// checked against [`PIVOT_TOLERANCE`] times its diagonal entry.
+pub fn solve_spd<R: Real>(m: &[Vec<R>], b: &[R]) -> Result<Vec<R>, Singular> {
+    let n = b.len();
+    let mut l: Vec<Vec<R>> = vec![vec![R::c(0.0); n]; n];
+    let mut d: Vec<R> = vec![R::c(0.0); n];
+    for j in 0..n {
+        let mut dj = m[j][j];
+        for k in 0..j {
+            dj = dj - l[j][k] * l[j][k] * d[k];
+        }
+        let dj = R::check(
+            dj,
+            R::c(PIVOT_TOLERANCE) * m[j][j],
+            m[j][j],
+            Site::MassMatrix(j),
+            false,
+        )?;
+        d[j] = dj;
+        let inv = R::c(1.0) / dj;
+        for i in j + 1..n {
+            let mut s = m[i][j];
+            for k in 0..j {
+                s = s - l[i][k] * l[j][k] * d[k];
+            }
+            l[i][j] = s * inv;
+        }
+    }
+    let mut y = b.to_vec();
+    for i in 0..n {
+        for k in 0..i {
+            y[i] = y[i] - l[i][k] * y[k];
+        }
+    }
+    for i in 0..n {
+        y[i] = y[i] / d[i];
+    }
+    for i in (0..n).rev() {
+        for k in i + 1..n {
+            y[i] = y[i] - l[k][i] * y[k];
+        }
+    }
+    Ok(y)
+}
+
+/// Forward dynamics: `u̇` with `I u̇ = Aᵀ τ − (C u − γ)`.
+pub fn forward_dynamics_generic<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    u: &[R],
+    tau: &[R],
+) -> Result<Vec<R>, Singular> {
+    let (pl, legs) = kinematics(plan, x)?;
+    let n = plan.dof();
+    let zero = vec![R::c(0.0); n];
+    let h = generalized_force(plan, &pl, &legs, u, &zero, true);
+    let a = actuation_matrix(plan, &legs);
+    let rhs: Vec<R> = (0..n)
+        .map(|i| {
+            let mut s = -h[i];
+            for (k, row) in a.iter().enumerate() {
+                s = s + row[i] * tau[k];
+            }
+            s
+        })
+        .collect();
+    let m = generalized_inertia(plan, &pl, &legs);
+    solve_spd(&m, &rhs)
+}
+
+/// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting after scaling the
+/// columns of `a` to unit 2-norm; a pivot `≤ ACTUATION_TOLERANCE` times the largest pivot (or a
+/// non-finite one) is reported as `Site::Actuation(pivot)` with the ratio of the largest to the
+/// smallest pivot as the condition estimate. Fixed-size, no allocation.
+pub fn lu_solve<const N: usize>(
+    a: &[[f64; N]; N],
+    b: &[f64; N],
+    transpose: bool,
+) -> Result<[f64; N], Singular> {
+    // Work on m = a·S (column scaling S) or, for the transpose, on aᵀ·S.
+    let mut m = [[0.0; N]; N];
+    for i in 0..N {
+        for j in 0..N {
+            m[i][j] = if transpose { a[j][i] } else { a[i][j] };
+        }
+    }
+    let mut sc = [1.0; N];
+    for j in 0..N {
+        let mut s = 0.0;
+        for row in m.iter() {
+            s += row[j] * row[j];
+        }
+        let s = crate::math::sqrt(s);
+        if s > 0.0 {
+            sc[j] = 1.0 / s;
+            for row in m.iter_mut() {
+                row[j] *= sc[j];
+            }
+        }
+    }
+    let mut x = *b;
+    let mut pmax: f64 = 0.0;
+    let mut pmin = f64::INFINITY;
+    for k in 0..N {
+        let mut p = k;
+        let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
+        for (i, row) in m.iter().enumerate().skip(k + 1) {
+            let v = if row[k] < 0.0 { -row[k] } else { row[k] };
+            if v > best {
+                best = v;
+                p = i;
+            }
+        }
+        m.swap(k, p);
+        x.swap(k, p);
+        // NaN never passes.
+        if !(best > 0.0) || !best.is_finite() {
+            return Err(Singular {
+                site: Site::Actuation(k),
+                value: m[k][k],
+                condition_estimate: f64::INFINITY,
+            });
+        }
+        pmax = if best > pmax { best } else { pmax };
+        pmin = if best < pmin { best } else { pmin };
+        if !(best > ACTUATION_TOLERANCE * pmax) {
+            return Err(Singular {
+                site: Site::Actuation(k),
+                value: m[k][k],
+                condition_estimate: pmax / best,
+            });
+        }
+        let inv = 1.0 / m[k][k];
+        for i in k + 1..N {
+            let f = m[i][k] * inv;
+            if f != 0.0 {
+                for j in k..N {
+                    m[i][j] -= f * m[k][j];
+                }
+                x[i] -= f * x[k];
+            }
+        }
+    }
+    for i in (0..N).rev() {
+        let mut s = x[i];
+        for j in i + 1..N {
+            s -= m[i][j] * x[j];
+        }
+        x[i] = s / m[i][i];
+    }
+    let _ = pmin;
+    for j in 0..N {
+        x[j] *= sc[j];
+    }
+    Ok(x)
+}
+
+/// `lu_solve` for the sizes the bundled platforms use, on row vectors.
+fn solve_dyn(a: &[Vec<f64>], b: &[f64], transpose: bool) -> Result<Vec<f64>, Singular> {
+    macro_rules! fixed {
+        ($n:literal) => {{
+            let mut m = [[0.0; $n]; $n];
+            let mut v = [0.0; $n];
+            for i in 0..$n {
+                v[i] = b[i];
+                for j in 0..$n {
+                    m[i][j] = a[i][j];
+                }
+            }
+            lu_solve(&m, &v, transpose).map(|x| x.to_vec())
+        }};
+    }
+    match b.len() {
+        1 => fixed!(1),
+        2 => fixed!(2),
+        3 => fixed!(3),
+        4 => fixed!(4),
+        5 => fixed!(5),
+        _ => fixed!(6),
+    }
+}
+
+/// `Err(Site::Input)` unless every value is finite.
+pub fn check_finite(inputs: &[&[f64]]) -> Result<(), Singular> {
+    for v in inputs.iter().flat_map(|s| s.iter()) {
+        if !v.is_finite() {
+            return Err(Singular {
+                site: Site::Input,
+                value: *v,
+                condition_estimate: f64::INFINITY,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Actuated joint positions (rad or m) for the platform coordinates `x`.
+pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = kinematics(plan, x)?;
+    Ok(actuated_positions(plan, &legs))
+}
+
+/// Every leg's joint positions (rad or m, the spec's joint order after U expansion) at `x`.
+pub fn leg_joint_positions(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = kinematics(plan, x)?;
+    Ok(legs
+        .iter()
+        .map(|lk| {
+            lk.q.iter()
+                .map(|q| match *q {
+                    JointPos::R(s, c) => libm::atan2(s, c),
+                    JointPos::P(d) => d,
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// The actuation matrix `A` at `x` (`q̇ = A u`).
+pub fn actuation(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = kinematics(plan, x)?;
+    Ok(actuation_matrix(plan, &legs))
+}
+
+/// Actuator rates `q̇ = A u`.
+pub fn actuator_rates(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[u])?;
+    let a = actuation(plan, x)?;
+    Ok(a.iter()
+        .map(|row| row.iter().zip(u).map(|(a, b)| a * b).sum())
+        .collect())
+}
+
+/// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m; gravity included).
+pub fn inverse_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let f = generalized_force(plan, &pl, &legs, u, ud, true);
+    let a = actuation_matrix(plan, &legs);
+    solve_dyn(&a, &f, true)
+}
+
+/// The generalized force `I u̇ + C u − γ` of the speeds `u` (before the actuation map).
+pub fn generalized_effort(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    Ok(generalized_force(plan, &pl, &legs, u, ud, true))
+}
+
+/// The generalized inertia `I = TᵀMT` of the speeds `u`.
+pub fn mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    Ok(generalized_inertia(plan, &pl, &legs))
+}
+
+/// The inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68).
+pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let i = generalized_inertia(plan, &pl, &legs);
+    let a = actuation_matrix(plan, &legs);
+    let n = plan.dof();
+    // B = I A⁻¹ column by column (A⁻¹ e_j), then A⁻ᵀ B.
+    let mut b = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        let mut e = vec![0.0; n];
+        e[j] = 1.0;
+        let c = solve_dyn(&a, &e, false)?;
+        for r in 0..n {
+            b[r][j] = (0..n).map(|k| i[r][k] * c[k]).sum();
+        }
+    }
+    let mut out = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        let col: Vec<f64> = (0..n).map(|r| b[r][j]).collect();
+        let c = solve_dyn(&a, &col, true)?;
+        for r in 0..n {
+            out[r][j] = c[r];
+        }
+    }
+    // Symmetrize (the exact matrix is symmetric).
+    for r in 0..n {
+        for c in r + 1..n {
+            let m = 0.5 * (out[r][c] + out[c][r]);
+            out[r][c] = m;
+            out[c][r] = m;
+        }
+    }
+    Ok(out)
+}
+
+/// Forward dynamics: `u̇` for the actuator efforts `tau`.
+pub fn forward_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    tau: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, tau])?;
+    forward_dynamics_generic(plan, x, u, tau)
+}
+
+/// Forward kinematics did not converge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoConvergence {
+    /// Newton iterations made.
+    pub iterations: usize,
+    /// The last residual `max |q(x) − q|` (m or rad; infinite when no pose was reachable).
+    pub residual: f64,
+}
+
+/// Newton iterations of [`forward_kinematics`] at most.
+pub const FK_MAX_ITERATIONS: usize = 50;
+/// Convergence of [`forward_kinematics`]: `max |q(x) − q| ≤ FK_TOLERANCE · (1 + max |q|)`.
+pub const FK_TOLERANCE: f64 = 1e-12;
+
+/// Wrap an angle difference to `(−π, π]`.
+fn wrap(a: f64) -> f64 {
+    let t = core::f64::consts::TAU;
+    let r = a - t * libm::round(a / t);
+    if r <= -core::f64::consts::PI {
+        r + t
+    } else {
+        r
+    }
+}
+
+/// `x` moved by the small motion `du` (`[δθ; δp]` or `δθ`, base frame): the rotation vector
+/// multiplies the quaternion from the left, the origin is translated.
+pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
+    let (qi, pi) = match motion {
+        PlatformMotion::Pose => (3, Some(0)),
+        PlatformMotion::Orientation { .. } => (0, None),
+    };
+    let th = [du[0], du[1], du[2]];
+    let a = libm::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+    let (s, c) = crate::math::sin_cos(0.5 * a);
+    let k = if a > 1e-300 { s / a } else { 0.5 };
+    let d = [c, k * th[0], k * th[1], k * th[2]];
+    let q = [x[qi], x[qi + 1], x[qi + 2], x[qi + 3]];
+    let mut r = [
+        d[0] * q[0] - d[1] * q[1] - d[2] * q[2] - d[3] * q[3],
+        d[0] * q[1] + d[1] * q[0] + d[2] * q[3] - d[3] * q[2],
+        d[0] * q[2] - d[1] * q[3] + d[2] * q[0] + d[3] * q[1],
+        d[0] * q[3] + d[1] * q[2] - d[2] * q[1] + d[3] * q[0],
+    ];
+    let n = libm::sqrt(r.iter().map(|v| v * v).sum());
+    for v in r.iter_mut() {
+        *v /= n;
+    }
+    let mut out = x.to_vec();
+    out[qi..qi + 4].copy_from_slice(&r);
+    if let Some(p) = pi {
+        for i in 0..3 {
+            out[p + i] += du[3 + i];
+        }
+    }
+    out
+}
+
+/// Forward kinematics: the platform coordinates `x` whose actuated joint positions are `q`, by
+/// Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it does not
+/// reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when the residual
+/// is within [`FK_TOLERANCE`]. The quaternion of the result is unit.
+pub fn forward_kinematics(
+    plan: &Plan,
+    q: &[f64],
+    guess: &[f64],
+) -> Result<Vec<f64>, NoConvergence> {
+    let n = plan.dof();
+    let revolute: Vec<bool> = plan
+        .legs
+        .iter()
+        .map(|l| l.joints[l.actuated] == JointKind::Revolute)
+        .collect();
+    if check_finite(&[q, guess]).is_err() {
+        return Err(NoConvergence {
+            iterations: 0,
+            residual: f64::INFINITY,
+        });
+    }
+    let qmax = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let tol = FK_TOLERANCE * (1.0 + qmax);
+    let residual = |x: &[f64]| -> Option<(Vec<f64>, f64, Vec<Vec<f64>>)> {
+        let (_, legs) = kinematics(plan, x).ok()?;
+        let qx = actuated_positions(plan, &legs);
+        let r: Vec<f64> = (0..n)
+            .map(|i| {
+                let d = q[i] - qx[i];
+                if revolute[i] { wrap(d) } else { d }
+            })
+            .collect();
+        let m = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if !m.is_finite() {
+            return None;
+        }
+        Some((r, m, actuation_matrix(plan, &legs)))
+    };
+    let mut x = retract(plan.motion, guess, &vec![0.0; n]);
+    let Some(mut cur) = residual(&x) else {
+        return Err(NoConvergence {
+            iterations: 0,
+            residual: f64::INFINITY,
+        });
+    };
+    for it in 0..FK_MAX_ITERATIONS {
+        if cur.1 <= tol {
+            return Ok(x);
+        }
+        let Ok(du) = solve_dyn(&cur.2, &cur.0, false) else {
+            return Err(NoConvergence {
+                iterations: it,
+                residual: cur.1,
+            });
+        };
+        let mut step = 1.0;
+        let mut next = None;
+        for _ in 0..20 {
+            let d: Vec<f64> = du.iter().map(|v| v * step).collect();
+            let xn = retract(plan.motion, &x, &d);
+            if let Some(r) = residual(&xn) {
+                if r.1 < cur.1 {
+                    next = Some((xn, r));
+                    break;
+                }
+            }
+            step *= 0.5;
+        }
+        match next {
+            Some((xn, r)) => {
+                x = xn;
+                cur = r;
+            }
+            None => {
+                return Err(NoConvergence {
+                    iterations: it + 1,
+                    residual: cur.1,
+                });
+            }
+        }
+    }
+    if cur.1 <= tol {
+        Ok(x)
+    } else {
+        Err(NoConvergence {
+            iterations: FK_MAX_ITERATIONS,
+            residual: cur.1,
+        })
+    }
+}

@@ -1,0 +1,119 @@
+//! Helpers for the parallel-manipulator tests: the bundled specs as models, random
+//! in-workspace states, and a strict relative error.
+
+use rand::Rng;
+use rand::rngs::StdRng;
+use runtime::parallel::noc::{self, Plan};
+use runtime::parallel::{ParallelModel, PlatformMotion};
+
+/// The bundled parallel specs: (module name, spec file name).
+pub const PARALLEL: [&str; 4] = [
+    "gough_stewart",
+    "sliding_hexapod",
+    "rus_hexapod",
+    "agile_eye",
+];
+
+/// The spec file of a bundled mechanism.
+pub fn spec_path(name: &str) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    root.join("mechanisms/specs").join(format!("{name}.toml"))
+}
+
+/// The validated model of a bundled parallel spec.
+pub fn model(name: &str) -> ParallelModel {
+    let path = spec_path(name);
+    let src = std::fs::read_to_string(&path).expect("spec readable");
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
+        Ok(_) => panic!("{name} is not a parallel mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+/// The home coordinates `x` of a model.
+pub fn home_x(m: &ParallelModel) -> Vec<f64> {
+    let r = m.home.rotation;
+    // Rotation matrix → unit quaternion (Shepperd's method, largest component first).
+    let tr = r[0][0] + r[1][1] + r[2][2];
+    let q = if tr > 0.0 {
+        let s = (tr + 1.0).sqrt() * 2.0;
+        [
+            0.25 * s,
+            (r[2][1] - r[1][2]) / s,
+            (r[0][2] - r[2][0]) / s,
+            (r[1][0] - r[0][1]) / s,
+        ]
+    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
+        [
+            (r[2][1] - r[1][2]) / s,
+            0.25 * s,
+            (r[0][1] + r[1][0]) / s,
+            (r[0][2] + r[2][0]) / s,
+        ]
+    } else if r[1][1] > r[2][2] {
+        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
+        [
+            (r[0][2] - r[2][0]) / s,
+            (r[0][1] + r[1][0]) / s,
+            0.25 * s,
+            (r[1][2] + r[2][1]) / s,
+        ]
+    } else {
+        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
+        [
+            (r[1][0] - r[0][1]) / s,
+            (r[0][2] + r[2][0]) / s,
+            (r[1][2] + r[2][1]) / s,
+            0.25 * s,
+        ]
+    };
+    match m.motion {
+        PlatformMotion::Pose => {
+            let t = m.home.translation;
+            vec![t[0], t[1], t[2], q[0], q[1], q[2], q[3]]
+        }
+        PlatformMotion::Orientation { .. } => q.to_vec(),
+    }
+}
+
+/// A random state near home that the runtime accepts: `x`, `u`, `ud`. Rotations up to
+/// `angle` rad, translations up to `reach` m; speeds and rates uniform in ±1.
+pub fn random_state(
+    plan: &Plan,
+    home: &[f64],
+    rng: &mut StdRng,
+    angle: f64,
+    reach: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = plan.dof();
+    loop {
+        let mut d = vec![0.0; n];
+        for (i, v) in d.iter_mut().enumerate() {
+            *v = if i < 3 { angle } else { reach } * rng.random_range(-1.0..1.0);
+        }
+        let x = noc::retract(plan.motion, home, &d);
+        if noc::inverse_dynamics(plan, &x, &vec![0.0; n], &vec![0.0; n]).is_err() {
+            continue;
+        }
+        let u: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let ud: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        return (x, u, ud);
+    }
+}
+
+/// `‖a − b‖∞ / ‖b‖∞` (strictly relative; infinite for NaN).
+pub fn rel(a: &[f64], b: &[f64]) -> f64 {
+    let num = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let den = b.iter().map(|y| y.abs()).fold(1e-300, f64::max);
+    if num.is_nan() || a.len() != b.len() {
+        f64::INFINITY
+    } else {
+        num / den
+    }
+}
