@@ -1,7 +1,6 @@
 //! Shared helpers for nocdyn's integration tests: random models and states, error norms.
 #![allow(clippy::needless_range_loop)]
 
-
 pub mod pkm;
 
 pub mod lagrange;

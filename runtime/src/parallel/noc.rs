@@ -676,6 +676,61 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
         .collect()
 }
 
+/// The motion of one leg body: angular velocity and acceleration, and the acceleration of its
+/// material point at the joint point `o_k` (velocities of points are not needed: the
+/// accelerations carry them in their `ω × (ω × r)` and Coriolis terms).
+#[derive(Clone, Copy, Debug)]
+struct BodyMotion<R> {
+    w: V<R>,
+    alpha: V<R>,
+    a: V<R>,
+}
+
+impl<R: Real> BodyMotion<R> {
+    /// Acceleration of the body's material point at `x`, knowing it at `o`.
+    fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
+        let r = sub(x, o);
+        add(
+            add(self.a, cross(self.alpha, r)),
+            cross(self.w, cross(self.w, r)),
+        )
+    }
+}
+
+/// The leg's body motions by the chain recursion (the lecture's eqs. 25–26, 33): for joint `j`
+/// with axis `e` through `o_j`, `ω_j = ω_{j−1} + θ̇ e`, `ω̇_j = ω̇_{j−1} + θ̈ e + θ̇ ω_{j−1} × e`
+/// (R), and `a_j(o_j) = a_{j−1}(o_j) + θ̈ e + 2 θ̇ ω_{j−1} × e` (P). `qdd = None`: θ̈ = 0 (the
+/// bias `J̇ θ̇`).
+fn chain<R: Real>(lp: &LegPlan, lk: &LegKin<R>, qd: &[R], qdd: Option<&[R]>) -> Vec<BodyMotion<R>> {
+    let n = lp.joints.len();
+    let mut out: Vec<BodyMotion<R>> = Vec::with_capacity(n);
+    for j in 0..n {
+        let (w0, alpha0, a0) = match out.last() {
+            None => (zero3::<R>(), zero3::<R>(), zero3::<R>()),
+            Some(p) => (p.w, p.alpha, p.accel_at(lk.o[j - 1], lk.o[j])),
+        };
+        let e = lk.e[j];
+        let we = cross(w0, e);
+        let qdd_e = match qdd {
+            Some(a) => scale(a[j], e),
+            None => zero3(),
+        };
+        out.push(match lp.joints[j] {
+            JointKind::Revolute => BodyMotion {
+                w: add(w0, scale(qd[j], e)),
+                alpha: add(add(alpha0, qdd_e), scale(qd[j], we)),
+                a: a0,
+            },
+            JointKind::Prismatic => BodyMotion {
+                w: w0,
+                alpha: alpha0,
+                a: add(add(a0, qdd_e), scale(R::c(2.0) * qd[j], we)),
+            },
+        });
+    }
+    out
+}
+
 /// The generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`) of the speeds `u`.
 pub fn generalized_force<R: Real>(
     plan: &Plan,
@@ -708,73 +763,19 @@ pub fn generalized_force<R: Real>(
         let a_l = mtv(&lk.frame, a_end);
         // Joint rates θ̇ = J⁻¹ v_end.
         let qd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], v_l)).collect();
-        // Angular velocities of the bodies (ω_j after joint j) and the end.
-        let mut om: Vec<V<R>> = Vec::with_capacity(n);
-        let mut acc = zero3::<R>();
-        for j in 0..n {
-            if lp.joints[j] == JointKind::Revolute {
-                acc = add(acc, scale(qd[j], lk.e[j]));
-            }
-            om.push(acc);
-        }
-        let om_before = |j: usize| if j == 0 { zero3::<R>() } else { om[j - 1] };
-        // Velocity of a point x of body k: Σ_{j≤k} θ̇_j col_j(x).
-        let point_vel = |k: usize, x: V<R>| -> V<R> {
-            let mut v = zero3::<R>();
-            for j in 0..=k {
-                let c = match lp.joints[j] {
-                    JointKind::Revolute => cross(lk.e[j], sub(x, lk.o[j])),
-                    JointKind::Prismatic => lk.e[j],
-                };
-                v = add(v, scale(qd[j], c));
-            }
-            v
-        };
-        // Velocities of the joint points (each joint point moves with the body before it).
-        let o_vel: Vec<V<R>> = (0..n)
-            .map(|j| {
-                if j == 0 {
-                    zero3()
-                } else {
-                    point_vel(j - 1, lk.o[j])
-                }
-            })
-            .collect();
-        // Bias acceleration (θ̈ = 0) of a point x of body k with velocity xd: Σ θ̇_j d/dt col_j.
-        let point_bias = |k: usize, x: V<R>, xd: V<R>| -> V<R> {
-            let mut b = zero3::<R>();
-            for j in 0..=k {
-                let ed = cross(om_before(j), lk.e[j]);
-                let c = match lp.joints[j] {
-                    JointKind::Revolute => add(
-                        cross(ed, sub(x, lk.o[j])),
-                        cross(lk.e[j], sub(xd, o_vel[j])),
-                    ),
-                    JointKind::Prismatic => ed,
-                };
-                b = add(b, scale(qd[j], c));
-            }
-            b
-        };
-        let ang_bias = |k: usize| -> V<R> {
-            let mut b = zero3::<R>();
-            for j in 0..=k {
-                if lp.joints[j] == JointKind::Revolute {
-                    b = add(b, scale(qd[j], cross(om_before(j), lk.e[j])));
-                }
-            }
-            b
-        };
-        // Joint accelerations θ̈ = J⁻¹ (a_end − J̇ θ̇).
+        // Joint accelerations θ̈ = J⁻¹ (a_end − J̇ θ̇): the end's acceleration with θ̈ = 0 first.
+        let bias = chain(lp, lk, &qd, None);
+        let last = n - 1;
         let bias_end = match lp.kind {
             LegKind::SphericalRr => {
                 // ω_P = θ̇0 e0 + θ̇1 e1 + θ̇2 e_end; e_end turns with body 1.
-                add(ang_bias(n - 1), scale(qd[2], cross(om[n - 1], lk.end)))
+                add(bias[last].alpha, scale(qd[2], cross(bias[last].w, lk.end)))
             }
-            _ => point_bias(n - 1, lk.end, v_l),
+            _ => bias[last].accel_at(lk.o[last], lk.end),
         };
         let rhs = sub(a_l, bias_end);
         let qdd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], rhs)).collect();
+        let motion = chain(lp, lk, &qd, Some(&qdd));
         // Body wrenches (about each mass centre) and the leg's joint efforts.
         let g_l = mtv(&lk.frame, cv::<R>(&g_world));
         let mut force = zero3::<R>();
@@ -785,20 +786,9 @@ pub fn generalized_force<R: Real>(
             let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
             if !massless {
                 let c = lk.com[k];
-                let cd = point_vel(k, c);
-                let mut a = point_bias(k, c, cd);
-                let mut wdot = ang_bias(k);
-                for j in 0..=k {
-                    let col = match lp.joints[j] {
-                        JointKind::Revolute => {
-                            wdot = add(wdot, scale(qdd[j], lk.e[j]));
-                            cross(lk.e[j], sub(c, lk.o[j]))
-                        }
-                        JointKind::Prismatic => lk.e[j],
-                    };
-                    a = add(a, scale(qdd[j], col));
-                }
-                let nk = euler(&lk.rot[k], &inertia, om[k], wdot);
+                let m = &motion[k];
+                let a = m.accel_at(lk.o[k], c);
+                let nk = euler(&lk.rot[k], &inertia, m.w, m.alpha);
                 let fk = scale(R::c(mass), sub(a, g_l));
                 force = add(force, fk);
                 moment0 = add(moment0, add(nk, cross(c, fk)));
