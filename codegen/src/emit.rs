@@ -249,6 +249,22 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
     };
     let stmts: Vec<TokenStream> = checks.into_iter().chain(stmts).collect();
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| operand(g, s, o)).collect();
+    // Parallel modules: a result that overflowed is an error, not an `Ok` with NaN or ∞.
+    let out_check = if f.sites {
+        quote! {
+            for v in [#(#outs),*].iter() {
+                if !v.is_finite() {
+                    return Err(Singular {
+                        site: Site::Input,
+                        value: *v,
+                        condition_estimate: f64::INFINITY,
+                    });
+                }
+            }
+        }
+    } else {
+        TokenStream::new()
+    };
     let ret = match f.shape {
         Shape::Vector => quote!([#(#outs),*]),
         Shape::FallibleVector => quote!(Ok([#(#outs),*])),
@@ -280,7 +296,7 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
             }
         }
     };
-    quote! { #(#stmts)* #ret }
+    quote! { #(#stmts)* #out_check #ret }
 }
 
 /// Statements per block beyond which a function body is split into blocks.

@@ -424,7 +424,8 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
             Actuation(usize),
             /// The platform quaternion is zero (or not finite).
             Platform,
-            /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite.
+            /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite, or so large that a result
+            /// overflows.
             Input,
         }
 
@@ -518,6 +519,9 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
             }
             for j in 0..DOF {
                 x[j] *= sc[j];
+                if !x[j].is_finite() {
+                    return Err(Singular { site: Site::Input, value: x[j], condition_estimate: f64::INFINITY });
+                }
             }
             Ok(x)
         }
@@ -559,8 +563,11 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
                 }
             }
             for r in 0..DOF {
-                for c in r + 1..DOF {
+                for c in r..DOF {
                     let m = 0.5 * (out[r][c] + out[c][r]);
+                    if !m.is_finite() {
+                        return Err(Singular { site: Site::Input, value: m, condition_estimate: f64::INFINITY });
+                    }
                     out[r][c] = m;
                     out[c][r] = m;
                 }

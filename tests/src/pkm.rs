@@ -31,10 +31,9 @@ pub fn model(name: &str) -> ParallelModel {
     }
 }
 
-/// The home coordinates `x` of a model.
-pub fn home_x(m: &ParallelModel) -> Vec<f64> {
-    let r = m.home.rotation;
-    // Rotation matrix → unit quaternion (Shepperd's method, largest component first).
+/// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method: the largest
+/// component first).
+pub fn matrix_quaternion(r: &[[f64; 3]; 3]) -> [f64; 4] {
     let tr = r[0][0] + r[1][1] + r[2][2];
     let q = if tr > 0.0 {
         let s = (tr + 1.0).sqrt() * 2.0;
@@ -69,6 +68,13 @@ pub fn home_x(m: &ParallelModel) -> Vec<f64> {
             0.25 * s,
         ]
     };
+    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    q.map(|c| c / n)
+}
+
+/// The home coordinates `x` of a model.
+pub fn home_x(m: &ParallelModel) -> Vec<f64> {
+    let q = matrix_quaternion(&m.home.rotation);
     match m.motion {
         PlatformMotion::Pose => {
             let t = m.home.translation;

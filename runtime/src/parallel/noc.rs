@@ -389,7 +389,15 @@ fn two_axes<R: Real>(
     let alpha = (R::c(w) * e2p - e1q) * R::c(den);
     let beta = (R::c(w) * e1q - e2p) * R::c(den);
     let pp = dot(p, p);
-    let g2 = (pp - alpha * alpha - beta * beta - R::c(2.0 * w) * alpha * beta) * R::c(1.0 / kk);
+    // γ² |e1 × e2|² = |p|² − α² − β² − 2wαβ. Near a leg singularity (q → ±e1) the difference
+    // cancels; for perpendicular axes (w = 0, α = e1·q) it is |e1 × q|² − (e2·p)² since |q| = |p|,
+    // which keeps the small value's relative accuracy (error ~ε/δ instead of ~ε/δ²).
+    let g2 = if w == 0.0 {
+        let eq = cross(cv(e1), q);
+        (dot(eq, eq) - e2p * e2p) * R::c(1.0 / kk)
+    } else {
+        (pp - alpha * alpha - beta * beta - R::c(2.0 * w) * alpha * beta) * R::c(1.0 / kk)
+    };
     // γ² < 0: the target is out of reach; γ² ≈ 0 (within 1e-12 of |p|²): the boundary of the
     // leg's workspace, where its Jacobian is singular.
     let g2 = R::check(g2, R::c(-1e-12) * pp, pp, Site::Reach(leg), false)?;
@@ -1043,6 +1051,7 @@ pub fn lu_solve<const N: usize>(
     for j in 0..N {
         x[j] *= sc[j];
     }
+    check_finite(&[&x])?;
     Ok(x)
 }
 
@@ -1085,11 +1094,17 @@ pub fn check_finite(inputs: &[&[f64]]) -> Result<(), Singular> {
     Ok(())
 }
 
+/// `Ok(v)` when every entry is finite, else `Err(Site::Input)` (an overflow).
+fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {
+    check_finite(&[&v])?;
+    Ok(v)
+}
+
 /// Actuated joint positions (rad or m) for the platform coordinates `x`.
 pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
     check_finite(&[x])?;
     let (_, legs) = kinematics(plan, x)?;
-    Ok(actuated_positions(plan, &legs))
+    finite(actuated_positions(plan, &legs))
 }
 
 /// Every leg's joint positions (rad or m, the spec's joint order after U expansion) at `x`.
@@ -1120,9 +1135,11 @@ pub fn actuation(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
 pub fn actuator_rates(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
     check_finite(&[u])?;
     let a = actuation(plan, x)?;
-    Ok(a.iter()
-        .map(|row| row.iter().zip(u).map(|(a, b)| a * b).sum())
-        .collect())
+    finite(
+        a.iter()
+            .map(|row| row.iter().zip(u).map(|(a, b)| a * b).sum())
+            .collect(),
+    )
 }
 
 /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m; gravity included).
@@ -1148,14 +1165,16 @@ pub fn generalized_effort(
 ) -> Result<Vec<f64>, Singular> {
     check_finite(&[x, u, ud])?;
     let (pl, legs) = kinematics(plan, x)?;
-    Ok(generalized_force(plan, &pl, &legs, u, ud, true))
+    finite(generalized_force(plan, &pl, &legs, u, ud, true))
 }
 
 /// The generalized inertia `I = TᵀMT` of the speeds `u`.
 pub fn mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
     check_finite(&[x])?;
     let (pl, legs) = kinematics(plan, x)?;
-    Ok(generalized_inertia(plan, &pl, &legs))
+    let i = generalized_inertia(plan, &pl, &legs);
+    check_finite(&[&i.concat()])?;
+    Ok(i)
 }
 
 /// The inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68).
@@ -1191,6 +1210,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
             out[c][r] = m;
         }
     }
+    check_finite(&[&out.concat()])?;
     Ok(out)
 }
 
@@ -1202,7 +1222,7 @@ pub fn forward_dynamics(
     tau: &[f64],
 ) -> Result<Vec<f64>, Singular> {
     check_finite(&[x, u, tau])?;
-    forward_dynamics_generic(plan, x, u, tau)
+    finite(forward_dynamics_generic(plan, x, u, tau)?)
 }
 
 /// Forward kinematics did not converge.

@@ -22,7 +22,8 @@ pub enum Site {
     Actuation(usize),
     /// The platform quaternion is zero or not finite.
     Platform,
-    /// An input (`x`, `u`, `u̇`, `τ` or `q`) is NaN or infinite.
+    /// An input (`x`, `u`, `u̇`, `τ` or `q`) is NaN or infinite, or so large that a result
+    /// overflows.
     Input,
 }
 
@@ -110,7 +111,8 @@ pub trait Real:
     /// `atan2(self, x)` (four-quadrant angle of the point `(x, self)`).
     fn atan2(self, x: Self) -> Self;
     /// `Ok(value)` when `value > threshold` (or `|value| > threshold` when `two_sided`), else
-    /// `Err(Singular { site, value, condition_estimate: scale / |value| })`. NaN fails.
+    /// `Err(Singular { site, value, condition_estimate })` with `scale / value` (`scale / |value|`
+    /// when two-sided), infinite when that is not positive. NaN fails.
     fn check(
         value: Self,
         threshold: Self,
@@ -149,7 +151,13 @@ impl Real for f64 {
         if ok {
             Ok(value)
         } else {
-            let a = if value < 0.0 { -value } else { value };
+            // As the generated code reports it: a one-sided test's non-positive value has no
+            // finite estimate.
+            let a = if two_sided && value < 0.0 {
+                -value
+            } else {
+                value
+            };
             Err(Singular {
                 site,
                 value,

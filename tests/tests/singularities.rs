@@ -1,0 +1,898 @@
+//! Walks toward the singularities of the bundled parallel manipulators and checks the documented
+//! failure behaviour of the `f64` routes (noc-method.md, "where the method fails";
+//! pkm-literature.md, "Where methods fail"): near a leg (type-I) or parallel (type-II)
+//! singularity an evaluation either returns a result accurate to 1e-6 (relative, ∞-norm) or
+//! says `Err(Singular)` with a large condition estimate — never NaN, never garbage, never a
+//! panic — and once it fails it keeps failing closer to the singularity.
+//!
+//! The reference is the same NOC equations evaluated in double-double (`tests::dd`,
+//! ~32 digits): `tests::dd::inverse_dynamics_dd`.
+//!
+//! Run `cargo test -p tests --test singularities -- --nocapture` to print the tables below.
+//! In them "κ pivots" is the largest over the smallest pivot of the column-scaled LU of `Aᵀ`
+//! (the runtime's estimate, computed in double-double), "κ₁" the 1-norm condition number of
+//! that scaled matrix; a route's cell is `Ok e` (relative error against double-double) or
+//! `Err site κ̂` (the reported condition estimate). Dynamic states: three random `(u, u̇)`
+//! with entries in ±1, the worst of them shown.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use runtime::parallel::noc::{self, Plan};
+use runtime::parallel::{ParallelModel, PlatformMotion, Singular, Site};
+use tests::dd;
+
+/// The relative accuracy an `Ok` result must reach against the double-double reference.
+const ACCURACY: f64 = 1e-6;
+/// An `Err` at a singularity must report a condition estimate above this.
+const MIN_CONDITION: f64 = 1e6;
+
+type Outcome = Result<Vec<f64>, Singular>;
+type Route = fn(&[f64], &[f64], &[f64]) -> Outcome;
+type DynRoute<'a> = Box<dyn Fn(&[f64], &[f64], &[f64]) -> Outcome + 'a>;
+
+// ---------------------------------------------------------------------------------------------
+// Models, poses, norms.
+
+/// The model of a bundled parallel spec (looked up in `mechanisms/specs/`, then in
+/// `mechanisms/specs-parallel/`).
+fn model(name: &str) -> ParallelModel {
+    tests::pkm::model(name)
+}
+
+fn plan(m: &ParallelModel) -> Plan {
+    Plan::new(m).unwrap_or_else(|e| panic!("{}: {e}", m.name))
+}
+
+/// Quaternion `[w, x, y, z]` product `a ⊗ b`.
+fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// Rotation by `deg` degrees about base axis `axis` (0, 1, 2 = x, y, z).
+fn axis_q(axis: usize, deg: f64) -> [f64; 4] {
+    let h = deg.to_radians() / 2.0;
+    let mut q = [h.cos(), 0.0, 0.0, 0.0];
+    q[1 + axis] = h.sin();
+    q
+}
+
+/// Exactly a quarter turn about `axis`, as the non-unit quaternion `(1, e)`: the evaluators
+/// normalize (`2/|q|² = 1`), so the rotation matrix is exact.
+fn quarter_q(axis: usize, sign: f64) -> [f64; 4] {
+    let mut q = [1.0, 0.0, 0.0, 0.0];
+    q[1 + axis] = sign;
+    q
+}
+
+/// The home orientation of `m` as a unit quaternion.
+fn home_q(m: &ParallelModel) -> [f64; 4] {
+    tests::pkm::matrix_quaternion(&m.home.rotation)
+}
+
+/// `x` for the platform origin `p` (pose platforms) and orientation `q`.
+fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
+    match m.motion {
+        PlatformMotion::Pose => vec![p[0], p[1], p[2], q[0], q[1], q[2], q[3]],
+        PlatformMotion::Orientation { .. } => q.to_vec(),
+    }
+}
+
+fn home_x(m: &ParallelModel) -> Vec<f64> {
+    tests::pkm::home_x(m)
+}
+
+/// `‖a − b‖∞ / ‖b‖∞` (infinite when anything is NaN).
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    tests::pkm::rel(a, b)
+}
+
+/// Three generic speed/rate states plus the static one.
+fn states(dof: usize, seed: u64) -> Vec<(Vec<f64>, Vec<f64>)> {
+    use rand::Rng;
+    let mut rng = tests::rng(seed);
+    let mut out = vec![(vec![0.0; dof], vec![0.0; dof])];
+    for _ in 0..3 {
+        let u = (0..dof).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let ud = (0..dof).map(|_| rng.random_range(-1.0..1.0)).collect();
+        out.push((u, ud));
+    }
+    out
+}
+
+fn arr<const N: usize>(v: &[f64]) -> [f64; N] {
+    let mut a = [0.0; N];
+    a.copy_from_slice(v);
+    a
+}
+
+/// The generated module's routes as [`Route`]s, their `Singular` mapped to the runtime's.
+macro_rules! generated_routes {
+    ($m:ident) => {
+        mod $m {
+            use mechanisms::$m as g;
+            use runtime::parallel::Singular;
+
+            pub fn err(e: g::Singular) -> Singular {
+                Singular {
+                    site: super::site_from_debug(&format!("{:?}", e.site)),
+                    value: e.value,
+                    condition_estimate: e.condition_estimate,
+                }
+            }
+            pub fn inverse_dynamics(x: &[f64], u: &[f64], ud: &[f64]) -> super::Outcome {
+                g::inverse_dynamics(&super::arr(x), &super::arr(u), &super::arr(ud))
+                    .map(|t| t.to_vec())
+                    .map_err(err)
+            }
+            pub fn forward_dynamics(x: &[f64], u: &[f64], tau: &[f64]) -> super::Outcome {
+                g::forward_dynamics(&super::arr(x), &super::arr(u), &super::arr(tau))
+                    .map(|t| t.to_vec())
+                    .map_err(err)
+            }
+            pub fn actuator_rates(x: &[f64], u: &[f64], _: &[f64]) -> super::Outcome {
+                g::actuator_rates(&super::arr(x), &super::arr(u))
+                    .map(|t| t.to_vec())
+                    .map_err(err)
+            }
+            pub fn inverse_kinematics(x: &[f64], _: &[f64], _: &[f64]) -> super::Outcome {
+                g::inverse_kinematics(&super::arr(x))
+                    .map(|t| t.to_vec())
+                    .map_err(err)
+            }
+            pub fn mass_matrix(x: &[f64], _: &[f64], _: &[f64]) -> super::Outcome {
+                g::mass_matrix(&super::arr(x))
+                    .map(|m| m.iter().flatten().copied().collect())
+                    .map_err(err)
+            }
+            pub fn actuator_mass_matrix(x: &[f64], _: &[f64], _: &[f64]) -> super::Outcome {
+                g::actuator_mass_matrix(&super::arr(x))
+                    .map(|m| m.iter().flatten().copied().collect())
+                    .map_err(err)
+            }
+            pub const ROUTES: [(&str, super::Route); 6] = [
+                ("inverse_dynamics", inverse_dynamics),
+                ("forward_dynamics", forward_dynamics),
+                ("actuator_rates", actuator_rates),
+                ("inverse_kinematics", inverse_kinematics),
+                ("mass_matrix", mass_matrix),
+                ("actuator_mass_matrix", actuator_mass_matrix),
+            ];
+        }
+    };
+}
+generated_routes!(gough_stewart);
+generated_routes!(agile_eye);
+generated_routes!(sliding_hexapod);
+generated_routes!(rus_hexapod);
+
+fn generated(name: &str) -> &'static [(&'static str, Route)] {
+    match name {
+        "gough_stewart" => &gough_stewart::ROUTES,
+        "agile_eye" => &agile_eye::ROUTES,
+        "sliding_hexapod" => &sliding_hexapod::ROUTES,
+        "rus_hexapod" => &rus_hexapod::ROUTES,
+        _ => panic!("no generated module {name}"),
+    }
+}
+
+fn generated_id(name: &str) -> Route {
+    generated(name)[0].1
+}
+
+// ---------------------------------------------------------------------------------------------
+// The walk.
+
+/// One point of a walk: `δ` (degrees from the singularity) and the coordinates.
+struct Point {
+    delta: f64,
+    x: Vec<f64>,
+}
+
+/// The runtime's `Site` for the `Debug` text of a generated module's `Site` (each generated
+/// module has its own copy of the type), through `Site::from_code`, so that variants added to
+/// both later map without naming them here.
+fn site_from_debug(d: &str) -> Site {
+    let (name, index) = match d.split_once('(') {
+        Some((n, rest)) => (n, rest.trim_end_matches(')').parse::<u16>().unwrap_or(0)),
+        None => (d, 0),
+    };
+    let base = match name {
+        "MassMatrix" => 0,
+        "Leg" => 256,
+        "Reach" => 512,
+        "Actuation" => 768,
+        "Platform" => 1024,
+        "Input" => 1025,
+        other => panic!("unknown generated site {other}"),
+    };
+    let site = Site::from_code(base + index);
+    assert_eq!(format!("{site:?}"), d, "site mapping");
+    site
+}
+
+/// A short name of a site (its `Debug` text, `Actuation` shortened).
+fn site_word(s: Site) -> String {
+    format!("{s:?}").replace("Actuation", "Act")
+}
+
+fn cell(o: &Outcome, reference: &Outcome) -> String {
+    match (o, reference) {
+        (Ok(t), Ok(r)) => format!("Ok {:.1e}", rel(t, r)),
+        (Ok(_), Err(_)) => "Ok (ref Err)".into(),
+        (Err(e), _) => format!("Err {} {:.1e}", site_word(e.site), e.condition_estimate),
+    }
+}
+
+/// The worst cell over several states: an `Err` beats an `Ok`; among `Ok`s the largest error.
+fn worst_cell(cells: &[(Outcome, Outcome)]) -> String {
+    let mut best: Option<(f64, String)> = None;
+    for (o, r) in cells {
+        let score = match (o, r) {
+            (Ok(t), Ok(r)) => rel(t, r),
+            _ => f64::INFINITY,
+        };
+        if best.as_ref().is_none_or(|(s, _)| score > *s) {
+            best = Some((score, cell(o, r)));
+        }
+    }
+    best.map(|b| b.1).unwrap_or_default()
+}
+
+/// One violation of the contract: what (without varying numbers), where (δ), a detail.
+struct Violation {
+    kind: String,
+    delta: f64,
+    detail: String,
+}
+
+/// Check one route's outcomes along a walk (points ordered toward the singularity; the last is
+/// the singular pose itself) against the contract; returns the violations.
+fn contract(
+    walk: &[Point],
+    outcomes: &[(Outcome, Outcome)],
+    allowed: &[fn(Site) -> bool],
+) -> Vec<Violation> {
+    let mut bad = Vec::new();
+    let mut push = |kind: &str, delta: f64, detail: String| {
+        bad.push(Violation {
+            kind: kind.into(),
+            delta,
+            detail,
+        })
+    };
+    let mut failed_at: Option<f64> = None;
+    for (p, (o, r)) in walk.iter().zip(outcomes) {
+        let d = p.delta;
+        match o {
+            Ok(t) => {
+                if t.iter().any(|v| !v.is_finite()) {
+                    push("Ok with non-finite entries", d, format!("{t:?}"));
+                }
+                match r {
+                    Ok(r) => {
+                        let e = rel(t, r);
+                        if e.is_nan() || e > ACCURACY {
+                            push(
+                                "Ok but not within 1e-6 (relative) of double-double",
+                                d,
+                                format!("{e:.1e}"),
+                            );
+                        }
+                    }
+                    Err(s) => push(
+                        "Ok although the double-double route fails",
+                        d,
+                        site_word(s.site),
+                    ),
+                }
+                if let Some(d0) = failed_at {
+                    push(
+                        "Ok again after an Err farther from the singularity",
+                        d,
+                        format!("Err at {d0:e}"),
+                    );
+                }
+                if d == 0.0 {
+                    push("Ok at the singular pose", d, String::new());
+                }
+            }
+            Err(s) => {
+                failed_at.get_or_insert(d);
+                if !allowed.iter().any(|f| f(s.site)) {
+                    push(
+                        &format!("Err at an unexpected site {}", site_word(s.site)),
+                        d,
+                        format!("value {:.1e}", s.value),
+                    );
+                }
+                if s.condition_estimate.is_nan() || s.condition_estimate <= MIN_CONDITION {
+                    push(
+                        "Err with a condition estimate not above 1e6",
+                        d,
+                        format!("{:.1e}", s.condition_estimate),
+                    );
+                }
+            }
+        }
+    }
+    bad
+}
+
+/// Evaluate the runtime and the generated code along `walk` for each state, print the table,
+/// return the violations of the contract.
+fn walk_report(
+    title: &str,
+    plan: &Plan,
+    walk: &[Point],
+    states: &[(Vec<f64>, Vec<f64>)],
+    generated: Option<Route>,
+    allowed: &[fn(Site) -> bool],
+) -> Vec<String> {
+    let mut bad = Vec::new();
+    // (route, kind) → δ → (a detail, states)
+    type Found = BTreeMap<(String, String), BTreeMap<usize, (String, BTreeSet<usize>)>>;
+    let mut violations: Found = BTreeMap::new();
+    // outcomes[route][state][point]
+    let mut table: Vec<Vec<Vec<(Outcome, Outcome)>>> = Vec::new();
+    let routes: Vec<(&str, DynRoute<'_>)> = {
+        let mut r: Vec<(&str, DynRoute<'_>)> = vec![(
+            "runtime",
+            Box::new(|x: &[f64], u: &[f64], ud: &[f64]| noc::inverse_dynamics(plan, x, u, ud)),
+        )];
+        if let Some(g) = generated {
+            r.push(("generated", Box::new(g)));
+        }
+        r
+    };
+    let reference: Vec<Vec<Outcome>> = states
+        .iter()
+        .map(|(u, ud)| {
+            walk.iter()
+                .map(|p| dd::inverse_dynamics_dd(plan, &p.x, u, ud))
+                .collect()
+        })
+        .collect();
+    for (name, f) in &routes {
+        let mut per_state = Vec::new();
+        for (si, (u, ud)) in states.iter().enumerate() {
+            let outs: Vec<(Outcome, Outcome)> = walk
+                .iter()
+                .zip(&reference[si])
+                .map(|(p, r)| {
+                    let o =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(&p.x, u, ud)))
+                            .unwrap_or_else(|_| {
+                                bad.push(format!(
+                                    "{title}, {name}, state {si}, δ={:e}: panic",
+                                    p.delta
+                                ));
+                                Err(Singular {
+                                    site: Site::Platform,
+                                    value: f64::NAN,
+                                    condition_estimate: f64::NAN,
+                                })
+                            });
+                    (o, r.clone())
+                })
+                .collect();
+            for v in contract(walk, &outs, allowed) {
+                let e = violations
+                    .entry((name.to_string(), v.kind))
+                    .or_default()
+                    .entry(walk.iter().position(|p| p.delta == v.delta).unwrap_or(0))
+                    .or_insert_with(|| (v.detail.clone(), BTreeSet::new()));
+                if v.detail > e.0 {
+                    e.0 = v.detail;
+                }
+                e.1.insert(si);
+            }
+            per_state.push(outs);
+        }
+        table.push(per_state);
+    }
+    // The table.
+    println!("\n### {title}\n");
+    let mut head = "| δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) |".to_string();
+    let mut rule = "|---:|---:|---:|---:|".to_string();
+    for (name, _) in &routes {
+        head.push_str(&format!(" {name}, static | {name}, dynamic (worst) |"));
+        rule.push_str("---|---|");
+    }
+    println!("{head}\n{rule}");
+    for (pi, p) in walk.iter().enumerate() {
+        let cond = dd::actuation_dd(plan, &p.x).map(|a| dd::conditioning(&a));
+        let (kp, k1) = match cond {
+            Ok(c) => (
+                format!("{:.2e}", c.pivot_ratio),
+                format!("{:.2e}", c.kappa1),
+            ),
+            Err(e) => (format!("Err {}", site_word(e.site)), "—".into()),
+        };
+        let tau = match &reference[0][pi] {
+            Ok(t) => format!("{:.2e}", t.iter().map(|v| v.abs()).fold(0.0, f64::max)),
+            Err(e) => format!("Err {}", site_word(e.site)),
+        };
+        let mut line = format!("| {:e} | {kp} | {k1} | {tau} |", p.delta);
+        for per_state in &table {
+            let stat = cell(&per_state[0][pi].0, &per_state[0][pi].1);
+            let dynamic: Vec<(Outcome, Outcome)> =
+                per_state[1..].iter().map(|s| s[pi].clone()).collect();
+            line.push_str(&format!(" {stat} | {} |", worst_cell(&dynamic)));
+        }
+        println!("{line}");
+    }
+    for ((route, kind), at) in violations {
+        let list: Vec<String> = at
+            .iter()
+            .map(|(pi, (detail, states))| {
+                let d = walk[*pi].delta;
+                let st: Vec<String> = states.iter().map(|s| s.to_string()).collect();
+                if detail.is_empty() {
+                    format!("δ={d:e} [states {}]", st.join(","))
+                } else {
+                    format!("δ={d:e} ({detail}) [states {}]", st.join(","))
+                }
+            })
+            .collect();
+        bad.push(format!("{title}, {route}: {kind} at {}", list.join(", ")));
+    }
+    bad
+}
+
+fn finish(bad: &[String]) {
+    if !bad.is_empty() {
+        println!("\nVIOLATIONS ({}):", bad.len());
+        for b in bad {
+            println!("  {b}");
+        }
+        panic!(
+            "{} violations of the documented failure behaviour; first: {}",
+            bad.len(),
+            bad[0]
+        );
+    }
+}
+
+/// δ = 10⁻¹ … 10⁻¹² degrees, then 0.
+fn deltas() -> Vec<f64> {
+    let mut d: Vec<f64> = (1..=12).map(|k| 10f64.powi(-k)).collect();
+    d.push(0.0);
+    d
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tests.
+
+/// The double-double reference agrees with the `f64` runtime at generic states away from
+/// singularities (sanity check of `tests::dd::inverse_dynamics_dd`).
+#[test]
+fn reference_agrees_with_runtime_at_generic_states() {
+    for name in [
+        "gough_stewart",
+        "sliding_hexapod",
+        "rus_hexapod",
+        "agile_eye",
+    ] {
+        let m = model(name);
+        let plan = plan(&m);
+        let home = home_x(&m);
+        let mut rng = tests::rng(7);
+        let mut worst: f64 = 0.0;
+        for _ in 0..20 {
+            use rand::Rng;
+            let n = plan.dof();
+            let d: Vec<f64> = (0..n)
+                .map(|i| {
+                    let a = if i < 3 { 0.1 } else { 0.02 * m.size() };
+                    a * rng.random_range(-1.0..1.0)
+                })
+                .collect();
+            let x = noc::retract(plan.motion, &home, &d);
+            let u: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let ud: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let a = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            let b = dd::inverse_dynamics_dd(&plan, &x, &u, &ud).unwrap();
+            worst = worst.max(rel(&a, &b));
+        }
+        println!("{name}: f64 runtime vs double-double, worst relative error {worst:.2e}");
+        assert!(worst < 1e-11, "{name}: {worst:e}");
+    }
+}
+
+/// Gough–Stewart (Tsai's 6-UPS, base and platform joints on semi-regular hexagons, platform
+/// centred over the base at home): the parallel (type-II) singularity at 90° yaw about the
+/// vertical axis through the platform centre (Fichter 1986). Walk `ψ = 90° − δ` from home
+/// (`x = [p_home, q_yaw(ψ) ⊗ q_home]`), `δ = 10⁻¹ … 10⁻¹²` degrees, then `δ = 0` with the exact
+/// quarter-turn quaternion `(1, 0, 0, 1)`; the static state and three with `u, u̇` in ±1.
+/// Measured (`--nocapture`):
+///
+/// | δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) | runtime, static | runtime, dynamic (worst) | generated, static | generated, dynamic (worst) |
+/// |---:|---:|---:|---:|---|---|---|---|
+/// | 1e-1 | 3.54e2 | 5.27e3 | 7.94e3 | Ok 8.6e-14 | Ok 8.6e-14 | Ok 8.6e-14 | Ok 8.6e-14 |
+/// | 1e-2 | 3.55e3 | 5.27e4 | 7.96e4 | Ok 4.4e-13 | Ok 4.4e-13 | Ok 4.4e-13 | Ok 4.4e-13 |
+/// | 1e-3 | 3.55e4 | 5.27e5 | 7.96e5 | Ok 3.0e-13 | Ok 3.0e-13 | Ok 3.0e-13 | Ok 3.0e-13 |
+/// | 1e-4 | 3.55e5 | 5.27e6 | 7.96e6 | Ok 1.9e-10 | Ok 1.9e-10 | Ok 1.9e-10 | Ok 1.9e-10 |
+/// | 1e-5 | 3.55e6 | 5.27e7 | 7.96e7 | Ok 6.0e-10 | Ok 6.0e-10 | Ok 6.0e-10 | Ok 6.0e-10 |
+/// | 1e-6 | 3.55e7 | 5.27e8 | 7.96e8 | Ok 2.2e-10 | Ok 2.2e-10 | Ok 2.2e-10 | Ok 2.2e-10 |
+/// | 1e-7 | 3.55e8 | 5.27e9 | 7.96e9 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 |
+/// | 1e-8 | 3.55e9 | 5.27e10 | 7.96e10 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 |
+/// | 1e-9 | 3.55e10 | 5.27e11 | 7.96e11 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 |
+/// | 1e-10 | 3.55e11 | 5.27e12 | 7.96e12 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 |
+/// | 1e-11 | 3.55e12 | 5.27e13 | 7.95e13 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 |
+/// | 1e-12 | 3.55e13 | 5.27e14 | 7.95e14 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 |
+/// | 0 | 1.80e16 | 2.68e17 | 4.04e17 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 |
+///
+/// The conditioning grows exactly like 1/δ (pivot ratio ≈ 35.5/δ°), so the singularity is at
+/// 90° to within the rounding of the spec's constants (at δ = 0 even double-double sees a
+/// pivot ratio of only 1.8e16, not an exactly singular `A`). Both `f64` routes are accurate to
+/// ≤ 6e-10 while they answer and switch to `Err(Actuation(5))` between δ = 1e-6° and 1e-7°
+/// (the 1e-8 pivot-ratio tolerance), with condition estimates that track the double-double
+/// pivot ratio. The relative error is the same for every state: near the singularity `τ` is
+/// dominated by its component along the null direction of `Aᵀ`, whose relative error is that of
+/// the small pivot.
+#[test]
+fn gough_stewart_yaw_singularity() {
+    let m = model("gough_stewart");
+    let plan = plan(&m);
+    let p = m.home.translation;
+    let qh = home_q(&m);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| {
+            let q = if d == 0.0 {
+                quarter_q(2, 1.0)
+            } else {
+                axis_q(2, 90.0 - d)
+            };
+            Point {
+                delta: d,
+                x: coords(&m, p, qmul(q, qh)),
+            }
+        })
+        .collect();
+    // Sanity: the singularity is really at 90°: the double-double condition grows like 1/δ.
+    let k = |d: usize| dd::conditioning(&dd::actuation_dd(&plan, &walk[d].x).unwrap()).pivot_ratio;
+    assert!(k(11) > 1e12 && k(11) / k(5) > 1e5, "{} {}", k(5), k(11));
+    let bad = walk_report(
+        "Gough–Stewart, yaw ψ = 90° − δ",
+        &plan,
+        &walk,
+        &states(6, 0x6f),
+        Some(generated_id("gough_stewart")),
+        &[|s| matches!(s, Site::Actuation(_))],
+    );
+    finish(&bad);
+}
+
+/// Agile Eye (spherical 3-RRR, exact Agile-Eye geometry): the platform turned by
+/// `R_x(30°)·R_y(90° − δ)`, which carries the platform axis `v₁ = z` of leg 1 onto its base axis
+/// `u₁ = x` at `δ = 0` while `v₂`, `v₃` stay generic. There `u₁, w₁, v₁` become coplanar (a leg
+/// singularity of leg 1) and, as pkm-literature.md says for this geometry, the actuation matrix
+/// becomes singular with it (its scaled pivot ratio grows like 1/δ). `δ = 0` uses the exact
+/// quarter-turn quaternion for `R_y(90°)`.
+///
+/// Measured (`--nocapture`; states: static, then three with `u, u̇` in ±1):
+///
+/// | δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) | runtime, static | runtime, dynamic (worst) | generated, static | generated, dynamic (worst) |
+/// |---:|---:|---:|---:|---|---|---|---|
+/// | 1e-1 | 6.62e2 | 1.57e3 | 8.46e1 | Ok 1.2e-13 | Ok 6.0e-11 | Ok 1.2e-13 | Ok 6.0e-11 |
+/// | 1e-2 | 6.62e3 | 1.57e4 | 8.47e2 | Ok 1.8e-12 | Ok 9.1e-9 | Ok 1.8e-12 | Ok 9.1e-9 |
+/// | 1e-3 | 6.62e4 | 1.57e5 | 8.47e3 | Ok 1.0e-11 | Ok 5.2e-7 | Ok 1.0e-11 | Ok 5.2e-7 |
+/// | 1e-4 | 6.62e5 | 1.57e6 | 8.47e4 | Ok 2.0e-10 | **Ok 1.0e-4** | Ok 2.0e-10 | **Ok 1.0e-4** |
+/// | 1e-5 | 6.62e6 | 1.57e7 | 8.47e5 | Ok 1.4e-9 | **Ok 7.0e-3** | Ok 1.4e-9 | **Ok 7.0e-3** |
+/// | 1e-6 | 6.62e7 | 1.57e8 | 8.47e6 | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
+/// | 1e-7 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 |
+/// | 1e-8 … 1e-11 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
+/// | 1e-12 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 |
+/// | 0 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
+///
+/// (The double-double route applies the runtime's leg tolerance too, hence its `Err Leg(0)`
+/// from δ = 1e-7°, where the leg's Hadamard ratio, ≈ δ in radians, falls below 1e-8.)
+///
+/// **The `f64` routes (runtime and generated) violate the contract here** (bold cells), so this
+/// test fails until `runtime/src/parallel/noc.rs` is fixed: the closed-form inverse kinematics
+/// of the spherical leg (`two_axes`, Paden–Kahan subproblem 2,
+/// `γ² = (|p|² − α² − β² − 2wαβ)/|k|²`) cancels catastrophically as `v₁ → u₁` (`γ² ~ δ²` formed
+/// as `1 − α²` with an absolute error ~ε), so the first joint's angle is wrong by ~ε/δ²
+/// (measured 3.8e-3 rad at δ = 1e-5° = 1.7e-7 rad) instead of the intrinsic ~ε/δ (2e-10);
+/// results with relative errors up to 7e-3 are returned as `Ok` (velocity-dependent terms,
+/// which grow like 1/δ², carry the error) before the leg Hadamard-ratio test (1e-8) fires.
+/// Forming `|p|² − α²` as `|e₁ × q|²` (Lagrange's identity; here `w = 0`, `β = 0`) brings
+/// `γ²`'s relative error at δ = 1e-5° from 8.7e-3 to 1.3e-9 (measured); alternatively the leg
+/// tolerance would have to be ~1e-5 instead of 1e-8 for this leg type.
+///
+/// (Closer in, `γ²` rounds to ≤ 0. Before the `γ² ≈ 0 → Site::Leg` check was added to
+/// `two_axes` during this work, that was reported as `Site::Reach(0)`, "outside the
+/// workspace", for a reachable pose; the walk now sees `Leg(0)` throughout.)
+#[test]
+fn agile_eye_leg_and_parallel_singularity() {
+    let m = model("agile_eye");
+    let plan = plan(&m);
+    let qh = home_q(&m);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| {
+            let qy = if d == 0.0 {
+                quarter_q(1, 1.0)
+            } else {
+                axis_q(1, 90.0 - d)
+            };
+            Point {
+                delta: d,
+                x: coords(&m, [0.0; 3], qmul(qmul(axis_q(0, 30.0), qy), qh)),
+            }
+        })
+        .collect();
+    let k = |d: usize| dd::conditioning(&dd::actuation_dd(&plan, &walk[d].x).unwrap()).pivot_ratio;
+    assert!(k(4) / k(1) > 1e2, "{} {}", k(1), k(4));
+    let bad = walk_report(
+        "Agile Eye, R_x(30°)·R_y(90° − δ): v₁ → u₁",
+        &plan,
+        &walk,
+        &states(3, 0xae),
+        Some(generated_id("agile_eye")),
+        &[
+            |s| matches!(s, Site::Leg(_)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
+    );
+    finish(&bad);
+}
+
+/// A platform axis approaching the base axis of a *different* leg (`v₂ → u₃` by
+/// `R_z(30°)·R_y(−90° + δ)`, `v₁`, `v₃` generic) is *not* singular for the exact Agile-Eye
+/// geometry: the actuation matrix stays well conditioned (scaled pivot ratio → √3) and the
+/// runtime is accurate to ~1e-16 all the way to δ = 0. Recorded so the claim is checked.
+#[test]
+fn agile_eye_other_leg_axis_is_not_singular() {
+    let m = model("agile_eye");
+    let plan = plan(&m);
+    let qh = home_q(&m);
+    for d in deltas() {
+        let qy = if d == 0.0 {
+            quarter_q(1, -1.0)
+        } else {
+            axis_q(1, -90.0 + d)
+        };
+        let x = coords(&m, [0.0; 3], qmul(qmul(axis_q(2, 30.0), qy), qh));
+        let c = dd::conditioning(&dd::actuation_dd(&plan, &x).unwrap());
+        assert!(c.pivot_ratio < 10.0, "δ={d:e}: {c:?}");
+        for (u, ud) in states(3, 1) {
+            let a = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            let b = dd::inverse_dynamics_dd(&plan, &x, &u, &ud).unwrap();
+            assert!(rel(&a, &b) < 1e-13, "δ={d:e}: {:e}", rel(&a, &b));
+        }
+    }
+}
+
+/// The runtime evaluators (`noc::*`) and the generated code under NaN and ±∞ in any one input
+/// (`x`, `u`, `u̇` or `τ`) of every bundled parallel mechanism at home: `Err`, or `Ok` with
+/// finite entries; never a panic, never NaN or ∞ returned as `Ok`.
+///
+/// Measured against the current runtime: every such input gives `Err(Site::Input)` from every
+/// route, runtime and generated (no panics). (Before `noc::check_finite` was added during this
+/// work, a non-finite `u`, `u̇` or `τ` went straight through: `inverse_dynamics`,
+/// `forward_dynamics` and `actuator_rates` returned `Ok` with NaN or ±∞ entries for all four
+/// mechanisms, and the generated `gough_stewart::inverse_kinematics` returned `Ok([±inf; …])`
+/// for an infinite position.)
+#[test]
+fn non_finite_inputs() {
+    let bad = probe_inputs(&[
+        (f64::NAN, "NaN"),
+        (f64::INFINITY, "±inf"),
+        (f64::NEG_INFINITY, "±inf"),
+    ]);
+    finish(&bad);
+}
+
+/// Finite inputs so large that the evaluation overflows (one entry of `x`, `u`, `u̇` or `τ`
+/// set to ±1e300): the same contract, `Err` or finite `Ok`, never NaN or ∞ as `Ok`.
+///
+/// Measured: **violated**. `inverse_dynamics` and `forward_dynamics` (runtime and generated)
+/// return `Ok` with NaN for a speed `u` of ±1e300 (the quadratic velocity terms overflow to ∞,
+/// then ∞ − ∞; all four mechanisms, 20 of 21 entries). The generated `inverse_kinematics`
+/// returns `Ok([±inf; …])` for a Gough–Stewart position entry of ±1e300 (the runtime says
+/// `Err(Leg(0))`: its U-joint checks run, the generated function dropped them because the leg
+/// lengths do not need the U angles) and `Ok` with NaN for an Agile-Eye quaternion entry
+/// `x[1..4]` of ±1e300 (the runtime says `Err(Reach(0))`). Nothing checks that the results are
+/// finite; this test fails until something does (e.g. a final finiteness check of the
+/// outputs, reported as `Site::Input`).
+#[test]
+fn overflowing_finite_inputs() {
+    let bad = probe_inputs(&[(1e300, "±1e300"), (-1e300, "±1e300")]);
+    finish(&bad);
+}
+
+/// Evaluate every runtime and generated route of every bundled parallel mechanism at home with
+/// one entry of `x`, `u` or `u̇`/`τ` replaced by each of `values`; print a table of outcomes and
+/// return the violations (panic, or `Ok` with a non-finite entry).
+fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
+    type Runtime = fn(&Plan, &[f64], &[f64], &[f64]) -> Outcome;
+    let runtime: [(&str, Runtime); 6] = [
+        ("inverse_dynamics", |p, x, u, ud| {
+            noc::inverse_dynamics(p, x, u, ud)
+        }),
+        ("forward_dynamics", |p, x, u, tau| {
+            noc::forward_dynamics(p, x, u, tau)
+        }),
+        ("actuator_rates", |p, x, u, _| noc::actuator_rates(p, x, u)),
+        ("inverse_kinematics", |p, x, _, _| {
+            noc::inverse_kinematics(p, x)
+        }),
+        ("mass_matrix", |p, x, _, _| {
+            noc::mass_matrix(p, x).map(|m| m.concat())
+        }),
+        ("actuator_mass_matrix", |p, x, _, _| {
+            noc::actuator_mass_matrix(p, x).map(|m| m.concat())
+        }),
+    ];
+    // (route, input) → outcome → mechanisms (with the offending index).
+    type Table = BTreeMap<(String, String), BTreeMap<String, BTreeSet<String>>>;
+    let mut table: Table = BTreeMap::new();
+    let mut bad_keys: BTreeSet<(String, String, String)> = BTreeSet::new();
+    for name in [
+        "gough_stewart",
+        "sliding_hexapod",
+        "rus_hexapod",
+        "agile_eye",
+    ] {
+        let m = model(name);
+        let plan = plan(&m);
+        let x0 = home_x(&m);
+        let n = plan.dof();
+        let u0: Vec<f64> = (0..n).map(|i| 0.1 * (i as f64 + 1.0)).collect();
+        let w0: Vec<f64> = (0..n).map(|i| 0.2 - 0.05 * i as f64).collect();
+        let gen_routes = generated(name);
+        for slot in 0..3 {
+            let len = [x0.len(), n, n][slot];
+            for i in 0..len {
+                for &(bad_value, value) in values {
+                    let (mut x, mut u, mut w) = (x0.clone(), u0.clone(), w0.clone());
+                    [&mut x, &mut u, &mut w][slot][i] = bad_value;
+                    let input = format!("{} {value}", ["x", "u", "u̇/τ"][slot]);
+                    let mut judge = |route: String, o: std::thread::Result<Outcome>| {
+                        let (outcome, violation) = match o {
+                            Err(_) => ("PANIC".to_string(), true),
+                            Ok(Ok(t)) if t.iter().any(|v| v.is_nan()) => {
+                                ("Ok with NaN".to_string(), true)
+                            }
+                            Ok(Ok(t)) if t.iter().any(|v| !v.is_finite()) => {
+                                ("Ok with ±inf".to_string(), true)
+                            }
+                            Ok(Ok(_)) => ("Ok, finite".to_string(), false),
+                            Ok(Err(e)) => (format!("Err {}", site_word(e.site)), false),
+                        };
+                        if violation {
+                            bad_keys.insert((route.clone(), input.clone(), outcome.clone()));
+                        }
+                        table
+                            .entry((route, input.clone()))
+                            .or_default()
+                            .entry(outcome)
+                            .or_default()
+                            .insert(format!("{name}[{i}]"));
+                    };
+                    let uses = |r: &str| match slot {
+                        0 => true,
+                        1 => matches!(
+                            r,
+                            "inverse_dynamics" | "forward_dynamics" | "actuator_rates"
+                        ),
+                        _ => matches!(r, "inverse_dynamics" | "forward_dynamics"),
+                    };
+                    for (rname, f) in runtime.iter().filter(|r| uses(r.0)) {
+                        let o = std::panic::catch_unwind(|| f(&plan, &x, &u, &w));
+                        judge(format!("runtime {rname}"), o);
+                    }
+                    for (rname, f) in gen_routes.iter().filter(|r| uses(r.0)) {
+                        let o = std::panic::catch_unwind(|| f(&x, &u, &w));
+                        judge(format!("generated {rname}"), o);
+                    }
+                }
+            }
+        }
+    }
+    let names: BTreeSet<&str> = values.iter().map(|v| v.1).collect();
+    let names: Vec<&str> = names.into_iter().collect();
+    println!(
+        "\n### Inputs (one entry of x, u or u̇/τ set to {})\n",
+        names.join(", ")
+    );
+    println!("| route | input | outcomes (mechanism[index] of the first few) |");
+    println!("|---|---|---|");
+    let short = |set: &BTreeSet<String>| -> String {
+        let v: Vec<&str> = set.iter().map(|s| s.as_str()).collect();
+        if v.len() > 4 {
+            format!("{}, … ({} cases)", v[..4].join(", "), v.len())
+        } else {
+            v.join(", ")
+        }
+    };
+    for ((route, input), outcomes) in &table {
+        let cells: Vec<String> = outcomes
+            .iter()
+            .map(|(o, set)| {
+                let mark = if bad_keys.contains(&(route.clone(), input.clone(), o.clone())) {
+                    " ✗"
+                } else {
+                    ""
+                };
+                format!("**{o}{mark}**: {}", short(set))
+            })
+            .collect();
+        println!("| {route} | {input} | {} |", cells.join("; "));
+    }
+    let bad: Vec<String> = bad_keys
+        .iter()
+        .map(|(route, input, outcome)| {
+            format!(
+                "{route} with {input}: {outcome} ({})",
+                short(&table[&(route.clone(), input.clone())][outcome])
+            )
+        })
+        .collect();
+    bad
+}
+
+/// A pose out of reach: the platform far from where the fixed-length legs can meet it. For the
+/// 6-RUS hexapod lifting the platform by 10 × its size is enough; the sliding (6-PUS) hexapod
+/// has vertical rails without stroke limits, so lifting is always reachable and the platform is
+/// moved sideways instead. Every route must say `Err(Site::Reach(_))` (no NaN, no panic).
+/// Measured: all do (runtime, double-double, generated; leg 0 first). The reported condition
+/// estimate differs: `scale/|value|` (≈ 4e-3) from the runtime, `inf` from the generated code,
+/// which tests `value > 0` instead of `|value| > 0` before dividing.
+#[test]
+fn out_of_reach() {
+    let cases: [(&str, [f64; 3]); 3] = [
+        ("rus_hexapod", [0.0, 0.0, 10.0]),
+        ("sliding_hexapod", [10.0, 0.0, 0.0]),
+        ("sliding_hexapod", [0.0, -10.0, 2.0]),
+    ];
+    for (name, dir) in cases {
+        let m = model(name);
+        let plan = plan(&m);
+        let s = m.size();
+        let mut x = home_x(&m);
+        for (xi, di) in x.iter_mut().zip(dir) {
+            *xi += di * s;
+        }
+        let z = vec![0.0; 6];
+        let u: Vec<f64> = (0..6).map(|i| 0.1 * i as f64).collect();
+        let outcomes: Vec<(&str, Outcome)> = vec![
+            ("runtime", noc::inverse_dynamics(&plan, &x, &u, &z)),
+            ("double-double", dd::inverse_dynamics_dd(&plan, &x, &u, &z)),
+            ("generated", generated_id(name)(&x, &u, &z)),
+            (
+                "runtime inverse_kinematics",
+                noc::inverse_kinematics(&plan, &x),
+            ),
+        ];
+        for (route, o) in outcomes {
+            match o {
+                Err(e) => {
+                    println!("{name} {dir:?}×{s:.3} m, {route}: {e}");
+                    assert!(
+                        matches!(e.site, Site::Reach(_)),
+                        "{name} {route}: expected Reach, got {e}"
+                    );
+                    assert!(!e.condition_estimate.is_nan());
+                }
+                Ok(t) => panic!("{name} {route}: out of reach but Ok({t:?})"),
+            }
+        }
+    }
+    // Lifting the sliding hexapod stays reachable (vertical rails) and accurate.
+    let m = model("sliding_hexapod");
+    let plan = plan(&m);
+    let mut x = home_x(&m);
+    x[2] += 10.0 * m.size();
+    let z = vec![0.0; 6];
+    let a = noc::inverse_dynamics(&plan, &x, &z, &z).unwrap();
+    let b = dd::inverse_dynamics_dd(&plan, &x, &z, &z).unwrap();
+    assert!(rel(&a, &b) < 1e-12);
+}
