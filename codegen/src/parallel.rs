@@ -186,6 +186,32 @@ pub fn lu_ops(n: usize) -> OpCount {
     c
 }
 
+/// Operation count of the emitted `lu_inverse::<N>` followed by `A⁻ᵀ I A⁻¹` (`I A⁻¹` in full,
+/// then the upper triangle of `A⁻ᵀ (I A⁻¹)`).
+pub fn lu_inverse_ops(n: usize) -> OpCount {
+    let mut c = OpCount::default();
+    c.mul += 2 * n * n;
+    c.add += n * n;
+    c.sqrt += n;
+    c.div += n;
+    for k in 0..n {
+        let rows = n - k - 1;
+        c.cmp += rows + 2;
+        c.div += 1;
+        c.mul += rows * (1 + (n - k) + n);
+        c.add += rows * ((n - k) + n);
+    }
+    // Back substitution for n right-hand sides, then the column scaling of the result.
+    c.mul += n * (n * (n - 1) / 2) + n * n;
+    c.add += n * (n * (n - 1) / 2);
+    c.div += n * n;
+    // I A⁻¹ (n² dot products of length n) and the upper triangle of A⁻ᵀ (I A⁻¹).
+    let tri = n * (n + 1) / 2;
+    c.mul += n * n * n + tri * n;
+    c.add += (n * n + tri) * (n - 1);
+    c
+}
+
 fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
     OpCount {
         add: a.add + b.add * times,
@@ -308,7 +334,7 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
         ("mass_matrix".into(), ops("mass_matrix")),
         (
             "actuator_mass_matrix".into(),
-            plus(ops("inertia_parts"), lu, 2 * n),
+            plus(ops("inertia_parts"), lu_inverse_ops(n), 1),
         ),
         ("forward_dynamics".into(), ops("forward_dynamics")),
         (
@@ -534,42 +560,110 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
             lu_solve(&a, &f, true)
         }
 
+        /// `A⁻¹` by one LU of `A` (columns scaled to unit norm, partial pivoting) and `DOF`
+        /// back substitutions; `Err(Site::Actuation)` as in `lu_solve`.
+        #[allow(clippy::all)]
+        fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+            let mut m = *a;
+            let mut sc = [1.0; DOF];
+            for j in 0..DOF {
+                let mut s = 0.0;
+                for i in 0..DOF {
+                    s += m[i][j] * m[i][j];
+                }
+                let s = #sqrt;
+                if s > 0.0 {
+                    sc[j] = 1.0 / s;
+                    for i in 0..DOF {
+                        m[i][j] *= sc[j];
+                    }
+                }
+            }
+            // Right-hand sides: the identity, permuted and eliminated with the matrix.
+            let mut x = [[0.0; DOF]; DOF];
+            for i in 0..DOF {
+                x[i][i] = 1.0;
+            }
+            let mut pmax: f64 = 0.0;
+            for k in 0..DOF {
+                let mut p = k;
+                let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
+                for i in k + 1..DOF {
+                    let v = if m[i][k] < 0.0 { -m[i][k] } else { m[i][k] };
+                    if v > best {
+                        best = v;
+                        p = i;
+                    }
+                }
+                m.swap(k, p);
+                x.swap(k, p);
+                if !(best > 0.0 && best < f64::INFINITY) {
+                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: f64::INFINITY });
+                }
+                if best > pmax {
+                    pmax = best;
+                }
+                if !(best > #act_tol_lit * pmax) {
+                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: pmax / best });
+                }
+                let inv = 1.0 / m[k][k];
+                for i in k + 1..DOF {
+                    let f = m[i][k] * inv;
+                    if f != 0.0 {
+                        for j in k..DOF {
+                            m[i][j] -= f * m[k][j];
+                        }
+                        for c in 0..DOF {
+                            x[i][c] -= f * x[k][c];
+                        }
+                    }
+                }
+            }
+            for c in 0..DOF {
+                for i in (0..DOF).rev() {
+                    let mut s = x[i][c];
+                    for j in i + 1..DOF {
+                        s -= m[i][j] * x[j][c];
+                    }
+                    x[i][c] = s / m[i][i];
+                }
+            }
+            for i in 0..DOF {
+                for c in 0..DOF {
+                    x[i][c] *= sc[i];
+                }
+            }
+            Ok(x)
+        }
+
         /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
         #[allow(clippy::all)]
         pub fn actuator_mass_matrix(x: &[f64; NX]) -> Result<[[f64; DOF]; DOF], Singular> {
             let (a, i) = inertia_parts(x)?;
+            let ai = lu_inverse(&a)?;
+            // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
             let mut b = [[0.0; DOF]; DOF];
-            for j in 0..DOF {
-                let mut e = [0.0; DOF];
-                e[j] = 1.0;
-                let c = lu_solve(&a, &e, false)?;
-                for r in 0..DOF {
+            for r in 0..DOF {
+                for c in 0..DOF {
                     let mut s = 0.0;
                     for k in 0..DOF {
-                        s += i[r][k] * c[k];
+                        s += i[r][k] * ai[k][c];
                     }
-                    b[r][j] = s;
+                    b[r][c] = s;
                 }
             }
             let mut out = [[0.0; DOF]; DOF];
-            for j in 0..DOF {
-                let mut col = [0.0; DOF];
-                for r in 0..DOF {
-                    col[r] = b[r][j];
-                }
-                let c = lu_solve(&a, &col, true)?;
-                for r in 0..DOF {
-                    out[r][j] = c[r];
-                }
-            }
             for r in 0..DOF {
                 for c in r..DOF {
-                    let m = 0.5 * (out[r][c] + out[c][r]);
-                    if !m.is_finite() {
-                        return Err(Singular { site: Site::Input, value: m, condition_estimate: f64::INFINITY });
+                    let mut s = 0.0;
+                    for k in 0..DOF {
+                        s += ai[k][r] * b[k][c];
                     }
-                    out[r][c] = m;
-                    out[c][r] = m;
+                    if !s.is_finite() {
+                        return Err(Singular { site: Site::Input, value: s, condition_estimate: f64::INFINITY });
+                    }
+                    out[r][c] = s;
+                    out[c][r] = s;
                 }
             }
             Ok(out)

@@ -218,9 +218,18 @@ fn inertia_spd_and_power_balance() {
         let u: Vec<f64> = (0..6).map(|_| lcg(&mut s)).collect();
         let ud: Vec<f64> = (0..6).map(|_| lcg(&mut s)).collect();
         let i = noc::mass_matrix(&plan, &x).unwrap();
+        // Two routes to I: per-leg end-point inertias J⁻ᵀ M_J J⁻¹ vs inverse-dynamics columns.
+        let (pl, legs) = noc::kinematics(&plan, &x).unwrap();
+        let by_columns = noc::generalized_inertia_by_columns(&plan, &pl, &legs);
         for r in 0..6 {
             for c in 0..6 {
                 assert_eq!(i[r][c], i[c][r]);
+                assert!(
+                    (i[r][c] - by_columns[r][c]).abs() < 1e-12 * (1.0 + i[r][r].abs()),
+                    "I[{r}][{c}] {} vs {}",
+                    i[r][c],
+                    by_columns[r][c]
+                );
             }
         }
         // d/dt (½ uᵀ I u) along x(t) = x ⊕ t u, u(t) = u + t ud equals uᵀ f.

@@ -872,9 +872,10 @@ fn euler<R: Real>(rot: &M<R>, inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
     mv(rot, nb)
 }
 
-/// The generalized inertia `I = TᵀMT` of the speeds `u` (exactly symmetric): column `j` is the
-/// generalized force of `u = 0`, `u̇ = e_j` without gravity.
-pub fn generalized_inertia<R: Real>(
+/// The generalized inertia `I = TᵀMT` of the speeds `u`, column by column: column `j` is the
+/// generalized force of `u = 0`, `u̇ = e_j` without gravity. A second route to
+/// [`generalized_inertia`] (the tests compare them).
+pub fn generalized_inertia_by_columns<R: Real>(
     plan: &Plan,
     pl: &Platform<R>,
     legs: &[LegKin<R>],
@@ -895,6 +896,148 @@ pub fn generalized_inertia<R: Real>(
                 .collect()
         })
         .collect()
+}
+
+/// `aᵀ I b` for a body with rotation `rot` and inertia `inertia` (body frame); `c (a·b)` for an
+/// isotropic inertia `c·1`.
+fn inertia_quad<R: Real>(rot: &M<R>, inertia: &Mat3, a: V<R>, b: V<R>) -> R {
+    let c = inertia[0][0];
+    let isotropic = inertia[1][1] == c
+        && inertia[2][2] == c
+        && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
+        && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3];
+    if isotropic {
+        return R::c(c) * dot(a, b);
+    }
+    let (ab, bb) = (mtv(rot, a), mtv(rot, b));
+    dot(ab, mv(&cm::<R>(inertia), bb))
+}
+
+/// The generalized inertia `I = TᵀMT = Σ_b T_bᵀ M_b T_b` of the speeds `u` (exactly symmetric),
+/// assembled per leg (eq. 68's structure): the leg's joint-space inertia `M_J` (its open chain),
+/// then its end-point inertia `Λ = J⁻ᵀ M_J J⁻¹`, then `Gᵀ Λ G` with `G` the map from `u` to the
+/// end point's velocity; plus the platform's `T_Pᵀ M_P T_P`.
+pub fn generalized_inertia<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+) -> Vec<Vec<R>> {
+    let n = plan.dof();
+    let z = R::c(0.0);
+    let mut out = vec![vec![z; n]; n];
+    let pose = matches!(plan.motion, PlatformMotion::Pose);
+    for (lp, lk) in plan.legs.iter().zip(legs) {
+        let nj = lp.joints.len();
+        // Joint-space inertia of the leg's open chain (bodies k ≥ max(i, j)).
+        let mut mj = [[z; 3]; 3];
+        for k in 0..nj {
+            let (mass, _, inertia) = lp.bodies[k];
+            let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
+            if massless {
+                continue;
+            }
+            let c = lk.com[k];
+            // Twist columns of body k at its mass centre: (angular, linear).
+            let cols: Vec<(Option<V<R>>, V<R>)> = (0..=k)
+                .map(|j| match lp.joints[j] {
+                    JointKind::Revolute => (Some(lk.e[j]), cross(lk.e[j], sub(c, lk.o[j]))),
+                    JointKind::Prismatic => (None, lk.e[j]),
+                })
+                .collect();
+            for i in 0..=k {
+                for j in i..=k {
+                    let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);
+                    if let (Some(a), Some(b)) = (cols[i].0, cols[j].0) {
+                        v = v + inertia_quad(&lk.rot[k], &inertia, a, b);
+                    }
+                    mj[i][j] = mj[i][j] + v;
+                }
+            }
+        }
+        for i in 0..3 {
+            for j in 0..i {
+                mj[i][j] = mj[j][i];
+            }
+        }
+        // Λ = Wᵀ... with the rows of J⁻¹ in the base frame: Λ = Σ_ij M_J[i][j] w_i w_jᵀ.
+        let w: [V<R>; 3] = [
+            mv(&lk.frame, lk.jinv[0]),
+            mv(&lk.frame, lk.jinv[1]),
+            mv(&lk.frame, lk.jinv[2]),
+        ];
+        let b: [V<R>; 3] = core::array::from_fn(|i| {
+            add(
+                add(scale(mj[i][0], w[0]), scale(mj[i][1], w[1])),
+                scale(mj[i][2], w[2]),
+            )
+        });
+        let mut lam = [[z; 3]; 3];
+        for r in 0..3 {
+            for c in r..3 {
+                lam[r][c] = w[0][r] * b[0][c] + w[1][r] * b[1][c] + w[2][r] * b[2][c];
+                lam[c][r] = lam[r][c];
+            }
+        }
+        if pose {
+            // G = [−[r]×, 1]: I_vv = Λ, I_ωv = [r]× Λ, I_ωω = [r]× Λ [r]×ᵀ.
+            let r = lk.arm;
+            let col = |c: usize| [lam[0][c], lam[1][c], lam[2][c]];
+            let p: [V<R>; 3] = core::array::from_fn(|c| cross(r, col(c))); // columns of [r]×Λ
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[3 + i][3 + j] = out[3 + i][3 + j] + lam[i][j];
+                    out[i][3 + j] = out[i][3 + j] + p[j][i];
+                }
+            }
+            // I_ωω = ([r]×Λ)[r]×ᵀ: row i of [r]×Λ crossed with r, as columns.
+            for i in 0..3 {
+                let row = [p[0][i], p[1][i], p[2][i]];
+                let q = cross(r, row); // column i of [r]× (row)ᵀ … = ([r]×Λ[r]×ᵀ)[:, i]
+                for j in 0..3 {
+                    out[j][i] = out[j][i] + q[j];
+                }
+            }
+        } else {
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[i][j] = out[i][j] + lam[i][j];
+                }
+            }
+        }
+    }
+    // The platform: ω columns e_j with mass-centre velocity e_j × r_c; v columns (pose) e_j.
+    let (mass, com, inertia) = plan.platform;
+    let rc = mv(&pl.rot, cv::<R>(&com));
+    let unit = |j: usize| {
+        let mut e = zero3::<R>();
+        e[j] = R::c(1.0);
+        e
+    };
+    let cols: Vec<(Option<V<R>>, V<R>)> = (0..n)
+        .map(|j| {
+            if j < 3 {
+                (Some(unit(j)), cross(unit(j), rc))
+            } else {
+                (None, unit(j - 3))
+            }
+        })
+        .collect();
+    for i in 0..n {
+        for j in i..n {
+            let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);
+            if let (Some(a), Some(b)) = (cols[i].0, cols[j].0) {
+                v = v + inertia_quad(&pl.rot, &inertia, a, b);
+            }
+            out[i][j] = out[i][j] + v;
+        }
+    }
+    // Exactly symmetric: the upper triangle.
+    for i in 0..n {
+        for j in 0..i {
+            out[i][j] = out[j][i];
+        }
+    }
+    out
 }
 
 /// Solve `m x = b` for a symmetric positive definite `m` by `LDLᵀ` (no pivoting), each pivot
