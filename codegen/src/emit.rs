@@ -504,6 +504,12 @@ pub(crate) fn render(header: &[String], tokens: TokenStream) -> String {
 
 /// The op-count table (markdown) of a set of functions.
 pub fn stats_table(rows: &[(String, OpCount)], dof: usize) -> Vec<String> {
+    stats_table_per(rows, dof, "joint")
+}
+
+/// [`stats_table`] with the per-unit column named `flops/<per>` (`"DOF"` for parallel
+/// mechanisms, whose functions are per degree of freedom of the platform).
+pub fn stats_table_per(rows: &[(String, OpCount)], dof: usize, per: &str) -> Vec<String> {
     // The `atan2` column appears only when some function calls it (parallel mechanisms with
     // revolute actuators), so tree tables keep their shape.
     let atan2 = rows.iter().any(|(_, c)| c.atan2 > 0);
@@ -514,7 +520,7 @@ pub fn stats_table(rows: &[(String, OpCount)], dof: usize) -> Vec<String> {
     };
     let mut v = vec![
         format!(
-            "| function | flops | flops/joint | add | mul | neg | div | sqrt | sin_cos | cmp |{h1}"
+            "| function | flops | flops/{per} | add | mul | neg | div | sqrt | sin_cos | cmp |{h1}"
         ),
         format!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|{h2}"),
     ];

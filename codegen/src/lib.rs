@@ -85,6 +85,15 @@ pub struct Generated {
     pub dof: usize,
     /// Warnings from the spec (e.g. an axis normalized).
     pub warnings: diag::Diagnostics,
+    /// What the op-count table divides by: `"joint"` (trees) or `"DOF"` (parallel mechanisms).
+    pub per: &'static str,
+}
+
+impl Generated {
+    /// The op-count table (markdown), as in the module's header.
+    pub fn stats_table(&self) -> Vec<String> {
+        emit::stats_table_per(&self.stats, self.dof, self.per)
+    }
 }
 
 /// Parse, validate and generate: the pure entry point (no I/O). `file_name` names the spec in
@@ -285,5 +294,6 @@ pub fn generate(model: &Model, cfg: &Config) -> Generated {
         stats,
         dof: n,
         warnings: diag::Diagnostics::new("", ""),
+        per: "joint",
     }
 }

@@ -95,7 +95,7 @@ fn main() -> ExitCode {
         eprint!("{}", out.warnings.render());
     }
     let text = if cli.stats {
-        let mut t = codegen::emit::stats_table(&out.stats, out.dof).join("\n");
+        let mut t = out.stats_table().join("\n");
         t.push('\n');
         t
     } else {

@@ -365,7 +365,7 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
         },
         "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
     ];
-    header.extend(emit::stats_table(&stats, n));
+    header.extend(emit::stats_table_per(&stats, n, "DOF"));
     let fns: Vec<TokenStream> = functions
         .iter()
         .map(|f| emit::function(g, cfg, f))
@@ -399,6 +399,7 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
         stats,
         dof: n,
         warnings: crate::diag::Diagnostics::new("", ""),
+        per: "DOF",
     })
 }
 

@@ -206,6 +206,48 @@ pub fn mat_vec(a: &Mat3, v: &Vec3) -> Vec3 {
     ]
 }
 
+/// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method: the largest
+/// component first, so no division by a small number).
+pub fn matrix_quaternion(r: &Mat3) -> [f64; 4] {
+    let sq = |v: f64| libm::sqrt(v);
+    let tr = r[0][0] + r[1][1] + r[2][2];
+    let q = if tr > 0.0 {
+        let s = sq(tr + 1.0) * 2.0;
+        [
+            0.25 * s,
+            (r[2][1] - r[1][2]) / s,
+            (r[0][2] - r[2][0]) / s,
+            (r[1][0] - r[0][1]) / s,
+        ]
+    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+        let s = sq(1.0 + r[0][0] - r[1][1] - r[2][2]) * 2.0;
+        [
+            (r[2][1] - r[1][2]) / s,
+            0.25 * s,
+            (r[0][1] + r[1][0]) / s,
+            (r[0][2] + r[2][0]) / s,
+        ]
+    } else if r[1][1] > r[2][2] {
+        let s = sq(1.0 + r[1][1] - r[0][0] - r[2][2]) * 2.0;
+        [
+            (r[0][2] - r[2][0]) / s,
+            (r[0][1] + r[1][0]) / s,
+            0.25 * s,
+            (r[1][2] + r[2][1]) / s,
+        ]
+    } else {
+        let s = sq(1.0 + r[2][2] - r[0][0] - r[1][1]) * 2.0;
+        [
+            (r[1][0] - r[0][1]) / s,
+            (r[0][2] + r[2][0]) / s,
+            (r[1][2] + r[2][1]) / s,
+            0.25 * s,
+        ]
+    };
+    let n = sq(q.iter().map(|c| c * c).sum::<f64>());
+    [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
+}
+
 /// `aᵀ`.
 pub fn transpose(a: &Mat3) -> Mat3 {
     [

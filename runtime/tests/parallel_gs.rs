@@ -33,6 +33,13 @@ fn massless(name: &str) -> Body {
 }
 
 pub fn gough_stewart() -> ParallelModel {
+    gough_stewart_at_yaw(0.0)
+}
+
+/// The same platform assembled at home with the platform turned by `yaw` about the vertical.
+pub fn gough_stewart_at_yaw(yaw: f64) -> ParallelModel {
+    let (sy, cy) = yaw.sin_cos();
+    let turn = [[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]];
     let b = [
         [-2.12, 1.374, 0.0],
         [-2.38, 1.224, 0.0],
@@ -52,7 +59,8 @@ pub fn gough_stewart() -> ParallelModel {
     let home = [-1.5, 0.0, 1.0];
     let mut legs = Vec::new();
     for i in 0..6 {
-        let a = [home[0] + p[i][0], home[1] + p[i][1], home[2] + p[i][2]];
+        let pr = runtime::model::mat_vec(&turn, &p[i]);
+        let a = [home[0] + pr[0], home[1] + pr[1], home[2] + pr[2]];
         let d: [f64; 3] = [a[0] - b[i][0], a[1] - b[i][1], a[2] - b[i][2]];
         let len: f64 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let len = len.sqrt();
@@ -133,7 +141,7 @@ pub fn gough_stewart() -> ParallelModel {
             inertia: [[0.08, 0.001, 0.0], [0.001, 0.09, 0.002], [0.0, 0.002, 0.1]],
         },
         home: Transform {
-            rotation: diag(1.0),
+            rotation: turn,
             translation: home,
         },
         legs,
@@ -276,4 +284,13 @@ fn inertia_spd_and_power_balance() {
             assert!((xf[k] - x[k]).abs() < 1e-9, "{xf:?} vs {x:?}");
         }
     }
+}
+
+/// A platform assembled at its parallel singularity (90° yaw, Fichter 1986) is rejected when it
+/// is prepared: the constraint Jacobian must have full rank at home.
+#[test]
+fn singular_home_is_rejected() {
+    let e = Plan::new(&gough_stewart_at_yaw(core::f64::consts::FRAC_PI_2)).unwrap_err();
+    assert!(e.contains("singular at its home pose"), "{e}");
+    assert!(Plan::new(&gough_stewart_at_yaw(0.3)).is_ok());
 }

@@ -3,8 +3,8 @@
 
 use rand::Rng;
 use rand::rngs::StdRng;
+use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
-use runtime::parallel::{ParallelModel, PlatformMotion};
 
 /// The bundled parallel specs: (module name, spec file name).
 pub const PARALLEL: [&str; 4] = [
@@ -31,57 +31,14 @@ pub fn model(name: &str) -> ParallelModel {
     }
 }
 
-/// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method: the largest
-/// component first).
+/// Unit quaternion `[w, x, y, z]` of a rotation matrix.
 pub fn matrix_quaternion(r: &[[f64; 3]; 3]) -> [f64; 4] {
-    let tr = r[0][0] + r[1][1] + r[2][2];
-    let q = if tr > 0.0 {
-        let s = (tr + 1.0).sqrt() * 2.0;
-        [
-            0.25 * s,
-            (r[2][1] - r[1][2]) / s,
-            (r[0][2] - r[2][0]) / s,
-            (r[1][0] - r[0][1]) / s,
-        ]
-    } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
-        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
-        [
-            (r[2][1] - r[1][2]) / s,
-            0.25 * s,
-            (r[0][1] + r[1][0]) / s,
-            (r[0][2] + r[2][0]) / s,
-        ]
-    } else if r[1][1] > r[2][2] {
-        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
-        [
-            (r[0][2] - r[2][0]) / s,
-            (r[0][1] + r[1][0]) / s,
-            0.25 * s,
-            (r[1][2] + r[2][1]) / s,
-        ]
-    } else {
-        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
-        [
-            (r[1][0] - r[0][1]) / s,
-            (r[0][2] + r[2][0]) / s,
-            (r[1][2] + r[2][1]) / s,
-            0.25 * s,
-        ]
-    };
-    let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-    q.map(|c| c / n)
+    runtime::model::matrix_quaternion(r)
 }
 
 /// The home coordinates `x` of a model.
 pub fn home_x(m: &ParallelModel) -> Vec<f64> {
-    let q = matrix_quaternion(&m.home.rotation);
-    match m.motion {
-        PlatformMotion::Pose => {
-            let t = m.home.translation;
-            vec![t[0], t[1], t[2], q[0], q[1], q[2], q[3]]
-        }
-        PlatformMotion::Orientation { .. } => q.to_vec(),
-    }
+    m.home_x()
 }
 
 /// A random state near home that the runtime accepts: `x`, `u`, `ud`. Rotations up to

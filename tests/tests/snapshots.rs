@@ -2,7 +2,7 @@
 //! the generator's output. A change here must be reviewed (`cargo insta review`), not waved
 //! through: the numbers in these files are checked independently by `generated.rs`.
 
-use codegen::{Config, compile, emit::stats_table};
+use codegen::{Config, compile};
 
 fn generate(path: &std::path::Path) -> codegen::Generated {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("spec");
@@ -21,7 +21,7 @@ fn generated_modules() {
 fn op_count_tables() {
     insta::glob!("../../mechanisms/specs", "*.{toml,urdf}", |path| {
         let g = generate(path);
-        insta::assert_snapshot!(stats_table(&g.stats, g.dof).join("\n"));
+        insta::assert_snapshot!(g.stats_table().join("\n"));
     });
 }
 

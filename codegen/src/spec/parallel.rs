@@ -481,6 +481,13 @@ fn lower_checked(
     {
         messages.push(e);
     }
+    // Full rank of the constraint Jacobian at home: `Plan::new` evaluates the legs and the
+    // actuation matrix there.
+    if messages.is_empty()
+        && let Err(e) = runtime::parallel::Plan::new(&pm)
+    {
+        messages.push(e);
+    }
     for msg in messages {
         diags.push(validate_diagnostic(spec, ps, &closing_joints, msg));
     }

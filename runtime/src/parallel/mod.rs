@@ -157,6 +157,18 @@ impl ParallelModel {
         self.motion.dof()
     }
 
+    /// The coordinates `x` of the home pose.
+    pub fn home_x(&self) -> Vec<f64> {
+        let q = crate::model::matrix_quaternion(&self.home.rotation);
+        match self.motion {
+            PlatformMotion::Pose => {
+                let t = self.home.translation;
+                alloc::vec![t[0], t[1], t[2], q[0], q[1], q[2], q[3]]
+            }
+            PlatformMotion::Orientation { .. } => q.to_vec(),
+        }
+    }
+
     /// The typical length of the mechanism (m): the largest distance of a joint origin or the
     /// home platform origin from the base origin, at least 1 mm. Tolerances scale with it.
     pub fn size(&self) -> f64 {

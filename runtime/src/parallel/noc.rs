@@ -307,7 +307,7 @@ impl Plan {
             }
             legs.push(plan);
         }
-        Ok(Plan {
+        let plan = Plan {
             motion: model.motion,
             gravity: model.gravity,
             platform: (
@@ -316,7 +316,17 @@ impl Plan {
                 model.platform.inertia,
             ),
             legs,
-        })
+        };
+        // The constraint Jacobian must have full rank at home: every leg Jacobian and the
+        // actuation matrix regular there.
+        let home = model.home_x();
+        let n = plan.dof();
+        inverse_dynamics(&plan, &home, &vec![0.0; n], &vec![0.0; n]).map_err(|e| {
+            alloc::format!(
+                "the mechanism is singular at its home pose ({e}); the constraint Jacobian must have full rank there"
+            )
+        })?;
+        Ok(plan)
     }
 
     /// Degrees of freedom.

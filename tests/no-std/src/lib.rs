@@ -1,6 +1,6 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
-//! mechanism. Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! mechanism (trees and parallel mechanisms). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
@@ -41,3 +41,37 @@ export!(
     chain7,
     iiwa14
 );
+
+macro_rules! export_parallel {
+    ($($m:ident),* $(,)?) => {
+        $(
+            pub mod $m {
+                use mechanisms::$m as g;
+                /// Calls every generated function of a parallel mechanism once; returns a checksum.
+                #[unsafe(no_mangle)]
+                pub extern "C" fn $m(x: &[f64; g::NX], u: &[f64; g::DOF], ud: &[f64; g::DOF]) -> f64 {
+                    let pick = |r: Result<f64, g::Singular>| match r {
+                        Ok(v) => v,
+                        Err(e) => e.value,
+                    };
+                    let q = g::inverse_kinematics(x);
+                    let mut s = pick(q.map(|q| q[0]));
+                    s += pick(g::actuator_rates(x, u).map(|v| v[0]));
+                    s += pick(g::inverse_dynamics(x, u, ud).map(|v| v[0]));
+                    s += pick(g::mass_matrix(x).map(|m| m[0][0]));
+                    s += pick(g::actuator_mass_matrix(x).map(|m| m[0][0]));
+                    s += pick(g::forward_dynamics(x, u, ud).map(|v| v[0]));
+                    if let Ok(q) = q {
+                        s += match g::forward_kinematics(&q, x) {
+                            Ok(xf) => xf[0],
+                            Err(e) => e.residual,
+                        };
+                    }
+                    s
+                }
+            }
+        )*
+    };
+}
+
+export_parallel!(gough_stewart, sliding_hexapod, rus_hexapod, agile_eye);
