@@ -36,6 +36,7 @@ pub mod build_script;
 pub mod diag;
 pub mod dynamics;
 pub mod emit;
+pub mod macro_support;
 pub mod parallel;
 pub mod schedule;
 pub mod spec;
@@ -104,13 +105,25 @@ pub fn compile(
     cfg: &Config,
 ) -> Result<Generated, diag::Diagnostics> {
     let (mechanism, warnings) = spec::load_mechanism(file_name, source)?;
-    let mut out = match mechanism {
-        spec::Mechanism::Tree(model) => generate(&model, cfg),
-        spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg).map_err(|msg| {
-            let mut d = diag::Diagnostics::new(file_name, source);
-            d.push(diag::Diagnostic::error(msg).with_key("platform"));
-            d
-        })?,
+    let error = |msg: String| {
+        let mut d = diag::Diagnostics::new(file_name, source);
+        d.push(diag::Diagnostic::error(msg).with_key("platform"));
+        d
+    };
+    // A panic while generating is a generator bug; inside someone's build it must still come
+    // out as a diagnostic, not as an aborted build script or macro.
+    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match mechanism {
+        spec::Mechanism::Tree(model) => Ok(generate(&model, cfg)),
+        spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
+    }));
+    let mut out = match generated {
+        Ok(Ok(out)) => out,
+        Ok(Err(msg)) => return Err(error(msg)),
+        Err(_) => {
+            return Err(error(
+                "internal error: the generator panicked on this spec (please report it)".into(),
+            ));
+        }
     };
     out.warnings = warnings;
     Ok(out)

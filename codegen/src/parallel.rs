@@ -242,6 +242,9 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
         PlatformMotion::Orientation { .. } => {
             "`x = [qw, qx, qy, qz]` (unit quaternion of the platform about the fixed centre, base frame); `u = ω` (rad/s, base-frame components)"
         }
+        PlatformMotion::PlanarPoint { .. } => {
+            "`x = [px, py]` (the point where the legs meet, m, base frame); `u = [vx, vy]` (m/s)"
+        }
     };
     let make = |name: &'static str,
                 doc: Vec<String>,
@@ -417,7 +420,9 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
     let (qi, has_p) = match plan.motion {
         PlatformMotion::Pose => (3usize, true),
         PlatformMotion::Orientation { .. } => (0usize, false),
+        PlatformMotion::PlanarPoint { .. } => (0usize, false),
     };
+    let planar = matches!(plan.motion, PlatformMotion::PlanarPoint { .. });
     let qi = Literal::usize_unsuffixed(qi);
     let translate = if has_p {
         quote! {
@@ -428,6 +433,14 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
     } else {
         quote!()
     };
+    let retract = retract_template(
+        planar,
+        qi.clone(),
+        translate.clone(),
+        sqrt_a.clone(),
+        sin_cos.clone(),
+        sqrt_n.clone(),
+    );
     let act_tol_lit = Literal::f64_unsuffixed(act_tol);
     let fk_tol_lit = Literal::f64_unsuffixed(fk_tol);
     let fk_max_lit = Literal::usize_unsuffixed(fk_max);
@@ -670,31 +683,7 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
             Ok(out)
         }
 
-        /// `x` moved by the small motion `du` (rotation vector, then translation; base frame).
-        #[allow(clippy::all)]
-        fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
-            let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
-            let a = #sqrt_a;
-            let (s, c) = #sin_cos;
-            let k = if a > 1e-300 { s / a } else { 0.5 };
-            let d = [c, k * du[0], k * du[1], k * du[2]];
-            let i = #qi;
-            let q = [x[i], x[i + 1], x[i + 2], x[i + 3]];
-            let r = [
-                d[0] * q[0] - d[1] * q[1] - d[2] * q[2] - d[3] * q[3],
-                d[0] * q[1] + d[1] * q[0] + d[2] * q[3] - d[3] * q[2],
-                d[0] * q[2] - d[1] * q[3] + d[2] * q[0] + d[3] * q[1],
-                d[0] * q[3] + d[1] * q[2] - d[2] * q[1] + d[3] * q[0],
-            ];
-            let n = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
-            let n = #sqrt_n;
-            let mut out = *x;
-            for j in 0..4 {
-                out[i + j] = r[j] / n;
-            }
-            #translate
-            out
-        }
+        #retract
 
         /// The residual `q − q(x)` (angles wrapped to (−π, π]), its max norm, and `A(x)`.
         #[allow(clippy::all)]
@@ -775,5 +764,57 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
                 Err(NoConvergence { iterations: #fk_max_lit, residual: cur.1 })
             }
         }
+    }
+}
+
+/// The `retract` template: `x ⊕ du`.
+fn retract_template(
+    planar: bool,
+    qi: Literal,
+    translate: TokenStream,
+    sqrt_a: TokenStream,
+    sin_cos: TokenStream,
+    sqrt_n: TokenStream,
+) -> TokenStream {
+    if planar {
+        return quote! {
+            /// `x` moved by `du` (the point's displacement, m).
+            #[allow(clippy::all)]
+            fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+                let mut out = *x;
+                for i in 0..NX {
+                    out[i] += du[i];
+                }
+                out
+            }
+        };
+    }
+    quote! {
+        /// `x` moved by the small motion `du` (rotation vector, then translation; base frame).
+        #[allow(clippy::all)]
+        fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+            let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
+            let a = #sqrt_a;
+            let (s, c) = #sin_cos;
+            let k = if a > 1e-300 { s / a } else { 0.5 };
+            let d = [c, k * du[0], k * du[1], k * du[2]];
+            let i = #qi;
+            let q = [x[i], x[i + 1], x[i + 2], x[i + 3]];
+            let r = [
+                d[0] * q[0] - d[1] * q[1] - d[2] * q[2] - d[3] * q[3],
+                d[0] * q[1] + d[1] * q[0] + d[2] * q[3] - d[3] * q[2],
+                d[0] * q[2] - d[1] * q[3] + d[2] * q[0] + d[3] * q[1],
+                d[0] * q[3] + d[1] * q[2] - d[2] * q[1] + d[3] * q[0],
+            ];
+            let n = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
+            let n = #sqrt_n;
+            let mut out = *x;
+            for j in 0..4 {
+                out[i + j] = r[j] / n;
+            }
+            #translate
+            out
+        }
+
     }
 }

@@ -208,6 +208,86 @@ fn unwritable_output_exits_1() {
     assert!(stderr(&o).contains("error"), "{}", stderr(&o));
 }
 
+/// `true` when `s` has something shaped like a date (`2024-05-27`) or a clock time (`12:34:56`).
+fn has_timestamp(s: &str) -> bool {
+    let b = s.as_bytes();
+    let digits = |at: usize, n: usize| {
+        b.get(at..at + n)
+            .is_some_and(|d| d.iter().all(u8::is_ascii_digit))
+    };
+    (0..b.len()).any(|i| {
+        let boundary = i == 0 || !b[i - 1].is_ascii_alphanumeric();
+        boundary
+            && ((digits(i, 4)
+                && b.get(i + 4) == Some(&b'-')
+                && digits(i + 5, 2)
+                && b.get(i + 7) == Some(&b'-')
+                && digits(i + 8, 2))
+                || (digits(i, 2)
+                    && b.get(i + 2) == Some(&b':')
+                    && digits(i + 3, 2)
+                    && b.get(i + 5) == Some(&b':')
+                    && digits(i + 6, 2)))
+    })
+}
+
+/// Every bundled spec (trees and parallel mechanisms, TOML and URDF) generates byte-identical
+/// modules in two separate processes, one given the spec by a relative and one by an absolute
+/// path. Each process seeds std's `HashMap`s differently (`RandomState` draws fresh random keys
+/// per process), so any iteration over a std hash map that reached the output would show up
+/// here; the generator itself uses `IndexMap`/`FxHash` (fixed order and seed). The output holds
+/// no absolute path (not the spec's, not the workspace's, not the home directory) and nothing
+/// shaped like a timestamp.
+#[test]
+fn every_bundled_spec_generates_identically_with_no_paths_or_timestamps() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = root.join("../mechanisms/specs");
+    let mut specs: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".toml") || n.ends_with(".urdf"))
+        .collect();
+    specs.sort();
+    assert!(specs.len() >= 10, "{specs:?}");
+    let workspace = root.parent().unwrap().canonicalize().unwrap();
+    let mut forbidden = vec![
+        workspace.to_str().unwrap().to_owned(),
+        root.to_str().unwrap().to_owned(),
+        env!("CARGO_TARGET_TMPDIR").to_owned(),
+    ];
+    if let Ok(home) = std::env::var("HOME")
+        && home.len() > 1
+    {
+        forbidden.push(home);
+    }
+    for name in specs {
+        let rel = format!("../mechanisms/specs/{name}");
+        let abs = dir.join(&name).canonicalize().unwrap();
+        let a = run(&[&rel]);
+        let b = run(&[path_str(&abs)]);
+        assert_eq!(a.status.code(), Some(0), "{name}: {}", stderr(&a));
+        assert_eq!(b.status.code(), Some(0), "{name}: {}", stderr(&b));
+        let code = stdout(&a);
+        assert!(code.contains("pub const DOF: usize"), "{name}");
+        assert!(a.stdout == b.stdout, "{name}: two runs differ");
+        for f in &forbidden {
+            assert!(
+                !code.contains(f.as_str()),
+                "{name}: the output contains {f}"
+            );
+        }
+        assert!(!code.contains(&name), "{name}: the output names the file");
+        assert!(!has_timestamp(code), "{name}: the output has a timestamp");
+    }
+}
+
+#[test]
+fn timestamp_detector_works() {
+    assert!(has_timestamp("// generated 2024-05-27"));
+    assert!(has_timestamp("at 12:34:56 UTC"));
+    assert!(!has_timestamp("x1234-56-78 = 1; [f64; 12]; a:b:c"));
+}
+
 #[test]
 fn output_is_identical_across_processes() {
     for spec in [PUMA, PUMA_URDF] {

@@ -1,6 +1,7 @@
-//! Rendered diagnostics of every bad spec in `tests/data/bad/` (one file per kind of error) and
-//! of every bad parallel spec in `tests/data/bad_parallel/` (read with `load_mechanism`), as
-//! insta snapshots; and the good specs (including every complete example in `docs/spec.md` and
+//! Rendered diagnostics of every bad spec in `tests/data/bad/` (one file per kind of error), of
+//! every bad parallel spec in `tests/data/bad_parallel/` (read with `load_mechanism`) and of the
+//! accepted-with-warnings specs in `tests/data/warn/`, as insta snapshots (the list of kinds is
+//! `tests/data/README.md`); specs too large to generate; and the good specs (including every complete example in `docs/spec.md` and
 //! the bundled parallel specs in `mechanisms/specs/`) load without warnings.
 
 use std::path::Path;
@@ -41,6 +42,109 @@ fn bad_urdf_specs() {
     insta::glob!("data/bad", "*.urdf", |path| {
         insta::assert_snapshot!(render_bad(path));
     });
+}
+
+/// Loads `path`, which must be accepted with at least one warning, and renders the warnings.
+fn render_warnings(path: &Path) -> String {
+    let name = path.file_name().unwrap().to_str().unwrap();
+    let source = std::fs::read_to_string(path).unwrap();
+    match codegen::spec::load(name, &source) {
+        Ok((_, warnings)) => {
+            assert!(!warnings.is_empty(), "{name}: no warning");
+            for d in warnings.iter() {
+                assert!(!d.is_error() && d.span.is_some(), "{name}: {d:?}");
+            }
+            warnings.render()
+        }
+        Err(e) => panic!("{name} was rejected:\n{}", e.render()),
+    }
+}
+
+/// Specs that are accepted with warnings (`tests/data/warn/`): non-unit axes are normalized.
+#[test]
+fn warning_specs() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/warn");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| cfg!(feature = "urdf") || p.extension().is_none_or(|e| e != "urdf"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
+    for path in files {
+        let name = path.file_name().unwrap().to_str().unwrap().to_owned();
+        insta::assert_snapshot!(format!("warning_specs@{name}"), render_warnings(&path));
+    }
+}
+
+/// A serial chain of `n` revolute joints, as TOML.
+fn chain_toml(n: usize) -> String {
+    let mut s = String::from("[mechanism]\nname = \"huge\"\n");
+    for i in 0..n {
+        let parent = if i == 0 {
+            "base".to_owned()
+        } else {
+            format!("l{}", i - 1)
+        };
+        s += &format!(
+            "[[body]]\nname = \"l{i}\"\nmass = 1.0\ncom = [0.1, 0.0, 0.0]\n[[joint]]\nname = \"j{i}\"\nkind = \"R\"\nparent = \"{parent}\"\nchild = \"l{i}\"\norigin = {{ xyz = [0.2, 0.0, 0.0] }}\naxis = [0.0, 1.0, 0.0]\n"
+        );
+    }
+    s
+}
+
+/// Specs too large to generate are refused before lowering, quickly and with a clear message:
+/// too many coordinates, too many entries (TOML and URDF) and too many bytes. `compile` on them
+/// returns the same diagnostics (it never starts generating).
+#[test]
+fn specs_too_large_are_refused_up_front() {
+    use codegen::spec::{MAX_DOF, MAX_ENTRIES, MAX_SOURCE_BYTES};
+    let start = std::time::Instant::now();
+    let check = |name: &str, src: &str, expect: &str| -> String {
+        let e = codegen::spec::load_mechanism(name, src).unwrap_err();
+        let r = e.render();
+        assert!(r.contains(expect), "{name}:\n{r}");
+        let c = codegen::compile(name, src, &codegen::Config::default()).unwrap_err();
+        assert_eq!(c.render(), r);
+        r
+    };
+    // Exactly at the limit is fine (only loaded here: generating 64 joints takes a while).
+    codegen::spec::load("at_limit.toml", &chain_toml(MAX_DOF)).unwrap();
+    let dof = check(
+        "too_many_dof.toml",
+        &chain_toml(MAX_DOF + 1),
+        "too many joint coordinates",
+    );
+    insta::assert_snapshot!("too_many_dof_generated", dof);
+    let entries = check(
+        "huge.toml",
+        &chain_toml(20 * MAX_ENTRIES),
+        "the spec is too large: 20480 bodies",
+    );
+    assert!(entries.contains("20480 joints"), "{entries}");
+    #[cfg(feature = "urdf")]
+    {
+        let mut u = String::from("<robot name=\"huge\">\n<link name=\"l0\"/>\n");
+        for i in 1..=20 * MAX_ENTRIES {
+            u += &format!(
+                "<link name=\"l{i}\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n<joint name=\"j{i}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{i}\"/></joint>\n",
+                i - 1
+            );
+        }
+        u += "</robot>\n";
+        check(
+            "huge.urdf",
+            &u,
+            "the robot is too large: 20481 <link> elements",
+        );
+    }
+    let big = format!("# {}\n", "x".repeat(MAX_SOURCE_BYTES));
+    check("big.toml", &big, "the spec is too large");
+    assert!(
+        start.elapsed().as_secs() < 20,
+        "refusing large specs took {:?}",
+        start.elapsed()
+    );
 }
 
 /// As [`render_bad`], through `load_mechanism` (trees and parallel mechanisms).

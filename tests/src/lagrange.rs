@@ -997,6 +997,11 @@ pub fn platform_pose(motion: PlatformMotion, x: &[f64]) -> Transform {
             rotation: quaternion_matrix([x[0], x[1], x[2], x[3]]),
             translation: centre,
         },
+        // A point in the plane z = height; its frame does not turn.
+        PlatformMotion::PlanarPoint { height } => Transform {
+            rotation: quaternion_matrix([1.0, 0.0, 0.0, 0.0]),
+            translation: [x[0], x[1], height],
+        },
     }
 }
 
@@ -1058,7 +1063,7 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
                 let axis = mat_vec(&lpose.rotation, &on_leg);
                 let centre = match model.motion {
                     PlatformMotion::Orientation { centre } => centre,
-                    PlatformMotion::Pose => plat.translation,
+                    PlatformMotion::Pose | PlatformMotion::PlanarPoint { .. } => plat.translation,
                 };
                 (
                     CJointKind::Revolute { axis },

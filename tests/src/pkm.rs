@@ -7,11 +7,12 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 4] = [
+pub const PARALLEL: [&str; 5] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
     "agile_eye",
+    "planar_five_bar",
 ];
 
 /// The spec file of a bundled mechanism.
@@ -54,7 +55,11 @@ pub fn random_state(
     loop {
         let mut d = vec![0.0; n];
         for (i, v) in d.iter_mut().enumerate() {
-            *v = if i < 3 { angle } else { reach } * rng.random_range(-1.0..1.0);
+            let planar = matches!(
+                plan.motion,
+                runtime::parallel::PlatformMotion::PlanarPoint { .. }
+            );
+            *v = if i < 3 && !planar { angle } else { reach } * rng.random_range(-1.0..1.0);
         }
         let x = noc::retract(plan.motion, home, &d);
         if noc::inverse_dynamics(plan, &x, &vec![0.0; n], &vec![0.0; n]).is_err() {

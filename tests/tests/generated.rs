@@ -240,3 +240,28 @@ fn planar_2r_matches_the_textbook_closed_form() {
         assert!(e <= TOL, "planar 2R vs closed form: {e:e}");
     }
 }
+
+/// Bad input to the generated tree functions (docs/spec.md, "Bad input"): NaN and ∞ propagate
+/// through `inverse_dynamics` and its parts by IEEE arithmetic (no panic, no check);
+/// `forward_dynamics` returns `Err(Singular)` when a NaN reaches a pivot of the mass matrix
+/// (here `q[1]`, which sets the 2R arm's mass matrix) and otherwise an `Ok` holding NaN.
+#[test]
+fn nan_and_infinity_propagate_as_documented() {
+    use mechanisms::planar_2r as mech;
+    let nan = f64::NAN;
+    let inf = f64::INFINITY;
+    let tau = mech::inverse_dynamics(&[0.1, nan], &[0.0; 2], &[0.0; 2]);
+    assert!(tau.iter().all(|t| t.is_nan()), "{tau:?}");
+    let tau = mech::inverse_dynamics(&[0.1, 0.2], &[inf, 0.0], &[0.0; 2]);
+    assert!(tau.iter().any(|t| !t.is_finite()), "{tau:?}");
+    assert!(
+        mech::mass_matrix(&[0.0, nan])
+            .iter()
+            .flatten()
+            .any(|m| m.is_nan())
+    );
+    assert!(mech::gravity(&[nan, 0.0]).iter().any(|g| g.is_nan()));
+    assert!(mech::forward_dynamics(&[0.1, nan], &[0.0; 2], &[1.0; 2]).is_err());
+    let qdd = mech::forward_dynamics(&[0.1, 0.2], &[0.0; 2], &[nan, 1.0]).unwrap();
+    assert!(qdd.iter().any(|x| x.is_nan()), "{qdd:?}");
+}

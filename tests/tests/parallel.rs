@@ -26,6 +26,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
     match m.motion {
         PlatformMotion::Pose => (0.15, 0.03 * m.size()),
         PlatformMotion::Orientation { .. } => (0.4, 0.0),
+        PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
     }
 }
 
@@ -104,6 +105,7 @@ generated_vs_runtime!(gough_stewart);
 generated_vs_runtime!(sliding_hexapod);
 generated_vs_runtime!(rus_hexapod);
 generated_vs_runtime!(agile_eye);
+generated_vs_runtime!(planar_five_bar);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -170,6 +172,7 @@ power_balance!(power_balance_gough_stewart, gough_stewart);
 power_balance!(power_balance_sliding_hexapod, sliding_hexapod);
 power_balance!(power_balance_rus_hexapod, rus_hexapod);
 power_balance!(power_balance_agile_eye, agile_eye);
+power_balance!(power_balance_planar_five_bar, planar_five_bar);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]
@@ -211,16 +214,32 @@ macro_rules! against_lagrange {
                 let closure = lagrange::closure_residual(&sys);
                 assert!(closure < 1e-12 * m.size(), "loop open by {closure:e}");
                 let platform = sys.bodies.len() - 1;
-                let prescribed = match m.motion {
-                    PlatformMotion::Pose => Prescribed::Pose {
-                        body: platform,
-                        point: [x[0], x[1], x[2]],
-                    },
-                    PlatformMotion::Orientation { .. } => {
-                        Prescribed::Orientation { body: platform }
-                    }
+                let (prescribed, uu, uud) = match m.motion {
+                    PlatformMotion::Pose => (
+                        Prescribed::Pose {
+                            body: platform,
+                            point: [x[0], x[1], x[2]],
+                        },
+                        u.clone(),
+                        ud.clone(),
+                    ),
+                    PlatformMotion::Orientation { .. } => (
+                        Prescribed::Orientation { body: platform },
+                        u.clone(),
+                        ud.clone(),
+                    ),
+                    // The point's in-plane velocity; the point body's idle spin is prescribed
+                    // zero (its rotational inertia is not part of the model).
+                    PlatformMotion::PlanarPoint { height } => (
+                        Prescribed::Pose {
+                            body: platform,
+                            point: [x[0], x[1], height],
+                        },
+                        vec![0.0, 0.0, 0.0, u[0], u[1], 0.0],
+                        vec![0.0, 0.0, 0.0, ud[0], ud[1], 0.0],
+                    ),
                 };
-                let sol = lagrange::inverse_dynamics(&sys, &prescribed, &u, &ud).unwrap();
+                let sol = lagrange::inverse_dynamics(&sys, &prescribed, &uu, &uud).unwrap();
                 let tau = g::inverse_dynamics(&arr(&x), &arr(&u), &arr(&ud)).unwrap();
                 worst = worst.max(rel(&tau, &sol.efforts));
             }
@@ -237,3 +256,4 @@ against_lagrange!(lagrange_gough_stewart, gough_stewart);
 against_lagrange!(lagrange_sliding_hexapod, sliding_hexapod);
 against_lagrange!(lagrange_rus_hexapod, rus_hexapod);
 against_lagrange!(lagrange_agile_eye, agile_eye);
+against_lagrange!(lagrange_planar_five_bar, planar_five_bar);

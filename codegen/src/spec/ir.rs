@@ -33,6 +33,8 @@ pub(crate) enum Coordinates {
     Pose,
     /// Three DOF: orientation about a fixed centre (a spherical mechanism).
     Orientation,
+    /// Two DOF: a point moving in a plane `z = const` (a planar five-bar).
+    Planar,
 }
 
 /// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`

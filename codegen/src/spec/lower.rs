@@ -22,10 +22,47 @@ pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
     }
     let topo = topo?;
     let built = build(spec, &topo, &axes, diags);
+    check_massless_subtrees(spec, &built, diags);
     if diags.has_errors() {
         None
     } else {
         Some(built.model)
+    }
+}
+
+/// A movable joint that moves only massless bodies (no mass and no inertia anywhere beyond it)
+/// has a zero row and column in the mass matrix at every configuration: `forward_dynamics`
+/// always returns `Err(Singular)`. A warning, not an error: inverse dynamics and gravity are
+/// still right, and URDFs often have such links (no `<inertial>`). Once per spec joint.
+fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) {
+    let m = &built.model;
+    let mut massive: Vec<bool> = m
+        .bodies
+        .iter()
+        .map(|b| b.mass != 0.0 || b.inertia.iter().flatten().any(|x| *x != 0.0))
+        .collect();
+    // Parents come before children: accumulate from the tips.
+    for i in (0..m.joints.len()).rev() {
+        if massive[i]
+            && let Some(p) = m.joints[i].parent
+        {
+            massive[p] = true;
+        }
+    }
+    let mut reported = Vec::new();
+    for (i, moves_mass) in massive.iter().enumerate() {
+        let sj = built.spec_joint[i];
+        if *moves_mass || reported.contains(&sj) {
+            continue;
+        }
+        reported.push(sj);
+        let j = &spec.joints[sj];
+        diags.push(
+            Diagnostic::warning(format!("joint \"{}\" moves only massless bodies", j.name))
+            .with_key(j.key.clone())
+            .with_span(j.span.clone())
+            .with_hint("its row of the mass matrix is zero at every configuration, so forward_dynamics will always return Err(Singular); give a body beyond it a mass or an inertia, or make the joint fixed"),
+        );
     }
 }
 

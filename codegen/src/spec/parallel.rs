@@ -312,7 +312,7 @@ fn lower_checked(
         let kinds: Vec<JointKind> = path.iter().map(|&k| model.joints[k].kind).collect();
         let supported = match motion {
             Coordinates::Pose => SUPPORTED_POSE,
-            Coordinates::Orientation => SUPPORTED_ORIENTATION,
+            Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
         };
         if !supported.contains(&kinds.as_slice()) {
             let word: Vec<&str> = spec_path
@@ -356,6 +356,11 @@ fn lower_checked(
         let frame = compose(&pose_in_tip, &origin);
         let child_origin = j.child_origin.unwrap_or(Transform::IDENTITY);
         let end = match j.kind {
+            // A planar point platform: the revolute joint at the point only ties the point.
+            Kind::Revolute if motion == Coordinates::Planar => LegEnd::Spherical {
+                on_leg: frame.translation,
+                on_platform: child_origin.translation,
+            },
             Kind::Revolute => {
                 let e = axes[c].first().copied().unwrap_or([0.0, 0.0, 1.0]);
                 LegEnd::Revolute {
@@ -383,6 +388,9 @@ fn lower_checked(
     let motion = match motion {
         Coordinates::Pose => PlatformMotion::Pose,
         Coordinates::Orientation => PlatformMotion::Orientation { centre },
+        Coordinates::Planar => PlatformMotion::PlanarPoint {
+            height: ps.home.translation[2],
+        },
     };
     let parts: Vec<MassProps> = platform_parts
         .iter()
@@ -579,7 +587,8 @@ fn check_platform(
 }
 
 /// Mobility by Grübler–Kutzbach, `M = λ(n − j − 1) + Σf` over the spec's bodies (plus the base)
-/// and joints, against the platform's DOF; and the number of actuators against the DOF.
+/// and joints (minus the idle spin of a planar point platform), against the platform's DOF; and
+/// the number of actuators against the DOF.
 fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
     let Some(coords) = ps.coordinates else {
         return;
@@ -587,6 +596,7 @@ fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
     let (lambda, dof, what) = match coords {
         Coordinates::Pose => (6i64, 6i64, "spatial, λ = 6"),
         Coordinates::Orientation => (3, 3, "spherical, λ = 3"),
+        Coordinates::Planar => (3, 2, "planar, λ = 3"),
     };
     let n = spec.bodies.len() as i64 + 1;
     let j = spec.joints.len() as i64;
@@ -600,10 +610,14 @@ fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
             Kind::Fixed => 0,
         })
         .sum();
-    let m = lambda * (n - j - 1) + f;
+    // A planar point platform's spin about the plane normal is idle (the point has no
+    // orientation), so it does not count.
+    let idle = i64::from(coords == Coordinates::Planar);
+    let m = lambda * (n - j - 1) + f - idle;
     let coords_word = match coords {
         Coordinates::Pose => "pose",
         Coordinates::Orientation => "orientation",
+        Coordinates::Planar => "planar",
     };
     if m != dof {
         diags.push(
@@ -617,6 +631,7 @@ fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
                 match coords {
                     Coordinates::Pose => ": each leg of a 6-DOF platform has six joint freedoms (UPS, PUS, RUS)",
                     Coordinates::Orientation => ": each leg of a spherical mechanism is R-R-R",
+                    Coordinates::Planar => ": each leg of a planar five-bar is R-R, joined at the point by a revolute",
                 }
             )),
         );
@@ -670,6 +685,7 @@ fn check_closing_joint(
         let (want, word) = match coords {
             Coordinates::Pose => (Kind::Spherical, "pose"),
             Coordinates::Orientation => (Kind::Revolute, "orientation"),
+            Coordinates::Planar => (Kind::Revolute, "planar"),
         };
         if j.kind != want {
             diags.push(

@@ -107,6 +107,14 @@ fn type_name(v: &DeValue<'_>) -> &'static str {
     }
 }
 
+/// `"2 kg"`, `"10mm"`, `"1.5 lb"` → `("2", "kg")`: a number followed by a word (a unit).
+fn number_with_unit(s: &str) -> Option<(&str, &str)> {
+    let s = s.trim();
+    let split = s.find(|c: char| c.is_alphabetic() || c == '°')?;
+    let (num, unit) = (s[..split].trim(), s[split..].trim());
+    (!num.is_empty() && num.parse::<f64>().is_ok() && !unit.is_empty()).then_some((num, unit))
+}
+
 fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t Val<'i>> {
     t.get(k)
 }
@@ -176,6 +184,13 @@ impl Reader<'_> {
             && s.trim().parse::<f64>().is_ok()
         {
             d.hint = Some("write the number without quotes".into());
+        } else if let DeValue::String(s) = v.get_ref()
+            && expected.contains("number")
+            && let Some((num, unit)) = number_with_unit(s)
+        {
+            d.hint = Some(format!(
+                "values are plain numbers in SI units (m, kg, kg·m², m/s²; angles in rad or as angle strings): convert {num} {unit} and write it without quotes and unit"
+            ));
         }
     }
 
@@ -222,7 +237,12 @@ impl Reader<'_> {
             }
         };
         match x {
-            Some(x) if x.is_finite() => Some(x),
+            Some(x) if x.is_finite() && super::in_range(x) => Some(x),
+            Some(x) if x.is_finite() => {
+                self.err(format!("value {x:e} is out of range"), key, v.span())
+                    .hint = Some(super::RANGE_HINT.into());
+                None
+            }
             Some(_) => {
                 self.err("value is not finite", key, v.span()).hint =
                     Some("nan and inf are not allowed: every value must be a finite number".into());
@@ -239,7 +259,16 @@ impl Reader<'_> {
     fn angle(&mut self, v: &Val<'_>, key: &str) -> Option<f64> {
         match v.get_ref() {
             DeValue::String(s) => match parse_angle(s) {
-                Ok(a) => Some(a),
+                Ok(a) if super::in_range(a) => Some(a),
+                Ok(a) => {
+                    self.err(
+                        format!("angle {s:?} ({a:e} rad) is out of range"),
+                        key,
+                        v.span(),
+                    )
+                    .hint = Some(super::RANGE_HINT.into());
+                    None
+                }
                 Err(e) => {
                     self.err(format!("invalid angle {s:?}: {e}"), key, v.span())
                         .hint = Some(ANGLE_HINT.into());
@@ -430,13 +459,14 @@ impl Reader<'_> {
                     p.coordinates = match s.as_str() {
                         "pose" => Some(Coordinates::Pose),
                         "orientation" => Some(Coordinates::Orientation),
+                        "planar" => Some(Coordinates::Planar),
                         other => {
                             let hint = suggest_hint(
                                 &other.to_ascii_lowercase(),
-                                &["pose", "orientation"],
+                                &["pose", "orientation", "planar"],
                             )
                             .unwrap_or_else(|| {
-                                "coordinates is \"pose\" (position and orientation, 6 DOF) or \"orientation\" (rotation about a fixed centre, 3 DOF)".into()
+                                "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF) or \"planar\" (a point in a plane, 2 DOF)".into()
                             });
                             self.err(
                                 format!("unknown platform coordinates {other:?}"),

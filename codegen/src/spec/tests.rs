@@ -531,7 +531,17 @@ mod urdf {
 
     #[test]
     fn urdf_conventions() {
-        let m = ok("r.urdf", URDF);
+        // The massless links l2, l3 and l2b draw one warning per joint moving only them.
+        let (m, w) = load("r.urdf", URDF).unwrap_or_else(|e| panic!("{}", e.render()));
+        let w: Vec<String> = w.iter().map(|d| d.message.clone()).collect();
+        assert_eq!(
+            w,
+            [
+                "joint \"j2b\" moves only massless bodies",
+                "joint \"j3\" moves only massless bodies",
+                "joint \"j2\" moves only massless bodies"
+            ]
+        );
         assert_eq!(m.name, "test_robot_2");
         assert_eq!(m.gravity, [0.0, 0.0, -9.81]);
         // Depth-first from the root, children in document order: j1, j2b, j2, j3.

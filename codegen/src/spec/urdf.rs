@@ -243,15 +243,28 @@ fn check_triple(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
             "non-finite number in {}=\"{}\"",
             attr.name, attr.value
         ))
+    } else if toks
+        .iter()
+        .any(|t| !t.parse::<f64>().is_ok_and(super::in_range))
+    {
+        Some(format!(
+            "number out of range in {}=\"{}\" (|x| <= 1e9)",
+            attr.name, attr.value
+        ))
     } else {
         None
     };
     if let Some(m) = msg {
+        let hint = if m.contains("out of range") {
+            super::RANGE_HINT
+        } else {
+            "write three finite numbers separated by spaces, e.g. \"0 0 1\""
+        };
         diags.push(
             Diagnostic::error(m)
                 .with_key(key)
                 .with_span(attr.span.clone())
-                .with_hint("write three finite numbers separated by spaces, e.g. \"0 0 1\""),
+                .with_hint(hint),
         );
     }
 }
@@ -259,7 +272,16 @@ fn check_triple(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
 /// Checks a single-number attribute strictly.
 fn check_number(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
     match attr.value.trim().parse::<f64>() {
-        Ok(x) if x.is_finite() => {}
+        Ok(x) if x.is_finite() && super::in_range(x) => {}
+        Ok(x) if x.is_finite() => diags.push(
+            Diagnostic::error(format!(
+                "value out of range {}=\"{}\"",
+                attr.name, attr.value
+            ))
+            .with_key(key)
+            .with_span(attr.span.clone())
+            .with_hint(super::RANGE_HINT),
+        ),
         Ok(_) => diags.push(
             Diagnostic::error(format!("non-finite value {}=\"{}\"", attr.name, attr.value))
                 .with_key(key)
@@ -442,6 +464,31 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         );
         return None;
     };
+    // The size limit, before anything quadratic in the number of links and joints.
+    for what in ["link", "joint"] {
+        let mut of_kind = tags
+            .iter()
+            .filter(|t| t.parent == Some(robot) && t.name == what);
+        let n = of_kind.clone().count();
+        if n > super::MAX_ENTRIES {
+            let first = of_kind.nth(super::MAX_ENTRIES).map(Tag::name_span);
+            diags.push(
+                Diagnostic::error(format!(
+                    "the robot is too large: {n} <{what}> elements (the limit is {})",
+                    super::MAX_ENTRIES
+                ))
+                .with_span(first)
+                .with_hint(format!(
+                    "this is the first one over the limit; nocdyn generates mechanisms of at most {} links and joints and {} degrees of freedom",
+                    super::MAX_ENTRIES,
+                    super::MAX_DOF
+                )),
+            );
+        }
+    }
+    if diags.has_errors() {
+        return None;
+    }
     let doc = Doc { tags, robot };
     let (link_tags, joint_tags) = precheck(&doc, diags);
     if diags.has_errors() {

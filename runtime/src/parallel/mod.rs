@@ -41,6 +41,13 @@ pub enum PlatformMotion {
         /// The fixed centre of rotation (base frame, m).
         centre: Vec3,
     },
+    /// Two DOF: a point `P` moving in the plane `z = height` of the base frame, where the legs
+    /// meet (a planar five-bar). `x = [px, py]` (m), `u = [vx, vy]` (m/s). The platform is a
+    /// point mass at `P` (its rotation is not a coordinate; rotational inertia is ignored).
+    PlanarPoint {
+        /// The plane's height `z` (base frame, m).
+        height: f64,
+    },
 }
 
 impl PlatformMotion {
@@ -49,6 +56,7 @@ impl PlatformMotion {
         match self {
             PlatformMotion::Pose => 7,
             PlatformMotion::Orientation { .. } => 4,
+            PlatformMotion::PlanarPoint { .. } => 2,
         }
     }
     /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
@@ -56,6 +64,7 @@ impl PlatformMotion {
         match self {
             PlatformMotion::Pose => 6,
             PlatformMotion::Orientation { .. } => 3,
+            PlatformMotion::PlanarPoint { .. } => 2,
         }
     }
 }
@@ -64,7 +73,8 @@ impl PlatformMotion {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LegEnd {
     /// A spherical joint: the point `on_leg` (last leg body's frame, m) coincides with the point
-    /// `on_platform` (platform frame, m).
+    /// `on_platform` (platform frame, m). For a [`PlatformMotion::PlanarPoint`] platform this is
+    /// the revolute joint at `P` (only the point matters: the platform is a point).
     Spherical {
         /// The joint centre in the last leg body's frame.
         on_leg: Vec3,
@@ -130,6 +140,9 @@ pub enum LegKind {
     /// Two revolutes then the revolute to the platform, all axes through the centre of an
     /// orientation mechanism: spherical RRR.
     SphericalRr,
+    /// Two revolutes with axes along the plane normal, to the point of a planar point platform:
+    /// the leg of a planar five-bar.
+    PlanarRr,
 }
 
 impl LegKind {
@@ -140,6 +153,7 @@ impl LegKind {
             LegKind::Pus => "PUS",
             LegKind::Rus => "RUS",
             LegKind::SphericalRr => "spherical RRR",
+            LegKind::PlanarRr => "planar RR",
         }
     }
 }
@@ -166,6 +180,9 @@ impl ParallelModel {
                 alloc::vec![t[0], t[1], t[2], q[0], q[1], q[2], q[3]]
             }
             PlatformMotion::Orientation { .. } => q.to_vec(),
+            PlatformMotion::PlanarPoint { .. } => {
+                alloc::vec![self.home.translation[0], self.home.translation[1]]
+            }
         }
     }
 
@@ -311,6 +328,22 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
             }
             LegKind::SphericalRr
         }
+        (PlatformMotion::PlanarPoint { .. }, LegEnd::Spherical { .. }, [R, R]) => {
+            for (k, (e, _)) in ax.iter().enumerate() {
+                if (e[0].abs() > 1e-12) || (e[1].abs() > 1e-12) {
+                    return Err(format!(
+                        "leg {name}: the axis of its joint {} is not along the plane normal z",
+                        leg.joints[k].name
+                    ));
+                }
+            }
+            LegKind::PlanarRr
+        }
+        (PlatformMotion::PlanarPoint { .. }, _, _) => {
+            return Err(format!(
+                "leg {name}: a planar point platform needs legs of two revolutes about z (R-R) that end in the point"
+            ));
+        }
         (PlatformMotion::Pose, LegEnd::Revolute { .. }, _) => {
             return Err(format!(
                 "leg {name}: a 6-DOF platform needs legs that end in a spherical joint"
@@ -327,7 +360,7 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
                 .map(|k| if *k == R { "R" } else { "P" })
                 .collect();
             return Err(format!(
-                "leg {name}: joints {} are not a supported leg type (supported: UPS, PUS, RUS for a 6-DOF platform; RRR with every axis through the centre for an orientation platform)",
+                "leg {name}: joints {} are not a supported leg type (supported: UPS, PUS, RUS for a 6-DOF platform; RRR with every axis through the centre for an orientation platform; RR about z for a planar point)",
                 word.join("-")
             ));
         }

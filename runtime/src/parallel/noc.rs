@@ -39,9 +39,11 @@ use super::{LegEnd, LegKind, ParallelModel, PlatformMotion};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
 
 /// Leg-Jacobian threshold: a leg is singular when `|det J_J| ≤ LEG_TOLERANCE · ∏‖columns‖`
-/// (the Hadamard ratio; its inverse, reported as the condition estimate, grows like the
-/// condition number of `J_J`).
-pub const LEG_TOLERANCE: f64 = 1e-8;
+/// (the Hadamard ratio `h`; its inverse, reported as the condition estimate, grows like the
+/// condition number of `J_J`). The velocity terms carry `J⁻¹` twice, so rounding near a leg
+/// singularity grows like `ε/h²` (measured on the five-bar's stretched leg): `1e-4` keeps it
+/// below about `1e-8`.
+pub const LEG_TOLERANCE: f64 = 1e-4;
 /// Actuation-matrix threshold: `A` (columns scaled to unit norm) is singular when a pivot of its
 /// partially pivoted LU is `≤ ACTUATION_TOLERANCE` times the largest pivot; the condition
 /// estimate is the ratio of the largest to the smallest pivot.
@@ -243,11 +245,18 @@ impl Plan {
                     on_platform,
                 } => (mat_vec(&last.rotation, &on_leg), on_platform),
             };
+            let u_centre = match kind {
+                LegKind::Ups | LegKind::SphericalRr => {
+                    meet(&points[0], &axes[0], &points[1], &axes[1])
+                }
+                LegKind::Pus | LegKind::Rus => meet(&points[1], &axes[1], &points[2], &axes[2]),
+                // The elbow of a planar RR leg.
+                LegKind::PlanarRr => points[1],
+            };
             let (ui, uj) = match kind {
-                LegKind::Ups | LegKind::SphericalRr => (0, 1),
+                LegKind::Ups | LegKind::SphericalRr | LegKind::PlanarRr => (0, 1),
                 LegKind::Pus | LegKind::Rus => (1, 2),
             };
-            let u_centre = meet(&points[ui], &axes[ui], &points[uj], &axes[uj]);
             let (e1, e2) = (axes[ui], axes[uj]);
             let k = cross3(&e1, &e2);
             let mut plan = LegPlan {
@@ -284,7 +293,7 @@ impl Plan {
                     plan.sigma_first = sign(dot3(&axes[0], &d));
                     plan.sigma_u = sign(dot3(&d, &k));
                 }
-                LegKind::Rus => {
+                LegKind::Rus | LegKind::PlanarRr => {
                     let d = sub3(&end_home, &u_centre);
                     plan.length = libm::sqrt(dot3(&d, &d));
                     plan.sigma_u = sign(dot3(&d, &k));
@@ -354,6 +363,12 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
     let (origin, q) = match plan.motion {
         PlatformMotion::Pose => ([x[0], x[1], x[2]], [x[3], x[4], x[5], x[6]]),
         PlatformMotion::Orientation { centre } => (cv(&centre), [x[0], x[1], x[2], x[3]]),
+        PlatformMotion::PlanarPoint { height } => {
+            return Ok(Platform {
+                rot: ident(),
+                origin: [x[0], x[1], R::c(height)],
+            });
+        }
     };
     let [w, a, b, c] = q;
     let n = w * w + a * a + b * b + c * c;
@@ -431,6 +446,15 @@ fn two_axes<R: Real>(
     let s1 = dot(cross(cv(e1), cq), qq) / n1;
     let c1 = dot(cq, qq) / n1;
     Ok([(s1, c1), (s2, c2)])
+}
+
+/// Paden–Kahan subproblem 1: `(sin, cos)` of the rotation about the unit `e` that turns `p`
+/// onto `q` (equal components across `e`).
+fn one_axis<R: Real>(e: &Vec3, p: V<R>, q: V<R>) -> (R, R) {
+    let pp = sub(p, scale(dot(cv(e), p), cv(e)));
+    let qq = sub(q, scale(dot(cv(e), q), cv(e)));
+    let n = dot(pp, pp);
+    (dot(cross(cv(e), pp), qq) / n, dot(pp, qq) / n)
 }
 
 /// RUS: `(sin, cos)` of the crank angle that puts the U centre at the rod length from `a` (`L`).
@@ -564,6 +588,18 @@ pub fn leg_kinematics<R: Real>(
             q.push(JointPos::R(a.0, a.1));
             q.push(JointPos::R(b.0, b.1));
         }
+        LegKind::PlanarRr => {
+            let (s0, c0) = rus_crank(lp, target, k)?;
+            let r0 = rot(&lp.axes[0], s0, c0);
+            let o0 = cv(&lp.points[0]);
+            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+            // The distal link's direction in the proximal link's home frame.
+            let qv = mtv(&r0, sub(target, u));
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let (s1, c1) = one_axis(&lp.axes[1], cv(&p), qv);
+            q.push(JointPos::R(s0, c0));
+            q.push(JointPos::R(s1, c1));
+        }
         LegKind::SphericalRr => {
             let [a, b] = two_axes(
                 &lp.axes[0],
@@ -611,6 +647,13 @@ pub fn leg_kinematics<R: Real>(
     // Jacobian columns and their adjugate.
     let cols: Vec<V<R>> = match lp.kind {
         LegKind::SphericalRr => vec![e[0], e[1], end],
+        // A virtual third column along the plane normal keeps J_J 3 × 3; its rate is zero
+        // because the end point moves in the plane.
+        LegKind::PlanarRr => vec![
+            cross(e[0], sub(end, o[0])),
+            cross(e[1], sub(end, o[1])),
+            e[0],
+        ],
         _ => (0..n)
             .map(|j| match lp.joints[j] {
                 JointKind::Revolute => cross(e[j], sub(end, o[j])),
@@ -663,18 +706,6 @@ pub fn actuated_positions<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<R> {
         .collect()
 }
 
-/// The end point's (or end axis's) velocity map: `v_end = G u` in the base frame, as rows.
-fn end_velocity<R: Real>(plan: &Plan, lk: &LegKin<R>, u: &[R]) -> V<R> {
-    match plan.motion {
-        PlatformMotion::Pose => {
-            let w = [u[0], u[1], u[2]];
-            let v = [u[3], u[4], u[5]];
-            add(v, cross(w, lk.arm))
-        }
-        PlatformMotion::Orientation { .. } => [u[0], u[1], u[2]],
-    }
-}
-
 /// The actuation matrix `A` (`q̇ = A u`), row-major `DOF × DOF`.
 pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>> {
     plan.legs
@@ -689,6 +720,7 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                     vec![m[0], m[1], m[2], g[0], g[1], g[2]]
                 }
                 PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
+                PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
             }
         })
         .collect()
@@ -761,8 +793,13 @@ pub fn generalized_force<R: Real>(
     let dof = plan.dof();
     let mut f: Vec<R> = vec![R::c(0.0); dof];
     let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
-    let w = [u[0], u[1], u[2]];
-    let wd = [ud[0], ud[1], ud[2]];
+    let planar = matches!(plan.motion, PlatformMotion::PlanarPoint { .. });
+    // Platform angular velocity and acceleration (a planar point does not turn).
+    let (w, wd) = if planar {
+        (zero3::<R>(), zero3::<R>())
+    } else {
+        ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
+    };
     for (lp, lk) in plan.legs.iter().zip(legs) {
         let n = lp.joints.len();
         // End velocity and acceleration (base frame), then in L.
@@ -775,8 +812,11 @@ pub fn generalized_force<R: Real>(
                 (v_end, a_end)
             }
             PlatformMotion::Orientation { .. } => (w, wd),
+            PlatformMotion::PlanarPoint { .. } => {
+                let z = R::c(0.0);
+                ([u[0], u[1], z], [ud[0], ud[1], z])
+            }
         };
-        let _ = end_velocity::<R>;
         let v_l = mtv(&lk.frame, v_end);
         let a_l = mtv(&lk.frame, a_end);
         // Joint rates θ̇ = J⁻¹ v_end.
@@ -836,14 +876,27 @@ pub fn generalized_force<R: Real>(
                     f[i] = f[i] + y[i];
                 }
             }
+            PlatformMotion::PlanarPoint { .. } => {
+                for i in 0..2 {
+                    f[i] = f[i] + y[i];
+                }
+            }
         }
     }
     // The platform.
+    if planar {
+        // A point mass at P.
+        let (mass, _, _) = plan.platform;
+        for i in 0..2 {
+            f[i] = f[i] + R::c(mass) * (ud[i] - R::c(g_world[i]));
+        }
+        return f;
+    }
     let (mass, com, inertia) = plan.platform;
     let r = mv(&pl.rot, cv::<R>(&com));
     let (a0,) = match plan.motion {
         PlatformMotion::Pose => ([ud[3], ud[4], ud[5]],),
-        PlatformMotion::Orientation { .. } => (zero3::<R>(),),
+        PlatformMotion::Orientation { .. } | PlatformMotion::PlanarPoint { .. } => (zero3::<R>(),),
     };
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(R::c(mass), sub(a, cv(&g_world)));
@@ -1008,12 +1061,20 @@ pub fn generalized_inertia<R: Real>(
                 }
             }
         } else {
-            for i in 0..3 {
-                for j in 0..3 {
+            // Orientation (u = ω) or planar point (u = in-plane velocity): I += Λ's block.
+            for i in 0..n {
+                for j in 0..n {
                     out[i][j] = out[i][j] + lam[i][j];
                 }
             }
         }
+    }
+    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+        let (mass, _, _) = plan.platform;
+        for i in 0..n {
+            out[i][i] = out[i][i] + R::c(mass);
+        }
+        return out;
     }
     // The platform: ω columns e_j with mass-centre velocity e_j × r_c; v columns (pose) e_j.
     let (mass, com, inertia) = plan.platform;
@@ -1409,6 +1470,9 @@ pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
     let (qi, pi) = match motion {
         PlatformMotion::Pose => (3, Some(0)),
         PlatformMotion::Orientation { .. } => (0, None),
+        PlatformMotion::PlanarPoint { .. } => {
+            return x.iter().zip(du).map(|(a, b)| a + b).collect();
+        }
     };
     let th = [du[0], du[1], du[2]];
     let a = libm::sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);

@@ -74,4 +74,10 @@ macro_rules! export_parallel {
     };
 }
 
-export_parallel!(gough_stewart, sliding_hexapod, rus_hexapod, agile_eye);
+export_parallel!(
+    gough_stewart,
+    sliding_hexapod,
+    rus_hexapod,
+    agile_eye,
+    planar_five_bar
+);
