@@ -492,10 +492,11 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
         /// Which actuators are revolute (angles are compared modulo 2π).
         const REVOLUTE: [bool; DOF] = [#(#revolute),*];
 
-        /// Solve `a x = b` (or `aᵀ x = b`) by LU with partial pivoting after scaling the columns
-        /// to unit norm; `Err(Site::Actuation)` when a pivot is not above the tolerance.
+        /// Solve `a X = B` (or `aᵀ X = B`) for `K` right-hand sides (`b[i][k]`: equation `i`,
+        /// right-hand side `k`) by one LU with partial pivoting after scaling the columns to
+        /// unit norm; `Err(Site::Actuation)` when a pivot is not above the tolerance.
         #[allow(clippy::all)]
-        fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF], transpose: bool) -> Result<[f64; DOF], Singular> {
+        fn lu_solve_many<const K: usize>(a: &[[f64; DOF]; DOF], b: &[[f64; K]; DOF], transpose: bool) -> Result<[[f64; K]; DOF], Singular> {
             let mut m = [[0.0; DOF]; DOF];
             for i in 0..DOF {
                 for j in 0..DOF {
@@ -546,24 +547,44 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
                         for j in k..DOF {
                             m[i][j] -= f * m[k][j];
                         }
-                        x[i] -= f * x[k];
+                        for c in 0..K {
+                            x[i][c] -= f * x[k][c];
+                        }
                     }
                 }
             }
-            for i in (0..DOF).rev() {
-                let mut s = x[i];
-                for j in i + 1..DOF {
-                    s -= m[i][j] * x[j];
+            for c in 0..K {
+                for i in (0..DOF).rev() {
+                    let mut s = x[i][c];
+                    for j in i + 1..DOF {
+                        s -= m[i][j] * x[j][c];
+                    }
+                    x[i][c] = s / m[i][i];
                 }
-                x[i] = s / m[i][i];
             }
-            for j in 0..DOF {
-                x[j] *= sc[j];
-                if !x[j].is_finite() {
-                    return Err(Singular { site: Site::Input, value: x[j], condition_estimate: f64::INFINITY });
+            for i in 0..DOF {
+                for c in 0..K {
+                    x[i][c] *= sc[i];
+                    if !x[i][c].is_finite() {
+                        return Err(Singular { site: Site::Input, value: x[i][c], condition_estimate: f64::INFINITY });
+                    }
                 }
             }
             Ok(x)
+        }
+
+        /// `lu_solve_many` for one right-hand side.
+        fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF], transpose: bool) -> Result<[f64; DOF], Singular> {
+            let mut bb = [[0.0; 1]; DOF];
+            for i in 0..DOF {
+                bb[i][0] = b[i];
+            }
+            let x = lu_solve_many(a, &bb, transpose)?;
+            let mut out = [0.0; DOF];
+            for i in 0..DOF {
+                out[i] = x[i][0];
+            }
+            Ok(out)
         }
 
         /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
@@ -574,80 +595,13 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
             lu_solve(&a, &f, true)
         }
 
-        /// `A⁻¹` by one LU of `A` (columns scaled to unit norm, partial pivoting) and `DOF`
-        /// back substitutions; `Err(Site::Actuation)` as in `lu_solve`.
-        #[allow(clippy::all)]
+        /// `A⁻¹`: one factorization for the `DOF` columns of the identity.
         fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
-            let mut m = *a;
-            let mut sc = [1.0; DOF];
-            for j in 0..DOF {
-                let mut s = 0.0;
-                for i in 0..DOF {
-                    s += m[i][j] * m[i][j];
-                }
-                let s = #sqrt;
-                if s > 0.0 {
-                    sc[j] = 1.0 / s;
-                    for i in 0..DOF {
-                        m[i][j] *= sc[j];
-                    }
-                }
-            }
-            // Right-hand sides: the identity, permuted and eliminated with the matrix.
-            let mut x = [[0.0; DOF]; DOF];
+            let mut e = [[0.0; DOF]; DOF];
             for i in 0..DOF {
-                x[i][i] = 1.0;
+                e[i][i] = 1.0;
             }
-            let mut pmax: f64 = 0.0;
-            for k in 0..DOF {
-                let mut p = k;
-                let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
-                for i in k + 1..DOF {
-                    let v = if m[i][k] < 0.0 { -m[i][k] } else { m[i][k] };
-                    if v > best {
-                        best = v;
-                        p = i;
-                    }
-                }
-                m.swap(k, p);
-                x.swap(k, p);
-                if !(best > 0.0 && best < f64::INFINITY) {
-                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: f64::INFINITY });
-                }
-                if best > pmax {
-                    pmax = best;
-                }
-                if !(best > #act_tol_lit * pmax) {
-                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: pmax / best });
-                }
-                let inv = 1.0 / m[k][k];
-                for i in k + 1..DOF {
-                    let f = m[i][k] * inv;
-                    if f != 0.0 {
-                        for j in k..DOF {
-                            m[i][j] -= f * m[k][j];
-                        }
-                        for c in 0..DOF {
-                            x[i][c] -= f * x[k][c];
-                        }
-                    }
-                }
-            }
-            for c in 0..DOF {
-                for i in (0..DOF).rev() {
-                    let mut s = x[i][c];
-                    for j in i + 1..DOF {
-                        s -= m[i][j] * x[j][c];
-                    }
-                    x[i][c] = s / m[i][i];
-                }
-            }
-            for i in 0..DOF {
-                for c in 0..DOF {
-                    x[i][c] *= sc[i];
-                }
-            }
-            Ok(x)
+            lu_solve_many(a, &e, false)
         }
 
         /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
