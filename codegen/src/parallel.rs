@@ -574,6 +574,7 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
         }
 
         /// `lu_solve_many` for one right-hand side.
+        #[allow(clippy::all)]
         fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF], transpose: bool) -> Result<[f64; DOF], Singular> {
             let mut bb = [[0.0; 1]; DOF];
             for i in 0..DOF {
@@ -596,6 +597,7 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
         }
 
         /// `A⁻¹`: one factorization for the `DOF` columns of the identity.
+        #[allow(clippy::all)]
         fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
             let mut e = [[0.0; DOF]; DOF];
             for i in 0..DOF {
