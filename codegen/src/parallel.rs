@@ -164,48 +164,38 @@ fn build(plan: &Plan) -> Result<Kernels, Singular> {
     })
 }
 
-/// Operation count of the emitted `lu_solve::<N>` (column scaling, partial pivoting, one
-/// right-hand side).
-pub fn lu_ops(n: usize) -> OpCount {
+/// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: column scaling,
+/// partial pivoting, `k` right-hand sides (`lu_solve` is `k = 1`, `lu_inverse` is `k = n`).
+pub fn lu_many_ops(n: usize, k: usize) -> OpCount {
     let mut c = OpCount::default();
     // Column scaling: norms, reciprocals, products.
     c.mul += 2 * n * n;
     c.add += n * n;
     c.sqrt += n;
     c.div += n;
-    for k in 0..n {
-        let rows = n - k - 1;
+    for p in 0..n {
+        let rows = n - p - 1;
         c.cmp += rows + 2;
         c.div += 1;
-        c.mul += rows * (1 + (n - k) + 1);
-        c.add += rows * ((n - k) + 1);
+        c.mul += rows * (1 + (n - p) + k);
+        c.add += rows * ((n - p) + k);
     }
-    c.mul += n * (n - 1) / 2 + n;
-    c.add += n * (n - 1) / 2;
-    c.div += n;
+    // Back substitution for k right-hand sides, then the column scaling of the result.
+    c.mul += k * (n * (n - 1) / 2) + n * k;
+    c.add += k * (n * (n - 1) / 2);
+    c.div += n * k;
     c
 }
 
-/// Operation count of the emitted `lu_inverse::<N>` followed by `A⁻ᵀ I A⁻¹` (`I A⁻¹` in full,
-/// then the upper triangle of `A⁻ᵀ (I A⁻¹)`).
+/// Operation count of `lu_solve` (one right-hand side).
+pub fn lu_ops(n: usize) -> OpCount {
+    lu_many_ops(n, 1)
+}
+
+/// Operation count of `lu_inverse` followed by `A⁻ᵀ I A⁻¹` (`I A⁻¹` in full, then the upper
+/// triangle of `A⁻ᵀ (I A⁻¹)`).
 pub fn lu_inverse_ops(n: usize) -> OpCount {
-    let mut c = OpCount::default();
-    c.mul += 2 * n * n;
-    c.add += n * n;
-    c.sqrt += n;
-    c.div += n;
-    for k in 0..n {
-        let rows = n - k - 1;
-        c.cmp += rows + 2;
-        c.div += 1;
-        c.mul += rows * (1 + (n - k) + n);
-        c.add += rows * ((n - k) + n);
-    }
-    // Back substitution for n right-hand sides, then the column scaling of the result.
-    c.mul += n * (n * (n - 1) / 2) + n * n;
-    c.add += n * (n * (n - 1) / 2);
-    c.div += n * n;
-    // I A⁻¹ (n² dot products of length n) and the upper triangle of A⁻ᵀ (I A⁻¹).
+    let mut c = lu_many_ops(n, n);
     let tri = n * (n + 1) / 2;
     c.mul += n * n * n + tri * n;
     c.add += (n * n + tri) * (n - 1);
