@@ -31,6 +31,10 @@ pub enum Part {
     Vector,
     /// `[[f64; DOF]; DOF]`, row-major.
     Matrix,
+    /// `[f64; NX]` with `NX` given (closed loops: all joint coordinates).
+    Coords(usize),
+    /// `f64`.
+    Scalar,
 }
 
 impl Part {
@@ -38,12 +42,16 @@ impl Part {
         match self {
             Part::Vector => dof,
             Part::Matrix => dof * dof,
+            Part::Coords(n) => n,
+            Part::Scalar => 1,
         }
     }
     fn ty(self) -> TokenStream {
         match self {
             Part::Vector => quote!([f64; DOF]),
             Part::Matrix => quote!([[f64; DOF]; DOF]),
+            Part::Coords(_) => quote!([f64; NX]),
+            Part::Scalar => quote!(f64),
         }
     }
 }
@@ -214,6 +222,11 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                         let (a, b) = (operand(g, s, a), operand(g, s, b));
                         math_call(cfg, "atan2", quote!(#a, #b))
                     }
+                    Node::Select(a, b, x, y) => {
+                        let (a, b) = (operand(g, s, a), operand(g, s, b));
+                        let (x, y) = (operand(g, s, x), operand(g, s, y));
+                        quote!(if f64::abs(#a) > f64::abs(#b) { #x } else { #y })
+                    }
                     _ => {
                         stmts.push(TokenStream::new());
                         continue;
@@ -281,7 +294,8 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                 let (now, later) = rest.split_at(p.len(n).min(rest.len()));
                 rest = later;
                 items.push(match p {
-                    Part::Vector => quote!([#(#now),*]),
+                    Part::Vector | Part::Coords(_) => quote!([#(#now),*]),
+                    Part::Scalar => quote!(#(#now)*),
                     Part::Matrix => {
                         let rows: Vec<TokenStream> =
                             now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
@@ -386,6 +400,14 @@ fn site_tokens(site: runtime::parallel::Site) -> TokenStream {
         S::Actuation(i) => {
             let i = Literal::usize_unsuffixed(i);
             quote!(site: Site::Actuation(#i))
+        }
+        S::Closure(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Closure(#i))
+        }
+        S::Constraint(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Constraint(#i))
         }
         S::Platform => quote!(site: Site::Platform),
         S::Input => quote!(site: Site::Input),

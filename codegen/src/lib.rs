@@ -33,11 +33,13 @@
 #![allow(clippy::needless_range_loop)] // index loops read like the equations
 
 pub mod build_script;
+pub mod closed;
 pub mod diag;
 pub mod dynamics;
 pub mod emit;
 pub mod macro_support;
 pub mod parallel;
+pub mod scalar;
 pub mod schedule;
 pub mod spec;
 pub mod sym;
@@ -115,6 +117,7 @@ pub fn compile(
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match mechanism {
         spec::Mechanism::Tree(model) => Ok(generate(&model, cfg)),
         spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
+        spec::Mechanism::Closed(model) => closed::generate(&model, cfg),
     }));
     let mut out = match generated {
         Ok(Ok(out)) => out,

@@ -70,6 +70,13 @@ fn main() -> ExitCode {
                         model.legs.len(),
                         model.dof()
                     ),
+                    codegen::spec::Mechanism::Closed(model) => eprintln!(
+                        "{}: ok (closed loops, {} joint coordinates, {} cut joints, {} DOF)",
+                        name,
+                        model.nx(),
+                        model.cuts.len(),
+                        model.dof()
+                    ),
                 }
                 ExitCode::SUCCESS
             }

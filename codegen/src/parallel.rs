@@ -5,102 +5,18 @@
 //! fixed templates (the partially pivoted LU of the actuation matrix, Newton's forward
 //! kinematics) into the module's public functions.
 
-use std::cell::RefCell;
-use std::ops::{Add, Div, Mul, Neg, Sub};
-
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use runtime::model::JointKind;
 use runtime::parallel::noc::{self, Plan};
-use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular, Site};
+use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular};
+
+use crate::scalar::{Sx, flat, ids, inputs, with};
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::schedule::{OpCount, schedule};
-use crate::sym::{Arg, ExprId, Graph, TWO_SIDED};
+use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
-
-thread_local! {
-    /// The graph the symbolic scalars of the current generation write to.
-    static GRAPH: RefCell<Graph> = RefCell::new(Graph::new());
-}
-
-fn with<T>(f: impl FnOnce(&mut Graph) -> T) -> T {
-    GRAPH.with(|c| f(&mut c.borrow_mut()))
-}
-
-/// A symbolic scalar: a node of the thread's current graph.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Sx(ExprId);
-
-macro_rules! binop {
-    ($tr:ident, $m:ident, $g:ident) => {
-        impl $tr for Sx {
-            type Output = Sx;
-            fn $m(self, o: Sx) -> Sx {
-                Sx(with(|g| g.$g(self.0, o.0)))
-            }
-        }
-    };
-}
-binop!(Add, add, add);
-binop!(Sub, sub, sub);
-binop!(Mul, mul, mul);
-binop!(Div, div, div);
-
-impl Neg for Sx {
-    type Output = Sx;
-    fn neg(self) -> Sx {
-        Sx(with(|g| g.neg(self.0)))
-    }
-}
-
-impl Real for Sx {
-    fn c(v: f64) -> Sx {
-        Sx(with(|g| g.constant(v)))
-    }
-    fn sqrt(self) -> Sx {
-        Sx(with(|g| g.sqrt(self.0)))
-    }
-    fn atan2(self, x: Sx) -> Sx {
-        Sx(with(|g| g.atan2(self.0, x.0)))
-    }
-    fn check(
-        value: Sx,
-        threshold: Sx,
-        scale: Sx,
-        site: Site,
-        two_sided: bool,
-    ) -> Result<Sx, Singular> {
-        let consts = with(|g| (g.as_const(value.0), g.as_const(threshold.0)));
-        if let (Some(v), Some(t)) = consts {
-            // Decided at generation time.
-            return f64::check(
-                v,
-                t,
-                with(|g| g.as_const(scale.0)).unwrap_or(1.0),
-                site,
-                two_sided,
-            )
-            .map(|_| value);
-        }
-        let code = site.code() | if two_sided { TWO_SIDED } else { 0 };
-        Ok(Sx(with(|g| {
-            g.guard(value.0, threshold.0, scale.0, code as usize)
-        })))
-    }
-}
-
-fn inputs(arg: Arg, n: usize) -> Vec<Sx> {
-    (0..n).map(|i| Sx(with(|g| g.input(arg, i)))).collect()
-}
-
-fn ids(v: &[Sx]) -> Vec<ExprId> {
-    v.iter().map(|s| s.0).collect()
-}
-
-fn flat(m: &[Vec<Sx>]) -> Vec<ExprId> {
-    m.iter().flatten().map(|s| s.0).collect()
-}
 
 /// The DAG kernels of a parallel mechanism.
 pub struct Kernels {

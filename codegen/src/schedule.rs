@@ -152,6 +152,7 @@ pub fn schedule(g: &Graph, roots: &[ExprId]) -> Schedule {
                     Node::Neg(..) => s.ops.neg += 1,
                     Node::Sqrt(..) => s.ops.sqrt += 1,
                     Node::Atan2(..) => s.ops.atan2 += 1,
+                    Node::Select(..) => s.ops.cmp += 1,
                     _ => {}
                 }
                 s.names.insert(id, next);

@@ -78,6 +78,9 @@ pub enum Node {
     Cos(ExprId),
     /// `atan2(a, b)`: the angle of the point `(b, a)`.
     Atan2(ExprId, ExprId),
+    /// `if |a| > |b| { x } else { y }` (NaN compares false): the data-dependent choice of
+    /// partial pivoting, emitted as a conditional move.
+    Select(ExprId, ExprId, ExprId, ExprId),
     /// Pivot `index` of a factorization: the operand when it is `> tol` (a node), else the
     /// function returns `Err(Singular)`; `scale` is the matrix diagonal entry the pivot came from
     /// (for the condition estimate). With [`TWO_SIDED`] set in `index` the test is
@@ -334,6 +337,26 @@ impl Graph {
         }
     }
 
+    /// `if |a| > |b| { x } else { y }`, folded when the choice is known: equal branches,
+    /// constant magnitudes, or a constant zero `a` (never larger).
+    pub fn select_abs_gt(&mut self, a: ExprId, b: ExprId, x: ExprId, y: ExprId) -> ExprId {
+        if x == y {
+            return x;
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(p), Some(q)) => {
+                if p.abs() > q.abs() {
+                    x
+                } else {
+                    y
+                }
+            }
+            (Some(p), None) if p == 0.0 => y,
+            _ if a == b => y,
+            _ => self.intern(Node::Select(a, b, x, y)),
+        }
+    }
+
     /// A checked pivot (see [`Node::Guard`]).
     pub fn guard(&mut self, value: ExprId, tol: ExprId, scale: ExprId, index: usize) -> ExprId {
         self.intern(Node::Guard {
@@ -346,17 +369,20 @@ impl Graph {
 
     /// Operands of a node, in order.
     pub fn operands(&self, id: ExprId) -> impl Iterator<Item = ExprId> {
-        let ops: [Option<ExprId>; 3] = match self.node(id) {
-            Node::Const(_) | Node::Input(..) => [None, None, None],
+        let ops: [Option<ExprId>; 4] = match self.node(id) {
+            Node::Const(_) | Node::Input(..) => [None, None, None, None],
             Node::Add(a, b)
             | Node::Sub(a, b)
             | Node::Mul(a, b)
             | Node::Div(a, b)
-            | Node::Atan2(a, b) => [Some(a), Some(b), None],
-            Node::Neg(a) | Node::Sqrt(a) | Node::Sin(a) | Node::Cos(a) => [Some(a), None, None],
+            | Node::Atan2(a, b) => [Some(a), Some(b), None, None],
+            Node::Neg(a) | Node::Sqrt(a) | Node::Sin(a) | Node::Cos(a) => {
+                [Some(a), None, None, None]
+            }
+            Node::Select(a, b, x, y) => [Some(a), Some(b), Some(x), Some(y)],
             Node::Guard {
                 value, tol, scale, ..
-            } => [Some(value), Some(tol), Some(scale)],
+            } => [Some(value), Some(tol), Some(scale), None],
         };
         ops.into_iter().flatten()
     }
@@ -392,6 +418,13 @@ impl Graph {
                 Node::Sin(a) => v(a).sin(),
                 Node::Cos(a) => v(a).cos(),
                 Node::Atan2(a, b) => v(a).atan2(v(b)),
+                Node::Select(a, b, x, y) => {
+                    if v(a).abs() > v(b).abs() {
+                        v(x)
+                    } else {
+                        v(y)
+                    }
+                }
                 Node::Guard {
                     value, tol, index, ..
                 } => {

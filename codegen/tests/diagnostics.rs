@@ -285,6 +285,9 @@ fn examples_in_docs_load_without_warnings() {
                     m.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
                     parallel += 1;
                 }
+                Mechanism::Closed(m) => {
+                    runtime::closed::Plan::new(&m).unwrap_or_else(|e| panic!("{name}: {e}"));
+                }
             }
             n += 1;
         }

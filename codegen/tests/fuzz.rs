@@ -71,6 +71,7 @@ fn check(name: &str, src: &str) -> Result<(), TestCaseError> {
         }
         Ok((Mechanism::Tree(m), _)) => m.dof() <= COMPILE_MAX_DOF,
         Ok((Mechanism::Parallel(m), _)) => m.legs.len() <= 3,
+        Ok((Mechanism::Closed(m), _)) => m.nx() <= COMPILE_MAX_DOF,
     };
     LOADED.fetch_add(1, Ordering::Relaxed);
     if !small {

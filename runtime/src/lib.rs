@@ -7,6 +7,8 @@
 //!   (`T`, `Ṫ`, `M`, `W`, `I = TᵀMT`, `C = Tᵀ(MṪ+WMT)`): the first oracle.
 //! * [`parallel`] (feature `alloc`): simple-platform parallel manipulators — the model, leg
 //!   kinematics and the NOC in actuator space, generic over the scalar so the generator reuses it.
+//! * [`closed`] (feature `alloc`): closed loops in joint coordinates — a spanning tree, cut
+//!   joints, independent coordinates — with the NOC `S = [1; −Φ_d⁻¹Φ_i]`, generic over the scalar.
 //! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
 //!   spatial (6-D) algebra, written from their own equations: the independent second route.
 #![no_std]
@@ -18,6 +20,8 @@ extern crate std;
 
 pub mod math;
 
+#[cfg(feature = "alloc")]
+pub mod closed;
 #[cfg(feature = "alloc")]
 pub mod model;
 #[cfg(feature = "alloc")]

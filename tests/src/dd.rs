@@ -305,6 +305,14 @@ impl Real for DD {
     fn atan2(self, x: Self) -> Self {
         DD::atan2(self, x)
     }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        DD::sin_cos(self)
+    }
+    #[inline]
+    fn select_abs_gt(a: DD, b: DD, x: DD, y: DD) -> DD {
+        if a.abs() > b.abs() { x } else { y }
+    }
     /// As for `f64`, with the comparison made on the double-double value; the value and the
     /// condition estimate of the `Singular` record are rounded to `f64`.
     fn check(

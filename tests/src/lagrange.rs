@@ -1093,3 +1093,65 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
         closure,
     }
 }
+
+/// A closed-loop mechanism in joint coordinates at the joint positions `x` (which should close
+/// the loops; see [`closure_residual`], fed from [`CSystem::closure`]). Bodies and joints as in
+/// [`from_tree`], then one joint per cut (parent: the cut's parent body, or the base; a cut to
+/// the base is written with the base as parent). Only the independent joints are actuated, so
+/// the efforts come in increasing joint order.
+pub fn from_closed(model: &runtime::closed::ClosedModel, x: &[f64]) -> CSystem {
+    let tree = &model.tree;
+    let mut sys = from_tree(tree, x);
+    for (i, j) in sys.joints.iter_mut().enumerate() {
+        j.actuated = model.independent.contains(&i);
+    }
+    // Body poses again (from_tree keeps only the Cartesian data).
+    let mut poses: Vec<Transform> = Vec::with_capacity(tree.dof());
+    for (i, j) in tree.joints.iter().enumerate() {
+        let parent = j.parent.map_or(Transform::IDENTITY, |p| poses[p]);
+        poses.push(place(&parent, j, x[i]).pose);
+    }
+    let pose_of = |b: Option<usize>| b.map_or(Transform::IDENTITY, |b| poses[b]);
+    for cut in &model.cuts {
+        let fa = pose_of(cut.parent).compose(&cut.frame_parent);
+        let fb = pose_of(cut.child).compose(&cut.frame_child);
+        let (parent, child) = match (cut.parent, cut.child) {
+            (p, Some(c)) => (p, c),
+            (Some(p), None) => (None, p),
+            (None, None) => continue,
+        };
+        let (kind, on_parent, on_child) = match cut.kind {
+            runtime::closed::CutKind::Revolute { axis } => {
+                let a = mat_vec(&fa.rotation, &axis);
+                (
+                    CJointKind::Revolute { axis: a },
+                    a,
+                    mat_vec(&fb.rotation, &axis),
+                )
+            }
+            runtime::closed::CutKind::Spherical => {
+                (CJointKind::Spherical, fa.translation, fb.translation)
+            }
+        };
+        sys.closure.push(Coincidence {
+            joint: sys.joints.len(),
+            on_parent,
+            on_child,
+        });
+        if let CJointKind::Revolute { .. } = kind {
+            sys.closure.push(Coincidence {
+                joint: sys.joints.len(),
+                on_parent: fa.translation,
+                on_child: fb.translation,
+            });
+        }
+        sys.joints.push(CJoint {
+            parent,
+            child,
+            point: fb.translation,
+            kind,
+            actuated: false,
+        });
+    }
+    sys
+}

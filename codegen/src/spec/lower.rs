@@ -354,9 +354,9 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
                         j.child, spec.joints[first].name
                     ))
             } else {
-                Diagnostic::error("closed chains are not supported yet (they arrive with the parallel-manipulator support)")
+                Diagnostic::error(format!("body \"{}\" is the child of two joints: this closes a loop", j.child))
                     .with_hint(format!(
-                        "body \"{}\" is already the child of joint \"{}\"; in a tree every body is the child of exactly one joint",
+                        "body \"{}\" is already the child of joint \"{}\"; to close a loop, give this joint `child_origin` (its frame in the child's body frame) and mark the independent joints `actuated` (docs/spec.md, \"Closed loops in joint coordinates\"), or add a [platform] table for a parallel mechanism",
                         j.child, spec.joints[first].name
                     ))
             };

@@ -11,6 +11,7 @@
 //! This is the only module that knows TOML, XML or serde.
 
 mod angle;
+mod closed;
 mod geom;
 mod ir;
 mod lower;
@@ -63,6 +64,9 @@ pub enum Mechanism {
     Tree(Model),
     /// A parallel manipulator (a TOML spec with a `[platform]` table).
     Parallel(ParallelModel),
+    /// Closed loops in joint coordinates (a TOML spec without `[platform]` whose loop-closing
+    /// joints have `child_origin`).
+    Closed(runtime::closed::ClosedModel),
 }
 
 impl Mechanism {
@@ -71,6 +75,7 @@ impl Mechanism {
         match self {
             Mechanism::Tree(m) => &m.name,
             Mechanism::Parallel(m) => &m.name,
+            Mechanism::Closed(m) => &m.name,
         }
     }
 }
@@ -92,10 +97,18 @@ pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagn
                 .with_hint("read it with codegen::spec::load_mechanism, which returns a ParallelModel; code generation for parallel mechanisms is not available yet"),
         );
     }
+    if let Some(Mechanism::Closed(_)) = &mechanism {
+        diags.push(
+            Diagnostic::error("this spec describes closed loops (joints with `child_origin`), which cannot be loaded as a tree")
+                .with_span(0..0)
+                .with_hint("read it with codegen::spec::load_mechanism, which returns a ClosedModel"),
+        );
+    }
     finish(mechanism, diags).and_then(|(m, d)| match m {
         Mechanism::Tree(m) => Ok((m, d)),
         // Unreachable: a parallel spec got an error above.
         Mechanism::Parallel(_) => Err(d),
+        Mechanism::Closed(_) => Err(d),
     })
 }
 
@@ -148,6 +161,8 @@ fn load_any(
         let mechanism = spec.and_then(|s| {
             if s.platform.is_some() {
                 parallel::lower_parallel(&s, &mut d).map(Mechanism::Parallel)
+            } else if closed::is_closed(&s) {
+                closed::lower_closed(&s, &mut d).map(Mechanism::Closed)
             } else {
                 lower::lower(&s, &mut d).map(Mechanism::Tree)
             }

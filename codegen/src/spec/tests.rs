@@ -682,6 +682,7 @@ mod parallel_specs {
                 m
             }
             Ok((Mechanism::Tree(_), _)) => panic!("{name} loaded as a tree"),
+            Ok((Mechanism::Closed(_), _)) => panic!("{name} loaded as closed loops"),
             Err(e) => panic!("{}", e.render()),
         }
     }

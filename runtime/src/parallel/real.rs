@@ -25,6 +25,13 @@ pub enum Site {
     /// An input (`x`, `u`, `u̇`, `τ` or `q`) is NaN or infinite, or so large that a result
     /// overflows.
     Input,
+    /// Closed loops in joint coordinates: loop-closure equation `k` is violated by more than
+    /// its tolerance (the joint positions `x` do not close the loops).
+    Closure(usize),
+    /// Closed loops in joint coordinates: pivot `i` of the constraint Jacobian's dependent
+    /// block `Φ_d` (a configuration where the independent coordinates do not determine the
+    /// others: a change of mobility or a bifurcation).
+    Constraint(usize),
 }
 
 impl Site {
@@ -38,6 +45,8 @@ impl Site {
             Site::Actuation(i) => 768 + i as u16,
             Site::Platform => 1024,
             Site::Input => 1025,
+            Site::Closure(k) => 1280 + k as u16,
+            Site::Constraint(i) => 1536 + i as u16,
         }
     }
 
@@ -49,6 +58,8 @@ impl Site {
             512..768 => Site::Reach(c as usize - 512),
             768..1024 => Site::Actuation(c as usize - 768),
             1024 => Site::Platform,
+            1280..1536 => Site::Closure(c as usize - 1280),
+            1536..1792 => Site::Constraint(c as usize - 1536),
             _ => Site::Input,
         }
     }
@@ -69,6 +80,14 @@ impl fmt::Display for Site {
             ),
             Site::Platform => write!(f, "the platform quaternion (zero or not finite)"),
             Site::Input => write!(f, "an input that is NaN or infinite"),
+            Site::Closure(k) => write!(
+                f,
+                "loop-closure equation {k} (the joint positions do not close the loops)"
+            ),
+            Site::Constraint(i) => write!(
+                f,
+                "pivot {i} of the constraint Jacobian's dependent block (the independent coordinates do not determine the others)"
+            ),
         }
     }
 }
@@ -110,6 +129,11 @@ pub trait Real:
     fn sqrt(self) -> Self;
     /// `atan2(self, x)` (four-quadrant angle of the point `(x, self)`).
     fn atan2(self, x: Self) -> Self;
+    /// `(sin self, cos self)`.
+    fn sin_cos(self) -> (Self, Self);
+    /// `x` when `|a| > |b|`, else `y` (NaN compares false): the one data-dependent choice,
+    /// for partial pivoting.
+    fn select_abs_gt(a: Self, b: Self, x: Self, y: Self) -> Self;
     /// `Ok(value)` when `value > threshold` (or `|value| > threshold` when `two_sided`), else
     /// `Err(Singular { site, value, condition_estimate })` with `scale / value` (`scale / |value|`
     /// when two-sided), infinite when that is not positive. NaN fails.
@@ -134,6 +158,14 @@ impl Real for f64 {
     #[inline]
     fn atan2(self, x: Self) -> Self {
         crate::math::atan2(self, x)
+    }
+    #[inline]
+    fn sin_cos(self) -> (f64, f64) {
+        crate::math::sin_cos(self)
+    }
+    #[inline]
+    fn select_abs_gt(a: f64, b: f64, x: f64, y: f64) -> f64 {
+        if a.abs() > b.abs() { x } else { y }
     }
     #[inline]
     fn check(

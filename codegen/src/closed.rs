@@ -1,0 +1,347 @@
+//! Closed loops in joint coordinates: the runtime's evaluator ([`runtime::closed::noc`],
+//! written over [`Real`]) run on the symbolic scalar, so the whole of every function — tree
+//! kinematics, loop Jacobian, the pivoted LU of `Φ_d` (its row swaps are `Select` nodes),
+//! the tree's Newton–Euler sweep and the projection `Sᵀ` — is one flat DAG kernel. Newton's
+//! assembly is the one loop, a fixed template around a DAG step.
+
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
+use runtime::closed::ClosedModel;
+use runtime::closed::noc::{self, Plan};
+use runtime::parallel::Singular;
+
+use crate::emit::{self, Function, Part, Shape};
+use crate::scalar::{flat, ids, inputs, with};
+use crate::schedule::{OpCount, schedule};
+use crate::sym::{Arg, ExprId, Graph};
+use crate::{Config, Generated, MathBackend, VERSION};
+
+/// The DAG kernels of a closed-loop mechanism.
+pub struct Kernels {
+    /// The shared DAG.
+    pub graph: Graph,
+    /// All joint rates `ẋ = S u`.
+    pub joint_rates: Vec<ExprId>,
+    /// Generalized forces of the independent coordinates.
+    pub inverse_dynamics: Vec<ExprId>,
+    /// `I`, row-major.
+    pub mass_matrix: Vec<ExprId>,
+    /// `u̇`.
+    pub forward_dynamics: Vec<ExprId>,
+    /// Newton step (`NX`) then the signed largest scaled residual.
+    pub newton_step: Vec<ExprId>,
+}
+
+/// Build the kernels (a generation-time `Singular` is a structural singularity).
+pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
+    with(|g| *g = Graph::new());
+    let r = build(plan);
+    let graph = with(std::mem::take);
+    r.map(|k| Kernels { graph, ..k })
+}
+
+fn build(plan: &Plan) -> Result<Kernels, Singular> {
+    let d = plan.dof();
+    let x = inputs(Arg::X, plan.nx());
+    let u = inputs(Arg::U, d);
+    let ud = inputs(Arg::Ud, d);
+    let tau = inputs(Arg::Tau, d);
+    let c = noc::configuration(plan, &x, true)?;
+    let rates = noc::joint_rates_generic(plan, &c, &u);
+    let f = noc::generalized_force(plan, &c, &u, &ud, true);
+    let m = noc::generalized_inertia(plan, &c);
+    let fd = noc::forward_dynamics_generic(plan, &x, &u, &tau)?;
+    let (step, worst) = noc::newton_step(plan, &x)?;
+    let mut newton = ids(&step);
+    newton.push(worst.0);
+    Ok(Kernels {
+        graph: Graph::new(),
+        joint_rates: ids(&rates),
+        inverse_dynamics: ids(&f),
+        mass_matrix: flat(&m),
+        forward_dynamics: ids(&fd),
+        newton_step: newton,
+    })
+}
+
+/// Generate the module of a closed-loop mechanism.
+pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> {
+    let plan = Plan::new(model)?;
+    let k = kernels(&plan).map_err(|e| {
+        format!("the mechanism is singular for every input ({e}); check the loop geometry")
+    })?;
+    let g = &k.graph;
+    let n = plan.dof();
+    let nx = plan.nx();
+    let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
+    let make = |name: &'static str,
+                doc: Vec<String>,
+                args: Vec<Arg>,
+                outputs: Vec<ExprId>,
+                shape: Shape,
+                public: bool| Function {
+        name,
+        doc,
+        args,
+        schedule: schedule(g, &outputs),
+        outputs,
+        shape,
+        dof: n,
+        public,
+        sites: true,
+    };
+    let coords = "`x`: every tree joint's position (rad or m, `JOINT_NAMES` order), closing the loops (see `forward_kinematics`); `u`: the rates of the independent coordinates (`x[INDEPENDENT[k]]`)";
+    let functions = [
+        make(
+            "joint_rates",
+            vec![format!(
+                "All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`). {coords}. `Err` when `x` does not close the loops (`Site::Closure`) or the independent coordinates do not determine the others (`Site::Constraint`)."
+            )],
+            vec![Arg::X, Arg::U],
+            k.joint_rates.clone(),
+            fallible(&[Part::Coords(nx)]),
+            true,
+        ),
+        make(
+            "inverse_dynamics",
+            vec![format!(
+                "Generalized forces of the independent coordinates, `f = Sᵀ τ_tree = I u̇ + C u − γ` (N or N·m, gravity included): the efforts of the actuated joints that produce the motion `(x, u, ud)`. {coords}."
+            )],
+            vec![Arg::X, Arg::U, Arg::Ud],
+            k.inverse_dynamics.clone(),
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        make(
+            "mass_matrix",
+            vec!["Generalized inertia `I = Sᵀ M S` of the independent coordinates (symmetric positive definite away from singularities).".into()],
+            vec![Arg::X],
+            k.mass_matrix.clone(),
+            fallible(&[Part::Matrix]),
+            true,
+        ),
+        make(
+            "forward_dynamics",
+            vec!["Rates `u̇` of the independent speeds with `I u̇ = τ − (C u − γ)` for the actuator efforts `tau`; `Err` where the method fails or a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
+            vec![Arg::X, Arg::U, Arg::Tau],
+            k.forward_dynamics.clone(),
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        make(
+            "newton_step",
+            vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates and the signed largest scaled loop-equation residual.".into()],
+            vec![Arg::X],
+            k.newton_step.clone(),
+            fallible(&[Part::Coords(nx), Part::Scalar]),
+            false,
+        ),
+    ];
+    let ops = |name: &str| {
+        functions
+            .iter()
+            .find(|f| f.name == name)
+            .map(|f| f.schedule.ops)
+            .unwrap_or_default()
+    };
+    let stats: Vec<(String, OpCount)> = vec![
+        ("joint_rates".into(), ops("joint_rates")),
+        ("inverse_dynamics".into(), ops("inverse_dynamics")),
+        ("mass_matrix".into(), ops("mass_matrix")),
+        ("forward_dynamics".into(), ops("forward_dynamics")),
+        (
+            "forward_kinematics (per Newton step)".into(),
+            ops("newton_step"),
+        ),
+    ];
+    let joint_names: Vec<String> = model.tree.joints.iter().map(|j| j.name.clone()).collect();
+    let act_names: Vec<String> = plan
+        .independent
+        .iter()
+        .map(|&j| joint_names[j].clone())
+        .collect();
+    let mut header = vec![
+        format!(
+            "@generated by nocdyn codegen {VERSION} from mechanism `{}` — do not edit.",
+            model.name
+        ),
+        format!(
+            "Closed loops in joint coordinates: {} cut joint(s), {} kept loop equations; NX = {nx} joint coordinates, DOF = {n} independent ({}). Units: SI (m, kg, s, rad, N, N·m).",
+            model.cuts.len(),
+            plan.rows.len(),
+            act_names.join(", ")
+        ),
+        match &cfg.math {
+            MathBackend::Libm => {
+                "Math backend: the `libm` crate (sin/cos, sqrt); otherwise core only.".into()
+            }
+            MathBackend::Std => "Math backend: std.".into(),
+            MathBackend::Runtime(p) => format!("Math backend: `{p}::math` (nocdyn runtime)."),
+        },
+        "Operation counts per call (the LU of `Φ_d` included; `cmp` counts its pivot selections):"
+            .into(),
+    ];
+    header.extend(emit::stats_table_per(&stats, n, "DOF"));
+    let fns: Vec<TokenStream> = functions
+        .iter()
+        .map(|f| emit::function(g, cfg, f))
+        .collect();
+    let nx_lit = Literal::usize_unsuffixed(nx);
+    let n_lit = Literal::usize_unsuffixed(n);
+    let indep: Vec<Literal> = plan
+        .independent
+        .iter()
+        .map(|&j| Literal::usize_unsuffixed(j))
+        .collect();
+    let revolute: Vec<bool> = plan
+        .independent
+        .iter()
+        .map(|&j| model.tree.joints[j].kind == runtime::model::JointKind::Revolute)
+        .collect();
+    let items = templates();
+    let tokens = quote! {
+        /// Number of position coordinates `x`: every joint of the spanning tree.
+        pub const NX: usize = #nx_lit;
+        /// Degrees of freedom: independent coordinates, speeds `u`, actuators.
+        pub const DOF: usize = #n_lit;
+        /// The tree joints, in the order of `x`.
+        pub const JOINT_NAMES: [&str; NX] = [#(#joint_names),*];
+        /// The independent (actuated) joints, in the order of `u` and `tau`.
+        pub const ACTUATOR_NAMES: [&str; DOF] = [#(#act_names),*];
+        /// Index in `x` of each independent coordinate.
+        pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
+        /// Which independent coordinates are angles.
+        const REVOLUTE: [bool; DOF] = [#(#revolute),*];
+        #items
+        #(#fns)*
+    };
+    let code = emit::render(&header, tokens);
+    Ok(Generated {
+        code,
+        stats,
+        dof: n,
+        warnings: crate::diag::Diagnostics::new("", ""),
+        per: "DOF",
+    })
+}
+
+fn templates() -> TokenStream {
+    let con_tol = noc::CONSTRAINT_TOLERANCE;
+    let clo_tol = noc::CLOSURE_TOLERANCE;
+    let fk_tol = Literal::f64_unsuffixed(noc::FK_TOLERANCE);
+    let fk_max = Literal::usize_unsuffixed(noc::FK_MAX_ITERATIONS);
+    let closure_doc = format!(
+        " Kept loop equation `k` exceeds `{clo_tol:e}` (times the mechanism's size for a point equation): `x` does not close the loops. `value` is `tol² − Φ_k²`."
+    );
+    let constraint_doc = format!(
+        " Pivot `i` of the LU of `Φ_d` (columns scaled to unit norm, partial pivoting) is `|p| ≤ {con_tol:e}`: the independent coordinates (nearly) fail to determine the others."
+    );
+    quote! {
+        /// Where an evaluation failed.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Site {
+            /// Pivot `i` of the generalized inertia's `LDLᵀ` (forward dynamics).
+            MassMatrix(usize),
+            #[doc = #closure_doc]
+            Closure(usize),
+            #[doc = #constraint_doc]
+            Constraint(usize),
+            /// An input is NaN or infinite, or so large that a result overflows.
+            Input,
+        }
+
+        /// A configuration where the method fails, or a non-finite input: never a NaN result.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Singular {
+            /// Which matrix, equation or pivot.
+            pub site: Site,
+            /// The value that failed its test.
+            pub value: f64,
+            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
+            pub condition_estimate: f64,
+        }
+
+        /// Forward kinematics did not converge.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct NoConvergence {
+            /// Newton iterations made.
+            pub iterations: usize,
+            /// The last largest scaled loop-equation residual.
+            pub residual: f64,
+        }
+
+        /// The independent coordinates of `x` (rad or m, `ACTUATOR_NAMES` order).
+        #[allow(clippy::all)]
+        pub fn inverse_kinematics(x: &[f64; NX]) -> Result<[f64; DOF], Singular> {
+            let mut q = [0.0; DOF];
+            for k in 0..DOF {
+                let v = x[INDEPENDENT[k]];
+                if !v.is_finite() {
+                    return Err(Singular { site: Site::Input, value: v, condition_estimate: f64::INFINITY });
+                }
+                q[k] = v;
+            }
+            Ok(q)
+        }
+
+        /// Forward kinematics (assembly): the joint positions that close the loops with the
+        /// independent coordinates `q` (angles compared as given), by Newton's method on the
+        /// dependent coordinates from `guess` (its branch), the step halved while it does not
+        /// reduce the residual; at most 50 iterations, converged when every kept loop
+        /// equation is within `1e-12` (times the mechanism's size for a point equation), then
+        /// one more full step (kept unless it raises the residual).
+        #[allow(clippy::all)]
+        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
+            let _ = REVOLUTE;
+            let mut x = *guess;
+            for k in 0..DOF {
+                x[INDEPENDENT[k]] = q[k];
+            }
+            let abs = |v: f64| if v < 0.0 { -v } else { v };
+            let Ok((mut dx, mut r)) = newton_step(&x) else {
+                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
+            };
+            for it in 0..#fk_max {
+                if abs(r) <= #fk_tol {
+                    // One more full step: the coordinates to rounding.
+                    let mut xn = x;
+                    for i in 0..NX {
+                        xn[i] += dx[i];
+                    }
+                    if let Ok((_, rn)) = newton_step(&xn) {
+                        if abs(rn) <= abs(r) {
+                            return Ok(xn);
+                        }
+                    }
+                    return Ok(x);
+                }
+                let mut step = 1.0;
+                let mut moved = false;
+                for _ in 0..20 {
+                    let mut xn = x;
+                    for i in 0..NX {
+                        xn[i] += step * dx[i];
+                    }
+                    if let Ok((dn, rn)) = newton_step(&xn) {
+                        if abs(rn) < abs(r) {
+                            x = xn;
+                            dx = dn;
+                            r = rn;
+                            moved = true;
+                            break;
+                        }
+                    }
+                    step *= 0.5;
+                }
+                if !moved {
+                    return Err(NoConvergence { iterations: it + 1, residual: abs(r) });
+                }
+            }
+            if abs(r) <= #fk_tol {
+                Ok(x)
+            } else {
+                Err(NoConvergence { iterations: #fk_max, residual: abs(r) })
+            }
+        }
+    }
+}

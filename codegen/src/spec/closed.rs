@@ -1,0 +1,170 @@
+//! Lowering of a closed-loop mechanism in joint coordinates (a spec without `[platform]` whose
+//! loop-closing joints carry `child_origin`) to a [`ClosedModel`]: the joints without
+//! `child_origin` form a spanning tree (lowered by [`super::lower`]); each joint with
+//! `child_origin` closes a loop between its parent and child bodies; the `actuated` joints are
+//! the independent coordinates.
+//!
+//! Checks, all reported together: the cut joints' kinds (revolute or spherical), `actuated`
+//! only on revolute or prismatic tree joints, at least one actuated joint, the tree rules for
+//! the rest, and then [`Plan::new`] (loops closed at home, the mobility against the number of
+//! actuated joints, the chosen coordinates determining the others).
+
+use runtime::closed::{ClosedModel, Cut, CutKind, Plan};
+use runtime::model::Transform;
+
+use super::geom::compose;
+use super::ir::{Kind, Spec};
+use super::lower::{self, Skip};
+use crate::diag::{Diagnostic, Diagnostics};
+
+/// `true` when `spec` is a closed-loop mechanism in joint coordinates.
+pub(crate) fn is_closed(spec: &Spec) -> bool {
+    spec.platform.is_none() && spec.joints.iter().any(|j| j.child_origin.is_some())
+}
+
+/// Validate a closed-loop spec and build its model; `None` when there was any error.
+pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<ClosedModel> {
+    let axes = lower::check_values(spec, diags);
+    let mut skip = Skip::none(spec);
+    // A joint with `child_origin` closes a loop only when its child is also reached by a tree
+    // joint (or is the base); otherwise `child_origin` is misplaced and the joint stays in the
+    // tree (one precise error instead of an echo about an unattached body).
+    let in_tree = |name: &str| {
+        name == super::ir::BASE
+            || spec
+                .joints
+                .iter()
+                .any(|k| k.child_origin.is_none() && k.child == name)
+    };
+    for j in &spec.joints {
+        if j.child_origin.is_some() && !in_tree(&j.child) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "joint \"{}\" has `child_origin`, which marks a loop-closing joint, but its child \"{}\" is reached by no other joint",
+                    j.name, j.child
+                ))
+                .with_key(format!("{}.child_origin", j.key))
+                .with_span(j.child_origin_span.clone().or(j.span.clone()))
+                .with_hint("in a tree the child's frame is the joint frame: remove child_origin; a loop-closing joint joins two bodies that the other joints already place (a parallel mechanism's joints into the platform need a [platform] table)"),
+            );
+        }
+    }
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if j.child_origin.is_some() && in_tree(&j.child) {
+            skip.joint[ji] = true;
+            if !matches!(j.kind, Kind::Revolute | Kind::Spherical) {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "joint \"{}\" closes a loop (it has `child_origin`), but a {} joint cannot close a loop",
+                        j.name,
+                        j.kind.word()
+                    ))
+                    .with_key(format!("{}.kind", j.key))
+                    .with_span(j.kind_span.clone())
+                    .with_hint("loop-closing joints are revolute or spherical; put the other joint of the loop in the tree (without child_origin) and close the loop at a revolute or spherical joint"),
+                );
+            }
+            if j.actuated {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "joint \"{}\" closes a loop and cannot be actuated",
+                        j.name
+                    ))
+                    .with_key(format!("{}.actuated", j.key))
+                    .with_span(j.actuated_span.clone().or(j.span.clone()))
+                    .with_hint("the independent coordinates are tree joints: close the loop at a passive joint"),
+                );
+            }
+        } else if j.actuated && !matches!(j.kind, Kind::Revolute | Kind::Prismatic) {
+            diags.push(
+                Diagnostic::error(format!("a {} joint cannot be actuated", j.kind.word()))
+                    .with_key(format!("{}.actuated", j.key))
+                    .with_span(j.actuated_span.clone().or(j.span.clone()))
+                    .with_hint("only revolute and prismatic joints can be actuated (be independent coordinates)"),
+            );
+        }
+    }
+    if !spec.joints.iter().any(|j| j.actuated) {
+        diags.push(
+            Diagnostic::error("no joint is actuated")
+                .with_span(spec.anchor.clone())
+                .with_hint("a closed-loop mechanism in joint coordinates takes its independent coordinates from the joints marked `actuated = true` (their efforts are the generalized forces); mark as many as it has degrees of freedom"),
+        );
+    }
+    let topo = lower::check_topology(spec, diags, &skip);
+    if diags.has_errors() {
+        return None;
+    }
+    let topo = topo?;
+    let built = lower::build(spec, &topo, &axes, diags);
+    if diags.has_errors() {
+        return None;
+    }
+    let model = built.model;
+    // Independent coordinates: the model joint of each actuated spec joint.
+    let mut independent = Vec::new();
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if j.actuated
+            && !skip.joint[ji]
+            && let Some(k) = built.spec_joint.iter().position(|&s| s == ji)
+        {
+            independent.push(k);
+        }
+    }
+    let mut cuts = Vec::new();
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if !skip.joint[ji] {
+            continue;
+        }
+        let body_of = |name: &str| -> Option<(Option<usize>, Transform)> {
+            if name == super::ir::BASE {
+                return Some((None, Transform::IDENTITY));
+            }
+            let b = spec.bodies.iter().position(|b| b.name == name)?;
+            let a = built.attach[b]?;
+            Some((a.target, a.pose))
+        };
+        let (Some((pa, pose_a)), Some((cb, pose_b))) = (body_of(&j.parent), body_of(&j.child))
+        else {
+            continue; // reported by the topology check
+        };
+        let (origin, _) = lower::placement_frames(&j.placement);
+        let frame_parent = compose(&pose_a, &origin);
+        let frame_child = compose(&pose_b, &j.child_origin.unwrap_or(Transform::IDENTITY));
+        let kind = match j.kind {
+            Kind::Revolute => CutKind::Revolute {
+                axis: axes[ji].first().copied().unwrap_or([0.0, 0.0, 1.0]),
+            },
+            _ => CutKind::Spherical,
+        };
+        cuts.push(Cut {
+            name: j.name.clone(),
+            parent: pa,
+            frame_parent,
+            child: cb,
+            frame_child,
+            kind,
+        });
+    }
+    let closed = ClosedModel {
+        name: spec.name.clone(),
+        tree: model,
+        cuts,
+        independent,
+    };
+    if let Err(e) = Plan::new(&closed) {
+        // Point at the first loop-closing joint (the loops are where the analysis failed).
+        let at = spec.joints.iter().find(|j| j.child_origin.is_some());
+        let mut d = Diagnostic::error(e).with_hint("the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)");
+        if let Some(j) = at {
+            d = d
+                .with_key(format!("{}.child_origin", j.key))
+                .with_span(j.child_origin_span.clone().or(j.span.clone()));
+        } else {
+            d = d.with_span(spec.anchor.clone());
+        }
+        diags.push(d);
+        return None;
+    }
+    Some(closed)
+}

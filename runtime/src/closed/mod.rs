@@ -1,0 +1,240 @@
+//! Closed loops in joint coordinates: a spanning tree of one-DOF joints plus loop-closing (cut)
+//! joints, with a chosen set of tree coordinates as the independent coordinates (a four-bar by
+//! its crank angle, a five-bar by its two actuated angles, a spherical five-bar, a Bricard
+//! linkage).
+//!
+//! # The model
+//! * The tree is a [`Model`] (its conventions: body `i` moved by joint `i`, parents first). Its
+//!   joint positions `x` (`NX` of them, rad or m) are the mechanism's position coordinates; at
+//!   `x = 0` (home) the spec's geometry closes every loop.
+//! * Each cut joint ([`Cut`]) joins a frame on one body (or the base) to a frame on another;
+//!   a revolute cut keeps the two frames' origins together and their axes aligned (5 scalar
+//!   equations), a spherical cut keeps the origins together (3). Together they are the loop
+//!   equations `Φ(x) = 0`.
+//! * The independent coordinates `x_i` (`DOF` of them, the joints marked `actuated`) determine
+//!   the others `x_d` through `Φ`; their rates `u = ẋ_i` are the speeds and their efforts are
+//!   the generalized forces (the actuator efforts when those joints are the actuated ones).
+//!
+//! # The method (noc-method.md, "Closed chains"; the lecture's eqs. 49–53 with the joint rates
+//! as the twist-shaping coordinates)
+//! * Redundant loop equations are common (a planar loop written in 3-D has 5 equations per cut
+//!   joint of which 2 are independent; the Bricard linkage has one redundant equation). At home,
+//!   [`Plan::new`] keeps `NX − DOF` rows of `Φ_x` that are independent over the dependent
+//!   columns (greedy Gram–Schmidt on unit-scaled rows) and checks that the others depend on
+//!   them: the mobility `NX − rank Φ_x` must equal `DOF`.
+//! * Velocities: `ẋ_d = −Φ_d⁻¹ Φ_i u`, i.e. `ẋ = S u`, `S = [1; −Φ_d⁻¹ Φ_i]` — the natural
+//!   orthogonal complement of the loop Jacobian (`Φ_x S = 0`).
+//! * Accelerations: `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`, the bias `Φ̇ ẋ` from the tree's body
+//!   accelerations with `ẍ = 0`.
+//! * Dynamics: the tree's joint efforts `τ_T` for `(x, ẋ, ẍ)` (recursive Newton–Euler), then
+//!   `f = Sᵀ τ_T = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`; the inertia `Sᵀ M_T S` from the bodies' twists in `u`.
+//! * `Φ_d` is factorized by LU with partial pivoting after scaling its columns to unit norm
+//!   (pivot choices are data-dependent selections, so the generated code pivots too); a pivot
+//!   `≤ CONSTRAINT_TOLERANCE` is `Singular { site: Constraint(i) }`.
+//!
+//! [`Model`]: crate::model::Model
+
+// NaN must fail the closure tests: negated comparisons on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use crate::model::{Model, Transform, Vec3, mat_vec};
+
+pub mod noc;
+
+pub use noc::Plan;
+
+/// How a cut joint closes its loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CutKind {
+    /// A revolute joint about `axis` (unit, in the cut joint's frame): origins coincide and the
+    /// axis is common (5 equations).
+    Revolute {
+        /// The axis in the joint frame.
+        axis: Vec3,
+    },
+    /// A spherical joint: origins coincide (3 equations).
+    Spherical,
+}
+
+/// A loop-closing joint between a frame on `parent` and a frame on `child` (`None`: the base).
+/// At home the two frames coincide.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cut {
+    /// Name (from the spec).
+    pub name: String,
+    /// Tree body carrying the first frame (`None`: the base).
+    pub parent: Option<usize>,
+    /// The joint frame in `parent`'s body frame.
+    pub frame_parent: Transform,
+    /// Tree body carrying the second frame.
+    pub child: Option<usize>,
+    /// The joint frame in `child`'s body frame.
+    pub frame_child: Transform,
+    /// Revolute or spherical.
+    pub kind: CutKind,
+}
+
+/// A validated closed-loop mechanism in joint coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClosedModel {
+    /// Mechanism name.
+    pub name: String,
+    /// The spanning tree (its `gravity` is the mechanism's).
+    pub tree: Model,
+    /// The loop-closing joints.
+    pub cuts: Vec<Cut>,
+    /// Indices of the independent (actuated) tree joints, in order.
+    pub independent: Vec<usize>,
+}
+
+/// Length tolerance of the closure check at home, relative to the mechanism's size.
+pub const HOME_TOLERANCE: f64 = 1e-9;
+
+impl ClosedModel {
+    /// Position coordinates (tree joints).
+    pub fn nx(&self) -> usize {
+        self.tree.dof()
+    }
+    /// Degrees of freedom (independent coordinates).
+    pub fn dof(&self) -> usize {
+        self.independent.len()
+    }
+
+    /// The typical length (m): the largest distance of a body origin or cut point from the base
+    /// origin at home, at least 1 mm.
+    pub fn size(&self) -> f64 {
+        let poses = home_poses(&self.tree);
+        let n = |v: &Vec3| libm::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        let mut s: f64 = 1e-3;
+        for p in &poses {
+            s = s.max(n(&p.translation));
+        }
+        for c in &self.cuts {
+            s = s.max(n(
+                &frame_at_home(&poses, c.parent, &c.frame_parent).translation
+            ));
+        }
+        s
+    }
+
+    /// Structural checks: independent joints valid and distinct, at least one cut, and every
+    /// loop closed at home (origins together, revolute axes aligned).
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.nx();
+        if self.cuts.is_empty() {
+            return Err("no loop-closing joint: this is a tree".into());
+        }
+        if self.independent.is_empty() {
+            return Err("no independent coordinate: mark the actuated joints".into());
+        }
+        for (k, &j) in self.independent.iter().enumerate() {
+            if j >= n || self.independent[..k].contains(&j) {
+                return Err(format!(
+                    "independent coordinate {k} is not a distinct tree joint"
+                ));
+            }
+        }
+        for c in &self.cuts {
+            for b in [c.parent, c.child].into_iter().flatten() {
+                if b >= n {
+                    return Err(format!("cut joint {}: unknown body {b}", c.name));
+                }
+            }
+            if c.parent == c.child {
+                return Err(format!("cut joint {} joins a body to itself", c.name));
+            }
+        }
+        let poses = home_poses(&self.tree);
+        let tol = HOME_TOLERANCE * self.size();
+        for c in &self.cuts {
+            let a = frame_at_home(&poses, c.parent, &c.frame_parent);
+            let b = frame_at_home(&poses, c.child, &c.frame_child);
+            let d = [
+                a.translation[0] - b.translation[0],
+                a.translation[1] - b.translation[1],
+                a.translation[2] - b.translation[2],
+            ];
+            let dist = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if !(dist <= tol) {
+                return Err(format!(
+                    "the loop through joint {} does not close at home: its frame's origin is {:?} m on one side and {:?} m on the other ({dist:.3e} m apart)",
+                    c.name, a.translation, b.translation
+                ));
+            }
+            if let CutKind::Revolute { axis } = c.kind {
+                let ea = mat_vec(&a.rotation, &axis);
+                let eb = mat_vec(&b.rotation, &axis);
+                let d = [ea[0] - eb[0], ea[1] - eb[1], ea[2] - eb[2]];
+                let dist = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                if !(dist <= 1e-9) {
+                    return Err(format!(
+                        "the loop through joint {} does not close at home: its axis is {ea:?} on one side and {eb:?} on the other",
+                        c.name
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Body poses of the tree at `x = 0` (base frame).
+pub fn home_poses(tree: &Model) -> Vec<Transform> {
+    let mut out: Vec<Transform> = Vec::with_capacity(tree.dof());
+    for j in &tree.joints {
+        let p = j.parent.map(|p| out[p]).unwrap_or(Transform::IDENTITY);
+        out.push(p.compose(&j.origin));
+    }
+    out
+}
+
+fn frame_at_home(poses: &[Transform], body: Option<usize>, frame: &Transform) -> Transform {
+    body.map(|b| poses[b])
+        .unwrap_or(Transform::IDENTITY)
+        .compose(frame)
+}
+
+/// Unit vectors `p1, p2` completing the unit `e` to a right-handed orthonormal basis
+/// (deterministic: `p1` is the coordinate axis least aligned with `e`, made orthogonal).
+pub fn perpendiculars(e: &Vec3) -> (Vec3, Vec3) {
+    let a = [e[0].abs(), e[1].abs(), e[2].abs()];
+    let k = if a[0] <= a[1] && a[0] <= a[2] {
+        0
+    } else if a[1] <= a[2] {
+        1
+    } else {
+        2
+    };
+    let mut t = [0.0; 3];
+    t[k] = 1.0;
+    let d = t[0] * e[0] + t[1] * e[1] + t[2] * e[2];
+    let mut p1 = [t[0] - d * e[0], t[1] - d * e[1], t[2] - d * e[2]];
+    let n = libm::sqrt(p1[0] * p1[0] + p1[1] * p1[1] + p1[2] * p1[2]);
+    for v in &mut p1 {
+        *v /= n;
+    }
+    // Exact zeros stay exact for coordinate axes.
+    for v in &mut p1 {
+        if v.abs() < 1e-17 {
+            *v = 0.0;
+        }
+    }
+    let p2 = [
+        e[1] * p1[2] - e[2] * p1[1],
+        e[2] * p1[0] - e[0] * p1[2],
+        e[0] * p1[1] - e[1] * p1[0],
+    ];
+    (p1, p2)
+}
+
+/// Ancestor flags: `anc[b][j]` is true when joint `j` moves body `b`.
+pub(crate) fn ancestry(tree: &Model) -> Vec<Vec<bool>> {
+    let n = tree.dof();
+    (0..n)
+        .map(|b| (0..n).map(|j| tree.supports(j, b)).collect())
+        .collect()
+}

@@ -1,0 +1,1032 @@
+//! The NOC of a closed-loop mechanism in joint coordinates, written once over [`Real`] so that
+//! the runtime (`f64`) and the generator (symbolic) evaluate the same equations (see the
+//! module docs of [`super`] for the method).
+//!
+//! # One evaluation
+//! 1. Tree kinematics from `x`: body rotations and origins, joint axes and points (base frame).
+//! 2. The kept loop equations `Φ` and their Jacobian rows over the joints (a cut's point rows:
+//!    the columns `e_j × (P − o_j)` (R) or `e_j` (P) of the joints between the two bodies; its
+//!    axis rows: `(ω_b − ω_a)·(m × n)` with `n` the axis on one side and `m ⊥ n` on the other).
+//! 3. `Φ_d` (dependent columns) by LU with partial pivoting; `ẋ = S u`.
+//! 4. The body motions with `ẍ = 0` give the bias `Φ̇ ẋ`; `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`.
+//! 5. The tree's inverse dynamics, then `f = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`.
+
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::{ClosedModel, CutKind, ancestry, perpendiculars};
+use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+use crate::parallel::noc::{
+    M, NoConvergence, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mv, rot, scale,
+    solve_spd, sub, zero3,
+};
+use crate::parallel::real::{Real, Singular, Site};
+
+/// Pivot threshold of `Φ_d`'s LU (columns scaled to unit norm): a pivot `|p| ≤ 1e-4` is a
+/// configuration where the independent coordinates (nearly) fail to determine the others. The
+/// velocity terms carry `Φ_d⁻¹` twice, so rounding grows like `ε/p²`; `1e-4` keeps it near
+/// `1e-8` (the same reasoning as [`crate::parallel::noc::LEG_TOLERANCE`]).
+pub const CONSTRAINT_TOLERANCE: f64 = 1e-4;
+/// Closure tolerance of the inputs: a kept loop equation larger than `1e-9` (times the
+/// mechanism's size for the point equations, in m; as is for the axis equations) means `x`
+/// does not close the loops: `Singular { site: Closure(k) }`.
+pub const CLOSURE_TOLERANCE: f64 = 1e-9;
+/// Newton (forward kinematics): at most this many iterations.
+pub const FK_MAX_ITERATIONS: usize = 50;
+/// Newton converges when every kept loop equation is within `1e-12` (point equations times
+/// the mechanism's size).
+pub const FK_TOLERANCE: f64 = 1e-12;
+/// Rank tolerance of the home analysis (relative to unit-scaled rows).
+pub const RANK_TOLERANCE: f64 = 1e-9;
+
+/// One kept loop equation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Row {
+    /// Component `k` (base frame) of `P_child − P_parent` of cut `cut`.
+    Point {
+        /// Cut index.
+        cut: usize,
+        /// Base-frame component.
+        k: usize,
+    },
+    /// `n · m` of cut `cut`: `n` its axis on the parent side, `m` (in the child body's frame)
+    /// one of the two unit vectors perpendicular to the axis at home.
+    Axis {
+        /// Cut index.
+        cut: usize,
+        /// `m` in the child body's frame.
+        m: Vec3,
+    },
+}
+
+/// One tree joint's constant data.
+#[derive(Clone, Debug)]
+pub struct JointPlan {
+    /// Parent body (`None`: base).
+    pub parent: Option<usize>,
+    /// Revolute or prismatic.
+    pub kind: JointKind,
+    /// Joint frame at `x = 0` in the parent body frame.
+    pub origin: Transform,
+    /// Unit axis in the joint frame.
+    pub axis: Vec3,
+    /// Body mass, mass centre, inertia (body frame).
+    pub body: (f64, Vec3, Mat3),
+}
+
+/// One cut joint's constant data.
+#[derive(Clone, Debug)]
+pub struct CutPlan {
+    /// Parent body (`None`: base).
+    pub parent: Option<usize>,
+    /// Child body (`None`: base).
+    pub child: Option<usize>,
+    /// The joint point in the parent's body frame.
+    pub point_parent: Vec3,
+    /// The joint point in the child's body frame.
+    pub point_child: Vec3,
+    /// Revolute: the axis in the parent's body frame.
+    pub axis_parent: Option<Vec3>,
+}
+
+/// What the evaluators need, prepared and checked once.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Gravity (base frame).
+    pub gravity: Vec3,
+    /// Tree joints.
+    pub joints: Vec<JointPlan>,
+    /// Cut joints.
+    pub cuts: Vec<CutPlan>,
+    /// The kept loop equations (`NX − DOF` of them).
+    pub rows: Vec<Row>,
+    /// Independent joints (in order).
+    pub independent: Vec<usize>,
+    /// Dependent joints (increasing).
+    pub dependent: Vec<usize>,
+    /// `anc[b][j]`: joint `j` moves body `b`.
+    pub anc: Vec<Vec<bool>>,
+    /// The mechanism's size (m).
+    pub size: f64,
+}
+
+impl Plan {
+    /// Validate `model`, choose the kept loop equations at home and check the mobility.
+    pub fn new(model: &ClosedModel) -> Result<Plan, alloc::string::String> {
+        model.validate()?;
+        let tree = &model.tree;
+        let n = tree.dof();
+        let joints: Vec<JointPlan> = tree
+            .joints
+            .iter()
+            .zip(&tree.bodies)
+            .map(|(j, b)| JointPlan {
+                parent: j.parent,
+                kind: j.kind,
+                origin: j.origin,
+                axis: j.axis,
+                body: (b.mass, b.com, b.inertia),
+            })
+            .collect();
+        let cuts: Vec<CutPlan> = model
+            .cuts
+            .iter()
+            .map(|c| CutPlan {
+                parent: c.parent,
+                child: c.child,
+                point_parent: c.frame_parent.translation,
+                point_child: c.frame_child.translation,
+                axis_parent: match c.kind {
+                    CutKind::Revolute { axis } => Some(mat_vec(&c.frame_parent.rotation, &axis)),
+                    CutKind::Spherical => None,
+                },
+            })
+            .collect();
+        // Candidate rows: per cut, the three point rows, then (revolute) two axis rows.
+        let mut candidates: Vec<Row> = Vec::new();
+        for (ci, c) in model.cuts.iter().enumerate() {
+            for k in 0..3 {
+                candidates.push(Row::Point { cut: ci, k });
+            }
+            if let CutKind::Revolute { axis } = c.kind {
+                let (p1, p2) = perpendiculars(&axis);
+                for p in [p1, p2] {
+                    candidates.push(Row::Axis {
+                        cut: ci,
+                        m: mat_vec(&c.frame_child.rotation, &p),
+                    });
+                }
+            }
+        }
+        let independent = model.independent.clone();
+        let dependent: Vec<usize> = (0..n).filter(|j| !independent.contains(j)).collect();
+        let mut plan = Plan {
+            gravity: tree.gravity,
+            joints,
+            cuts,
+            rows: candidates.clone(),
+            independent,
+            dependent,
+            anc: ancestry(tree),
+            size: model.size(),
+        };
+        // The Jacobian of every candidate at home, rows scaled to unit norm.
+        let x0 = vec![0.0; n];
+        let kin = kinematics(&plan, &x0);
+        let jac: Vec<Vec<f64>> = candidates
+            .iter()
+            .map(|r| jacobian_row(&plan, &kin, r))
+            .collect();
+        let nd = plan.dependent.len();
+        let unit = |v: &[f64]| -> Vec<f64> {
+            let s = libm::sqrt(v.iter().map(|x| x * x).sum::<f64>());
+            if s > 0.0 {
+                v.iter().map(|x| x / s).collect()
+            } else {
+                v.to_vec()
+            }
+        };
+        // Mobility at home: NX − rank of the loop equations (all columns).
+        let rank = {
+            let mut basis: Vec<Vec<f64>> = Vec::new();
+            for row in &jac {
+                let mut r = unit(row);
+                for b in &basis {
+                    let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
+                    for (x, y) in r.iter_mut().zip(b) {
+                        *x -= d * y;
+                    }
+                }
+                let s = libm::sqrt(r.iter().map(|x| x * x).sum::<f64>());
+                if s > 1e-6 {
+                    basis.push(r.iter().map(|x| x / s).collect());
+                }
+            }
+            basis.len()
+        };
+        if n - rank != plan.independent.len() {
+            return Err(alloc::format!(
+                "the mechanism has {} degree(s) of freedom at home ({n} joint coordinates, {rank} independent loop equations) but {} joint(s) are actuated; mark one actuated joint per degree of freedom",
+                n - rank,
+                plan.independent.len()
+            ));
+        }
+        // Greedy Gram–Schmidt over the dependent columns.
+        let dep = |row: &[f64]| -> Vec<f64> { plan.dependent.iter().map(|&j| row[j]).collect() };
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut kept: Vec<usize> = Vec::new();
+        let mut resid: Vec<Vec<f64>> = jac.iter().map(|r| unit(&dep(r))).collect();
+        for _ in 0..nd {
+            let mut best = (0usize, -1.0);
+            for (i, r) in resid.iter().enumerate() {
+                let s = r.iter().map(|x| x * x).sum::<f64>();
+                if !kept.contains(&i) && s > best.1 + 1e-12 {
+                    best = (i, s);
+                }
+            }
+            if !(best.1 > RANK_TOLERANCE * RANK_TOLERANCE) {
+                return Err(alloc::format!(
+                    "the actuated joints do not determine the others at home: the loop equations have rank {} over the {nd} other joint coordinates (mark a different set of joints as actuated)",
+                    kept.len()
+                ));
+            }
+            let b = unit(&resid[best.0]);
+            kept.push(best.0);
+            for r in resid.iter_mut() {
+                let d: f64 = r.iter().zip(&b).map(|(x, y)| x * y).sum();
+                for (x, y) in r.iter_mut().zip(&b) {
+                    *x -= d * y;
+                }
+            }
+            basis.push(b);
+        }
+        // Mobility: every candidate row (all columns) must depend on the kept ones.
+        let mut full: Vec<Vec<f64>> = Vec::new();
+        for &k in &kept {
+            let mut r = unit(&jac[k]);
+            for b in &full {
+                let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in r.iter_mut().zip(b) {
+                    *x -= d * y;
+                }
+            }
+            full.push(unit(&r));
+        }
+        for (i, row) in jac.iter().enumerate() {
+            if kept.contains(&i) {
+                continue;
+            }
+            let mut r = unit(row);
+            for b in &full {
+                let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in r.iter_mut().zip(b) {
+                    *x -= d * y;
+                }
+            }
+            let s = libm::sqrt(r.iter().map(|x| x * x).sum::<f64>());
+            if s > 1e-6 {
+                return Err(alloc::format!(
+                    "the loop equations have more independent rows than the {nd} dependent coordinates: the mechanism has fewer degrees of freedom than the {} marked actuated (loop equation {i} of cut {} is independent of the rest)",
+                    plan.independent.len(),
+                    model.cuts[row_cut(&candidates[i])].name
+                ));
+            }
+        }
+        kept.sort_unstable();
+        plan.rows = kept.iter().map(|&i| candidates[i]).collect();
+        // The full evaluation must succeed at home.
+        let d = plan.independent.len();
+        inverse_dynamics(&plan, &x0, &vec![0.0; d], &vec![0.0; d]).map_err(|e| {
+            alloc::format!("the mechanism is singular at its home configuration ({e})")
+        })?;
+        Ok(plan)
+    }
+
+    /// Position coordinates (tree joints).
+    pub fn nx(&self) -> usize {
+        self.joints.len()
+    }
+    /// Degrees of freedom.
+    pub fn dof(&self) -> usize {
+        self.independent.len()
+    }
+}
+
+fn row_cut(r: &Row) -> usize {
+    match r {
+        Row::Point { cut, .. } | Row::Axis { cut, .. } => *cut,
+    }
+}
+
+/// Tree kinematics at `x` (base frame).
+#[derive(Clone, Debug)]
+pub struct Kin<R> {
+    /// Body rotations (body → base).
+    pub rot: Vec<M<R>>,
+    /// Body origins.
+    pub pos: Vec<V<R>>,
+    /// Joint axes.
+    pub e: Vec<V<R>>,
+    /// Joint points (the joint frame's origin before a prismatic displacement).
+    pub o: Vec<V<R>>,
+}
+
+/// Body poses, joint axes and points at `x`.
+pub fn kinematics<R: Real>(plan: &Plan, x: &[R]) -> Kin<R> {
+    let n = plan.nx();
+    let mut k = Kin {
+        rot: Vec::with_capacity(n),
+        pos: Vec::with_capacity(n),
+        e: Vec::with_capacity(n),
+        o: Vec::with_capacity(n),
+    };
+    for (i, j) in plan.joints.iter().enumerate() {
+        let (rp, pp) = match j.parent {
+            Some(p) => (k.rot[p], k.pos[p]),
+            None => (ident::<R>(), zero3::<R>()),
+        };
+        let r0 = mm(&rp, &cm(&j.origin.rotation));
+        let o = add(pp, mv(&rp, cv(&j.origin.translation)));
+        let e = mv(&r0, cv(&j.axis));
+        let (r, p) = match j.kind {
+            JointKind::Revolute => {
+                let (s, c) = x[i].sin_cos();
+                (mm(&r0, &rot(&j.axis, s, c)), o)
+            }
+            JointKind::Prismatic => (r0, add(o, scale(x[i], e))),
+        };
+        k.rot.push(r);
+        k.pos.push(p);
+        k.e.push(e);
+        k.o.push(o);
+    }
+    k
+}
+
+fn point_of<R: Real>(k: &Kin<R>, body: Option<usize>, local: &Vec3) -> V<R> {
+    match body {
+        Some(b) => add(k.pos[b], mv(&k.rot[b], cv(local))),
+        None => cv(local),
+    }
+}
+
+fn dir_of<R: Real>(k: &Kin<R>, body: Option<usize>, local: &Vec3) -> V<R> {
+    match body {
+        Some(b) => mv(&k.rot[b], cv(local)),
+        None => cv(local),
+    }
+}
+
+/// The value of a loop equation at `x`.
+fn row_value<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> R {
+    match *r {
+        Row::Point { cut, k: i } => {
+            let c = &plan.cuts[cut];
+            let a = point_of(k, c.parent, &c.point_parent);
+            let b = point_of(k, c.child, &c.point_child);
+            b[i] - a[i]
+        }
+        Row::Axis { cut, m } => {
+            let c = &plan.cuts[cut];
+            let n = dir_of(k, c.parent, &c.axis_parent.unwrap_or([0.0; 3]));
+            let mm_ = dir_of(k, c.child, &m);
+            dot(n, mm_)
+        }
+    }
+}
+
+/// `+1` for joints that move `child` only, `−1` for those that move `parent` only, else 0.
+fn side(plan: &Plan, parent: Option<usize>, child: Option<usize>, j: usize) -> i32 {
+    let on = |b: Option<usize>| b.map(|b| plan.anc[b][j]).unwrap_or(false);
+    match (on(child), on(parent)) {
+        (true, false) => 1,
+        (false, true) => -1,
+        _ => 0,
+    }
+}
+
+/// The Jacobian row of a loop equation over all joints.
+fn jacobian_row<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> Vec<R> {
+    let n = plan.nx();
+    let mut out = vec![R::c(0.0); n];
+    match *r {
+        Row::Point { cut, k: i } => {
+            let c = &plan.cuts[cut];
+            let p = point_of(k, c.child, &c.point_child);
+            for j in 0..n {
+                let s = side(plan, c.parent, c.child, j);
+                if s == 0 {
+                    continue;
+                }
+                let col = match plan.joints[j].kind {
+                    JointKind::Revolute => cross(k.e[j], sub(p, k.o[j])),
+                    JointKind::Prismatic => k.e[j],
+                };
+                out[j] = if s > 0 { col[i] } else { -col[i] };
+            }
+        }
+        Row::Axis { cut, m } => {
+            let c = &plan.cuts[cut];
+            let nv = dir_of(k, c.parent, &c.axis_parent.unwrap_or([0.0; 3]));
+            let w = cross(dir_of(k, c.child, &m), nv);
+            for j in 0..n {
+                let s = side(plan, c.parent, c.child, j);
+                if s == 0 || is_prismatic_plan(plan, j) {
+                    continue;
+                }
+                let v = dot(k.e[j], w);
+                out[j] = if s > 0 { v } else { -v };
+            }
+        }
+    }
+    out
+}
+
+fn is_prismatic_plan(plan: &Plan, j: usize) -> bool {
+    plan.joints[j].kind == JointKind::Prismatic
+}
+
+/// A body's motion: angular velocity `w` and acceleration `alpha`, the velocity `v` and
+/// acceleration `a` of its material point at its joint point `o`.
+#[derive(Clone, Copy, Debug)]
+pub struct BodyMotion<R> {
+    /// Angular velocity.
+    pub w: V<R>,
+    /// Angular acceleration.
+    pub alpha: V<R>,
+    /// Velocity of the material point at `o`.
+    pub v: V<R>,
+    /// Acceleration of the material point at `o`.
+    pub a: V<R>,
+}
+
+impl<R: Real> BodyMotion<R> {
+    fn at_rest() -> Self {
+        BodyMotion {
+            w: zero3(),
+            alpha: zero3(),
+            v: zero3(),
+            a: zero3(),
+        }
+    }
+    /// Velocity of the material point at `x`, knowing the motion at `o`.
+    fn vel_at(&self, o: V<R>, x: V<R>) -> V<R> {
+        add(self.v, cross(self.w, sub(x, o)))
+    }
+    /// Acceleration of the material point at `x`.
+    fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
+        let r = sub(x, o);
+        add(
+            add(self.a, cross(self.alpha, r)),
+            cross(self.w, cross(self.w, r)),
+        )
+    }
+}
+
+/// Body motions by the tree recursion (the lecture's eqs. 25–26, 33): `ω = ω_p + ẋ e`,
+/// `ω̇ = ω̇_p + ẍ e + ẋ ω_p × e` (R); `a(o) = a_p(o) + ẍ e + 2 ẋ ω_p × e` (P). `xdd = None`: `ẍ = 0`.
+pub fn motions<R: Real>(
+    plan: &Plan,
+    k: &Kin<R>,
+    xd: &[R],
+    xdd: Option<&[R]>,
+) -> Vec<BodyMotion<R>> {
+    let n = plan.nx();
+    let mut out: Vec<BodyMotion<R>> = Vec::with_capacity(n);
+    for i in 0..n {
+        let o = k.o[i];
+        let (w0, al0, v0, a0) = match plan.joints[i].parent {
+            None => (zero3(), zero3(), zero3(), zero3()),
+            Some(p) => {
+                let m = &out[p];
+                (m.w, m.alpha, m.vel_at(k.o[p], o), m.accel_at(k.o[p], o))
+            }
+        };
+        let e = k.e[i];
+        let we = cross(w0, e);
+        let qdd_e = match xdd {
+            Some(a) => scale(a[i], e),
+            None => zero3(),
+        };
+        out.push(match plan.joints[i].kind {
+            JointKind::Revolute => BodyMotion {
+                w: add(w0, scale(xd[i], e)),
+                alpha: add(add(al0, qdd_e), scale(xd[i], we)),
+                v: v0,
+                a: a0,
+            },
+            JointKind::Prismatic => BodyMotion {
+                w: w0,
+                alpha: al0,
+                v: add(v0, scale(xd[i], e)),
+                a: add(add(a0, qdd_e), scale(R::c(2.0) * xd[i], we)),
+            },
+        });
+    }
+    out
+}
+
+fn motion_of<R: Real>(m: &[BodyMotion<R>], body: Option<usize>) -> BodyMotion<R> {
+    body.map(|b| m[b]).unwrap_or_else(BodyMotion::at_rest)
+}
+
+fn origin_of<R: Real>(k: &Kin<R>, body: Option<usize>) -> V<R> {
+    body.map(|b| k.o[b]).unwrap_or_else(zero3)
+}
+
+/// `Φ̇ ẋ` of a kept loop equation from the body motions with `ẍ = 0`.
+fn row_bias<R: Real>(plan: &Plan, k: &Kin<R>, m: &[BodyMotion<R>], r: &Row) -> R {
+    match *r {
+        Row::Point { cut, k: i } => {
+            let c = &plan.cuts[cut];
+            let p = point_of(k, c.child, &c.point_child);
+            let ab = motion_of(m, c.child).accel_at(origin_of(k, c.child), p);
+            let aa = motion_of(m, c.parent).accel_at(origin_of(k, c.parent), p);
+            ab[i] - aa[i]
+        }
+        Row::Axis { cut, m: ml } => {
+            let c = &plan.cuts[cut];
+            let n = dir_of(k, c.parent, &c.axis_parent.unwrap_or([0.0; 3]));
+            let mv_ = dir_of(k, c.child, &ml);
+            let (ma, mb) = (motion_of(m, c.parent), motion_of(m, c.child));
+            let dw = sub(mb.w, ma.w);
+            let da = sub(mb.alpha, ma.alpha);
+            // d/dt[(ω_b − ω_a)·(m × n)] with ṁ = ω_b × m, ṅ = ω_a × n.
+            let mdot_n = cross(cross(mb.w, mv_), n);
+            let m_ndot = cross(mv_, cross(ma.w, n));
+            dot(da, cross(mv_, n)) + dot(dw, add(mdot_n, m_ndot))
+        }
+    }
+}
+
+/// An LU factorization with partial pivoting (data-dependent row swaps recorded as the
+/// compared magnitudes), of a matrix with columns scaled to unit norm.
+#[derive(Clone, Debug)]
+pub struct Lu<R> {
+    m: Vec<Vec<R>>,
+    swaps: Vec<(usize, usize, R, R)>,
+    sc: Vec<R>,
+}
+
+/// Factorize the square `a`; a column of zero norm or a pivot `|p| ≤ CONSTRAINT_TOLERANCE`
+/// is `Singular { site: Constraint(i) }` (condition estimate `1/|p|`).
+pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
+    let n = a.len();
+    let mut sc = Vec::with_capacity(n);
+    for j in 0..n {
+        let mut s = R::c(0.0);
+        for i in 0..n {
+            s = s + a[i][j] * a[i][j];
+        }
+        let s = R::check(s, R::c(0.0), R::c(1.0), Site::Constraint(j), false)?;
+        sc.push(R::c(1.0) / s.sqrt());
+    }
+    let mut m: Vec<Vec<R>> = (0..n)
+        .map(|i| (0..n).map(|j| a[i][j] * sc[j]).collect())
+        .collect();
+    let mut swaps = Vec::new();
+    for k in 0..n {
+        for i in k + 1..n {
+            let (p, q) = (m[i][k], m[k][k]);
+            swaps.push((k, i, p, q));
+            for j in 0..n {
+                let (x, y) = (m[i][j], m[k][j]);
+                m[k][j] = R::select_abs_gt(p, q, x, y);
+                m[i][j] = R::select_abs_gt(p, q, y, x);
+            }
+        }
+        let piv = R::check(
+            m[k][k],
+            R::c(CONSTRAINT_TOLERANCE),
+            R::c(1.0),
+            Site::Constraint(k),
+            true,
+        )?;
+        let inv = R::c(1.0) / piv;
+        for i in k + 1..n {
+            let f = m[i][k] * inv;
+            m[i][k] = f;
+            for j in k + 1..n {
+                m[i][j] = m[i][j] - f * m[k][j];
+            }
+        }
+    }
+    Ok(Lu { m, swaps, sc })
+}
+
+impl<R: Real> Lu<R> {
+    /// Solve `a x = b`.
+    pub fn solve(&self, b: &[R]) -> Vec<R> {
+        let n = b.len();
+        let mut x = b.to_vec();
+        for &(k, i, p, q) in &self.swaps {
+            let (xi, xk) = (x[i], x[k]);
+            x[k] = R::select_abs_gt(p, q, xi, xk);
+            x[i] = R::select_abs_gt(p, q, xk, xi);
+        }
+        for i in 0..n {
+            for j in 0..i {
+                x[i] = x[i] - self.m[i][j] * x[j];
+            }
+        }
+        for i in (0..n).rev() {
+            for j in i + 1..n {
+                x[i] = x[i] - self.m[i][j] * x[j];
+            }
+            x[i] = x[i] / self.m[i][i];
+        }
+        for i in 0..n {
+            x[i] = x[i] * self.sc[i];
+        }
+        x
+    }
+
+    /// Solve `aᵀ y = b`.
+    pub fn solve_t(&self, b: &[R]) -> Vec<R> {
+        let n = b.len();
+        let mut z: Vec<R> = (0..n).map(|i| b[i] * self.sc[i]).collect();
+        // Uᵀ z' = D b (forward), Lᵀ w = z' (backward), y = Pᵀ w.
+        for i in 0..n {
+            for j in 0..i {
+                z[i] = z[i] - self.m[j][i] * z[j];
+            }
+            z[i] = z[i] / self.m[i][i];
+        }
+        for i in (0..n).rev() {
+            for j in i + 1..n {
+                z[i] = z[i] - self.m[j][i] * z[j];
+            }
+        }
+        for &(k, i, p, q) in self.swaps.iter().rev() {
+            let (zi, zk) = (z[i], z[k]);
+            z[k] = R::select_abs_gt(p, q, zi, zk);
+            z[i] = R::select_abs_gt(p, q, zk, zi);
+        }
+        z
+    }
+}
+
+/// The configuration-level quantities shared by every function.
+pub struct Config<R> {
+    /// Tree kinematics.
+    pub kin: Kin<R>,
+    /// Jacobian rows of the kept equations (all joints).
+    pub jac: Vec<Vec<R>>,
+    /// LU of `Φ_d`.
+    pub lu: Lu<R>,
+}
+
+/// Kinematics, the loop Jacobian and the LU of `Φ_d` at `x`; with `check`, the kept loop
+/// equations must hold within [`CLOSURE_TOLERANCE`].
+pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Config<R>, Singular> {
+    let kin = kinematics(plan, x);
+    if check {
+        for (i, r) in plan.rows.iter().enumerate() {
+            let tol = CLOSURE_TOLERANCE * row_scale(plan, r);
+            let v = row_value(plan, &kin, r);
+            // |Φ| < tol  ⇔  tol² − Φ² > 0.
+            R::check(
+                R::c(tol * tol) - v * v,
+                R::c(0.0),
+                R::c(tol * tol),
+                Site::Closure(i),
+                false,
+            )?;
+        }
+    }
+    let jac: Vec<Vec<R>> = plan
+        .rows
+        .iter()
+        .map(|r| jacobian_row(plan, &kin, r))
+        .collect();
+    let phid: Vec<Vec<R>> = jac
+        .iter()
+        .map(|row| plan.dependent.iter().map(|&j| row[j]).collect())
+        .collect();
+    let lu = lu_factor(&phid)?;
+    Ok(Config { kin, jac, lu })
+}
+
+fn row_scale(plan: &Plan, r: &Row) -> f64 {
+    match r {
+        Row::Point { .. } => plan.size,
+        Row::Axis { .. } => 1.0,
+    }
+}
+
+/// All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`).
+pub fn joint_rates_generic<R: Real>(plan: &Plan, c: &Config<R>, u: &[R]) -> Vec<R> {
+    let rhs: Vec<R> = c
+        .jac
+        .iter()
+        .map(|row| {
+            plan.independent
+                .iter()
+                .zip(u)
+                .fold(R::c(0.0), |s, (&j, &uj)| s - row[j] * uj)
+        })
+        .collect();
+    let xd_d = c.lu.solve(&rhs);
+    let mut xd = vec![R::c(0.0); plan.nx()];
+    for (k, &j) in plan.independent.iter().enumerate() {
+        xd[j] = u[k];
+    }
+    for (k, &j) in plan.dependent.iter().enumerate() {
+        xd[j] = xd_d[k];
+    }
+    xd
+}
+
+/// The tree's joint efforts for the body motions `m` (recursive Newton–Euler, backward
+/// sweep): each body's `w = M ṫ + W M t − w^G` (eq. 12) summed over subtrees; `τ_j = e_j · n`
+/// (R, the moment about the joint point) or `e_j · f` (P).
+pub fn tree_efforts<R: Real>(
+    plan: &Plan,
+    k: &Kin<R>,
+    m: &[BodyMotion<R>],
+    gravity: bool,
+) -> Vec<R> {
+    let n = plan.nx();
+    let g: V<R> = if gravity { cv(&plan.gravity) } else { zero3() };
+    // Subtree force and moment about the base origin.
+    let mut force: Vec<V<R>> = vec![zero3(); n];
+    let mut moment: Vec<V<R>> = vec![zero3(); n];
+    let mut tau = vec![R::c(0.0); n];
+    for i in (0..n).rev() {
+        let (mass, com, inertia) = plan.joints[i].body;
+        let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
+        if !massless {
+            let c = add(k.pos[i], mv(&k.rot[i], cv(&com)));
+            let a = m[i].accel_at(k.o[i], c);
+            let f = scale(R::c(mass), sub(a, g));
+            let nc = euler(&k.rot[i], &inertia, m[i].w, m[i].alpha);
+            force[i] = add(force[i], f);
+            moment[i] = add(moment[i], add(nc, cross(c, f)));
+        }
+        tau[i] = match plan.joints[i].kind {
+            JointKind::Revolute => dot(k.e[i], sub(moment[i], cross(k.o[i], force[i]))),
+            JointKind::Prismatic => dot(k.e[i], force[i]),
+        };
+        if let Some(p) = plan.joints[i].parent {
+            force[p] = add(force[p], force[i]);
+            moment[p] = add(moment[p], moment[i]);
+        }
+    }
+    tau
+}
+
+/// The generalized force `f = I u̇ + C u − γ` (`γ` only with `gravity`) of the independent
+/// coordinates: `f = Sᵀ τ_T = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`.
+pub fn generalized_force<R: Real>(
+    plan: &Plan,
+    c: &Config<R>,
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    let xd = joint_rates_generic(plan, c, u);
+    let bias_m = motions(plan, &c.kin, &xd, None);
+    let rhs: Vec<R> = plan
+        .rows
+        .iter()
+        .zip(&c.jac)
+        .map(|(r, row)| {
+            let b = row_bias(plan, &c.kin, &bias_m, r);
+            plan.independent
+                .iter()
+                .zip(ud)
+                .fold(-b, |s, (&j, &a)| s - row[j] * a)
+        })
+        .collect();
+    let xdd_d = c.lu.solve(&rhs);
+    let mut xdd = vec![R::c(0.0); plan.nx()];
+    for (k, &j) in plan.independent.iter().enumerate() {
+        xdd[j] = ud[k];
+    }
+    for (k, &j) in plan.dependent.iter().enumerate() {
+        xdd[j] = xdd_d[k];
+    }
+    let m = motions(plan, &c.kin, &xd, Some(&xdd));
+    let tau = tree_efforts(plan, &c.kin, &m, gravity);
+    let td: Vec<R> = plan.dependent.iter().map(|&j| tau[j]).collect();
+    let y = c.lu.solve_t(&td);
+    plan.independent
+        .iter()
+        .map(|&j| {
+            c.jac
+                .iter()
+                .zip(&y)
+                .fold(tau[j], |s, (row, &yk)| s - row[j] * yk)
+        })
+        .collect()
+}
+
+/// The generalized inertia `I = Sᵀ M_T S` of the independent coordinates, from each body's
+/// twist per unit speed (exactly symmetric: the upper triangle mirrored).
+pub fn generalized_inertia<R: Real>(plan: &Plan, c: &Config<R>) -> Vec<Vec<R>> {
+    let d = plan.dof();
+    let n = plan.nx();
+    // Column k of S: the joint rates for u = e_k; the bodies' angular velocities and mass
+    // centre velocities for it.
+    let mut cols: Vec<Vec<(V<R>, V<R>)>> = Vec::with_capacity(d);
+    for k in 0..d {
+        let mut e = vec![R::c(0.0); d];
+        e[k] = R::c(1.0);
+        let xd = joint_rates_generic(plan, c, &e);
+        let m = motions(plan, &c.kin, &xd, None);
+        cols.push(
+            (0..n)
+                .map(|b| {
+                    let (_, com, _) = plan.joints[b].body;
+                    let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
+                    (m[b].w, m[b].vel_at(c.kin.o[b], cw))
+                })
+                .collect(),
+        );
+    }
+    let mut out = vec![vec![R::c(0.0); d]; d];
+    for b in 0..n {
+        let (mass, _, inertia) = plan.joints[b].body;
+        if mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0) {
+            continue;
+        }
+        for i in 0..d {
+            for j in i..d {
+                let (wi, vi) = cols[i][b];
+                let (wj, vj) = cols[j][b];
+                let v = R::c(mass) * dot(vi, vj) + inertia_quad(&c.kin.rot[b], &inertia, wi, wj);
+                out[i][j] = out[i][j] + v;
+            }
+        }
+    }
+    for i in 0..d {
+        for j in 0..i {
+            out[i][j] = out[j][i];
+        }
+    }
+    out
+}
+
+/// Forward dynamics: `u̇` with `I u̇ = τ − (C u − γ)`.
+pub fn forward_dynamics_generic<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    u: &[R],
+    tau: &[R],
+) -> Result<Vec<R>, Singular> {
+    let c = configuration(plan, x, true)?;
+    let d = plan.dof();
+    let zero = vec![R::c(0.0); d];
+    let h = generalized_force(plan, &c, u, &zero, true);
+    let rhs: Vec<R> = (0..d).map(|i| tau[i] - h[i]).collect();
+    let m = generalized_inertia(plan, &c);
+    solve_spd(&m, &rhs)
+}
+
+/// One Newton step of the loop equations at `x` (the independent coordinates held): the full
+/// step `Δx` (zero on the independent coordinates) and the largest scaled residual
+/// `max_k |Φ_k| / scale_k` (signed: the entry of largest magnitude).
+pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R), Singular> {
+    let c = configuration(plan, x, false)?;
+    let phi: Vec<R> = plan
+        .rows
+        .iter()
+        .map(|r| row_value(plan, &c.kin, r))
+        .collect();
+    let rhs: Vec<R> = phi.iter().map(|&v| -v).collect();
+    let dd = c.lu.solve(&rhs);
+    let mut dx = vec![R::c(0.0); plan.nx()];
+    for (k, &j) in plan.dependent.iter().enumerate() {
+        dx[j] = dd[k];
+    }
+    let mut worst = R::c(0.0);
+    for (r, &v) in plan.rows.iter().zip(&phi) {
+        let s = v * R::c(1.0 / row_scale(plan, r));
+        worst = R::select_abs_gt(s, worst, s, worst);
+    }
+    Ok((dx, worst))
+}
+
+// ---------------------------------------------------------------------------------------------
+// f64 API
+
+fn check_finite(inputs: &[&[f64]]) -> Result<(), Singular> {
+    crate::parallel::noc::check_finite(inputs)
+}
+
+fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {
+    for &x in &v {
+        if !x.is_finite() {
+            return Err(Singular {
+                site: Site::Input,
+                value: x,
+                condition_estimate: f64::INFINITY,
+            });
+        }
+    }
+    Ok(v)
+}
+
+/// All joint rates `ẋ = S u` at the closed configuration `x`.
+pub fn joint_rates(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u])?;
+    let c = configuration(plan, x, true)?;
+    finite(joint_rates_generic(plan, &c, u))
+}
+
+/// Generalized forces of the independent coordinates (the actuator efforts, N or N·m) for the
+/// motion `(x, u, u̇)`, gravity included.
+pub fn inverse_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let c = configuration(plan, x, true)?;
+    finite(generalized_force(plan, &c, u, ud, true))
+}
+
+/// `C u − γ` and friends: the generalized force with a chosen gravity switch.
+pub fn generalized_effort(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+    gravity: bool,
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let c = configuration(plan, x, true)?;
+    finite(generalized_force(plan, &c, u, ud, gravity))
+}
+
+/// The generalized inertia of the independent coordinates.
+pub fn mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let c = configuration(plan, x, true)?;
+    let m = generalized_inertia(plan, &c);
+    for row in &m {
+        finite(row.clone())?;
+    }
+    Ok(m)
+}
+
+/// Forward dynamics `u̇` for the efforts `tau` of the independent coordinates.
+pub fn forward_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    tau: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, tau])?;
+    finite(forward_dynamics_generic(plan, x, u, tau)?)
+}
+
+/// The largest scaled loop-equation residual at `x` (m relative to the size, or rad).
+pub fn closure_residual(plan: &Plan, x: &[f64]) -> f64 {
+    let k = kinematics(plan, x);
+    plan.rows
+        .iter()
+        .map(|r| (row_value(plan, &k, r) / row_scale(plan, r)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Forward kinematics (assembly): the closed configuration whose independent coordinates are
+/// `xi`, by Newton's method on the dependent coordinates from `guess` (the step halved while it
+/// does not reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when
+/// every kept loop equation is within [`FK_TOLERANCE`] (point equations times the size); then
+/// one more full step (kept unless it raises the residual) takes the coordinates to rounding.
+pub fn forward_kinematics(
+    plan: &Plan,
+    xi: &[f64],
+    guess: &[f64],
+) -> Result<Vec<f64>, NoConvergence> {
+    let mut x = guess.to_vec();
+    for (k, &j) in plan.independent.iter().enumerate() {
+        x[j] = xi[k];
+    }
+    let fail = |it, r: f64| NoConvergence {
+        iterations: it,
+        residual: r,
+    };
+    let Ok((mut dx, mut r)) = newton_step(plan, &x) else {
+        return Err(fail(0, f64::INFINITY));
+    };
+    for it in 0..FK_MAX_ITERATIONS {
+        if r.abs() <= FK_TOLERANCE {
+            // One more full step (Newton converges quadratically): the coordinates to rounding.
+            let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+            if let Ok((_, rn)) = newton_step(plan, &xn)
+                && rn.abs() <= r.abs()
+            {
+                return Ok(xn);
+            }
+            return Ok(x);
+        }
+        let mut step = 1.0;
+        let mut moved = false;
+        for _ in 0..20 {
+            let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + step * b).collect();
+            if let Ok((dn, rn)) = newton_step(plan, &xn)
+                && rn.abs() < r.abs()
+            {
+                x = xn;
+                dx = dn;
+                r = rn;
+                moved = true;
+                break;
+            }
+            step *= 0.5;
+        }
+        if !moved {
+            return Err(fail(it + 1, r.abs()));
+        }
+    }
+    if r.abs() <= FK_TOLERANCE {
+        Ok(x)
+    } else {
+        Err(fail(FK_MAX_ITERATIONS, r.abs()))
+    }
+}

@@ -1,0 +1,43 @@
+//! Helpers for the closed-loop (joint-coordinate) tests: the bundled specs as models and random
+//! assembled states.
+
+use rand::Rng;
+use rand::rngs::StdRng;
+use runtime::closed::ClosedModel;
+use runtime::closed::noc::{self, Plan};
+
+/// The bundled closed-loop specs (module names).
+pub const CLOSED: [&str; 1] = ["four_bar"];
+
+/// The validated model of a bundled closed-loop spec.
+pub fn model(name: &str) -> ClosedModel {
+    let path = crate::pkm::spec_path(name);
+    let src = std::fs::read_to_string(&path).expect("spec readable");
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("{name} is not a closed-loop mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+/// A random assembled state: the independent coordinates moved from home by up to `reach`
+/// (rad or m) and the rest found by Newton from home (retried until it converges and the
+/// configuration is regular); speeds and rates uniform in ±1.
+pub fn random_state(plan: &Plan, rng: &mut StdRng, reach: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = plan.dof();
+    let home = vec![0.0; plan.nx()];
+    loop {
+        let xi: Vec<f64> = (0..n)
+            .map(|_| reach * rng.random_range(-1.0..1.0))
+            .collect();
+        let Ok(x) = noc::forward_kinematics(plan, &xi, &home) else {
+            continue;
+        };
+        if noc::inverse_dynamics(plan, &x, &vec![0.0; n], &vec![0.0; n]).is_err() {
+            continue;
+        }
+        let u: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let ud: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        return (x, u, ud);
+    }
+}

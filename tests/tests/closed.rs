@@ -1,0 +1,220 @@
+//! Closed loops in joint coordinates: the runtime (NOC, `S = [1; −Φ_d⁻¹Φ_i]`) against the
+//! independent Cartesian Newton–Euler + Lagrange-multiplier route, the generated code against
+//! the runtime, power balance, assembly round trips and the failure behaviour.
+
+use rand::Rng;
+use runtime::closed::noc::{self, Plan};
+use tests::closed::{CLOSED, model, random_state};
+use tests::lagrange::{self, Prescribed};
+use tests::pkm::rel;
+
+/// Efforts of the independent joints by the Lagrange route, in `independent` order.
+fn lagrange_efforts(
+    m: &runtime::closed::ClosedModel,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Vec<f64> {
+    // The route takes the actuated joints in increasing joint order.
+    let mut order: Vec<usize> = (0..m.independent.len()).collect();
+    order.sort_by_key(|&k| m.independent[k]);
+    let us: Vec<f64> = order.iter().map(|&k| u[k]).collect();
+    let uds: Vec<f64> = order.iter().map(|&k| ud[k]).collect();
+    let sys = lagrange::from_closed(m, x);
+    assert!(
+        lagrange::closure_residual(&sys) < 1e-9,
+        "the state does not close the loops"
+    );
+    let sol = lagrange::inverse_dynamics(&sys, &Prescribed::ActuatedJoints, &us, &uds)
+        .unwrap_or_else(|e| panic!("Lagrange route failed: {e}"));
+    let mut out = vec![0.0; u.len()];
+    for (i, &k) in order.iter().enumerate() {
+        out[k] = sol.efforts[i];
+    }
+    out
+}
+
+fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Error of accelerations recovered by forward dynamics from the efforts `tau`, relative to
+/// the accelerations those efforts can produce (`max |τ| / max |I|`) or to `ud`, whichever is
+/// larger: a small `ud` under large gravity efforts is recovered only to the efforts' precision.
+fn fd_error(back: &[f64], ud: &[f64], tau: &[f64], mm: &[Vec<f64>]) -> f64 {
+    let imax = mm.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    max_abs_diff(back, ud) / max_abs(ud).max(max_abs(tau) / imax)
+}
+
+#[test]
+fn runtime_matches_newton_euler_with_lagrange_multipliers() {
+    for name in CLOSED {
+        let m = model(name);
+        let plan = Plan::new(&m).unwrap();
+        let mut rng = tests::rng(11);
+        let mut worst: f64 = 0.0;
+        for _ in 0..100 {
+            let (x, u, ud) = random_state(&plan, &mut rng, 3.0);
+            let ours = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            let theirs = lagrange_efforts(&m, &x, &u, &ud);
+            worst = worst.max(rel(&ours, &theirs));
+        }
+        println!("{name}: NOC vs Lagrange multipliers, max relative error (max norm) {worst:.1e}");
+        assert!(worst < 1e-10, "{name}: {worst:e}");
+    }
+}
+
+#[test]
+fn mass_matrix_is_the_acceleration_part_of_inverse_dynamics() {
+    for name in CLOSED {
+        let m = model(name);
+        let plan = Plan::new(&m).unwrap();
+        let n = plan.dof();
+        let mut rng = tests::rng(12);
+        for _ in 0..50 {
+            let (x, u, ud) = random_state(&plan, &mut rng, 3.0);
+            let mm = noc::mass_matrix(&plan, &x).unwrap();
+            let with = noc::generalized_effort(&plan, &x, &u, &ud, true).unwrap();
+            let without = noc::generalized_effort(&plan, &x, &u, &vec![0.0; n], true).unwrap();
+            let iud: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| mm[i][j] * ud[j]).sum())
+                .collect();
+            let diff: Vec<f64> = with.iter().zip(&without).map(|(a, b)| a - b).collect();
+            // Relative to the efforts being differenced (the gravity part cancels).
+            let e = max_abs_diff(&diff, &iud) / max_abs(&with).max(max_abs(&without));
+            assert!(e < 1e-12, "{name}: {e:e}");
+            // Forward dynamics inverts inverse dynamics.
+            let back = noc::forward_dynamics(&plan, &x, &u, &with).unwrap();
+            let e = fd_error(&back, &ud, &with, &mm);
+            assert!(e < 1e-10, "{name}: {e:e}");
+        }
+    }
+}
+
+/// Power balance along a smooth motion: `d/dt (½ uᵀ I u) = (f − (−γ))ᵀ u` with `f` the
+/// generalized force without gravity, checked by central differences of the kinetic energy
+/// along the motion `x_i(t) = x_i0 + a sin(ωt)` assembled by Newton.
+#[test]
+fn kinetic_energy_rate_equals_power() {
+    for name in CLOSED {
+        let m = model(name);
+        let plan = Plan::new(&m).unwrap();
+        let n = plan.dof();
+        let mut rng = tests::rng(13);
+        for _ in 0..10 {
+            let x0: Vec<f64> = (0..n).map(|_| rng.random_range(-2.0..2.0)).collect();
+            let amp: Vec<f64> = (0..n).map(|_| rng.random_range(-0.5..0.5)).collect();
+            let w = 1.3;
+            let mut guess = vec![0.0; plan.nx()];
+            let mut state = |t: f64| {
+                let xi: Vec<f64> = (0..n).map(|k| x0[k] + amp[k] * (w * t).sin()).collect();
+                let u: Vec<f64> = (0..n).map(|k| amp[k] * w * (w * t).cos()).collect();
+                let ud: Vec<f64> = (0..n).map(|k| -amp[k] * w * w * (w * t).sin()).collect();
+                let x = noc::forward_kinematics(&plan, &xi, &guess).unwrap();
+                guess = x.clone();
+                (x, u, ud)
+            };
+            let ke = |x: &[f64], u: &[f64]| {
+                let mm = noc::mass_matrix(&plan, x).unwrap();
+                0.5 * (0..n)
+                    .map(|i| (0..n).map(|j| u[i] * mm[i][j] * u[j]).sum::<f64>())
+                    .sum::<f64>()
+            };
+            let t = 0.4;
+            let h = 1e-4;
+            let (xa, ua, _) = state(t - h);
+            let (x, u, ud) = state(t);
+            let (xb, ub, _) = state(t + h);
+            let rate = (ke(&xb, &ub) - ke(&xa, &ua)) / (2.0 * h);
+            let f = noc::generalized_effort(&plan, &x, &u, &ud, false).unwrap();
+            let power: f64 = f.iter().zip(&u).map(|(a, b)| a * b).sum();
+            let scale = power.abs().max(rate.abs()).max(1e-3);
+            assert!(
+                (rate - power).abs() / scale < 1e-6,
+                "{name}: dT/dt {rate} vs power {power}"
+            );
+        }
+    }
+}
+
+#[test]
+fn assembly_round_trip_from_a_perturbed_guess() {
+    for name in CLOSED {
+        let m = model(name);
+        let plan = Plan::new(&m).unwrap();
+        let mut rng = tests::rng(14);
+        for _ in 0..100 {
+            let (x, _, _) = random_state(&plan, &mut rng, 3.0);
+            let xi: Vec<f64> = plan.independent.iter().map(|&j| x[j]).collect();
+            let guess: Vec<f64> = x
+                .iter()
+                .map(|v| v + rng.random_range(-0.05..0.05))
+                .collect();
+            let back = noc::forward_kinematics(&plan, &xi, &guess).unwrap();
+            assert!(rel(&back, &x) < 1e-10, "{name}: {:?} vs {:?}", back, x);
+        }
+    }
+}
+
+#[test]
+fn inputs_that_do_not_close_the_loops_are_refused() {
+    for name in CLOSED {
+        let m = model(name);
+        let plan = Plan::new(&m).unwrap();
+        let n = plan.dof();
+        let mut rng = tests::rng(15);
+        let (mut x, u, ud) = random_state(&plan, &mut rng, 1.0);
+        let j = plan.dependent[0];
+        x[j] += 1e-3;
+        let e = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap_err();
+        assert!(matches!(e.site, runtime::parallel::Site::Closure(_)), "{e}");
+        let mut bad = x.clone();
+        bad[0] = f64::NAN;
+        let e = noc::inverse_dynamics(&plan, &bad, &u, &vec![0.0; n]).unwrap_err();
+        assert_eq!(e.site, runtime::parallel::Site::Input);
+    }
+}
+
+macro_rules! generated_matches_runtime {
+    ($($m:ident),*) => {$(
+        {
+            use mechanisms::$m as g;
+            let m = model(stringify!($m));
+            let plan = Plan::new(&m).unwrap();
+            let mut rng = tests::rng(16);
+            let mut worst: f64 = 0.0;
+            for _ in 0..500 {
+                let (x, u, ud) = random_state(&plan, &mut rng, 3.0);
+                let xa: [f64; g::NX] = x.clone().try_into().unwrap();
+                let ua: [f64; g::DOF] = u.clone().try_into().unwrap();
+                let uda: [f64; g::DOF] = ud.clone().try_into().unwrap();
+                let ours = g::inverse_dynamics(&xa, &ua, &uda).unwrap();
+                let theirs = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+                worst = worst.max(rel(&ours, &theirs));
+                let mm = g::mass_matrix(&xa).unwrap();
+                let mr = noc::mass_matrix(&plan, &x).unwrap();
+                worst = worst.max(rel(&mm.concat(), &mr.concat()));
+                let rates = g::joint_rates(&xa, &ua).unwrap();
+                let rr = noc::joint_rates(&plan, &x, &u).unwrap();
+                worst = worst.max(rel(&rates, &rr));
+                let fd = g::forward_dynamics(&xa, &ua, &ours).unwrap();
+                worst = worst.max(fd_error(&fd, &ud, &ours, &mr));
+                let xi = g::inverse_kinematics(&xa).unwrap();
+                let guess: [f64; g::NX] = core::array::from_fn(|i| x[i] + rng.random_range(-0.05..0.05));
+                let back = g::forward_kinematics(&xi, &guess).unwrap();
+                worst = worst.max(rel(&back, &x));
+            }
+            println!("{}: generated vs runtime, max relative error {worst:.1e}", stringify!($m));
+            assert!(worst < 1e-10, "{}: {worst:e}", stringify!($m));
+        }
+    )*};
+}
+
+#[test]
+fn generated_code_matches_the_runtime() {
+    generated_matches_runtime!(four_bar);
+}
