@@ -28,7 +28,8 @@ pub struct Kernels {
     pub mass_matrix: Vec<ExprId>,
     /// `u̇`.
     pub forward_dynamics: Vec<ExprId>,
-    /// Newton step (`NX`) then the signed largest scaled residual.
+    /// Newton step (`NX`), the signed largest scaled residual of the kept loop equations, then
+    /// that of every loop equation and axis alignment.
     pub newton_step: Vec<ExprId>,
 }
 
@@ -51,9 +52,10 @@ fn build(plan: &Plan) -> Result<Kernels, Singular> {
     let f = noc::generalized_force(plan, &c, &u, &ud, true);
     let m = noc::generalized_inertia(plan, &c);
     let fd = noc::forward_dynamics_generic(plan, &x, &u, &tau)?;
-    let (step, worst) = noc::newton_step(plan, &x)?;
+    let (step, kept, full) = noc::newton_step(plan, &x)?;
     let mut newton = ids(&step);
-    newton.push(worst.0);
+    newton.push(kept.0);
+    newton.push(full.0);
     Ok(Kernels {
         graph: Graph::new(),
         joint_rates: ids(&rates),
@@ -130,10 +132,10 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
         ),
         make(
             "newton_step",
-            vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates and the signed largest scaled loop-equation residual.".into()],
+            vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates, the signed largest scaled residual of the kept loop equations, and that of every loop equation and revolute-axis alignment.".into()],
             vec![Arg::X],
             k.newton_step.clone(),
-            fallible(&[Part::Coords(nx), Part::Scalar]),
+            fallible(&[Part::Coords(nx), Part::Scalar, Part::Scalar]),
             false,
         ),
     ];
@@ -230,6 +232,7 @@ fn templates() -> TokenStream {
     let clo_tol = noc::CLOSURE_TOLERANCE;
     let fk_tol = Literal::f64_unsuffixed(noc::FK_TOLERANCE);
     let fk_max = Literal::usize_unsuffixed(noc::FK_MAX_ITERATIONS);
+    let full_tol = Literal::f64_unsuffixed(noc::FULL_TOLERANCE);
     let closure_doc = format!(
         " Kept loop equation `k` exceeds `{clo_tol:e}` (times the mechanism's size for a point equation): `x` does not close the loops. `value` is `tol² − Φ_k²`."
     );
@@ -288,8 +291,10 @@ fn templates() -> TokenStream {
         /// independent coordinates `q` (angles compared as given), by Newton's method on the
         /// dependent coordinates from `guess` (its branch), the step halved while it does not
         /// reduce the residual; at most 50 iterations, converged when every kept loop
-        /// equation is within `1e-12` (times the mechanism's size for a point equation), then
-        /// one more full step (kept unless it raises the residual).
+        /// equation is within `1e-12` (times the mechanism's size for a point equation) and
+        /// every loop equation (the redundant ones too) and revolute-axis alignment within
+        /// `1e-9` (else a spurious branch: `Err`), then one more full step (kept unless it
+        /// raises the residual).
         #[allow(clippy::all)]
         pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
             let _ = REVOLUTE;
@@ -298,18 +303,22 @@ fn templates() -> TokenStream {
                 x[INDEPENDENT[k]] = q[k];
             }
             let abs = |v: f64| if v < 0.0 { -v } else { v };
-            let Ok((mut dx, mut r)) = newton_step(&x) else {
+            let Ok((mut dx, mut r, mut full)) = newton_step(&x) else {
                 return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
             };
             for it in 0..#fk_max {
                 if abs(r) <= #fk_tol {
+                    if !(abs(full) <= #full_tol) {
+                        // The kept equations hold but not all of them: a spurious branch.
+                        return Err(NoConvergence { iterations: it, residual: abs(full) });
+                    }
                     // One more full step: the coordinates to rounding.
                     let mut xn = x;
                     for i in 0..NX {
                         xn[i] += dx[i];
                     }
-                    if let Ok((_, rn)) = newton_step(&xn) {
-                        if abs(rn) <= abs(r) {
+                    if let Ok((_, rn, fulln)) = newton_step(&xn) {
+                        if abs(rn) <= abs(r) && abs(fulln) <= #full_tol {
                             return Ok(xn);
                         }
                     }
@@ -322,11 +331,12 @@ fn templates() -> TokenStream {
                     for i in 0..NX {
                         xn[i] += step * dx[i];
                     }
-                    if let Ok((dn, rn)) = newton_step(&xn) {
+                    if let Ok((dn, rn, fulln)) = newton_step(&xn) {
                         if abs(rn) < abs(r) {
                             x = xn;
                             dx = dn;
                             r = rn;
+                            full = fulln;
                             moved = true;
                             break;
                         }
@@ -337,11 +347,7 @@ fn templates() -> TokenStream {
                     return Err(NoConvergence { iterations: it + 1, residual: abs(r) });
                 }
             }
-            if abs(r) <= #fk_tol {
-                Ok(x)
-            } else {
-                Err(NoConvergence { iterations: #fk_max, residual: abs(r) })
-            }
+            Err(NoConvergence { iterations: #fk_max, residual: abs(r) })
         }
     }
 }

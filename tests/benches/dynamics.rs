@@ -177,6 +177,79 @@ macro_rules! bench_parallel {
 bench_parallel!(gough_stewart, gough_stewart);
 bench_parallel!(agile_eye, agile_eye);
 
+/// A bundled closed-loop mechanism in joint coordinates: generated vs the runtime evaluator
+/// (`runtime::closed::noc`) vs the independent Newton–Euler + Lagrange-multiplier route (dense
+/// SVD over every body's twist), inverse dynamics; and generated vs runtime forward dynamics.
+macro_rules! bench_closed {
+    ($fn_name:ident, $module:ident) => {
+        fn $fn_name(c: &mut Criterion) {
+            use mechanisms::$module as generated;
+            use runtime::closed::noc::{self, Plan};
+            const NX: usize = generated::NX;
+            const N: usize = generated::DOF;
+            let name = stringify!($module);
+            let model = tests::closed::model(name);
+            let plan = Plan::new(&model).expect("valid model");
+            let (x, u, ud) =
+                tests::closed::random_state(&plan, &mut rng(N as u64), tests::closed::reach(name));
+            let x: [f64; NX] = x.try_into().unwrap();
+            let u: [f64; N] = u.try_into().unwrap();
+            let ud: [f64; N] = ud.try_into().unwrap();
+            let tau = generated::inverse_dynamics(&x, &u, &ud).expect("regular state");
+            let reference = noc::inverse_dynamics(&plan, &x, &u, &ud).expect("regular state");
+            assert!(rel_err(&tau, &reference) < 1e-9, "{name}: ID vs runtime");
+            let sys = tests::lagrange::from_closed(&model, &x);
+
+            let mut g = c.benchmark_group(format!("{name}/inverse_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| generated::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    noc::inverse_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&ud),
+                    )
+                })
+            });
+            g.bench_function("lagrange_multipliers", |b| {
+                b.iter(|| {
+                    tests::lagrange::inverse_dynamics(
+                        black_box(&sys),
+                        &tests::lagrange::Prescribed::ActuatedJoints,
+                        black_box(&u),
+                        black_box(&ud),
+                    )
+                })
+            });
+            g.finish();
+
+            let mut g = c.benchmark_group(format!("{name}/forward_dynamics"));
+            g.bench_function("generated", |b| {
+                b.iter(|| {
+                    generated::forward_dynamics(black_box(&x), black_box(&u), black_box(&tau))
+                })
+            });
+            g.bench_function("runtime_noc", |b| {
+                b.iter(|| {
+                    noc::forward_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&tau),
+                    )
+                })
+            });
+            g.finish();
+        }
+    };
+}
+
+bench_closed!(five_bar_joints, five_bar_joints);
+bench_closed!(spherical_five_bar, spherical_five_bar);
+
 fn config() -> Criterion {
     Criterion::default()
         .measurement_time(Duration::from_secs(2))
@@ -187,6 +260,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye
+    targets = puma560, chain7, gough_stewart, agile_eye, five_bar_joints, spherical_five_bar
 }
 criterion_main!(benches);

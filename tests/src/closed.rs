@@ -7,7 +7,13 @@ use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
 /// The bundled closed-loop specs (module names).
-pub const CLOSED: [&str; 1] = ["four_bar"];
+pub const CLOSED: [&str; 5] = [
+    "four_bar",
+    "five_bar_joints",
+    "spherical_five_bar",
+    "bricard",
+    "n_four_bar",
+];
 
 /// The validated model of a bundled closed-loop spec.
 pub fn model(name: &str) -> ClosedModel {
@@ -40,4 +46,10 @@ pub fn random_state(plan: &Plan, rng: &mut StdRng, reach: f64) -> (Vec<f64>, Vec
         let ud: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         return (x, u, ud);
     }
+}
+
+/// How far (rad or m) the random states move the independent coordinates from home: the
+/// N-four-bar's change points (bars horizontal) lie π/2 from home, so it stays within 1.2 rad.
+pub fn reach(name: &str) -> f64 {
+    if name == "n_four_bar" { 1.2 } else { 3.0 }
 }

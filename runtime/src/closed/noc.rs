@@ -38,6 +38,9 @@ pub const FK_MAX_ITERATIONS: usize = 50;
 /// Newton converges when every kept loop equation is within `1e-12` (point equations times
 /// the mechanism's size).
 pub const FK_TOLERANCE: f64 = 1e-12;
+/// Newton's result must also satisfy every loop equation (the redundant ones) and keep the
+/// revolute axes aligned within this (scaled); else it is a spurious branch of the kept ones.
+pub const FULL_TOLERANCE: f64 = 1e-9;
 /// Rank tolerance of the home analysis (relative to unit-scaled rows).
 pub const RANK_TOLERANCE: f64 = 1e-9;
 
@@ -89,6 +92,9 @@ pub struct CutPlan {
     pub point_child: Vec3,
     /// Revolute: the axis in the parent's body frame.
     pub axis_parent: Option<Vec3>,
+    /// Revolute: the axis in the child's body frame (closed loops have it equal to the
+    /// parent's, not opposite).
+    pub axis_child: Option<Vec3>,
 }
 
 /// What the evaluators need, prepared and checked once.
@@ -102,6 +108,8 @@ pub struct Plan {
     pub cuts: Vec<CutPlan>,
     /// The kept loop equations (`NX − DOF` of them).
     pub rows: Vec<Row>,
+    /// Every loop equation (the kept ones and the redundant ones), for the closure checks.
+    pub all_rows: Vec<Row>,
     /// Independent joints (in order).
     pub independent: Vec<usize>,
     /// Dependent joints (increasing).
@@ -142,6 +150,10 @@ impl Plan {
                     CutKind::Revolute { axis } => Some(mat_vec(&c.frame_parent.rotation, &axis)),
                     CutKind::Spherical => None,
                 },
+                axis_child: match c.kind {
+                    CutKind::Revolute { axis } => Some(mat_vec(&c.frame_child.rotation, &axis)),
+                    CutKind::Spherical => None,
+                },
             })
             .collect();
         // Candidate rows: per cut, the three point rows, then (revolute) two axis rows.
@@ -167,6 +179,7 @@ impl Plan {
             joints,
             cuts,
             rows: candidates.clone(),
+            all_rows: candidates.clone(),
             independent,
             dependent,
             anc: ancestry(tree),
@@ -375,6 +388,14 @@ fn row_value<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> R {
             dot(n, mm_)
         }
     }
+}
+
+/// `n_parent · n_child − 1` of revolute cut `cut` (zero when the axes are aligned, `−2` when
+/// opposite: the axis equations `n·m = 0` hold for both).
+fn alignment<R: Real>(plan: &Plan, k: &Kin<R>, cut: usize) -> Option<R> {
+    let c = &plan.cuts[cut];
+    let (a, b) = (c.axis_parent?, c.axis_child?);
+    Some(dot(dir_of(k, c.parent, &a), dir_of(k, c.child, &b)) - R::c(1.0))
 }
 
 /// `+1` for joints that move `child` only, `−1` for those that move `parent` only, else 0.
@@ -676,6 +697,20 @@ pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Confi
             )?;
         }
     }
+    if check {
+        for cut in 0..plan.cuts.len() {
+            if let Some(a) = alignment(plan, &kin, cut) {
+                // Aligned, not opposite: n_a·n_b > 0.
+                R::check(
+                    a + R::c(1.0),
+                    R::c(0.0),
+                    R::c(1.0),
+                    Site::Closure(plan.rows.len() + cut),
+                    false,
+                )?;
+            }
+        }
+    }
     let jac: Vec<Vec<R>> = plan
         .rows
         .iter()
@@ -865,10 +900,11 @@ pub fn forward_dynamics_generic<R: Real>(
     solve_spd(&m, &rhs)
 }
 
-/// One Newton step of the loop equations at `x` (the independent coordinates held): the full
-/// step `Δx` (zero on the independent coordinates) and the largest scaled residual
-/// `max_k |Φ_k| / scale_k` (signed: the entry of largest magnitude).
-pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R), Singular> {
+/// One Newton step of the kept loop equations at `x` (the independent coordinates held): the
+/// full step `Δx` (zero on the independent coordinates), the largest scaled residual of the kept
+/// equations, `max_k |Φ_k| / scale_k`, and that of every loop equation and of the revolute
+/// axes' alignment `n_a·n_b − 1` (both signed: the entry of largest magnitude).
+pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R, R), Singular> {
     let c = configuration(plan, x, false)?;
     let phi: Vec<R> = plan
         .rows
@@ -881,12 +917,24 @@ pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R), Singula
     for (k, &j) in plan.dependent.iter().enumerate() {
         dx[j] = dd[k];
     }
-    let mut worst = R::c(0.0);
+    let mut kept = R::c(0.0);
     for (r, &v) in plan.rows.iter().zip(&phi) {
         let s = v * R::c(1.0 / row_scale(plan, r));
+        kept = R::select_abs_gt(s, kept, s, kept);
+    }
+    // Converged means every loop equation, the redundant ones too, and the revolute axes
+    // aligned (not opposite): the kept equations alone also vanish on spurious branches.
+    let mut worst = R::c(0.0);
+    for r in &plan.all_rows {
+        let s = row_value(plan, &c.kin, r) * R::c(1.0 / row_scale(plan, r));
         worst = R::select_abs_gt(s, worst, s, worst);
     }
-    Ok((dx, worst))
+    for cut in 0..plan.cuts.len() {
+        if let Some(s) = alignment(plan, &c.kin, cut) {
+            worst = R::select_abs_gt(s, worst, s, worst);
+        }
+    }
+    Ok((dx, kept, worst))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -964,13 +1012,10 @@ pub fn forward_dynamics(
     finite(forward_dynamics_generic(plan, x, u, tau)?)
 }
 
-/// The largest scaled loop-equation residual at `x` (m relative to the size, or rad).
+/// The largest scaled loop-equation residual at `x` (every equation, m relative to the size
+/// or dimensionless, and the revolute axes' alignment), as [`forward_kinematics`] tests it.
 pub fn closure_residual(plan: &Plan, x: &[f64]) -> f64 {
-    let k = kinematics(plan, x);
-    plan.rows
-        .iter()
-        .map(|r| (row_value(plan, &k, r) / row_scale(plan, r)).abs())
-        .fold(0.0, f64::max)
+    newton_step(plan, x).map_or(f64::INFINITY, |(_, _, r)| r.abs())
 }
 
 /// Forward kinematics (assembly): the closed configuration whose independent coordinates are
@@ -991,15 +1036,20 @@ pub fn forward_kinematics(
         iterations: it,
         residual: r,
     };
-    let Ok((mut dx, mut r)) = newton_step(plan, &x) else {
+    let Ok((mut dx, mut r, mut full)) = newton_step(plan, &x) else {
         return Err(fail(0, f64::INFINITY));
     };
     for it in 0..FK_MAX_ITERATIONS {
         if r.abs() <= FK_TOLERANCE {
+            if !(full.abs() <= FULL_TOLERANCE) {
+                // The kept equations hold but not all of them: a spurious branch.
+                return Err(fail(it, full.abs()));
+            }
             // One more full step (Newton converges quadratically): the coordinates to rounding.
             let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
-            if let Ok((_, rn)) = newton_step(plan, &xn)
+            if let Ok((_, rn, fulln)) = newton_step(plan, &xn)
                 && rn.abs() <= r.abs()
+                && fulln.abs() <= FULL_TOLERANCE
             {
                 return Ok(xn);
             }
@@ -1009,12 +1059,13 @@ pub fn forward_kinematics(
         let mut moved = false;
         for _ in 0..20 {
             let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + step * b).collect();
-            if let Ok((dn, rn)) = newton_step(plan, &xn)
+            if let Ok((dn, rn, fulln)) = newton_step(plan, &xn)
                 && rn.abs() < r.abs()
             {
                 x = xn;
                 dx = dn;
                 r = rn;
+                full = fulln;
                 moved = true;
                 break;
             }
@@ -1024,9 +1075,5 @@ pub fn forward_kinematics(
             return Err(fail(it + 1, r.abs()));
         }
     }
-    if r.abs() <= FK_TOLERANCE {
-        Ok(x)
-    } else {
-        Err(fail(FK_MAX_ITERATIONS, r.abs()))
-    }
+    Err(fail(FK_MAX_ITERATIONS, r.abs()))
 }
