@@ -7,12 +7,13 @@ use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
 /// The bundled closed-loop specs (module names).
-pub const CLOSED: [&str; 5] = [
+pub const CLOSED: [&str; 6] = [
     "four_bar",
     "five_bar_joints",
     "spherical_five_bar",
     "bricard",
     "n_four_bar",
+    "tripod_3prs",
 ];
 
 /// The validated model of a bundled closed-loop spec.
@@ -49,7 +50,12 @@ pub fn random_state(plan: &Plan, rng: &mut StdRng, reach: f64) -> (Vec<f64>, Vec
 }
 
 /// How far (rad or m) the random states move the independent coordinates from home: the
-/// N-four-bar's change points (bars horizontal) lie π/2 from home, so it stays within 1.2 rad.
+/// N-four-bar's change points (bars horizontal) lie π/2 from home, so it stays within 1.2 rad;
+/// the tripod's sliders move by up to 5 cm.
 pub fn reach(name: &str) -> f64 {
-    if name == "n_four_bar" { 1.2 } else { 3.0 }
+    match name {
+        "n_four_bar" => 1.2,
+        "tripod_3prs" => 0.05,
+        _ => 3.0,
+    }
 }

@@ -234,7 +234,8 @@ fn generated_code_matches_the_runtime() {
         five_bar_joints,
         spherical_five_bar,
         bricard,
-        n_four_bar
+        n_four_bar,
+        tripod_3prs
     );
 }
 
