@@ -107,6 +107,12 @@ impl Builder {
         self
     }
 
+    /// The scalar type of the generated code (`f64` by default).
+    pub fn float(&mut self, float: crate::Float) -> &mut Self {
+        self.config.float = float;
+        self
+    }
+
     /// Module name of each spec (see the module docs), in the order added.
     pub fn module_names(&self) -> Vec<String> {
         self.specs

@@ -1,5 +1,5 @@
 //! Closed loops in joint coordinates: the runtime's evaluator ([`runtime::closed::noc`],
-//! written over [`Real`]) run on the symbolic scalar, so the whole of every function — tree
+//! written over [`runtime::parallel::Real`]) run on the symbolic scalar, so the whole of every function — tree
 //! kinematics, loop Jacobian, the pivoted LU of `Φ_d` (its row swaps are `Select` nodes),
 //! the tree's Newton–Euler sweep and the projection `Sᵀ` — is one flat DAG kernel. Newton's
 //! assembly is the one loop, a fixed template around a DAG step.
@@ -201,6 +201,7 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
         .map(|&j| model.tree.joints[j].kind == runtime::model::JointKind::Revolute)
         .collect();
     let items = templates();
+    let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of position coordinates `x`: every joint of the spanning tree.
         pub const NX: usize = #nx_lit;
@@ -216,6 +217,7 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
         const REVOLUTE: [bool; DOF] = [#(#revolute),*];
         #items
         #(#fns)*
+        #indices
     };
     let code = emit::render(&header, tokens);
     Ok(Generated {
@@ -228,11 +230,21 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
 }
 
 fn templates() -> TokenStream {
-    let con_tol = noc::CONSTRAINT_TOLERANCE;
-    let clo_tol = noc::CLOSURE_TOLERANCE;
-    let fk_tol = Literal::f64_unsuffixed(noc::FK_TOLERANCE);
+    let tol = crate::scalar::tolerance;
+    let con_tol = tol(noc::CONSTRAINT_TOLERANCE);
+    let clo_tol = tol(noc::CLOSURE_TOLERANCE);
+    let fk_tol = Literal::f64_unsuffixed(tol(noc::FK_TOLERANCE));
+    // In single precision the loop equations' rounding floor can sit above the rescaled 1e-12
+    // (near 1e-5 of the size for poorly conditioned loops, measured on the four-bar and
+    // Bricard): when no step reduces the residual any more, a residual within the rescaled
+    // 1e-10 (3.7e-5) is accepted. In f64 the two are the same.
+    let stall_tol = Literal::f64_unsuffixed(if tol(1.0e-12) == 1.0e-12 {
+        noc::FK_TOLERANCE
+    } else {
+        tol(1e-10)
+    });
     let fk_max = Literal::usize_unsuffixed(noc::FK_MAX_ITERATIONS);
-    let full_tol = Literal::f64_unsuffixed(noc::FULL_TOLERANCE);
+    let full_tol = Literal::f64_unsuffixed(tol(noc::FULL_TOLERANCE));
     let closure_doc = format!(
         " Kept loop equation `k` exceeds `{clo_tol:e}` (times the mechanism's size for a point equation): `x` does not close the loops. `value` is `tol² − Φ_k²`."
     );
@@ -344,6 +356,9 @@ fn templates() -> TokenStream {
                     step *= 0.5;
                 }
                 if !moved {
+                    if abs(r) <= #stall_tol && abs(full) <= #full_tol {
+                        return Ok(x);
+                    }
                     return Err(NoConvergence { iterations: it + 1, residual: abs(r) });
                 }
             }

@@ -1275,7 +1275,7 @@ pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
     let mut inv_d = vec![g.zero(); n];
     let mut l = vec![vec![g.zero(); n]; n];
     for k in (0..n).rev() {
-        let tol = g.scale(PIVOT_TOLERANCE, m[k][k]);
+        let tol = g.scale(crate::scalar::tolerance(PIVOT_TOLERANCE), m[k][k]);
         let d = g.guard(h[k][k], tol, m[k][k], k);
         let one = g.constant(1.0);
         inv_d[k] = g.div(one, d);

@@ -495,6 +495,7 @@ pub fn module(
             }
         }
     });
+    let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of degrees of freedom (joint coordinates).
         pub const DOF: usize = #dof_lit;
@@ -502,6 +503,7 @@ pub fn module(
         pub const JOINT_NAMES: [&str; DOF] = [#(#names),*];
         #singular
         #(#fns)*
+        #indices
     };
     render(header, tokens)
 }
@@ -521,6 +523,55 @@ pub(crate) fn render(header: &[String], tokens: TokenStream) -> String {
     }
     out.push('\n');
     out.push_str(&prettyplease::unparse(&file));
+    out
+}
+
+/// The `f32` version of a generated module's text: the identifier `f64` becomes `f32`
+/// (types, `f64::INFINITY`, `f64::abs`, `core::f64::consts`) and the math calls become their
+/// single-precision forms (`libm::sincosf`, `sqrtf`, `atan2f`; `runtime::math::*_f32`). The
+/// thresholds were already chosen for `f32` while generating. Identifiers only: no literal is
+/// touched (every constant the generator writes is within `f32`'s range or rounds in it).
+pub fn to_f32(code: &str) -> String {
+    let mut out = String::with_capacity(code.len() + 128);
+    // The header names the precision right after its first line.
+    let code = match code.split_once('\n') {
+        Some((first, rest)) if first.starts_with("// @generated") => {
+            out.push_str(first);
+            out.push_str("\n// Scalar: f32 (single precision; the guards' thresholds and Newton's tolerance rescaled to it).\n");
+            rest
+        }
+        _ => code,
+    };
+    let b = code.as_bytes();
+    let mut i = 0;
+    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    while i < b.len() {
+        if ident(b[i]) && (i == 0 || !ident(b[i - 1])) {
+            let start = i;
+            while i < b.len() && ident(b[i]) {
+                i += 1;
+            }
+            let word = &code[start..i];
+            let prev = code[..start].trim_end();
+            let called = code[i..].starts_with('(');
+            let math = prev.ends_with("libm::") || prev.ends_with("math::");
+            let w = match word {
+                "f64" => "f32",
+                "sincos" if called && prev.ends_with("libm::") => "sincosf",
+                "sqrt" if called && prev.ends_with("libm::") => "sqrtf",
+                "atan2" if called && prev.ends_with("libm::") => "atan2f",
+                "sin_cos" if called && math => "sin_cos_f32",
+                "sqrt" if called && math => "sqrt_f32",
+                "atan2" if called && math => "atan2_f32",
+                w => w,
+            };
+            out.push_str(w);
+        } else {
+            let c = code[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+        }
+    }
     out
 }
 

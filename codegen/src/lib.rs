@@ -37,6 +37,7 @@ pub mod closed;
 pub mod diag;
 pub mod dynamics;
 pub mod emit;
+pub mod indices;
 pub mod macro_support;
 pub mod parallel;
 pub mod scalar;
@@ -62,17 +63,32 @@ pub enum MathBackend {
     Runtime(String),
 }
 
+/// The floating-point type of the generated code.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Float {
+    /// `f64` (default).
+    #[default]
+    F64,
+    /// `f32`, for FPUs without double precision. The same equations; the thresholds of the
+    /// guards and of Newton's method are rescaled to single precision (see
+    /// [`runtime::parallel::real::f32_tolerance`]) and the math calls are the `f32` ones.
+    F32,
+}
+
 /// Generation options.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Config {
     /// Math backend for trigonometry and square roots.
     pub math: MathBackend,
+    /// Scalar type of the generated code.
+    pub float: Float,
 }
 
 impl Default for Config {
     fn default() -> Self {
         Config {
             math: MathBackend::Libm,
+            float: Float::F64,
         }
     }
 }
@@ -114,10 +130,13 @@ pub fn compile(
     };
     // A panic while generating is a generator bug; inside someone's build it must still come
     // out as a diagnostic, not as an aborted build script or macro.
-    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match mechanism {
-        spec::Mechanism::Tree(model) => Ok(generate(&model, cfg)),
-        spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
-        spec::Mechanism::Closed(model) => closed::generate(&model, cfg),
+    let single = cfg.float == Float::F32;
+    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        scalar::with_precision(single, || match mechanism {
+            spec::Mechanism::Tree(model) => Ok(generate(&model, cfg)),
+            spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
+            spec::Mechanism::Closed(model) => closed::generate(&model, cfg),
+        })
     }));
     let mut out = match generated {
         Ok(Ok(out)) => out,
@@ -129,6 +148,9 @@ pub fn compile(
         }
     };
     out.warnings = warnings;
+    if single {
+        out.code = emit::to_f32(&out.code);
+    }
     Ok(out)
 }
 

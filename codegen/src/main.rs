@@ -1,14 +1,20 @@
-//! `codegen`: the command-line adapter over [`codegen::compile`].
+//! `codegen`: the command-line adapter over [`codegen::compile`], plus the workspace tools of
+//! `docs/indices.md`.
 //!
 //! ```text
 //! cargo run -p codegen -- SPEC.(toml|urdf) [-o OUT.rs] [--check] [--stats] [--math libm|std|runtime]
+//! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
+//! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S]
 //! ```
-//! Exit codes: 0 success, 2 invalid spec (diagnostics on stderr, nothing written), 1 I/O error.
+//! Exit codes: 0 success, 2 invalid spec or arguments (diagnostics on stderr, nothing written),
+//! 1 I/O error. A spec file literally named `map` or `isotropy` must be written `./map`.
+
+mod cli;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, ValueEnum};
+use clap::{Parser, Subcommand, ValueEnum};
 use codegen::{Config, MathBackend};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -23,10 +29,20 @@ enum Math {
 
 /// Generate flat, allocation-free Rust dynamics code from a mechanism spec.
 #[derive(Debug, Parser)]
-#[command(name = "codegen", version, about)]
+#[command(
+    name = "codegen",
+    version,
+    about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 struct Cli {
+    /// Workspace tools (dynamic performance indices); without one, generate code.
+    #[command(subcommand)]
+    command: Option<Command>,
     /// Mechanism spec: `.toml` (nocdyn spec) or `.urdf`.
-    spec: PathBuf,
+    #[arg(required = true)]
+    spec: Option<PathBuf>,
     /// Write the module here (default: standard output).
     #[arg(short, long, value_name = "OUT.rs")]
     output: Option<PathBuf>,
@@ -42,18 +58,48 @@ struct Cli {
     /// Crate path of the runtime for `--math runtime`.
     #[arg(long, default_value = "runtime", value_name = "PATH")]
     runtime_path: String,
+    /// Scalar type of the generated code (`f32`: single precision, thresholds rescaled).
+    #[arg(long, value_enum, default_value = "f64")]
+    float: FloatArg,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FloatArg {
+    /// Double precision (default).
+    F64,
+    /// Single precision.
+    F32,
+}
+
+/// The subcommands (`docs/indices.md`).
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Map a dynamic performance index over a 2-D slice of the workspace (CSV + SVG heat map).
+    Map(cli::map::MapArgs),
+    /// Search the workspace for dynamically isotropic points (`M = σ·1`).
+    Isotropy(cli::isotropy::IsotropyArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let source = match std::fs::read_to_string(&cli.spec) {
+    match cli.command {
+        Some(Command::Map(args)) => return cli::map::run(&args),
+        Some(Command::Isotropy(args)) => return cli::isotropy::run(&args),
+        None => {}
+    }
+    // `required = true` makes clap reject a missing spec when there is no subcommand.
+    let Some(spec) = cli.spec.as_ref() else {
+        eprintln!("error: a spec file is required");
+        return ExitCode::from(2);
+    };
+    let source = match std::fs::read_to_string(spec) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: cannot read {}: {e}", cli.spec.display());
+            eprintln!("error: cannot read {}: {e}", spec.display());
             return ExitCode::from(1);
         }
     };
-    let name = cli.spec.to_string_lossy().into_owned();
+    let name = spec.to_string_lossy().into_owned();
     if cli.check {
         return match codegen::spec::load_mechanism(&name, &source) {
             Ok((mechanism, warnings)) => {
@@ -91,7 +137,17 @@ fn main() -> ExitCode {
         Math::Std => MathBackend::Std,
         Math::Runtime => MathBackend::Runtime(cli.runtime_path.clone()),
     };
-    let out = match codegen::compile(&name, &source, &Config { math }) {
+    let out = match codegen::compile(
+        &name,
+        &source,
+        &Config {
+            math,
+            float: match cli.float {
+                FloatArg::F64 => codegen::Float::F64,
+                FloatArg::F32 => codegen::Float::F32,
+            },
+        },
+    ) {
         Ok(o) => o,
         Err(d) => {
             eprint!("{}", d.render());
@@ -118,4 +174,38 @@ fn main() -> ExitCode {
         None => print!("{text}"),
     }
     ExitCode::SUCCESS
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn plain_generation_still_parses() {
+        let c = Cli::try_parse_from(["codegen", "a.toml", "-o", "x.rs", "--stats"]).unwrap();
+        assert!(c.command.is_none());
+        assert_eq!(c.spec.as_deref(), Some(std::path::Path::new("a.toml")));
+        assert!(c.stats);
+        assert!(Cli::try_parse_from(["codegen"]).is_err());
+    }
+
+    #[test]
+    fn subcommands_parse() {
+        let c = Cli::try_parse_from([
+            "codegen", "map", "a.toml", "--index", "dci2", "--axes", "px,py", "--range",
+            "-0.1:0.1", "--steps", "11",
+        ])
+        .unwrap();
+        assert!(matches!(c.command, Some(Command::Map(_))));
+        let c = Cli::try_parse_from(["codegen", "isotropy", "a.toml", "--samples", "8"]).unwrap();
+        assert!(matches!(c.command, Some(Command::Isotropy(_))));
+        // Generation flags do not mix with a subcommand.
+        assert!(Cli::try_parse_from(["codegen", "a.toml", "map", "b.toml"]).is_err());
+    }
 }

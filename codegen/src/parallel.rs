@@ -292,6 +292,7 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
     let items = templates(cfg, &plan, &names, &revolute);
     let nx_lit = Literal::usize_unsuffixed(nx);
     let n_lit = Literal::usize_unsuffixed(n);
+    let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of position coordinates `x`.
         pub const NX: usize = #nx_lit;
@@ -301,6 +302,7 @@ pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#names),*];
         #items
         #(#fns)*
+        #indices
     };
     let code = emit::render(&header, tokens);
     Ok(Generated {
@@ -319,9 +321,10 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
     let sqrt_n = emit::math_call(cfg, "sqrt", quote!(n));
     let sqrt_a = emit::math_call(cfg, "sqrt", quote!(a2));
     let sin_cos = emit::math_call(cfg, "sin_cos", quote!(0.5 * a));
-    let leg_tol = noc::LEG_TOLERANCE;
-    let act_tol = noc::ACTUATION_TOLERANCE;
-    let fk_tol = noc::FK_TOLERANCE;
+    let tol = crate::scalar::tolerance;
+    let leg_tol = tol(noc::LEG_TOLERANCE);
+    let act_tol = tol(noc::ACTUATION_TOLERANCE);
+    let fk_tol = tol(noc::FK_TOLERANCE);
     let fk_max = noc::FK_MAX_ITERATIONS;
     let (qi, has_p) = match plan.motion {
         PlatformMotion::Pose => (3usize, true),
@@ -658,7 +661,7 @@ fn retract_template(
             let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
             let a = #sqrt_a;
             let (s, c) = #sin_cos;
-            let k = if a > 1e-300 { s / a } else { 0.5 };
+            let k = if a > 0.0 { s / a } else { 0.5 };
             let d = [c, k * du[0], k * du[1], k * du[2]];
             let i = #qi;
             let q = [x[i], x[i + 1], x[i + 2], x[i + 3]];

@@ -12,6 +12,25 @@ use crate::sym::{Arg, ExprId, Graph, TWO_SIDED};
 thread_local! {
     /// The graph the symbolic scalars of the current generation write to.
     static GRAPH: RefCell<Graph> = RefCell::new(Graph::new());
+    /// The current generation targets `f32`: thresholds are rescaled ([`tolerance`]).
+    static SINGLE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Run `f` with the thresholds of the target precision (`f32` when `single`).
+pub(crate) fn with_precision<T>(single: bool, f: impl FnOnce() -> T) -> T {
+    let before = SINGLE.with(|c| c.replace(single));
+    let out = f();
+    SINGLE.with(|c| c.set(before));
+    out
+}
+
+/// The threshold for the current target of a test whose `f64` threshold is `t`.
+pub(crate) fn tolerance(t: f64) -> f64 {
+    if SINGLE.with(|c| c.get()) {
+        runtime::parallel::real::f32_tolerance(t)
+    } else {
+        t
+    }
 }
 
 pub(crate) fn with<T>(f: impl FnOnce(&mut Graph) -> T) -> T {
@@ -56,6 +75,9 @@ impl Real for Sx {
     }
     fn sin_cos(self) -> (Sx, Sx) {
         with(|g| (Sx(g.sin(self.0)), Sx(g.cos(self.0))))
+    }
+    fn tolerance(t: f64) -> f64 {
+        tolerance(t)
     }
     fn select_abs_gt(a: Sx, b: Sx, x: Sx, y: Sx) -> Sx {
         Sx(with(|g| g.select_abs_gt(a.0, b.0, x.0, y.0)))

@@ -68,7 +68,10 @@ fn builder(spec: &str, math: &MathBackend, tag: &str) -> Vec<u8> {
 
 /// The text `mechanism!(spec, …)` expands to (before the spec-tracking constant).
 fn macro_text(spec: &str, math: &MathBackend) -> Vec<u8> {
-    let cfg = Config { math: math.clone() };
+    let cfg = Config {
+        math: math.clone(),
+        ..Config::default()
+    };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))
         .into_bytes()

@@ -9,6 +9,9 @@
 //!   kinematics and the NOC in actuator space, generic over the scalar so the generator reuses it.
 //! * [`closed`] (feature `alloc`): closed loops in joint coordinates — a spanning tree, cut
 //!   joints, independent coordinates — with the NOC `S = [1; −Φ_d⁻¹Φ_i]`, generic over the scalar.
+//! * [`indices`] (feature `alloc`): dynamic performance indices of an inertia matrix — Asada's
+//!   ellipsoid, condition number, Ma & Angeles' DCI (both normalizations), Yoshikawa's
+//!   manipulability, Khatib & Burdick's isotropic acceleration.
 //! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
 //!   spatial (6-D) algebra, written from their own equations: the independent second route.
 #![no_std]
@@ -22,6 +25,8 @@ pub mod math;
 
 #[cfg(feature = "alloc")]
 pub mod closed;
+#[cfg(feature = "alloc")]
+pub mod indices;
 #[cfg(feature = "alloc")]
 pub mod model;
 #[cfg(feature = "alloc")]

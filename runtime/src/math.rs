@@ -68,3 +68,16 @@ pub fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
     }
 }
+
+/// `atan2(y, x)` in single precision.
+#[inline(always)]
+pub fn atan2_f32(y: f32, x: f32) -> f32 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        y.atan2(x)
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::atan2f(y, x)
+    }
+}

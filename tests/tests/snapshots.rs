@@ -32,3 +32,23 @@ fn generation_is_deterministic() {
         assert_eq!(generate(path).code, generate(path).code);
     });
 }
+
+/// Single precision: the `f32` modules of a tree, a parallel and a closed-loop mechanism (the
+/// same equations as their `f64` snapshots; the thresholds rescaled, the math calls `f32`).
+#[test]
+fn f32_modules() {
+    for spec in ["puma560.toml", "agile_eye.toml", "four_bar.toml"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../mechanisms/specs")
+            .join(spec);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let cfg = Config {
+            float: codegen::Float::F32,
+            ..Config::default()
+        };
+        let code = compile(spec, &src, &cfg)
+            .unwrap_or_else(|d| panic!("{d}"))
+            .code;
+        insta::assert_snapshot!(format!("f32_{spec}"), code);
+    }
+}

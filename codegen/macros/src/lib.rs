@@ -16,12 +16,13 @@
 //! # Arguments
 //!
 //! ```text
-//! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"])
+//! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"])
 //! ```
 //!
 //! - The path is relative to the calling crate's `CARGO_MANIFEST_DIR` (its `Cargo.toml`
 //!   directory), not to the source file; an absolute path is used as it is.
 //! - `math` (default `"libm"`) is the CLI's `--math`: where `sin_cos` and `sqrt` come from.
+//! - `float` (default `"f64"`) is the CLI's `--float`: the scalar type of the generated code.
 //!   - `"libm"`: the calling crate needs the `libm` crate as a dependency (`libm = "0.2"`); the
 //!     code is `no_std`.
 //!   - `"std"`: `f64::sin_cos` from std.
@@ -102,6 +103,7 @@ struct Args {
     spec: LitStr,
     math: Option<LitStr>,
     runtime_path: Option<LitStr>,
+    float: Option<LitStr>,
 }
 
 impl Parse for Args {
@@ -111,6 +113,7 @@ impl Parse for Args {
             spec,
             math: None,
             runtime_path: None,
+            float: None,
         };
         while !input.is_empty() {
             input.parse::<Token![,]>()?;
@@ -123,10 +126,13 @@ impl Parse for Args {
             let slot = match key.to_string().as_str() {
                 "math" => &mut args.math,
                 "runtime_path" => &mut args.runtime_path,
+                "float" => &mut args.float,
                 other => {
                     return Err(Error::new(
                         key.span(),
-                        format!("unknown option `{other}`: expected `math` or `runtime_path`"),
+                        format!(
+                            "unknown option `{other}`: expected `math`, `runtime_path` or `float`"
+                        ),
                     ));
                 }
             };
@@ -171,7 +177,20 @@ impl Args {
                 "`runtime_path` needs `math = \"runtime\"`",
             ));
         }
-        Ok(Config { math })
+        let float = match &self.float {
+            None => codegen::Float::F64,
+            Some(f) => match f.value().as_str() {
+                "f64" => codegen::Float::F64,
+                "f32" => codegen::Float::F32,
+                other => {
+                    return Err(Error::new(
+                        f.span(),
+                        format!("unknown float type \"{other}\": expected \"f64\" or \"f32\""),
+                    ));
+                }
+            },
+        };
+        Ok(Config { math, float })
     }
 }
 

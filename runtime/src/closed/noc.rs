@@ -600,7 +600,7 @@ pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
         }
         let piv = R::check(
             m[k][k],
-            R::c(CONSTRAINT_TOLERANCE),
+            R::c(R::tolerance(CONSTRAINT_TOLERANCE)),
             R::c(1.0),
             Site::Constraint(k),
             true,
@@ -685,7 +685,7 @@ pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Confi
     let kin = kinematics(plan, x);
     if check {
         for (i, r) in plan.rows.iter().enumerate() {
-            let tol = CLOSURE_TOLERANCE * row_scale(plan, r);
+            let tol = R::tolerance(CLOSURE_TOLERANCE) * row_scale(plan, r);
             let v = row_value(plan, &kin, r);
             // |Φ| < tol  ⇔  tol² − Φ² > 0.
             R::check(
@@ -1010,6 +1010,53 @@ pub fn forward_dynamics(
 ) -> Result<Vec<f64>, Singular> {
     check_finite(&[x, u, tau])?;
     finite(forward_dynamics_generic(plan, x, u, tau)?)
+}
+
+/// Condition estimate of the loop equations' dependent block at `x`: the reciprocal of the
+/// smallest pivot of the unit-column-scaled, partially pivoted LU of `Φ_d` (1 for orthonormal
+/// columns; `∞` where the independent coordinates stop determining the others). The functions
+/// return `Err(Constraint)` above `1 / CONSTRAINT_TOLERANCE` = 1e4.
+pub fn constraint_condition(plan: &Plan, x: &[f64]) -> f64 {
+    let k = kinematics(plan, x);
+    let phid: Vec<Vec<f64>> = plan
+        .rows
+        .iter()
+        .map(|r| {
+            let row = jacobian_row(plan, &k, r);
+            plan.dependent.iter().map(|&j| row[j]).collect()
+        })
+        .collect();
+    // The same factorization without the threshold.
+    let n = phid.len();
+    let mut m = phid;
+    for j in 0..n {
+        let s = libm::sqrt((0..n).map(|i| m[i][j] * m[i][j]).sum::<f64>());
+        if !(s > 0.0) {
+            return f64::INFINITY;
+        }
+        for row in m.iter_mut() {
+            row[j] /= s;
+        }
+    }
+    let mut smallest = f64::INFINITY;
+    for c in 0..n {
+        let p = (c..n)
+            .max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))
+            .unwrap_or(c);
+        m.swap(c, p);
+        let piv = m[c][c];
+        smallest = smallest.min(piv.abs());
+        if piv == 0.0 {
+            return f64::INFINITY;
+        }
+        for i in c + 1..n {
+            let f = m[i][c] / piv;
+            for j in c..n {
+                m[i][j] -= f * m[c][j];
+            }
+        }
+    }
+    1.0 / smallest
 }
 
 /// The largest scaled loop-equation residual at `x` (every equation, m relative to the size

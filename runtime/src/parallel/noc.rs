@@ -427,7 +427,13 @@ fn two_axes<R: Real>(
     };
     // γ² < 0: the target is out of reach; γ² ≈ 0 (within 1e-12 of |p|²): the boundary of the
     // leg's workspace, where its Jacobian is singular.
-    let g2 = R::check(g2, R::c(-1e-12) * pp, pp, Site::Reach(leg), false)?;
+    let g2 = R::check(
+        g2,
+        R::c(-R::tolerance(1e-12)) * pp,
+        pp,
+        Site::Reach(leg),
+        false,
+    )?;
     let g2 = R::check(g2, R::c(0.0), pp, Site::Leg(leg), false)?;
     let gamma = R::c(sigma) * g2.sqrt();
     let c = add(
@@ -668,7 +674,13 @@ pub fn leg_kinematics<R: Real>(
     let r2 = cross(cols[0], cols[1]);
     let det = dot(cols[0], r0);
     let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
-    let det = R::check(det, R::c(LEG_TOLERANCE) * hn, hn, Site::Leg(k), true)?;
+    let det = R::check(
+        det,
+        R::c(R::tolerance(LEG_TOLERANCE)) * hn,
+        hn,
+        Site::Leg(k),
+        true,
+    )?;
     let id = R::c(1.0) / det;
     Ok(LegKin {
         q,
@@ -1126,7 +1138,7 @@ pub fn solve_spd<R: Real>(m: &[Vec<R>], b: &[R]) -> Result<Vec<R>, Singular> {
         }
         let dj = R::check(
             dj,
-            R::c(PIVOT_TOLERANCE) * m[j][j],
+            R::c(R::tolerance(PIVOT_TOLERANCE)) * m[j][j],
             m[j][j],
             Site::MassMatrix(j),
             false,

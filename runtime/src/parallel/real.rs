@@ -114,6 +114,18 @@ impl fmt::Display for Singular {
     }
 }
 
+/// The single-precision counterpart of an `f64` threshold `t`: the same fraction of the
+/// significant digits, `t^(23/52)` (the ratio of the mantissa widths), so a test that leaves
+/// `f64` results `k` digits short of full precision leaves `f32` ones short by the same
+/// proportion. E.g. `1e-4 → 1.7e-2`, `1e-8 → 2.9e-4`, `1e-9 → 1.0e-4`, `1e-12 → 4.9e-6`.
+pub fn f32_tolerance(t: f64) -> f64 {
+    if t > 0.0 && t < 1.0 {
+        libm::pow(t, 23.0 / 52.0)
+    } else {
+        t
+    }
+}
+
 /// A scalar: `f64`, or a node of the generator's expression DAG.
 pub trait Real:
     Copy
@@ -131,6 +143,11 @@ pub trait Real:
     fn atan2(self, x: Self) -> Self;
     /// `(sin self, cos self)`.
     fn sin_cos(self) -> (Self, Self);
+    /// The threshold to use for a test whose `f64` threshold is `t`: `t` itself, except when
+    /// the generator targets `f32` code, where it is [`f32_tolerance`]`(t)`.
+    fn tolerance(t: f64) -> f64 {
+        t
+    }
     /// `x` when `|a| > |b|`, else `y` (NaN compares false): the one data-dependent choice,
     /// for partial pivoting.
     fn select_abs_gt(a: Self, b: Self, x: Self, y: Self) -> Self;

@@ -1,0 +1,394 @@
+//! `codegen isotropy SPEC`: search the workspace for dynamically isotropic points, where the
+//! inertia is `M = σ·1` (Ma & Angeles 1990), and print them as the lecture's table does.
+//!
+//! The search minimizes Ma & Angeles' `ψ` (Frobenius weights) from random starts by
+//! Levenberg–Marquardt on the residuals `r = √(w/2) · e` (so `ψ = ‖r‖²`, `e` the upper-triangle
+//! entries of `(M − σ1)/σ` with `σ = tr(M²)/tr M`, or of `M − σ1` with `σ = tr M / n` for
+//! `--normalization trace`), with forward-difference Jacobians. The search box, around home:
+//! * parallel mechanisms: a rotation vector `δθ` (each component in `±angle-range` rad, applied
+//!   to the home orientation by `runtime::parallel::noc::retract`) and a position offset (each
+//!   component in `±range` m);
+//! * trees: every joint in `±π` (revolute) or `±range` (prismatic).
+//!
+//! Points where the runtime returns `Err(Singular)` reject the step. Local minima closer than
+//! 1e-4 of the box are merged. A point is reported as isotropic when its dimensionless `ψ` is at
+//! most `--tolerance`; when there is none, the best local minima are listed instead, marked as
+//! such.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use runtime::indices::{Normalization, Weights};
+use runtime::model::JointKind;
+use runtime::parallel::PlatformMotion;
+
+use super::map::fmt_g;
+use super::{Rng, SpaceArg, Target, progress};
+
+/// The DCI minimized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum NormArg {
+    /// `σ = tr(M²)/tr M`, `(M − σ1)/σ` (dimensionless).
+    Dimensionless,
+    /// `σ = tr M / n`, `M − σ1`.
+    Trace,
+}
+
+/// Arguments of `isotropy`.
+#[derive(Debug, Args)]
+pub struct IsotropyArgs {
+    /// Mechanism spec (`.toml` or `.urdf`).
+    pub spec: PathBuf,
+    /// Random starts.
+    #[arg(long, default_value_t = 64)]
+    pub samples: usize,
+    /// Seed of the random starts (runs repeat exactly).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Parallel mechanisms: actuator space (`A⁻ᵀ I A⁻¹`) or platform speeds (`I`).
+    #[arg(long, value_enum, default_value = "actuator")]
+    pub space: SpaceArg,
+    /// The DCI normalization minimized.
+    #[arg(long, value_enum, default_value = "dimensionless")]
+    pub normalization: NormArg,
+    /// Half-width of the search box for positions (m).
+    #[arg(long, default_value_t = 0.1)]
+    pub range: f64,
+    /// Half-width of the search box for rotations of a platform (rad).
+    #[arg(long, default_value_t = 1.0)]
+    pub angle_range: f64,
+    /// A point is isotropic when its dimensionless ψ is at most this.
+    #[arg(long, default_value_t = 1e-12)]
+    pub tolerance: f64,
+    /// How many local minima to list when no isotropic point is found.
+    #[arg(long, default_value_t = 5)]
+    pub top: usize,
+}
+
+/// A local minimum.
+#[derive(Clone, Debug)]
+pub struct Minimum {
+    /// Search parameters.
+    pub p: Vec<f64>,
+    /// Coordinates `x` (platform coordinates or joint positions).
+    pub x: Vec<f64>,
+    /// `σ = tr M / n`.
+    pub sigma: f64,
+    /// ψ, `σ = tr M / n`, Frobenius weights.
+    pub psi_trace: f64,
+    /// ψ, dimensionless, Frobenius weights.
+    pub psi_dimensionless: f64,
+    /// The matrix's entries (row-major), to merge points with the same inertia.
+    pub matrix: Vec<f64>,
+}
+
+struct Problem<'a> {
+    target: &'a Target,
+    base: Vec<f64>,
+    half: Vec<f64>,
+    norm: Normalization,
+}
+
+impl Problem<'_> {
+    fn x(&self, p: &[f64]) -> Vec<f64> {
+        match self.target {
+            Target::Tree(_) => p.to_vec(),
+            Target::Parallel { model, .. } => {
+                runtime::parallel::noc::retract(model.motion, &self.base, p)
+            }
+        }
+    }
+
+    /// `r = √(w/2) e` over the upper triangle, or `None` where the point fails.
+    fn residuals(&self, p: &[f64]) -> Option<DVector<f64>> {
+        let m = self.target.matrix(&self.x(p)).ok()?;
+        let n = m.nrows();
+        let tr: f64 = m.trace();
+        let (sigma, div) = match self.norm {
+            Normalization::Trace => (tr / n as f64, 1.0),
+            Normalization::Dimensionless => {
+                let s = m.iter().map(|v| v * v).sum::<f64>() / tr;
+                (s, s)
+            }
+        };
+        let mut r = Vec::with_capacity(n * (n + 1) / 2);
+        for i in 0..n {
+            for j in i..n {
+                let w: f64 = if i == j { 1.0 } else { 2.0 };
+                let e = (m[(i, j)] - if i == j { sigma } else { 0.0 }) / div;
+                r.push((0.5 * w).sqrt() * e);
+            }
+        }
+        let r = DVector::from_vec(r);
+        r.iter().all(|v| v.is_finite()).then_some(r)
+    }
+
+    fn clamp(&self, p: &mut [f64]) {
+        for (v, h) in p.iter_mut().zip(&self.half) {
+            *v = v.clamp(-h, *h);
+        }
+    }
+
+    /// Levenberg–Marquardt from `p`.
+    fn descend(&self, mut p: Vec<f64>) -> Option<Vec<f64>> {
+        let d = p.len();
+        let mut r = self.residuals(&p)?;
+        let mut f = r.norm_squared();
+        let mut mu = 1e-3;
+        for _ in 0..200 {
+            if f < 1e-30 {
+                break;
+            }
+            // Forward-difference Jacobian, steps relative to the box.
+            let mut jac = DMatrix::zeros(r.len(), d);
+            for k in 0..d {
+                let h = 1e-7 * self.half[k];
+                let mut q = p.clone();
+                q[k] += h;
+                let col = match self.residuals(&q) {
+                    Some(rk) => (rk - &r) / h,
+                    None => {
+                        // Backward difference next to a singular point.
+                        q[k] = p[k] - h;
+                        (&r - self.residuals(&q)?) / h
+                    }
+                };
+                jac.set_column(k, &col);
+            }
+            let g = jac.transpose() * &r;
+            let a = jac.transpose() * &jac;
+            let mut accepted = false;
+            for _ in 0..30 {
+                let mut lhs = a.clone();
+                for k in 0..d {
+                    lhs[(k, k)] += mu * (a[(k, k)].max(1e-300));
+                }
+                let Some(step) = lhs.lu().solve(&(-&g)) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let mut q: Vec<f64> = p.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+                self.clamp(&mut q);
+                if let Some(rq) = self.residuals(&q) {
+                    let fq = rq.norm_squared();
+                    if fq < f {
+                        let moved = p
+                            .iter()
+                            .zip(&q)
+                            .zip(&self.half)
+                            .map(|((a, b), h)| ((a - b) / h).abs())
+                            .fold(0.0, f64::max);
+                        p = q;
+                        r = rq;
+                        f = fq;
+                        mu = (mu / 3.0).max(1e-12);
+                        accepted = true;
+                        if moved < 1e-14 {
+                            return Some(p);
+                        }
+                        break;
+                    }
+                }
+                mu *= 10.0;
+            }
+            if !accepted {
+                break;
+            }
+        }
+        Some(p)
+    }
+}
+
+/// Run `isotropy`.
+pub fn run(args: &IsotropyArgs) -> ExitCode {
+    let target = match Target::load(&args.spec, args.space) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let valid = args.range > 0.0
+        && args.range.is_finite()
+        && args.angle_range > 0.0
+        && args.angle_range.is_finite()
+        && args.samples > 0
+        && args.tolerance >= 0.0;
+    if !valid {
+        eprintln!(
+            "error: --range and --angle-range must be positive, --samples at least 1, --tolerance non-negative"
+        );
+        return ExitCode::from(2);
+    }
+    let (base, half, names): (Vec<f64>, Vec<f64>, Vec<String>) = match &target {
+        Target::Tree(model) => (
+            vec![0.0; model.dof()],
+            model
+                .joints
+                .iter()
+                .map(|j| {
+                    if j.kind == JointKind::Revolute {
+                        std::f64::consts::PI
+                    } else {
+                        args.range
+                    }
+                })
+                .collect(),
+            model.joints.iter().map(|j| j.name.clone()).collect(),
+        ),
+        Target::Parallel { model, .. } => {
+            let (half, names): (Vec<f64>, Vec<&str>) = match model.motion {
+                PlatformMotion::Pose => (
+                    [[args.angle_range; 3], [args.range; 3]].concat(),
+                    vec!["px", "py", "pz", "qw", "qx", "qy", "qz"],
+                ),
+                PlatformMotion::Orientation { .. } => {
+                    (vec![args.angle_range; 3], vec!["qw", "qx", "qy", "qz"])
+                }
+                PlatformMotion::PlanarPoint { .. } => (vec![args.range; 2], vec!["px", "py"]),
+            };
+            (
+                model.home_x(),
+                half,
+                names.into_iter().map(String::from).collect(),
+            )
+        }
+    };
+    let norm = match args.normalization {
+        NormArg::Dimensionless => Normalization::Dimensionless,
+        NormArg::Trace => Normalization::Trace,
+    };
+    let problem = Problem {
+        target: &target,
+        base,
+        half: half.clone(),
+        norm,
+    };
+    let mut rng = Rng::new(args.seed);
+    let starts: Vec<Vec<f64>> = (0..args.samples)
+        .map(|_| half.iter().map(|h| rng.uniform(-h, *h)).collect())
+        .collect();
+    let t0 = Instant::now();
+    let pb = progress(starts.len() as u64, "isotropy");
+    let found: Vec<Minimum> = starts
+        .into_par_iter()
+        .filter_map(|s| {
+            let out = problem.descend(s).and_then(|p| {
+                let x = problem.x(&p);
+                let m = target.matrix(&x).ok()?;
+                let w = Weights::frobenius(m.nrows());
+                let d1 = runtime::indices::dci(&m, Normalization::Trace, &w).ok()?;
+                let d2 = runtime::indices::dci(&m, Normalization::Dimensionless, &w).ok()?;
+                Some(Minimum {
+                    p,
+                    x,
+                    sigma: d1.sigma,
+                    psi_trace: d1.psi,
+                    psi_dimensionless: d2.psi,
+                    matrix: m.iter().copied().collect(),
+                })
+            });
+            pb.inc(1);
+            out
+        })
+        .collect();
+    pb.finish_and_clear();
+    let elapsed = t0.elapsed();
+
+    // Merge duplicates, best first: points closer than 1e-4 of the box; and, among points that
+    // are not isotropic, points with the same matrix to 1e-5 of its largest entry (a coordinate
+    // the inertia does not depend on, such as a tree's first joint about gravity, gives a
+    // continuum of equal minima). Distinct isotropic points may share σ·1 (mirror images), so
+    // they are merged by distance only.
+    let mut found = found;
+    found.sort_by(|a, b| a.psi_dimensionless.total_cmp(&b.psi_dimensionless));
+    let mut minima: Vec<Minimum> = Vec::new();
+    for m in found {
+        let dup = minima.iter().any(|o| {
+            let near =
+                o.p.iter()
+                    .zip(&m.p)
+                    .zip(&half)
+                    .all(|((a, b), h)| ((a - b) / h).abs() < 1e-4);
+            let big = o.matrix.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let same = o
+                .matrix
+                .iter()
+                .zip(&m.matrix)
+                .all(|(a, b)| (a - b).abs() <= 1e-5 * big);
+            near || (same && m.psi_dimensionless > args.tolerance)
+        });
+        if !dup {
+            minima.push(m);
+        }
+    }
+    let isotropic: Vec<&Minimum> = minima
+        .iter()
+        .filter(|m| m.psi_dimensionless <= args.tolerance)
+        .collect();
+    let (matrix, unit, _) = target.matrix_words();
+    println!("mechanism: {} ({} DOF)", target.name(), target.dof());
+    println!("matrix: {matrix}; sigma in {unit}");
+    println!(
+        "search: {} random starts (seed {}), Levenberg-Marquardt on psi ({}), W = Frobenius (1 on the diagonal, 2 off it); {:.2} s",
+        args.samples,
+        args.seed,
+        match norm {
+            Normalization::Trace => "sigma = tr(M)/n",
+            Normalization::Dimensionless => "sigma = tr(M^2)/tr(M), dimensionless",
+        },
+        elapsed.as_secs_f64()
+    );
+    let rows: Vec<&Minimum> = if isotropic.is_empty() {
+        println!(
+            "no isotropic point found (psi2 <= {:e}); the {} best local minima of psi:",
+            args.tolerance,
+            args.top.min(minima.len())
+        );
+        minima.iter().take(args.top).collect()
+    } else {
+        println!(
+            "{} dynamically isotropic point(s) (psi2 <= {:e}):",
+            isotropic.len(),
+            args.tolerance
+        );
+        isotropic
+    };
+    let joint_words = match &target {
+        Target::Parallel { plan, .. } => Some(plan),
+        Target::Tree(_) => None,
+    };
+    println!(
+        "| point | coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
+        names.join(", ")
+    );
+    println!("|---|---|---|---:|---:|---:|");
+    for (k, m) in rows.iter().enumerate() {
+        let coords =
+            m.x.iter()
+                .map(|v| fixed6(*v))
+                .collect::<Vec<_>>()
+                .join(", ");
+        let q = match joint_words {
+            Some(plan) => runtime::parallel::noc::inverse_kinematics(plan, &m.x)
+                .map(|q| q.iter().map(|v| fixed6(*v)).collect::<Vec<_>>().join(", "))
+                .unwrap_or_else(|_| "-".into()),
+            None => coords.clone(),
+        };
+        println!(
+            "| {} | ({coords}) | ({q}) | {} | {} | {} |",
+            k + 1,
+            fmt_g(m.sigma),
+            fmt_g(m.psi_trace),
+            fmt_g(m.psi_dimensionless)
+        );
+    }
+    ExitCode::SUCCESS
+}
+
+/// Six decimals, without a "-0.000000".
+fn fixed6(v: f64) -> String {
+    let v = if v.abs() < 5e-7 { 0.0 } else { v };
+    format!("{v:.6}")
+}

@@ -1,0 +1,265 @@
+//! The `map` and `isotropy` subcommands as a user runs them (`docs/indices.md`), and that the
+//! plain generation command line is unchanged beside them.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use runtime::indices::{Space, parallel_indices};
+use runtime::parallel::Plan;
+use runtime::parallel::noc;
+
+const EYE: &str = "../mechanisms/specs/agile_eye.toml";
+const FIVE: &str = "../mechanisms/specs/planar_five_bar.toml";
+const TWO_R: &str = "../mechanisms/specs/planar_2r.toml";
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("the codegen binary runs")
+}
+
+fn text(b: &[u8]) -> &str {
+    std::str::from_utf8(b).expect("UTF-8")
+}
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_map")
+        .join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+fn parallel(path: &str) -> runtime::parallel::ParallelModel {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let src = std::fs::read_to_string(&p).unwrap();
+    match codegen::spec::load_mechanism(path, &src) {
+        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
+        _ => panic!("{path} is a parallel mechanism"),
+    }
+}
+
+/// Rows of a CSV file (header first).
+fn csv(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+#[test]
+fn map_agile_eye_writes_csv_and_svg() {
+    let dir = scratch("eye");
+    let prefix = dir.join("eye");
+    let o = run(&[
+        "map",
+        EYE,
+        "--index",
+        "dci",
+        "--axes",
+        "rx,ry",
+        "--range",
+        "-0.5:0.5",
+        "--steps",
+        "7,5",
+        "-o",
+        prefix.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(
+        out.contains("W = Frobenius (1 on the diagonal, 2 off it)"),
+        "{out}"
+    );
+    assert!(out.contains("A^-T I A^-1"), "{out}");
+    // No progress bar when stderr is not a terminal.
+    assert!(text(&o.stderr).is_empty(), "{}", text(&o.stderr));
+
+    let rows = csv(&dir.join("eye.csv"));
+    assert_eq!(rows.len(), 1 + 7 * 5);
+    assert_eq!(rows[0], ["ix", "iy", "rx_rad", "ry_rad", "dci", "status"]);
+    assert!(rows[1..].iter().all(|r| r[5] == "ok"));
+    // The point rx = 0.5, ry = 0 (ix = 6, iy = 2) is the home orientation turned by 0.5 rad
+    // about the base x axis: the quaternion (cos 0.25, sin 0.25, 0, 0).
+    let row = rows
+        .iter()
+        .find(|r| r[0] == "6" && r[1] == "2")
+        .expect("row (6, 2)");
+    assert_eq!(row[2].parse::<f64>().unwrap(), 0.5);
+    assert_eq!(row[3].parse::<f64>().unwrap(), 0.0);
+    let m = parallel(EYE);
+    let plan = Plan::new(&m).unwrap();
+    let x = [0.25f64.cos(), 0.25f64.sin(), 0.0, 0.0];
+    let want = parallel_indices(&plan, &x, Space::Actuator)
+        .unwrap()
+        .dci_trace
+        .psi;
+    let got: f64 = row[4].parse().unwrap();
+    assert!((got - want).abs() <= 1e-11 * want, "{got} vs {want}");
+
+    let svg = std::fs::read_to_string(dir.join("eye.svg")).unwrap();
+    assert!(svg.starts_with("<svg"), "{}", &svg[..60.min(svg.len())]);
+    assert!(svg.matches("<rect").count() >= 35);
+    assert!(svg.contains("agile_eye: dci"));
+}
+
+#[test]
+fn map_five_bar_marks_unreachable_points() {
+    let dir = scratch("five");
+    let prefix = dir.join("five");
+    // py from home 0.3 m up to 0.6 m: the legs (0.2 + 0.25 m) cannot reach the top rows.
+    let o = run(&[
+        "map",
+        FIVE,
+        "--index",
+        "dci2",
+        "--range",
+        "-0.05:0.05,-0.05:0.3",
+        "--grid",
+        "6,8",
+        "--threads",
+        "2",
+        "-o",
+        prefix.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", text(&o.stderr));
+    let rows = csv(&dir.join("five.csv"));
+    assert_eq!(rows.len(), 1 + 6 * 8);
+    assert_eq!(rows[0], ["ix", "iy", "px_m", "py_m", "dci2", "status"]);
+    let unreachable = rows.iter().filter(|r| r[5] == "unreachable").count();
+    let ok = rows.iter().filter(|r| r[5] == "ok").count();
+    assert!(
+        unreachable > 0 && ok > 0,
+        "{unreachable} unreachable, {ok} ok"
+    );
+    // Absolute coordinates: py spans 0.25 … 0.6 m.
+    let py: Vec<f64> = rows[1..].iter().map(|r| r[3].parse().unwrap()).collect();
+    let (lo, hi) = py
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    assert!(
+        (lo - 0.25).abs() < 1e-9 && (hi - 0.6).abs() < 1e-9,
+        "{lo} {hi}"
+    );
+    // Every unreachable row has an empty value; the top row (py = 0.6) is out of reach
+    // (|P − A| ≥ 0.6 > 0.45 m).
+    for r in &rows[1..] {
+        assert_eq!(r[4].is_empty(), r[5] != "ok");
+        if r[1] == "7" {
+            assert_eq!(r[5], "unreachable");
+        }
+    }
+    let svg = std::fs::read_to_string(dir.join("five.svg")).unwrap();
+    assert!(svg.contains("unreachable"));
+}
+
+#[test]
+fn map_tree_over_two_joints() {
+    let dir = scratch("tree");
+    let prefix = dir.join("two_r");
+    let o = run(&[
+        "map",
+        TWO_R,
+        "--index",
+        "cond",
+        "--steps",
+        "5",
+        "-o",
+        prefix.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", text(&o.stderr));
+    let rows = csv(&dir.join("two_r.csv"));
+    assert_eq!(rows.len(), 1 + 25);
+    assert!(rows[0][2].ends_with("_rad") && rows[0][3].ends_with("_rad"));
+    assert!(rows[1..].iter().all(|r| r[5] == "ok"));
+    // The condition number of a 2R arm does not depend on the first joint.
+    for r in &rows[1..] {
+        let same: Vec<&Vec<String>> = rows[1..].iter().filter(|s| s[1] == r[1]).collect();
+        let v: f64 = r[4].parse().unwrap();
+        for s in same {
+            let w: f64 = s[4].parse().unwrap();
+            assert!((v - w).abs() <= 1e-12 * v, "{v} vs {w}");
+        }
+    }
+}
+
+#[test]
+fn map_rejects_bad_arguments() {
+    let dir = scratch("bad");
+    let p = dir.join("x");
+    let p = p.to_str().unwrap();
+    for args in [
+        vec!["map", EYE, "--axes", "px,py", "-o", p],
+        vec!["map", EYE, "--axes", "rx", "-o", p],
+        vec!["map", EYE, "--axes", "rx,rx", "-o", p],
+        vec!["map", FIVE, "--steps", "1", "-o", p],
+        vec!["map", FIVE, "--range", "0.1:-0.1", "-o", p],
+        vec!["map", FIVE, "--index", "nope", "-o", p],
+        vec!["map", "tests/data/bad/negative_mass.toml", "-o", p],
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
+        assert!(!dir.join("x.csv").exists(), "{args:?} wrote a CSV");
+    }
+    let o = run(&["map", "no/such/spec.toml", "-o", p]);
+    assert_eq!(o.status.code(), Some(1));
+}
+
+#[test]
+fn plain_generation_is_unchanged() {
+    let o = run(&[TWO_R]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert!(text(&o.stdout).contains("pub fn inverse_dynamics"));
+    let o = run(&[FIVE, "--check"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let o = run(&[]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+/// The five-bar has a dynamically isotropic point; at the printed coordinates the runtime's
+/// actuator-space inertia is σ·1 with the printed σ.
+#[test]
+fn isotropy_finds_the_five_bar_isotropic_point() {
+    let o = run(&["isotropy", FIVE, "--samples", "16"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(out.contains("dynamically isotropic point"), "{out}");
+    assert!(out.contains("W = Frobenius"), "{out}");
+    let row = out
+        .lines()
+        .find(|l| l.starts_with("| 1 |"))
+        .unwrap_or_else(|| panic!("{out}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    let coords: Vec<f64> = cells[2]
+        .trim_matches(|c| c == '(' || c == ')')
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    let sigma: f64 = cells[4].parse().unwrap();
+    let m = parallel(FIVE);
+    let plan = Plan::new(&m).unwrap();
+    let ma = noc::actuator_mass_matrix(&plan, &coords).unwrap();
+    // Printed to six decimals: M matches σ·1 to that precision.
+    assert!((ma[0][0] - sigma).abs() < 2e-6, "{ma:?} vs {sigma}");
+    assert!((ma[1][1] - sigma).abs() < 2e-6, "{ma:?} vs {sigma}");
+    assert!(ma[0][1].abs() < 2e-6 * sigma.max(1.0), "{ma:?}");
+}
+
+#[test]
+fn isotropy_agile_eye_prints_a_table() {
+    let o = run(&["isotropy", EYE, "--samples", "4", "--seed", "3"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    assert!(
+        out.contains("| point | coordinates (qw, qx, qy, qz)"),
+        "{out}"
+    );
+    assert!(out.contains("sigma [kg m^2]"), "{out}");
+    assert!(out.lines().any(|l| l.starts_with("| 1 |")), "{out}");
+}

