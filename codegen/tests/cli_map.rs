@@ -263,3 +263,49 @@ fn isotropy_agile_eye_prints_a_table() {
     assert!(out.contains("sigma [kg m^2]"), "{out}");
     assert!(out.lines().any(|l| l.starts_with("| 1 |")), "{out}");
 }
+
+/// Closed loops in joint coordinates (the 2-DOF spherical five-bar pointing mechanism): the
+/// slice is over the two actuated joints, the others assembled on the home branch; the value at
+/// home is the condition number of the runtime's inertia of the actuated joints there.
+#[test]
+fn map_closed_loops_over_the_actuated_joints() {
+    let dir = scratch("closed");
+    let prefix = dir.join("pointing");
+    let o = run(&[
+        "map",
+        "../mechanisms/specs/spherical_five_bar.toml",
+        "--index",
+        "cond",
+        "--range",
+        "-0.4:0.4",
+        "--steps",
+        "5",
+        "-o",
+        prefix.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", text(&o.stderr));
+    let rows = csv(&dir.join("pointing.csv"));
+    assert_eq!(rows.len(), 1 + 25);
+    assert!(rows[0][2].starts_with("a1") && rows[0][3].starts_with("b1"));
+    let centre = rows[1..]
+        .iter()
+        .find(|r| r[2].parse::<f64>().unwrap() == 0.0 && r[3].parse::<f64>().unwrap() == 0.0)
+        .expect("the home point is on the grid");
+    assert_eq!(centre[5], "ok");
+    let src = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/spherical_five_bar.toml"),
+    )
+    .unwrap();
+    let Ok((codegen::spec::Mechanism::Closed(m), _)) =
+        codegen::spec::load_mechanism("spherical_five_bar.toml", &src)
+    else {
+        panic!("not a closed-loop spec")
+    };
+    let plan = runtime::closed::Plan::new(&m).unwrap();
+    let mm = runtime::closed::noc::mass_matrix(&plan, &[0.0; 4]).unwrap();
+    let want = runtime::indices::inertia_indices(&runtime::indices::from_rows(&mm).unwrap())
+        .unwrap()
+        .condition;
+    let got: f64 = centre[4].parse().unwrap();
+    assert!((got - want).abs() <= 1e-6 * want, "{got} vs {want}");
+}

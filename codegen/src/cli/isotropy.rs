@@ -97,6 +97,8 @@ impl Problem<'_> {
     fn x(&self, p: &[f64]) -> Vec<f64> {
         match self.target {
             Target::Tree(_) => p.to_vec(),
+            // Closed loops: p moves the independent joints from home.
+            Target::Closed { .. } => self.base.iter().zip(p).map(|(a, b)| a + b).collect(),
             Target::Parallel { model, .. } => {
                 runtime::parallel::noc::retract(model.motion, &self.base, p)
             }
@@ -237,6 +239,23 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
                 .collect(),
             model.joints.iter().map(|j| j.name.clone()).collect(),
         ),
+        Target::Closed { model, plan } => (
+            vec![0.0; plan.dof()],
+            plan.independent
+                .iter()
+                .map(|&j| {
+                    if model.tree.joints[j].kind == JointKind::Revolute {
+                        std::f64::consts::PI
+                    } else {
+                        args.range
+                    }
+                })
+                .collect(),
+            plan.independent
+                .iter()
+                .map(|&j| model.tree.joints[j].name.clone())
+                .collect(),
+        ),
         Target::Parallel { model, .. } => {
             let (half, names): (Vec<f64>, Vec<&str>) = match model.motion {
                 PlatformMotion::Pose => (
@@ -357,7 +376,7 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
     };
     let joint_words = match &target {
         Target::Parallel { plan, .. } => Some(plan),
-        Target::Tree(_) => None,
+        Target::Tree(_) | Target::Closed { .. } => None,
     };
     println!(
         "| point | coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",

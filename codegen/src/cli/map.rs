@@ -170,6 +170,16 @@ pub fn resolve_axes(target: &Target, spec: Option<&str>) -> Result<[Axis; 2], St
                 revolute: j.kind == JointKind::Revolute,
             })
             .collect(),
+        Target::Closed { model, plan } => plan
+            .independent
+            .iter()
+            .enumerate()
+            .map(|(k, &j)| Axis::Joint {
+                name: model.tree.joints[j].name.clone(),
+                index: k,
+                revolute: model.tree.joints[j].kind == JointKind::Revolute,
+            })
+            .collect(),
     };
     let name_of = |a: &Axis| match a {
         Axis::Position { name, .. } | Axis::Rotation { name, .. } | Axis::Joint { name, .. } => {
@@ -225,7 +235,7 @@ pub fn point(target: &Target, axes: &[Axis; 2], base: &[f64], u: f64, v: f64) ->
             PlatformMotion::Orientation { .. } => Some(0),
             PlatformMotion::PlanarPoint { .. } => None,
         },
-        Target::Tree(_) => None,
+        Target::Tree(_) | Target::Closed { .. } => None,
     };
     // Rotations compose from the left in the order given: R_a(u) · R_b(v) · R_home.
     let mut rot = [1.0, 0.0, 0.0, 0.0];
@@ -252,6 +262,12 @@ fn base_point(target: &Target, at: Option<&str>) -> Result<Vec<f64>, String> {
                 return Err("--at applies to trees only".into());
             }
             Ok(model.home_x())
+        }
+        Target::Closed { plan, .. } => {
+            if at.is_some() {
+                return Err("--at applies to trees only".into());
+            }
+            Ok(vec![0.0; plan.dof()])
         }
         Target::Tree(model) => match at {
             None => Ok(vec![0.0; model.dof()]),

@@ -110,6 +110,7 @@ impl Failure {
             Failure::Singular(site) => match site {
                 Site::Leg(k) => format!("singular_leg_{k}"),
                 Site::Actuation(i) => format!("singular_actuation_{i}"),
+                Site::Constraint(i) => format!("singular_constraint_{i}"),
                 _ => "singular".into(),
             },
             Failure::Invalid(_) => "invalid".into(),
@@ -129,6 +130,14 @@ pub enum Target {
         plan: Box<Plan>,
         /// Actuator or platform space.
         space: Space,
+    },
+    /// Closed loops in joint coordinates: `x` the independent (actuated) joint positions; the
+    /// others follow by assembly from home (the home branch).
+    Closed {
+        /// The model.
+        model: Box<runtime::closed::ClosedModel>,
+        /// The runtime's plan.
+        plan: Box<runtime::closed::Plan>,
     },
 }
 
@@ -163,12 +172,15 @@ impl Target {
                     },
                 })
             }
-            #[allow(unreachable_patterns)]
-            _ => {
-                eprintln!(
-                    "error: {name}: `map` and `isotropy` support trees and simple-platform parallel mechanisms only (not closed loops in joint coordinates yet)"
-                );
-                Err(ExitCode::from(2))
+            Mechanism::Closed(model) => {
+                let plan = runtime::closed::Plan::new(&model).map_err(|e| {
+                    eprintln!("error: {name}: {e}");
+                    ExitCode::from(2)
+                })?;
+                Ok(Target::Closed {
+                    model: Box::new(model),
+                    plan: Box::new(plan),
+                })
             }
         }
     }
@@ -178,6 +190,7 @@ impl Target {
         match self {
             Target::Tree(m) => m.dof(),
             Target::Parallel { model, .. } => model.dof(),
+            Target::Closed { model, .. } => model.dof(),
         }
     }
 
@@ -186,6 +199,7 @@ impl Target {
         match self {
             Target::Tree(m) => &m.name,
             Target::Parallel { model, .. } => &model.name,
+            Target::Closed { model, .. } => &model.name,
         }
     }
 
@@ -202,6 +216,10 @@ impl Target {
                     EvalError::Singular(s) => Failure::Singular(s.site),
                     EvalError::Index(i) => Failure::Invalid(i),
                 }),
+            Target::Closed { .. } => {
+                let m = self.matrix(x)?;
+                indices::inertia_indices(&m).map_err(Failure::Invalid)
+            }
         }
     }
 
@@ -228,6 +246,17 @@ impl Target {
                 .map_err(singular)?;
                 indices::from_rows(&rows).map_err(Failure::Invalid)?
             }
+            Target::Closed { plan, .. } => {
+                use runtime::closed::noc as cnoc;
+                if x.len() != plan.dof() || x.iter().any(|v| !v.is_finite()) {
+                    return Err(Failure::Invalid(IndexError::NotFinite { row: 0, col: 0 }));
+                }
+                // Assemble on the home branch; no convergence = not reachable on it.
+                let full = cnoc::forward_kinematics(plan, x, &vec![0.0; plan.nx()])
+                    .map_err(|_| Failure::Unreachable)?;
+                let rows = cnoc::mass_matrix(plan, &full).map_err(singular)?;
+                indices::from_rows(&rows).map_err(Failure::Invalid)?
+            }
         };
         indices::validate_spd(&m).map_err(Failure::Invalid)
     }
@@ -235,6 +264,25 @@ impl Target {
     /// Which matrix the indices use, and its unit (for the messages).
     pub fn matrix_words(&self) -> (String, String, String) {
         match self {
+            Target::Closed { model, plan } => {
+                let rev: Vec<bool> = plan
+                    .independent
+                    .iter()
+                    .map(|&j| model.tree.joints[j].kind == JointKind::Revolute)
+                    .collect();
+                let (unit, acc) = if rev.iter().all(|r| *r) {
+                    ("kg m^2", "rad/s^2 per N m")
+                } else if rev.iter().all(|r| !*r) {
+                    ("kg", "m/s^2 per N")
+                } else {
+                    ("mixed", "mixed")
+                };
+                (
+                    "inertia S^T M S of the actuated (independent) joints, closed loops assembled on the home branch".into(),
+                    unit.into(),
+                    acc.into(),
+                )
+            }
             Target::Tree(model) => {
                 let all_r = model.joints.iter().all(|j| j.kind == JointKind::Revolute);
                 let all_p = model.joints.iter().all(|j| j.kind == JointKind::Prismatic);
