@@ -12,6 +12,8 @@
 //! * [`indices`] (feature `alloc`): dynamic performance indices of an inertia matrix — Asada's
 //!   ellipsoid, condition number, Ma & Angeles' DCI (both normalizations), Yoshikawa's
 //!   manipulability, Khatib & Burdick's isotropic acceleration.
+//! * [`simulate`] (feature `alloc`): fixed-step RK4 and symplectic Euler of any of the above
+//!   with no actuation, and its energy drift.
 //! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
 //!   spatial (6-D) algebra, written from their own equations: the independent second route.
 #![no_std]
@@ -35,3 +37,5 @@ pub mod noc;
 pub mod parallel;
 #[cfg(feature = "alloc")]
 pub mod rnea;
+#[cfg(feature = "alloc")]
+pub mod simulate;

@@ -1124,3 +1124,15 @@ pub fn forward_kinematics(
     }
     Err(fail(FK_MAX_ITERATIONS, r.abs()))
 }
+
+/// Potential energy of gravity at `x`, `−Σ m_b gᵀ c_b` (J, zero at the base origin).
+pub fn potential_energy(plan: &Plan, x: &[f64]) -> f64 {
+    let k = kinematics(plan, x);
+    let mut v = 0.0;
+    for (b, j) in plan.joints.iter().enumerate() {
+        let (mass, com, _) = j.body;
+        let c = add(k.pos[b], mv(&k.rot[b], cv(&com)));
+        v -= mass * dot(cv(&plan.gravity), c);
+    }
+    v
+}

@@ -1604,3 +1604,19 @@ pub fn forward_kinematics(
         })
     }
 }
+
+/// Potential energy of gravity at `x`, `−Σ m_b gᵀ c_b` over the platform and every leg body
+/// (J, zero at the base origin). `Err` where the legs cannot be solved.
+pub fn potential_energy(plan: &Plan, x: &[f64]) -> Result<f64, Singular> {
+    let (pl, legs) = kinematics(plan, x)?;
+    let g: V<f64> = plan.gravity;
+    let (mass, com, _) = plan.platform;
+    let mut v = -mass * dot(g, add(pl.origin, mv(&pl.rot, com)));
+    for (lp, lk) in plan.legs.iter().zip(&legs) {
+        for (k, (m, _, _)) in lp.bodies.iter().enumerate() {
+            let c = lp.frame.apply(&lk.com[k]);
+            v -= m * dot(g, c);
+        }
+    }
+    Ok(v)
+}

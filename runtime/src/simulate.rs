@@ -1,0 +1,213 @@
+//! Forward-dynamics simulation of any mechanism the runtime evaluates, with its energy: the
+//! stability test of the charter ("test stability where methods fail").
+//!
+//! The state is `(x, u)`: a tree's joint positions and rates; a parallel mechanism's platform
+//! coordinates (the quaternion kept on the unit sphere by [`parallel::noc::retract`]) and
+//! speeds; a closed loop's joint positions (all of them) and the independent rates. A closed
+//! loop is integrated in its independent coordinates and reassembled by Newton after every
+//! stage (coordinate partitioning): its loops cannot drift open.
+//!
+//! Two fixed-step schemes: classical Runge–Kutta 4 (on a manifold: every stage moves `x` by
+//! `h·c·u` through the retraction) and semi-implicit (symplectic) Euler,
+//! `u' = u + h u̇(x, u)`, `x' = x ⊕ h u'`.
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::closed;
+use crate::model::Model;
+use crate::parallel;
+
+/// What to simulate.
+#[derive(Clone, Copy, Debug)]
+pub enum Mechanism<'a> {
+    /// A tree (`runtime::noc`).
+    Tree(&'a Model),
+    /// A simple-platform parallel mechanism.
+    Parallel(&'a parallel::Plan),
+    /// Closed loops in joint coordinates.
+    Closed(&'a closed::Plan),
+}
+
+/// The integration scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Classical fourth-order Runge–Kutta.
+    Rk4,
+    /// Semi-implicit (symplectic) Euler.
+    SymplecticEuler,
+}
+
+/// The outcome of a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// Simulated time reached (s): the full duration unless `stopped` says why not.
+    pub time: f64,
+    /// Total energy `T + V` at the start (J; `V` is zero at the base origin).
+    pub energy0: f64,
+    /// Largest kinetic energy along the run (J): the energy exchanged with gravity.
+    pub max_kinetic: f64,
+    /// Largest `|E(t) − E(0)|` (J).
+    pub max_drift: f64,
+    /// Largest loop-closure residual (closed loops: scaled as in
+    /// `closed::noc::closure_residual`; zero otherwise).
+    pub max_closure: f64,
+    /// Why the run stopped early (a singular configuration, a failed assembly), if it did.
+    pub stopped: Option<String>,
+}
+
+impl Report {
+    /// `max |E − E0| / max T`: the drift relative to the energy in motion.
+    pub fn relative_drift(&self) -> f64 {
+        if self.max_kinetic > 0.0 {
+            self.max_drift / self.max_kinetic
+        } else {
+            self.max_drift
+        }
+    }
+}
+
+impl Mechanism<'_> {
+    /// Speed rates `u̇` with no actuation.
+    pub fn acceleration(&self, x: &[f64], u: &[f64]) -> Result<Vec<f64>, String> {
+        match self {
+            Mechanism::Tree(m) => crate::noc::forward_dynamics(m, x, u, &vec![0.0; u.len()])
+                .map(|v| v.iter().copied().collect())
+                .map_err(|e| format!("{e:?}")),
+            Mechanism::Parallel(p) => parallel::noc::forward_dynamics(p, x, u, &vec![0.0; u.len()])
+                .map_err(|e| format!("{e}")),
+            Mechanism::Closed(p) => closed::noc::forward_dynamics(p, x, u, &vec![0.0; u.len()])
+                .map_err(|e| format!("{e}")),
+        }
+    }
+
+    /// `x ⊕ d` (`d` in speed coordinates).
+    pub fn advance(&self, x: &[f64], d: &[f64]) -> Result<Vec<f64>, String> {
+        match self {
+            Mechanism::Tree(_) => Ok(x.iter().zip(d).map(|(a, b)| a + b).collect()),
+            Mechanism::Parallel(p) => Ok(parallel::noc::retract(p.motion, x, d)),
+            Mechanism::Closed(p) => {
+                let xi: Vec<f64> = p
+                    .independent
+                    .iter()
+                    .zip(d)
+                    .map(|(&j, dj)| x[j] + dj)
+                    .collect();
+                closed::noc::forward_kinematics(p, &xi, x)
+                    .map_err(|e| format!("assembly failed: {e:?}"))
+            }
+        }
+    }
+
+    /// Kinetic and potential energy (J).
+    pub fn energy(&self, x: &[f64], u: &[f64]) -> Result<(f64, f64), String> {
+        let quad = |m: &[Vec<f64>]| {
+            0.5 * (0..u.len())
+                .map(|i| (0..u.len()).map(|j| u[i] * m[i][j] * u[j]).sum::<f64>())
+                .sum::<f64>()
+        };
+        match self {
+            Mechanism::Tree(m) => Ok((
+                crate::noc::kinetic_energy(m, x, u),
+                crate::noc::potential_energy(m, x),
+            )),
+            Mechanism::Parallel(p) => {
+                let mm = parallel::noc::mass_matrix(p, x).map_err(|e| format!("{e}"))?;
+                let v = parallel::noc::potential_energy(p, x).map_err(|e| format!("{e}"))?;
+                Ok((quad(&mm), v))
+            }
+            Mechanism::Closed(p) => {
+                let mm = closed::noc::mass_matrix(p, x).map_err(|e| format!("{e}"))?;
+                Ok((quad(&mm), closed::noc::potential_energy(p, x)))
+            }
+        }
+    }
+
+    fn closure(&self, x: &[f64]) -> f64 {
+        match self {
+            Mechanism::Closed(p) => closed::noc::closure_residual(p, x),
+            _ => 0.0,
+        }
+    }
+}
+
+/// Simulate from `(x0, u0)` with no actuation for `steps` steps of `dt` s.
+pub fn simulate(
+    mech: Mechanism<'_>,
+    x0: &[f64],
+    u0: &[f64],
+    dt: f64,
+    steps: usize,
+    method: Method,
+) -> Result<Report, String> {
+    let (t0, v0) = mech.energy(x0, u0)?;
+    let mut r = Report {
+        time: 0.0,
+        energy0: t0 + v0,
+        max_kinetic: t0,
+        max_drift: 0.0,
+        max_closure: mech.closure(x0),
+        stopped: None,
+    };
+    let (mut x, mut u) = (x0.to_vec(), u0.to_vec());
+    let axpy = |a: &[f64], s: f64, b: &[f64]| -> Vec<f64> {
+        a.iter().zip(b).map(|(p, q)| p + s * q).collect()
+    };
+    let scale = |s: f64, a: &[f64]| -> Vec<f64> { a.iter().map(|v| s * v).collect() };
+    for n in 0..steps {
+        let step = || -> Result<(Vec<f64>, Vec<f64>), String> {
+            match method {
+                Method::SymplecticEuler => {
+                    let a = mech.acceleration(&x, &u)?;
+                    let un = axpy(&u, dt, &a);
+                    let xn = mech.advance(&x, &scale(dt, &un))?;
+                    Ok((xn, un))
+                }
+                Method::Rk4 => {
+                    let a1 = mech.acceleration(&x, &u)?;
+                    let u1 = u.clone();
+                    let x2 = mech.advance(&x, &scale(0.5 * dt, &u1))?;
+                    let u2 = axpy(&u, 0.5 * dt, &a1);
+                    let a2 = mech.acceleration(&x2, &u2)?;
+                    let x3 = mech.advance(&x, &scale(0.5 * dt, &u2))?;
+                    let u3 = axpy(&u, 0.5 * dt, &a2);
+                    let a3 = mech.acceleration(&x3, &u3)?;
+                    let x4 = mech.advance(&x, &scale(dt, &u3))?;
+                    let u4 = axpy(&u, dt, &a3);
+                    let a4 = mech.acceleration(&x4, &u4)?;
+                    let dx: Vec<f64> = (0..u.len())
+                        .map(|i| dt / 6.0 * (u1[i] + 2.0 * u2[i] + 2.0 * u3[i] + u4[i]))
+                        .collect();
+                    let du: Vec<f64> = (0..u.len())
+                        .map(|i| dt / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i]))
+                        .collect();
+                    Ok((mech.advance(&x, &dx)?, axpy(&u, 1.0, &du)))
+                }
+            }
+        };
+        let (xn, un) = match step() {
+            Ok(s) => s,
+            Err(e) => {
+                r.stopped = Some(e);
+                return Ok(r);
+            }
+        };
+        x = xn;
+        u = un;
+        r.time = (n + 1) as f64 * dt;
+        match mech.energy(&x, &u) {
+            Ok((t, v)) => {
+                r.max_kinetic = r.max_kinetic.max(t);
+                r.max_drift = r.max_drift.max((t + v - r.energy0).abs());
+            }
+            Err(e) => {
+                r.stopped = Some(e);
+                return Ok(r);
+            }
+        }
+        r.max_closure = r.max_closure.max(mech.closure(&x));
+    }
+    Ok(r)
+}
