@@ -508,6 +508,21 @@ pub fn inverse_dynamics_dd(
     Ok(out)
 }
 
+/// Double-double reference of a closed loop's (or, with `closed::noc::Plan::tree`, a tree's)
+/// generalized forces: the generic evaluator `runtime::closed::noc` run in double-double, the
+/// loop closure not checked (the inputs are `f64` states).
+pub fn closed_inverse_dynamics_dd(
+    plan: &runtime::closed::noc::Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    use runtime::closed::noc as cnoc;
+    let c = cnoc::configuration::<DD>(plan, &lift(x), false)?;
+    let f = cnoc::generalized_force(plan, &c, &lift(u), &lift(ud), true);
+    Ok(f.iter().map(|t| t.to_f64()).collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -297,6 +297,34 @@ impl Plan {
         Ok(plan)
     }
 
+    /// A tree as a mechanism without loops: every joint independent, no loop equations. The
+    /// same generic evaluator then gives the tree's dynamics over any scalar (e.g. a
+    /// double-double reference for the speed/accuracy chart).
+    pub fn tree(tree: &crate::model::Model) -> Plan {
+        Plan {
+            gravity: tree.gravity,
+            joints: tree
+                .joints
+                .iter()
+                .zip(&tree.bodies)
+                .map(|(j, b)| JointPlan {
+                    parent: j.parent,
+                    kind: j.kind,
+                    origin: j.origin,
+                    axis: j.axis,
+                    body: (b.mass, b.com, b.inertia),
+                })
+                .collect(),
+            cuts: Vec::new(),
+            rows: Vec::new(),
+            all_rows: Vec::new(),
+            independent: (0..tree.dof()).collect(),
+            dependent: Vec::new(),
+            anc: ancestry(tree),
+            size: 1.0,
+        }
+    }
+
     /// Position coordinates (tree joints).
     pub fn nx(&self) -> usize {
         self.joints.len()

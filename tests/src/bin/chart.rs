@@ -1,0 +1,418 @@
+//! Speed against accuracy, measured in one run (issue 4, "the chart"): for the PUMA 560 (a
+//! tree), the Gough–Stewart platform (a parallel mechanism) and the five-bar in joint
+//! coordinates (closed loops), every way nocdyn offers to compute the inverse dynamics, timed
+//! (median over repeated batches of 256 random regular states, ns per call) and compared with a
+//! double-double evaluation of the same equations (`tests::dd`; the worst relative error in the
+//! ∞-norm over the states). Writes `PREFIX.csv`, `PREFIX.md` and `PREFIX.svg` (log–log).
+//!
+//! ```text
+//! cargo run --release -p tests --bin chart [-- PREFIX]      (default: docs/figures/chart)
+//! ```
+
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::time::Instant;
+
+use plotters::prelude::*;
+use rand::Rng;
+
+const STATES: usize = 256;
+const BATCHES: usize = 31;
+
+struct Point {
+    mechanism: &'static str,
+    candidate: &'static str,
+    ns: f64,
+    error: f64,
+}
+
+/// Median ns per call of `f` over the state indices: `BATCHES` batches of all states, or 3 when
+/// one batch takes more than 0.2 s (the Lagrange-multiplier routes).
+fn time(mut f: impl FnMut(usize) -> f64) -> f64 {
+    let mut batch = || {
+        let t = Instant::now();
+        let mut acc = 0.0;
+        for i in 0..STATES {
+            acc += f(i);
+        }
+        black_box(acc);
+        t.elapsed().as_nanos() as f64 / STATES as f64
+    };
+    let first = batch();
+    let n = if first * STATES as f64 > 2e8 {
+        3
+    } else {
+        BATCHES
+    };
+    let mut per: Vec<f64> = (1..n).map(|_| batch()).collect();
+    per.push(first);
+    per.sort_by(f64::total_cmp);
+    per[n / 2]
+}
+
+fn worst(f: impl Fn(usize) -> Vec<f64>, reference: &[Vec<f64>]) -> f64 {
+    (0..STATES)
+        .map(|i| tests::pkm::rel(&f(i), &reference[i]))
+        .fold(0.0, f64::max)
+}
+
+fn puma(points: &mut Vec<Point>) {
+    use mechanisms::f32::puma560 as s;
+    use mechanisms::puma560 as g;
+    let path = tests::pkm::spec_path("puma560");
+    let (model, _) = codegen::spec::load(
+        &path.to_string_lossy(),
+        &std::fs::read_to_string(&path).unwrap(),
+    )
+    .unwrap();
+    let plan = runtime::closed::noc::Plan::tree(&model);
+    let mut rng = tests::rng(31);
+    let states: Vec<[[f64; 6]; 3]> = (0..STATES)
+        .map(|_| core::array::from_fn(|_| core::array::from_fn(|_| rng.random_range(-1.5..1.5))))
+        .collect();
+    // Reference at the f32-rounded states so that every candidate sees the same inputs.
+    let states: Vec<[[f64; 6]; 3]> = states
+        .iter()
+        .map(|s| s.map(|v| v.map(|x| x as f32 as f64)))
+        .collect();
+    let reference: Vec<Vec<f64>> = states
+        .iter()
+        .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
+        .collect();
+    let m = "PUMA 560";
+    let mut add = |candidate, ns, error| {
+        points.push(Point {
+            mechanism: m,
+            candidate,
+            ns,
+            error,
+        });
+    };
+    let g64 = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        g::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64",
+        time(|i| g64(black_box(i))[0]),
+        worst(g64, &reference),
+    );
+    let s32 = |i: usize| {
+        let [q, qd, qdd] = states[i].map(|v| v.map(|x| x as f32));
+        s::inverse_dynamics(&q, &qd, &qdd)
+            .iter()
+            .map(|&v| v as f64)
+            .collect::<Vec<_>>()
+    };
+    add(
+        "generated f32",
+        time(|i| s32(black_box(i))[0]),
+        worst(s32, &reference),
+    );
+    let noc = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        runtime::noc::inverse_dynamics(&model, q, qd, qdd)
+            .iter()
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    add(
+        "runtime NOC (nalgebra)",
+        time(|i| noc(black_box(i))[0]),
+        worst(noc, &reference),
+    );
+    let rnea = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        runtime::rnea::inverse_dynamics(&model, q, qd, qdd)
+            .iter()
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    add(
+        "RNEA (spatial algebra)",
+        time(|i| rnea(black_box(i))[0]),
+        worst(rnea, &reference),
+    );
+    let lag = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        let sys = tests::lagrange::from_tree(&model, q);
+        tests::lagrange::inverse_dynamics(
+            &sys,
+            &tests::lagrange::Prescribed::ActuatedJoints,
+            qd,
+            qdd,
+        )
+        .unwrap()
+        .efforts
+    };
+    add(
+        "Newton–Euler + Lagrange multipliers",
+        time(|i| lag(black_box(i))[0]),
+        worst(lag, &reference),
+    );
+}
+
+fn gough_stewart(points: &mut Vec<Point>) {
+    use mechanisms::f32::gough_stewart as s;
+    use mechanisms::gough_stewart as g;
+    use runtime::parallel::noc;
+    let model = tests::pkm::model("gough_stewart");
+    let plan = noc::Plan::new(&model).unwrap();
+    let home = model.home_x();
+    let mut rng = tests::rng(32);
+    let states: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..STATES)
+        .map(|_| {
+            let (x, u, ud) =
+                tests::pkm::random_state(&plan, &home, &mut rng, 0.1, 0.02 * model.size());
+            let r = |v: Vec<f64>| v.iter().map(|&a| a as f32 as f64).collect::<Vec<_>>();
+            (r(x), r(u), r(ud))
+        })
+        .collect();
+    let reference: Vec<Vec<f64>> = states
+        .iter()
+        .map(|(x, u, ud)| tests::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .collect();
+    let m = "Gough–Stewart";
+    let mut add = |candidate, ns, error| {
+        points.push(Point {
+            mechanism: m,
+            candidate,
+            ns,
+            error,
+        });
+    };
+    let arr = |i: usize| -> ([f64; 7], [f64; 6], [f64; 6]) {
+        let (x, u, ud) = &states[i];
+        (
+            x.clone().try_into().unwrap(),
+            u.clone().try_into().unwrap(),
+            ud.clone().try_into().unwrap(),
+        )
+    };
+    let g64 = |i: usize| {
+        let (x, u, ud) = arr(i);
+        g::inverse_dynamics(&x, &u, &ud).unwrap().to_vec()
+    };
+    add(
+        "generated f64",
+        time(|i| g64(black_box(i))[0]),
+        worst(g64, &reference),
+    );
+    let s32 = |i: usize| {
+        let (x, u, ud) = arr(i);
+        let (x, u, ud) = (
+            x.map(|v| v as f32),
+            u.map(|v| v as f32),
+            ud.map(|v| v as f32),
+        );
+        s::inverse_dynamics(&x, &u, &ud)
+            .unwrap()
+            .iter()
+            .map(|&v| v as f64)
+            .collect::<Vec<_>>()
+    };
+    add(
+        "generated f32",
+        time(|i| s32(black_box(i))[0]),
+        worst(s32, &reference),
+    );
+    let rt = |i: usize| {
+        let (x, u, ud) = &states[i];
+        noc::inverse_dynamics(&plan, x, u, ud).unwrap()
+    };
+    add(
+        "runtime (leg-wise, f64)",
+        time(|i| rt(black_box(i))[0]),
+        worst(rt, &reference),
+    );
+    let lag = |i: usize| {
+        let (x, u, ud) = &states[i];
+        let legs = noc::leg_joint_positions(&plan, x).unwrap();
+        let sys = tests::lagrange::from_parallel(&model, &legs, x);
+        let p = sys.bodies.len() - 1;
+        let pre = tests::lagrange::Prescribed::Pose {
+            body: p,
+            point: [x[0], x[1], x[2]],
+        };
+        tests::lagrange::inverse_dynamics(&sys, &pre, u, ud)
+            .unwrap()
+            .efforts
+    };
+    add(
+        "Newton–Euler + Lagrange multipliers",
+        time(|i| lag(black_box(i))[0]),
+        worst(lag, &reference),
+    );
+}
+
+fn five_bar(points: &mut Vec<Point>) {
+    use mechanisms::f32::five_bar_joints as s;
+    use mechanisms::five_bar_joints as g;
+    use runtime::closed::noc;
+    let model = tests::closed::model("five_bar_joints");
+    let plan = noc::Plan::new(&model).unwrap();
+    let mut rng = tests::rng(33);
+    let mut states: Vec<([f64; 4], [f64; 2], [f64; 2])> = Vec::new();
+    while states.len() < STATES {
+        let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, 1.0);
+        let x: [f64; 4] = x.try_into().unwrap();
+        // Assemble the f32-rounded independent coordinates in f64: the common state.
+        let xi = [
+            x[plan.independent[0]] as f32 as f64,
+            x[plan.independent[1]] as f32 as f64,
+        ];
+        let Ok(x) = g::forward_kinematics(&xi, &x) else {
+            continue;
+        };
+        states.push((
+            x,
+            [u[0] as f32 as f64, u[1] as f32 as f64],
+            [ud[0] as f32 as f64, ud[1] as f32 as f64],
+        ));
+    }
+    let reference: Vec<Vec<f64>> = states
+        .iter()
+        .map(|(x, u, ud)| tests::dd::closed_inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .collect();
+    let m = "five-bar (joint coordinates)";
+    let mut add = |candidate, ns, error| {
+        points.push(Point {
+            mechanism: m,
+            candidate,
+            ns,
+            error,
+        });
+    };
+    let g64 = |i: usize| {
+        let (x, u, ud) = &states[i];
+        g::inverse_dynamics(x, u, ud).unwrap().to_vec()
+    };
+    add(
+        "generated f64",
+        time(|i| g64(black_box(i))[0]),
+        worst(g64, &reference),
+    );
+    let s32 = |i: usize| {
+        let (x, u, ud) = &states[i];
+        let xi = [x[plan.independent[0]] as f32, x[plan.independent[1]] as f32];
+        let x32 = s::forward_kinematics(&xi, &x.map(|v| v as f32)).unwrap();
+        s::inverse_dynamics(&x32, &u.map(|v| v as f32), &ud.map(|v| v as f32))
+            .unwrap()
+            .iter()
+            .map(|&v| v as f64)
+            .collect::<Vec<_>>()
+    };
+    // The f32 time includes its own assembly (f32 states cannot hold the f64 closure).
+    add(
+        "generated f32 (+ f32 assembly)",
+        time(|i| s32(black_box(i))[0]),
+        worst(s32, &reference),
+    );
+    let rt = |i: usize| {
+        let (x, u, ud) = &states[i];
+        noc::inverse_dynamics(&plan, x, u, ud).unwrap()
+    };
+    add(
+        "runtime (generic, f64)",
+        time(|i| rt(black_box(i))[0]),
+        worst(rt, &reference),
+    );
+    let lag = |i: usize| {
+        let (x, u, ud) = &states[i];
+        let sys = tests::lagrange::from_closed(&model, x);
+        tests::lagrange::inverse_dynamics(&sys, &tests::lagrange::Prescribed::ActuatedJoints, u, ud)
+            .unwrap()
+            .efforts
+    };
+    add(
+        "Newton–Euler + Lagrange multipliers",
+        time(|i| lag(black_box(i))[0]),
+        worst(lag, &reference),
+    );
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let prefix = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "docs/figures/chart".into());
+    let mut points = Vec::new();
+    puma(&mut points);
+    gough_stewart(&mut points);
+    five_bar(&mut points);
+    let mut csv = String::from("mechanism,candidate,ns_per_call,max_relative_error\n");
+    let mut md = String::from(
+        "| mechanism | candidate | ns per call | × generated f64 | worst relative error vs double-double |\n|---|---|---:|---:|---:|\n",
+    );
+    for p in &points {
+        let base = points
+            .iter()
+            .find(|q| q.mechanism == p.mechanism && q.candidate == "generated f64")
+            .map_or(1.0, |q| q.ns);
+        writeln!(
+            csv,
+            "{},{},{:.1},{:.3e}",
+            p.mechanism, p.candidate, p.ns, p.error
+        )?;
+        writeln!(
+            md,
+            "| {} | {} | {:.0} | {:.1} | {:.1e} |",
+            p.mechanism,
+            p.candidate,
+            p.ns,
+            p.ns / base,
+            p.error
+        )?;
+    }
+    std::fs::write(format!("{prefix}.csv"), &csv)?;
+    std::fs::write(format!("{prefix}.md"), &md)?;
+    print!("{md}");
+    let svg = format!("{prefix}.svg");
+    let root = SVGBackend::new(&svg, (900, 600)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (x0, x1) = (1.0f64, 1e8f64);
+    let (y0, y1) = (1e-17f64, 1e-3f64);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Inverse dynamics: time per call against error (one run)",
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("ns per call (median)")
+        .y_desc("worst relative error vs double-double")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()?;
+    let colours = [RED, BLUE, GREEN];
+    let mechs = ["PUMA 560", "Gough–Stewart", "five-bar (joint coordinates)"];
+    for (k, m) in mechs.iter().enumerate() {
+        let c = colours[k];
+        let pts: Vec<&Point> = points.iter().filter(|p| p.mechanism == *m).collect();
+        chart
+            .draw_series(
+                pts.iter()
+                    .map(|p| Circle::new((p.ns, p.error.max(y0 * 2.0)), 5, c.filled())),
+            )?
+            .label(*m)
+            .legend(move |(x, y)| Circle::new((x, y), 5, c.filled()));
+        chart.draw_series(pts.iter().map(|p| {
+            Text::new(
+                p.candidate.to_string(),
+                (p.ns * 1.15, p.error.max(y0 * 2.0)),
+                ("sans-serif", 11).into_font().color(&c),
+            )
+        }))?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
+    root.present()?;
+    eprintln!("wrote {prefix}.csv, {prefix}.md and {svg}");
+    Ok(())
+}
