@@ -11,7 +11,7 @@ use runtime::closed::noc::{self, Plan};
 use runtime::parallel::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
-use crate::scalar::{flat, ids, inputs, with};
+use crate::scalar::{flat, ids, in_fresh_graph, inputs};
 use crate::schedule::{OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
@@ -35,9 +35,7 @@ pub struct Kernels {
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    with(|g| *g = Graph::new());
-    let r = build(plan);
-    let graph = with(std::mem::take);
+    let (r, graph) = in_fresh_graph(|| build(plan));
     r.map(|k| Kernels { graph, ..k })
 }
 

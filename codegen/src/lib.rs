@@ -133,7 +133,10 @@ pub fn compile(
     let single = cfg.float == Float::F32;
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || match mechanism {
-            spec::Mechanism::Tree(model) => Ok(generate(&model, cfg)),
+            spec::Mechanism::Tree(model) => {
+                let only = spec::scene_functions(file_name, source);
+                Ok(generate_selected(&model, cfg, only.as_deref()))
+            }
             spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
             spec::Mechanism::Closed(model) => closed::generate(&model, cfg),
         })
@@ -219,6 +222,12 @@ pub fn symbolic(model: &Model) -> Symbolic {
 
 /// Generate the module for a validated model.
 pub fn generate(model: &Model, cfg: &Config) -> Generated {
+    generate_selected(model, cfg, None)
+}
+
+/// [`generate`] with only the public functions named in `only` (`[scene] functions`; `None`:
+/// all of them). Functions not asked for are not emitted, so their operations cost nothing.
+pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -> Generated {
     let Symbolic {
         graph: g,
         dof: n,
@@ -290,6 +299,7 @@ pub fn generate(model: &Model, cfg: &Config) -> Generated {
     ];
     let functions: Vec<Function<'_>> = specs
         .into_iter()
+        .filter(|s| only.is_none_or(|o| o.iter().any(|f| f == s.0)))
         .map(|(name, doc, args, outputs, shape)| {
             let schedule = schedule(&g, &outputs);
             Function {

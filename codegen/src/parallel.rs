@@ -11,7 +11,7 @@ use runtime::model::JointKind;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular};
 
-use crate::scalar::{Sx, flat, ids, inputs, with};
+use crate::scalar::{Sx, flat, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::schedule::{OpCount, schedule};
@@ -41,9 +41,7 @@ pub struct Kernels {
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
 /// input: a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    with(|g| *g = Graph::new());
-    let r = build(plan);
-    let graph = with(std::mem::take);
+    let (r, graph) = in_fresh_graph(|| build(plan));
     r.map(|k| Kernels { graph, ..k })
 }
 

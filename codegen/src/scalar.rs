@@ -16,6 +16,13 @@ thread_local! {
     static SINGLE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
+/// Run `f` on a fresh graph and return its result with the graph it built.
+pub(crate) fn in_fresh_graph<T>(f: impl FnOnce() -> T) -> (T, Graph) {
+    with(|g| *g = Graph::new());
+    let r = f();
+    (r, with(std::mem::take))
+}
+
 /// Run `f` with the thresholds of the target precision (`f32` when `single`).
 pub(crate) fn with_precision<T>(single: bool, f: impl FnOnce() -> T) -> T {
     let before = SINGLE.with(|c| c.replace(single));

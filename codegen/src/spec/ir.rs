@@ -24,6 +24,27 @@ pub(crate) struct Spec {
     pub joints_incomplete: bool,
     /// The `[platform]` table: present for a parallel mechanism (TOML only).
     pub platform: Option<PlatformSpec>,
+    /// The `[scene]` table: what the application needs (TOML only).
+    pub scene: SceneSpec,
+}
+
+/// A name written in the `[scene]` table, with where.
+#[derive(Clone, Debug)]
+pub(crate) struct Named {
+    pub name: String,
+    pub key: String,
+    pub span: Span,
+}
+
+/// The `[scene]` table: model no more than the application needs.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SceneSpec {
+    /// Emit only these public functions (trees).
+    pub functions: Option<Vec<Named>>,
+    /// Bodies modelled as point masses at their mass centres (no rotational inertia).
+    pub point_mass: Vec<Named>,
+    /// Bodies modelled as massless (no mass, no inertia).
+    pub massless: Vec<Named>,
 }
 
 /// How a parallel mechanism's platform moves (`platform.coordinates`).

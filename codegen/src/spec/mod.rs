@@ -153,11 +153,15 @@ fn load_any(
         } else {
             read_toml::read(source, &mut d)
         };
-        let spec = spec.filter(|s| check_size(s, &mut d));
+        let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
+            apply_scene(&mut s, &mut d);
+            s
+        });
         let platform = spec
             .as_ref()
             .and_then(|s| s.platform.as_ref())
             .map(|p| p.span.clone().unwrap_or(0..0));
+        let functions = spec.as_ref().and_then(|s| s.scene.functions.clone());
         let mechanism = spec.and_then(|s| {
             if s.platform.is_some() {
                 parallel::lower_parallel(&s, &mut d).map(Mechanism::Parallel)
@@ -167,6 +171,9 @@ fn load_any(
                 lower::lower(&s, &mut d).map(Mechanism::Tree)
             }
         });
+        if let (Some(m), Some(fs)) = (&mechanism, &functions) {
+            check_scene_functions(m, fs, &mut d);
+        }
         (mechanism, d, platform)
     }));
     match result {
@@ -182,6 +189,82 @@ fn load_any(
             (None, diags, None)
         }
     }
+}
+
+/// The public functions a tree module has (`[scene] functions` picks among them).
+pub const TREE_FUNCTIONS: [&str; 5] = [
+    "mass_matrix",
+    "coriolis",
+    "gravity",
+    "inverse_dynamics",
+    "forward_dynamics",
+];
+
+/// `[scene]`: point masses and massless bodies replace the bodies' inertial data before
+/// lowering (so everything downstream, fixed-joint merging included, sees the scene's model).
+fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
+    let scene = spec.scene.clone();
+    let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
+    let find = |n: &ir::Named, diags: &mut Diagnostics| -> Option<usize> {
+        let i = names.iter().position(|b| *b == n.name);
+        if i.is_none() {
+            let mut d = Diagnostic::error(format!("unknown body {:?}", n.name))
+                .with_key(n.key.clone())
+                .with_span(n.span.clone());
+            if let Some(h) = suggest_hint(&n.name, &names) {
+                d = d.with_hint(h);
+            }
+            diags.push(d);
+        }
+        i
+    };
+    let mut point = Vec::new();
+    let mut massless = Vec::new();
+    for n in &scene.point_mass {
+        point.extend(find(n, diags));
+    }
+    for n in &scene.massless {
+        massless.extend(find(n, diags));
+    }
+    for i in point {
+        spec.bodies[i].inertia = [[0.0; 3]; 3];
+    }
+    for i in massless {
+        spec.bodies[i].mass = 0.0;
+        spec.bodies[i].inertia = [[0.0; 3]; 3];
+    }
+}
+
+fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostics) {
+    for f in fs {
+        let ok = matches!(m, Mechanism::Tree(_)) && TREE_FUNCTIONS.contains(&f.name.as_str());
+        if !ok {
+            let hint = if matches!(m, Mechanism::Tree(_)) {
+                format!("a tree module offers {}", TREE_FUNCTIONS.join(", "))
+            } else {
+                "choosing functions is supported for trees only so far; remove scene.functions"
+                    .into()
+            };
+            diags.push(
+                Diagnostic::error(format!("cannot select function {:?}", f.name))
+                    .with_key(f.key.clone())
+                    .with_span(f.span.clone())
+                    .with_hint(hint),
+            );
+        }
+    }
+}
+
+/// The functions `[scene] functions` selects (`None`: all). Pure: reads the TOML again.
+pub fn scene_functions(file_name: &str, source: &str) -> Option<Vec<String>> {
+    if is_urdf(file_name) {
+        return None;
+    }
+    let mut d = Diagnostics::new(file_name, source);
+    let spec = read_toml::read(source, &mut d)?;
+    spec.scene
+        .functions
+        .map(|v| v.into_iter().map(|n| n.name).collect())
 }
 
 /// The size limits ([`MAX_ENTRIES`], [`MAX_DOF`]), checked before lowering so that no stage

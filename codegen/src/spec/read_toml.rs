@@ -10,14 +10,16 @@ use toml::de::{DeTable, DeValue};
 
 use super::angle::{ANGLE_HINT, parse_angle};
 use super::ir::{
-    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Placement, PlatformSpec, Spec,
+    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Named, Placement, PlatformSpec,
+    SceneSpec, Spec,
 };
 use super::{sanitize_name, suggest_hint};
 use crate::diag::{Diagnostic, Diagnostics};
 
 type Val<'i> = Spanned<DeValue<'i>>;
 
-const TOP_KEYS: &[&str] = &["mechanism", "platform", "body", "joint"];
+const TOP_KEYS: &[&str] = &["mechanism", "platform", "scene", "body", "joint"];
+const SCENE_KEYS: &[&str] = &["functions", "gravity", "point_mass", "massless"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
 const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
 const BODY_KEYS: &[&str] = &["name", "mass", "com", "inertia", "inertia_rpy"];
@@ -394,6 +396,26 @@ impl Reader<'_> {
             let span = key_span(root, "platform").unwrap_or(v.span());
             self.platform(v, span)
         });
+        let mut scene = SceneSpec::default();
+        if let Some(v) = get(root, "scene")
+            && let Some(t) = self.table(v, "scene")
+        {
+            self.unknown_keys(t, SCENE_KEYS, "scene");
+            if let Some(f) = get(t, "functions") {
+                scene.functions = self.names(f, "scene.functions");
+            }
+            if let Some(g) = get(t, "gravity")
+                && let Some(g) = self.triple(g, "scene.gravity", false)
+            {
+                gravity = g;
+            }
+            if let Some(b) = get(t, "point_mass") {
+                scene.point_mass = self.names(b, "scene.point_mass").unwrap_or_default();
+            }
+            if let Some(b) = get(t, "massless") {
+                scene.massless = self.names(b, "scene.massless").unwrap_or_default();
+            }
+        }
         let bodies = self
             .entries(root, "body")
             .into_iter()
@@ -412,7 +434,28 @@ impl Reader<'_> {
             anchor,
             joints_incomplete: self.joints_incomplete,
             platform,
+            scene,
         }
+    }
+
+    /// An array of strings, each with its key and span.
+    fn names(&mut self, v: &Val<'_>, key: &str) -> Option<Vec<Named>> {
+        let DeValue::Array(a) = v.get_ref() else {
+            self.type_error("an array of names", v, key);
+            return None;
+        };
+        let mut out = Vec::new();
+        for (k, e) in a.iter().enumerate() {
+            let ek = format!("{key}[{k}]");
+            if let Some(s) = self.string(e, &ek) {
+                out.push(Named {
+                    name: s,
+                    key: ek,
+                    span: Some(e.span()),
+                });
+            }
+        }
+        Some(out)
     }
 
     /// The `[platform]` table of a parallel mechanism.

@@ -660,5 +660,6 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         anchor: Some(robot_span),
         joints_incomplete: false,
         platform: None,
+        scene: Default::default(),
     })
 }

@@ -126,18 +126,7 @@ impl Plan {
         model.validate()?;
         let tree = &model.tree;
         let n = tree.dof();
-        let joints: Vec<JointPlan> = tree
-            .joints
-            .iter()
-            .zip(&tree.bodies)
-            .map(|(j, b)| JointPlan {
-                parent: j.parent,
-                kind: j.kind,
-                origin: j.origin,
-                axis: j.axis,
-                body: (b.mass, b.com, b.inertia),
-            })
-            .collect();
+        let joints = joint_plans(tree);
         let cuts: Vec<CutPlan> = model
             .cuts
             .iter()
@@ -303,18 +292,7 @@ impl Plan {
     pub fn tree(tree: &crate::model::Model) -> Plan {
         Plan {
             gravity: tree.gravity,
-            joints: tree
-                .joints
-                .iter()
-                .zip(&tree.bodies)
-                .map(|(j, b)| JointPlan {
-                    parent: j.parent,
-                    kind: j.kind,
-                    origin: j.origin,
-                    axis: j.axis,
-                    body: (b.mass, b.com, b.inertia),
-                })
-                .collect(),
+            joints: joint_plans(tree),
             cuts: Vec::new(),
             rows: Vec::new(),
             all_rows: Vec::new(),
@@ -333,6 +311,21 @@ impl Plan {
     pub fn dof(&self) -> usize {
         self.independent.len()
     }
+}
+
+/// The tree's joints with their bodies' inertial data.
+fn joint_plans(tree: &crate::model::Model) -> Vec<JointPlan> {
+    tree.joints
+        .iter()
+        .zip(&tree.bodies)
+        .map(|(j, b)| JointPlan {
+            parent: j.parent,
+            kind: j.kind,
+            origin: j.origin,
+            axis: j.axis,
+            body: (b.mass, b.com, b.inertia),
+        })
+        .collect()
 }
 
 fn row_cut(r: &Row) -> usize {

@@ -1,0 +1,95 @@
+//! `[scene]`: model no more than the application needs. A scene with point masses, massless
+//! bodies and a gravity override gives exactly the model of the spec edited by hand, and
+//! `functions` emits only the functions asked for.
+
+use codegen::spec::load;
+
+const ARM: &str = r#"
+[mechanism]
+name = "arm"
+gravity = [0.0, 0.0, -9.81]
+SCENE
+[[body]]
+name = "link1"
+mass = 1.0
+com = [0.5, 0.0, 0.0]
+inertia = { ixx = 0.01, iyy = 0.1, izz = 0.1 }
+
+[[body]]
+name = "link2"
+mass = MASS2
+com = [0.4, 0.0, 0.0]
+inertia = INERTIA2
+
+[[joint]]
+name = "j1"
+kind = "revolute"
+parent = "base"
+child = "link1"
+axis = [0.0, 0.0, 1.0]
+
+[[joint]]
+name = "j2"
+kind = "revolute"
+parent = "link1"
+child = "link2"
+origin = { xyz = [1.0, 0.0, 0.0] }
+axis = [0.0, 0.0, 1.0]
+"#;
+
+fn spec(scene: &str, mass2: &str, inertia2: &str) -> String {
+    ARM.replace("SCENE", scene)
+        .replace("MASS2", mass2)
+        .replace("INERTIA2", inertia2)
+}
+
+#[test]
+fn scene_bodies_and_gravity_are_the_hand_edited_model() {
+    let full = "{ ixx = 0.01, iyy = 0.05, izz = 0.05 }";
+    let zero = "{ ixx = 0.0, iyy = 0.0, izz = 0.0 }";
+    let scene = spec(
+        "[scene]\ngravity = [0.0, -9.81, 0.0]\npoint_mass = [\"link2\"]\n",
+        "1.0",
+        full,
+    );
+    let edited = spec("", "1.0", zero).replace("[0.0, 0.0, -9.81]", "[0.0, -9.81, 0.0]");
+    let (a, _) = load("scene.toml", &scene).unwrap();
+    let (b, _) = load("edited.toml", &edited).unwrap();
+    assert_eq!(a, b);
+    let scene = spec("[scene]\nmassless = [\"link2\"]\n", "1.0", full);
+    let edited = spec("", "0.0", zero);
+    let (a, _) = load("scene.toml", &scene).unwrap();
+    let (b, _) = load("edited.toml", &edited).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn scene_functions_emit_only_what_is_asked_for() {
+    let full = "{ ixx = 0.01, iyy = 0.05, izz = 0.05 }";
+    let src = spec(
+        "[scene]\nfunctions = [\"inverse_dynamics\", \"mass_matrix\"]\n",
+        "1.0",
+        full,
+    );
+    let g = codegen::compile("arm.toml", &src, &codegen::Config::default()).unwrap();
+    assert!(g.code.contains("pub fn inverse_dynamics"));
+    assert!(g.code.contains("pub fn mass_matrix"));
+    for f in ["coriolis", "gravity", "forward_dynamics"] {
+        assert!(!g.code.contains(&format!("pub fn {f}(")), "{f} was emitted");
+    }
+    assert_eq!(g.stats.len(), 2);
+    // The same numbers as the full module's inverse dynamics.
+    let all = codegen::compile(
+        "arm.toml",
+        &spec("", "1.0", full),
+        &codegen::Config::default(),
+    )
+    .unwrap();
+    let id = |g: &codegen::Generated| {
+        g.stats
+            .iter()
+            .find(|(n, _)| n == "inverse_dynamics")
+            .map(|(_, c)| c.flops())
+    };
+    assert_eq!(id(&g), id(&all));
+}
