@@ -78,6 +78,8 @@ enum Command {
     Map(cli::map::MapArgs),
     /// Search the workspace for dynamically isotropic points (`M = σ·1`).
     Isotropy(cli::isotropy::IsotropyArgs),
+    /// The cheapest fidelity (point-mass or massless bodies) within an effort tolerance.
+    Reduce(cli::reduce::ReduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -85,6 +87,7 @@ fn main() -> ExitCode {
     match cli.command {
         Some(Command::Map(args)) => return cli::map::run(&args),
         Some(Command::Isotropy(args)) => return cli::isotropy::run(&args),
+        Some(Command::Reduce(args)) => return cli::reduce::run(&args),
         None => {}
     }
     // `required = true` makes clap reject a missing spec when there is no subcommand.

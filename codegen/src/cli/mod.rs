@@ -9,6 +9,7 @@
 
 pub mod isotropy;
 pub mod map;
+pub mod reduce;
 pub mod svg;
 
 use std::process::ExitCode;

@@ -255,6 +255,17 @@ fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostic
     }
 }
 
+/// The spec's body names in file order (TOML only; `None` when it cannot be read). For tools
+/// that write `[scene]` tables (`codegen reduce`).
+pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
+    if is_urdf(file_name) {
+        return None;
+    }
+    let mut d = Diagnostics::new(file_name, source);
+    let spec = read_toml::read(source, &mut d)?;
+    Some(spec.bodies.into_iter().map(|b| b.name).collect())
+}
+
 /// The functions `[scene] functions` selects (`None`: all). Pure: reads the TOML again.
 pub fn scene_functions(file_name: &str, source: &str) -> Option<Vec<String>> {
     if is_urdf(file_name) {

@@ -1,0 +1,333 @@
+//! `codegen reduce SPEC --tolerance 1e-3`: the cheapest model that is accurate enough.
+//!
+//! Fidelity levels are `[scene]` tables (`point_mass`, `massless`): a greedy search starts from
+//! the full model and, step by step, takes the body (for parallel mechanisms: the group of
+//! corresponding bodies of every leg) whose reduction saves the most inverse-dynamics flops
+//! while the actuator efforts stay within the tolerance of the full model's — the largest
+//! relative error (∞-norm per state) over random regular states, evaluated by the runtime. It
+//! prints the table of every level tried and writes the cheapest spec that meets the tolerance.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use codegen::spec::Mechanism;
+
+use super::Rng;
+
+/// Arguments of `reduce`.
+#[derive(Debug, clap::Args)]
+pub struct ReduceArgs {
+    /// Mechanism spec (TOML, without a `[scene]` table).
+    pub spec: PathBuf,
+    /// Largest accepted relative error of the actuator efforts (∞-norm, worst state).
+    #[arg(long, default_value = "1e-3")]
+    pub tolerance: f64,
+    /// Random regular states to compare on.
+    #[arg(long, default_value = "200")]
+    pub samples: usize,
+    /// Random seed.
+    #[arg(long, default_value = "1")]
+    pub seed: u64,
+    /// Write the reduced spec here (default: standard output).
+    #[arg(short, long, value_name = "OUT.toml")]
+    pub output: Option<PathBuf>,
+}
+
+/// A fidelity level: which bodies are point masses, which massless.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Level {
+    point_mass: Vec<String>,
+    massless: Vec<String>,
+}
+
+impl Level {
+    fn scene(&self) -> String {
+        let list = |v: &[String]| {
+            v.iter()
+                .map(|n| format!("{n:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        format!(
+            "\n# Written by `codegen reduce`: the cheapest fidelity within the tolerance.\n[scene]\npoint_mass = [{}]\nmassless = [{}]\n",
+            list(&self.point_mass),
+            list(&self.massless)
+        )
+    }
+    fn describe(&self) -> String {
+        if self.point_mass.is_empty() && self.massless.is_empty() {
+            return "full model".into();
+        }
+        let mut parts = Vec::new();
+        if !self.point_mass.is_empty() {
+            parts.push(format!("point masses: {}", self.point_mass.join(" ")));
+        }
+        if !self.massless.is_empty() {
+            parts.push(format!("massless: {}", self.massless.join(" ")));
+        }
+        parts.join("; ")
+    }
+}
+
+/// One evaluation state.
+type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn efforts(m: &Mechanism, s: &State) -> Option<Vec<f64>> {
+    let (x, u, ud) = s;
+    match m {
+        Mechanism::Tree(model) => Some(
+            runtime::noc::inverse_dynamics(model, x, u, ud)
+                .iter()
+                .copied()
+                .collect(),
+        ),
+        Mechanism::Parallel(model) => {
+            let plan = runtime::parallel::Plan::new(model).ok()?;
+            runtime::parallel::noc::inverse_dynamics(&plan, x, u, ud).ok()
+        }
+        Mechanism::Closed(model) => {
+            let plan = runtime::closed::Plan::new(model).ok()?;
+            runtime::closed::noc::inverse_dynamics(&plan, x, u, ud).ok()
+        }
+    }
+}
+
+fn states(m: &Mechanism, n: usize, rng: &mut Rng) -> Vec<State> {
+    let mut out = Vec::new();
+    let mut tries = 0;
+    while out.len() < n && tries < 100 * n {
+        tries += 1;
+        let s: State = match m {
+            Mechanism::Tree(model) => {
+                let d = model.dof();
+                (
+                    (0..d).map(|_| rng.uniform(-3.0, 3.0)).collect(),
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                )
+            }
+            Mechanism::Parallel(model) => {
+                let d = model.dof();
+                let (angle, reach) = match model.motion {
+                    runtime::parallel::PlatformMotion::Pose => (0.1, 0.02 * model.size()),
+                    runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
+                    runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+                };
+                let planar = matches!(
+                    model.motion,
+                    runtime::parallel::PlatformMotion::PlanarPoint { .. }
+                );
+                let du: Vec<f64> = (0..d)
+                    .map(|i| {
+                        let r = if i < 3 && !planar { angle } else { reach };
+                        rng.uniform(-r, r)
+                    })
+                    .collect();
+                (
+                    runtime::parallel::noc::retract(model.motion, &model.home_x(), &du),
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                )
+            }
+            Mechanism::Closed(model) => {
+                let Ok(plan) = runtime::closed::Plan::new(model) else {
+                    return out;
+                };
+                let d = plan.dof();
+                let xi: Vec<f64> = (0..d).map(|_| rng.uniform(-0.5, 0.5)).collect();
+                let Ok(x) =
+                    runtime::closed::noc::forward_kinematics(&plan, &xi, &vec![0.0; plan.nx()])
+                else {
+                    continue;
+                };
+                (
+                    x,
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+                )
+            }
+        };
+        if efforts(m, &s).is_some_and(|t| t.iter().all(|v| v.is_finite())) {
+            out.push(s);
+        }
+    }
+    out
+}
+
+/// Worst and RMS relative error of `m`'s efforts against `reference` over `states`.
+fn errors(m: &Mechanism, states: &[State], reference: &[Vec<f64>]) -> Option<(f64, f64)> {
+    let mut worst: f64 = 0.0;
+    let mut sum = 0.0;
+    for (s, r) in states.iter().zip(reference) {
+        let t = efforts(m, s)?;
+        let num = t
+            .iter()
+            .zip(r)
+            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        let den = r.iter().fold(1e-300f64, |a, q| a.max(q.abs()));
+        let e = num / den;
+        worst = worst.max(e);
+        sum += e * e;
+    }
+    Some((worst, (sum / states.len().max(1) as f64).sqrt()))
+}
+
+/// Run `reduce`.
+pub fn run(args: &ReduceArgs) -> ExitCode {
+    let source = match std::fs::read_to_string(&args.spec) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: cannot read {}: {e}", args.spec.display());
+            return ExitCode::from(1);
+        }
+    };
+    let name = args.spec.to_string_lossy().into_owned();
+    if source
+        .lines()
+        .any(|l| l.trim_start().starts_with("[scene]"))
+    {
+        eprintln!("error: {name}: `reduce` writes the [scene] table itself; remove the spec's own");
+        return ExitCode::from(2);
+    }
+    if args.tolerance.is_nan() || args.tolerance <= 0.0 || args.samples == 0 {
+        eprintln!("error: --tolerance must be positive and --samples at least 1");
+        return ExitCode::from(2);
+    }
+    let full = match codegen::spec::load_mechanism(&name, &source) {
+        Ok((m, _)) => m,
+        Err(d) => {
+            eprint!("{}", d.render());
+            return ExitCode::from(2);
+        }
+    };
+    let Some(bodies) = codegen::spec::body_names(&name, &source) else {
+        eprintln!("error: {name}: `reduce` needs a TOML spec");
+        return ExitCode::from(2);
+    };
+    // Groups of bodies reduced together: a parallel mechanism's k-th body of every leg (the
+    // legs are alike); one body otherwise. The platform stays.
+    let groups: Vec<Vec<String>> = match &full {
+        Mechanism::Parallel(model) => {
+            let longest = model.legs.iter().map(|l| l.bodies.len()).max().unwrap_or(0);
+            (0..longest)
+                .map(|k| {
+                    model
+                        .legs
+                        .iter()
+                        .filter_map(|l| l.bodies.get(k))
+                        .map(|b| b.name.clone())
+                        .filter(|n| bodies.contains(n))
+                        .collect::<Vec<_>>()
+                })
+                .filter(|g| !g.is_empty())
+                .collect()
+        }
+        _ => bodies.iter().map(|b| vec![b.clone()]).collect(),
+    };
+    let mut rng = Rng::new(args.seed);
+    let samples = states(&full, args.samples, &mut rng);
+    if samples.is_empty() {
+        eprintln!("error: {name}: no regular state found to compare on");
+        return ExitCode::from(2);
+    }
+    let reference: Vec<Vec<f64>> = samples
+        .iter()
+        .map(|s| efforts(&full, s).unwrap_or_default())
+        .collect();
+    let flops = |level: &Level| -> Option<usize> {
+        let src = format!("{source}{}", level.scene());
+        let g = codegen::compile(&name, &src, &codegen::Config::default()).ok()?;
+        g.stats
+            .iter()
+            .find(|(n, _)| n == "inverse_dynamics")
+            .map(|(_, c)| c.flops())
+    };
+    let evaluate = |level: &Level| -> Option<(usize, f64, f64)> {
+        let src = format!("{source}{}", level.scene());
+        let (m, _) = codegen::spec::load_mechanism(&name, &src).ok()?;
+        let (worst, rms) = errors(&m, &samples, &reference)?;
+        Some((flops(level)?, worst, rms))
+    };
+    let mut current = Level::default();
+    let Some((mut cost, _, _)) = evaluate(&current) else {
+        eprintln!("error: {name}: the full model cannot be generated");
+        return ExitCode::from(2);
+    };
+    let pb = super::progress(0, "reduce");
+    println!(
+        "reduce: {} ({} states, tolerance {:e} on the worst relative actuator-effort error, inf-norm)",
+        full.name(),
+        samples.len(),
+        args.tolerance
+    );
+    println!(
+        "| fidelity | inverse dynamics flops | max relative error | RMS relative error | accepted |"
+    );
+    println!("|---|---:|---:|---:|---|");
+    println!("| {} | {cost} | 0 | 0 | (reference) |", current.describe());
+    loop {
+        let mut best: Option<(Level, usize, f64, f64)> = None;
+        for g in &groups {
+            if g.iter().any(|b| current.massless.contains(b)) {
+                continue;
+            }
+            let mut tries = Vec::new();
+            if !g.iter().all(|b| current.point_mass.contains(b)) {
+                let mut l = current.clone();
+                let add: Vec<String> = g
+                    .iter()
+                    .filter(|b| !l.point_mass.contains(b))
+                    .cloned()
+                    .collect();
+                l.point_mass.extend(add);
+                tries.push(l);
+            }
+            let mut l = current.clone();
+            l.point_mass.retain(|b| !g.contains(b));
+            l.massless.extend(g.iter().cloned());
+            tries.push(l);
+            for l in tries {
+                pb.inc(1);
+                let Some((f, worst, rms)) = evaluate(&l) else {
+                    continue;
+                };
+                let ok = worst <= args.tolerance && f < cost;
+                println!(
+                    "| {} | {f} | {worst:.2e} | {rms:.2e} | {} |",
+                    l.describe(),
+                    if ok { "yes" } else { "no" }
+                );
+                if ok && best.as_ref().is_none_or(|b| f < b.1) {
+                    best = Some((l, f, worst, rms));
+                }
+            }
+        }
+        match best {
+            Some((l, f, _, _)) => {
+                current = l;
+                cost = f;
+            }
+            None => break,
+        }
+    }
+    pb.finish_and_clear();
+    println!(
+        "cheapest within tolerance: {} ({cost} flops)",
+        current.describe()
+    );
+    let out = if current == Level::default() {
+        source.clone()
+    } else {
+        format!("{source}{}", current.scene())
+    };
+    match &args.output {
+        Some(p) => {
+            if let Err(e) = std::fs::write(p, out) {
+                eprintln!("error: {}: {e}", p.display());
+                return ExitCode::from(1);
+            }
+        }
+        None => print!("{out}"),
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,68 @@
+//! `codegen reduce`: on the Gough–Stewart platform with its legs as bundled (0.1 kg, inertia
+//! 1/160 kg·m² each, heavy for a 1.5 kg platform) it keeps the full model at a 1e-3 tolerance;
+//! with legs whose rotational inertia is 100 times smaller it drops that inertia (point-mass
+//! legs) but keeps their masses, and the spec it writes loads and generates.
+
+use std::path::Path;
+use std::process::Command;
+
+fn reduce(spec: &Path, out: &Path) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .args([
+            "reduce",
+            spec.to_str().unwrap(),
+            "--tolerance",
+            "1e-3",
+            "--samples",
+            "40",
+            "-o",
+        ])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+#[test]
+fn heavy_legs_stay_light_legs_lose_their_rotational_inertia() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_reduce");
+    std::fs::create_dir_all(&dir).unwrap();
+    let gs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/gough_stewart.toml");
+    let out = dir.join("heavy.toml");
+    let table = reduce(&gs, &out);
+    assert!(
+        table.contains("cheapest within tolerance: full model"),
+        "{table}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap(),
+        std::fs::read_to_string(&gs).unwrap()
+    );
+
+    let light = std::fs::read_to_string(&gs).unwrap().replace(
+        "inertia = { ixx = 0.00625, iyy = 0.00625, izz = 0.00625 }",
+        "inertia = { ixx = 0.0000625, iyy = 0.0000625, izz = 0.0000625 }",
+    );
+    let light_path = dir.join("light_in.toml");
+    std::fs::write(&light_path, &light).unwrap();
+    let out = dir.join("light.toml");
+    let table = reduce(&light_path, &out);
+    assert!(
+        table.contains("cheapest within tolerance: point masses"),
+        "{table}"
+    );
+    let reduced = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        reduced.contains("[scene]") && reduced.contains("massless = []"),
+        "{reduced}"
+    );
+    // The written spec loads and generates.
+    codegen::compile("light.toml", &reduced, &codegen::Config::default())
+        .unwrap_or_else(|d| panic!("{d}"));
+}
