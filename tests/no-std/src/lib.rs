@@ -1,6 +1,6 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
-//! mechanism (trees and parallel mechanisms). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
@@ -81,3 +81,70 @@ export_parallel!(
     agile_eye,
     planar_five_bar
 );
+
+macro_rules! export_closed {
+    ($($m:ident),* $(,)?) => {
+        $(
+            pub mod $m {
+                use mechanisms::$m as g;
+                /// Calls every generated function of a closed-loop mechanism once; returns a
+                /// checksum.
+                #[unsafe(no_mangle)]
+                pub extern "C" fn $m(x: &[f64; g::NX], u: &[f64; g::DOF], ud: &[f64; g::DOF]) -> f64 {
+                    let pick = |r: Result<f64, g::Singular>| match r {
+                        Ok(v) => v,
+                        Err(e) => e.value,
+                    };
+                    let q = g::inverse_kinematics(x);
+                    let mut s = pick(q.map(|q| q[0]));
+                    s += pick(g::joint_rates(x, u).map(|v| v[0]));
+                    s += pick(g::inverse_dynamics(x, u, ud).map(|v| v[0]));
+                    s += pick(g::mass_matrix(x).map(|m| m[0][0]));
+                    s += pick(g::forward_dynamics(x, u, ud).map(|v| v[0]));
+                    if let Ok(m) = g::mass_matrix(x) {
+                        s += match g::inertia_indices(&m) {
+                            Ok(i) => i.condition,
+                            Err(_) => 0.0,
+                        };
+                    }
+                    if let Ok(q) = q {
+                        s += match g::forward_kinematics(&q, x) {
+                            Ok(xf) => xf[0],
+                            Err(e) => e.residual,
+                        };
+                    }
+                    s
+                }
+            }
+        )*
+    };
+}
+
+export_closed!(
+    four_bar,
+    five_bar_joints,
+    spherical_five_bar,
+    bricard,
+    n_four_bar,
+    tripod_3prs
+);
+
+/// Single precision (`mechanisms` feature `f32`): one module of each kind.
+pub mod single {
+    use mechanisms::f32::{four_bar, gough_stewart, puma560};
+
+    /// Calls the `f32` inverse dynamics of a tree, a parallel and a closed-loop mechanism.
+    #[unsafe(no_mangle)]
+    pub extern "C" fn single_precision(a: &[f32; 6], b: &[f32; 7], c: &[f32; 3]) -> f32 {
+        let t = puma560::inverse_dynamics(a, a, a)[0];
+        let g = match gough_stewart::inverse_dynamics(b, a, a) {
+            Ok(v) => v[0],
+            Err(e) => e.value,
+        };
+        let f = match four_bar::inverse_dynamics(c, &[a[0]], &[a[1]]) {
+            Ok(v) => v[0],
+            Err(e) => e.value,
+        };
+        t + g + f
+    }
+}
