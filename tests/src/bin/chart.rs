@@ -331,6 +331,147 @@ fn five_bar(points: &mut Vec<Point>) {
     );
 }
 
+/// The second chart: error against condition while walking the Gough–Stewart platform to its
+/// parallel singularity at 90° yaw (`ψ = 90° − δ`, δ = 10⁻¹ … 10⁻¹² degrees; a dynamic state
+/// with `u`, `u̇` in ±1), for the generated `f64` and `f32` code, the runtime and the
+/// Lagrange-multiplier route. The condition is the double-double pivot ratio of `A` (columns
+/// scaled). A route that answers `Err` at a step has no point there (the table says so).
+fn walk(prefix: &str) -> Result<(), Box<dyn std::error::Error>> {
+    use mechanisms::f32::gough_stewart as s;
+    use mechanisms::gough_stewart as g;
+    use runtime::parallel::noc;
+    let model = tests::pkm::model("gough_stewart");
+    let plan = noc::Plan::new(&model).unwrap();
+    let home = model.home_x();
+    let qh = [home[3], home[4], home[5], home[6]];
+    let qmul = |a: [f64; 4], b: [f64; 4]| {
+        [
+            a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+            a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+            a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+            a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+        ]
+    };
+    let u = [0.3, -0.2, 0.1, 0.05, -0.1, 0.2];
+    let ud = [-0.4, 0.3, 0.2, -0.1, 0.15, -0.25];
+    let routes = [
+        "generated f64",
+        "generated f32",
+        "runtime f64",
+        "Lagrange multipliers",
+    ];
+    let mut rows: Vec<(f64, f64, Vec<Option<f64>>)> = Vec::new();
+    for k in 1..=12 {
+        let delta = 10f64.powi(-k);
+        let psi = (90.0 - delta).to_radians();
+        let q = qmul([(psi / 2.0).cos(), 0.0, 0.0, (psi / 2.0).sin()], qh);
+        let x: Vec<f64> = vec![home[0], home[1], home[2], q[0], q[1], q[2], q[3]];
+        // The f32 code gets the state rounded to f32; its reference is taken there.
+        let x32: Vec<f64> = x.iter().map(|&v| v as f32 as f64).collect();
+        let cond = tests::dd::conditioning(
+            &tests::dd::actuation_dd(&plan, &x).map_err(|e| e.to_string())?,
+        )
+        .pivot_ratio;
+        let Ok(reference) = tests::dd::inverse_dynamics_dd(&plan, &x, &u, &ud) else {
+            continue;
+        };
+        let reference32 = tests::dd::inverse_dynamics_dd(&plan, &x32, &u, &ud).ok();
+        let err = |t: Vec<f64>| tests::pkm::rel(&t, &reference);
+        let xa: [f64; 7] = x.clone().try_into().unwrap();
+        let e64 = g::inverse_dynamics(&xa, &u, &ud)
+            .ok()
+            .map(|t| err(t.to_vec()));
+        let e32 = s::inverse_dynamics(
+            &xa.map(|v| v as f32),
+            &u.map(|v| v as f32),
+            &ud.map(|v| v as f32),
+        )
+        .ok()
+        .map(|t| err(t.iter().map(|&v| v as f64).collect()));
+        let ert = noc::inverse_dynamics(&plan, &x, &u, &ud).ok().map(err);
+        let elg = noc::leg_joint_positions(&plan, &x).ok().and_then(|legs| {
+            let sys = tests::lagrange::from_parallel(&model, &legs, &x);
+            let p = sys.bodies.len() - 1;
+            let pre = tests::lagrange::Prescribed::Pose {
+                body: p,
+                point: [x[0], x[1], x[2]],
+            };
+            tests::lagrange::inverse_dynamics(&sys, &pre, &u, &ud)
+                .ok()
+                .map(|s| err(s.efforts))
+        });
+        rows.push((delta, cond, vec![e64, e32, ert, elg]));
+    }
+    let mut md = String::from("| δ (deg) | condition (dd pivot ratio) |");
+    for r in routes {
+        md.push_str(&format!(" {r} |"));
+    }
+    md.push_str("\n|---:|---:|---:|---:|---:|---:|\n");
+    let mut csv = String::from("delta_deg,condition,route,relative_error\n");
+    for (d, c, es) in &rows {
+        md.push_str(&format!("| {d:.0e} | {c:.2e} |"));
+        for (r, e) in routes.iter().zip(es) {
+            match e {
+                Some(e) => {
+                    md.push_str(&format!(" {e:.1e} |"));
+                    writeln!(csv, "{d:e},{c:e},{r},{e:e}")?;
+                }
+                None => md.push_str(" Err |"),
+            }
+        }
+        md.push('\n');
+    }
+    std::fs::write(format!("{prefix}_walk.md"), &md)?;
+    std::fs::write(format!("{prefix}_walk.csv"), &csv)?;
+    print!("{md}");
+    let svg = format!("{prefix}_walk.svg");
+    let root = SVGBackend::new(&svg, (900, 600)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Gough–Stewart walked to its 90° yaw singularity: error against condition",
+            ("sans-serif", 18),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (1e1f64..1e16f64).log_scale(),
+            (1e-17f64..1e1f64).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("condition (double-double pivot ratio of A)")
+        .y_desc("relative error vs double-double (missing: Err)")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()?;
+    let colours = [RED, BLUE, GREEN, MAGENTA];
+    for (k, r) in routes.iter().enumerate() {
+        let c = colours[k];
+        let pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter_map(|(_, cond, es)| es[k].map(|e| (*cond, e.max(2e-17))))
+            .collect();
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                pts.clone(),
+                c.stroke_width(2),
+            )))?
+            .label(*r)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
+    root.present()?;
+    eprintln!("wrote {prefix}_walk.csv, {prefix}_walk.md and {svg}");
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let prefix = std::env::args()
         .nth(1)
@@ -414,5 +555,5 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .draw()?;
     root.present()?;
     eprintln!("wrote {prefix}.csv, {prefix}.md and {svg}");
-    Ok(())
+    walk(&prefix)
 }
