@@ -387,7 +387,8 @@ fn walk(prefix: &str) -> Result<(), Box<dyn std::error::Error>> {
             &ud.map(|v| v as f32),
         )
         .ok()
-        .map(|t| err(t.iter().map(|&v| v as f64).collect()));
+        .zip(reference32)
+        .map(|(t, r)| tests::pkm::rel(&t.iter().map(|&v| v as f64).collect::<Vec<_>>(), &r));
         let ert = noc::inverse_dynamics(&plan, &x, &u, &ud).ok().map(err);
         let elg = noc::leg_joint_positions(&plan, &x).ok().and_then(|legs| {
             let sys = tests::lagrange::from_parallel(&model, &legs, &x);
