@@ -45,6 +45,17 @@ pub(crate) struct SceneSpec {
     pub point_mass: Vec<Named>,
     /// Bodies modelled as massless (no mass, no inertia).
     pub massless: Vec<Named>,
+    /// A payload rigidly added to a body.
+    pub payload: Option<Payload>,
+}
+
+/// `[scene] payload = { body, mass, com, inertia }`: inertial data in the body's frame.
+#[derive(Clone, Debug)]
+pub(crate) struct Payload {
+    pub body: Named,
+    pub mass: f64,
+    pub com: Vec3,
+    pub inertia: Mat3,
 }
 
 /// How a parallel mechanism's platform moves (`platform.coordinates`).

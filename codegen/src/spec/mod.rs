@@ -226,6 +226,37 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
     for n in &scene.massless {
         massless.extend(find(n, diags));
     }
+    if let Some(p) = &scene.payload
+        && let Some(i) = find(&p.body, diags)
+    {
+        if !(p.mass.is_finite() && p.mass >= 0.0) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "payload mass {} is not a finite, non-negative number",
+                    p.mass
+                ))
+                .with_key("scene.payload.mass")
+                .with_span(p.body.span.clone()),
+            );
+        } else {
+            let b = &mut spec.bodies[i];
+            let c = geom::MassProps::combine(&[
+                geom::MassProps {
+                    mass: b.mass,
+                    com: b.com,
+                    inertia: b.inertia,
+                },
+                geom::MassProps {
+                    mass: p.mass,
+                    com: p.com,
+                    inertia: p.inertia,
+                },
+            ]);
+            b.mass = c.mass;
+            b.com = c.com;
+            b.inertia = c.inertia;
+        }
+    }
     for i in point {
         spec.bodies[i].inertia = [[0.0; 3]; 3];
     }

@@ -10,7 +10,7 @@ use toml::de::{DeTable, DeValue};
 
 use super::angle::{ANGLE_HINT, parse_angle};
 use super::ir::{
-    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Named, Placement, PlatformSpec,
+    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Named, Payload, Placement, PlatformSpec,
     SceneSpec, Spec,
 };
 use super::{sanitize_name, suggest_hint};
@@ -19,7 +19,8 @@ use crate::diag::{Diagnostic, Diagnostics};
 type Val<'i> = Spanned<DeValue<'i>>;
 
 const TOP_KEYS: &[&str] = &["mechanism", "platform", "scene", "body", "joint"];
-const SCENE_KEYS: &[&str] = &["functions", "gravity", "point_mass", "massless"];
+const SCENE_KEYS: &[&str] = &["functions", "gravity", "point_mass", "massless", "payload"];
+const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
 const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
 const BODY_KEYS: &[&str] = &["name", "mass", "com", "inertia", "inertia_rpy"];
@@ -415,6 +416,9 @@ impl Reader<'_> {
             if let Some(b) = get(t, "massless") {
                 scene.massless = self.names(b, "scene.massless").unwrap_or_default();
             }
+            if let Some(p) = get(t, "payload") {
+                scene.payload = self.payload(p);
+            }
         }
         let bodies = self
             .entries(root, "body")
@@ -436,6 +440,45 @@ impl Reader<'_> {
             platform,
             scene,
         }
+    }
+
+    /// `[scene] payload`: `body` (required), `mass`, `com`, `inertia` (default zero).
+    fn payload(&mut self, v: &Val<'_>) -> Option<Payload> {
+        let path = "scene.payload";
+        let t = self.table(v, path)?;
+        self.unknown_keys(t, PAYLOAD_KEYS, path);
+        let Some(b) = get(t, "body") else {
+            self.missing(
+                "body",
+                path,
+                v.span(),
+                "the body that carries the payload: body = \"<its name>\"",
+            );
+            return None;
+        };
+        let name = self.string(b, "scene.payload.body")?;
+        let mass = match get(t, "mass") {
+            Some(m) => self.number(m, "scene.payload.mass")?,
+            None => 0.0,
+        };
+        let com = match get(t, "com") {
+            Some(c) => self.triple(c, "scene.payload.com", false)?,
+            None => [0.0; 3],
+        };
+        let inertia = match get(t, "inertia") {
+            Some(i) => self.inertia(i, "scene.payload.inertia")?,
+            None => [[0.0; 3]; 3],
+        };
+        Some(Payload {
+            body: Named {
+                name,
+                key: "scene.payload.body".into(),
+                span: Some(b.span()),
+            },
+            mass,
+            com,
+            inertia,
+        })
     }
 
     /// An array of strings, each with its key and span.
