@@ -123,3 +123,42 @@ fn scene_payload_is_the_combined_body() {
         }
     }
 }
+
+/// Locking the PUMA 560's joint 5 at 0.3 rad: a 5-joint model whose inverse dynamics equal
+/// the full model's with joint 5 held there (rate and acceleration zero), for the other joints
+/// (the locked joint's effort is the reaction that holds it).
+#[test]
+fn scene_locked_joint_is_the_full_model_held_there() {
+    let path = tests::pkm::spec_path("puma560");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let locked = src.replacen(
+        "\n[[body]]",
+        "\n[scene]\nlocked = { j5 = 0.3 }\n\n[[body]]",
+        1,
+    );
+    let (full, _) = load("puma560.toml", &src).unwrap();
+    let (reduced, _) = load("puma560_locked.toml", &locked).unwrap();
+    assert_eq!(reduced.dof(), 5);
+    let mut rng = tests::rng(41);
+    use rand::Rng;
+    for _ in 0..50 {
+        let r: [[f64; 5]; 3] =
+            core::array::from_fn(|_| core::array::from_fn(|_| rng.random_range(-1.5..1.5)));
+        let lift = |v: &[f64; 5], held: f64| [v[0], v[1], v[2], v[3], held, v[4]];
+        let tf = runtime::rnea::inverse_dynamics(
+            &full,
+            &lift(&r[0], 0.3),
+            &lift(&r[1], 0.0),
+            &lift(&r[2], 0.0),
+        );
+        let tr = runtime::rnea::inverse_dynamics(&reduced, &r[0], &r[1], &r[2]);
+        for (k, i) in [0, 1, 2, 3, 5].into_iter().enumerate() {
+            assert!(
+                (tr[k] - tf[i]).abs() <= 1e-11 * tf[i].abs().max(1.0),
+                "joint {i}: {} vs {}",
+                tr[k],
+                tf[i]
+            );
+        }
+    }
+}

@@ -47,6 +47,8 @@ pub(crate) struct SceneSpec {
     pub massless: Vec<Named>,
     /// A payload rigidly added to a body.
     pub payload: Option<Payload>,
+    /// Joints locked at a value (rad or m): they become fixed joints, their bodies merge.
+    pub locked: Vec<(Named, f64)>,
 }
 
 /// `[scene] payload = { body, mass, com, inertia }`: inertial data in the body's frame.

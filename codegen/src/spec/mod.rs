@@ -257,6 +257,52 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
             b.inertia = c.inertia;
         }
     }
+    // Locked joints become fixed joints placed at their value.
+    for (n, value) in &scene.locked {
+        let Some(j) = spec.joints.iter_mut().find(|j| j.name == n.name) else {
+            let names: Vec<&str> = spec.joints.iter().map(|j| j.name.as_str()).collect();
+            let mut d = Diagnostic::error(format!("unknown joint {:?}", n.name))
+                .with_key(n.key.clone())
+                .with_span(n.span.clone());
+            if let Some(h) = suggest_hint(&n.name, &names) {
+                d = d.with_hint(h);
+            }
+            diags.push(d);
+            continue;
+        };
+        if !matches!(j.kind, ir::Kind::Revolute | ir::Kind::Prismatic) {
+            diags.push(
+                Diagnostic::error(format!("cannot lock a {} joint", j.kind.word()))
+                    .with_key(n.key.clone())
+                    .with_span(n.span.clone())
+                    .with_hint("only revolute and prismatic joints can be locked"),
+            );
+            continue;
+        }
+        let axis = j
+            .axes
+            .first()
+            .map(|a| a.v)
+            .filter(|v| geom::norm(v) > 1e-12)
+            .map(|v| {
+                let l = geom::norm(&v);
+                [v[0] / l, v[1] / l, v[2] / l]
+            })
+            .unwrap_or([0.0, 0.0, 1.0]);
+        let motion = if j.kind == ir::Kind::Revolute {
+            runtime::model::Transform {
+                rotation: runtime::model::axis_angle(&axis, *value),
+                translation: [0.0; 3],
+            }
+        } else {
+            geom::trans([axis[0] * value, axis[1] * value, axis[2] * value])
+        };
+        let (origin, offset) = lower::placement_frames(&j.placement);
+        j.placement = ir::Placement::Origin(geom::compose(&geom::compose(&origin, &motion), &offset));
+        j.kind = ir::Kind::Fixed;
+        j.axes.clear();
+        j.actuated = false;
+    }
     for i in point {
         spec.bodies[i].inertia = [[0.0; 3]; 3];
     }

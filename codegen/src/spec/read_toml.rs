@@ -19,7 +19,14 @@ use crate::diag::{Diagnostic, Diagnostics};
 type Val<'i> = Spanned<DeValue<'i>>;
 
 const TOP_KEYS: &[&str] = &["mechanism", "platform", "scene", "body", "joint"];
-const SCENE_KEYS: &[&str] = &["functions", "gravity", "point_mass", "massless", "payload"];
+const SCENE_KEYS: &[&str] = &[
+    "functions",
+    "gravity",
+    "point_mass",
+    "massless",
+    "payload",
+    "locked",
+];
 const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
 const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
@@ -418,6 +425,23 @@ impl Reader<'_> {
             }
             if let Some(p) = get(t, "payload") {
                 scene.payload = self.payload(p);
+            }
+            if let Some(l) = get(t, "locked")
+                && let Some(lt) = self.table(l, "scene.locked")
+            {
+                for (k, v) in lt.iter() {
+                    let key = format!("scene.locked.{}", k.get_ref());
+                    if let Some(x) = self.angle(v, &key) {
+                        scene.locked.push((
+                            Named {
+                                name: k.get_ref().to_string(),
+                                key,
+                                span: Some(k.span()),
+                            },
+                            x,
+                        ));
+                    }
+                }
             }
         }
         let bodies = self
