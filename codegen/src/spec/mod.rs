@@ -298,7 +298,8 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
             geom::trans([axis[0] * value, axis[1] * value, axis[2] * value])
         };
         let (origin, offset) = lower::placement_frames(&j.placement);
-        j.placement = ir::Placement::Origin(geom::compose(&geom::compose(&origin, &motion), &offset));
+        j.placement =
+            ir::Placement::Origin(geom::compose(&geom::compose(&origin, &motion), &offset));
         j.kind = ir::Kind::Fixed;
         j.axes.clear();
         j.actuated = false;
