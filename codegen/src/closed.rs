@@ -31,6 +31,9 @@ pub struct Kernels {
     /// Newton step (`NX`), the signed largest scaled residual of the kept loop equations, then
     /// that of every loop equation and axis alignment.
     pub newton_step: Vec<ExprId>,
+    /// The closure tests of the inputs: scheduled (as extra roots) in every function that
+    /// takes a closed `x`, though no output uses them.
+    pub checks: Vec<ExprId>,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -61,6 +64,7 @@ fn build(plan: &Plan) -> Result<Kernels, Singular> {
         mass_matrix: flat(&m),
         forward_dynamics: ids(&fd),
         newton_step: newton,
+        checks: ids(&c.checks),
     })
 }
 
@@ -83,7 +87,13 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
         name,
         doc,
         args,
-        schedule: schedule(g, &outputs),
+        // The closure tests first (they are cheap and guard everything else), except in
+        // Newton's step, which runs on open configurations by design.
+        schedule: if name == "newton_step" {
+            schedule(g, &outputs)
+        } else {
+            schedule(g, &[k.checks.clone(), outputs.clone()].concat())
+        },
         outputs,
         shape,
         dof: n,

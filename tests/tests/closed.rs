@@ -223,6 +223,20 @@ macro_rules! generated_matches_runtime {
             println!("{}: generated vs runtime, max relative error {worst:.1e}; Newton from a perturbed guess failed in both {fk_failures} of 500 times", stringify!($m));
             assert!(fk_failures <= 25, "{}: {fk_failures}", stringify!($m));
             assert!(worst < 1e-10, "{}: {worst:e}", stringify!($m));
+            // The generated code refuses what the runtime refuses: open loops, NaN.
+            let (x, u, ud) = random_state(&plan, &mut rng, reach(name));
+            let mut open: [f64; g::NX] = x.clone().try_into().unwrap();
+            open[plan.dependent[0]] += 1e-3;
+            let (ua, uda): ([f64; g::DOF], [f64; g::DOF]) =
+                (u.clone().try_into().unwrap(), ud.clone().try_into().unwrap());
+            let e = g::inverse_dynamics(&open, &ua, &uda).unwrap_err();
+            assert!(matches!(e.site, g::Site::Closure(_)), "{}: {e:?}", stringify!($m));
+            let mut nan: [f64; g::NX] = x.clone().try_into().unwrap();
+            nan[0] = f64::NAN;
+            let e = g::mass_matrix(&nan).unwrap_err();
+            assert_eq!(e.site, g::Site::Input, "{}", stringify!($m));
+            let e = g::forward_dynamics(&open, &ua, &[f64::INFINITY; g::DOF]).unwrap_err();
+            assert!(matches!(e.site, g::Site::Input | g::Site::Closure(_)), "{}: {e:?}", stringify!($m));
         }
     )*};
 }

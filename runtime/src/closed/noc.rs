@@ -698,37 +698,42 @@ pub struct Config<R> {
     pub jac: Vec<Vec<R>>,
     /// LU of `Φ_d`.
     pub lu: Lu<R>,
+    /// The checked values of the closure tests (with `check`). Nothing else uses them, so a
+    /// generator must keep them alive (schedule them as extra roots), or the tests vanish as
+    /// dead code.
+    pub checks: Vec<R>,
 }
 
 /// Kinematics, the loop Jacobian and the LU of `Φ_d` at `x`; with `check`, the kept loop
 /// equations must hold within [`CLOSURE_TOLERANCE`].
 pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Config<R>, Singular> {
     let kin = kinematics(plan, x);
+    let mut checks = Vec::new();
     if check {
         for (i, r) in plan.rows.iter().enumerate() {
             let tol = R::tolerance(CLOSURE_TOLERANCE) * row_scale(plan, r);
             let v = row_value(plan, &kin, r);
             // |Φ| < tol  ⇔  tol² − Φ² > 0.
-            R::check(
+            checks.push(R::check(
                 R::c(tol * tol) - v * v,
                 R::c(0.0),
                 R::c(tol * tol),
                 Site::Closure(i),
                 false,
-            )?;
+            )?);
         }
     }
     if check {
         for cut in 0..plan.cuts.len() {
             if let Some(a) = alignment(plan, &kin, cut) {
                 // Aligned, not opposite: n_a·n_b > 0.
-                R::check(
+                checks.push(R::check(
                     a + R::c(1.0),
                     R::c(0.0),
                     R::c(1.0),
                     Site::Closure(plan.rows.len() + cut),
                     false,
-                )?;
+                )?);
             }
         }
     }
@@ -742,7 +747,12 @@ pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Confi
         .map(|row| plan.dependent.iter().map(|&j| row[j]).collect())
         .collect();
     let lu = lu_factor(&phid)?;
-    Ok(Config { kin, jac, lu })
+    Ok(Config {
+        kin,
+        jac,
+        lu,
+        checks,
+    })
 }
 
 fn row_scale(plan: &Plan, r: &Row) -> f64 {
