@@ -70,6 +70,24 @@ fn build(plan: &Plan) -> Result<Kernels, Singular> {
 
 /// Generate the module of a closed-loop mechanism.
 pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> {
+    generate_selected(model, cfg, None)
+}
+
+/// The public functions of a closed-loop module that `[scene] functions` can leave out
+/// (`inverse_kinematics` and `forward_kinematics` are always emitted).
+pub const SELECTABLE: [&str; 4] = [
+    "joint_rates",
+    "inverse_dynamics",
+    "mass_matrix",
+    "forward_dynamics",
+];
+
+/// [`generate`] with only the selectable functions named in `only` (`None`: all).
+pub fn generate_selected(
+    model: &ClosedModel,
+    cfg: &Config,
+    only: Option<&[String]>,
+) -> Result<Generated, String> {
     let plan = Plan::new(model)?;
     let k = kernels(&plan).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the loop geometry")
@@ -154,16 +172,19 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
             .map(|f| f.schedule.ops)
             .unwrap_or_default()
     };
-    let stats: Vec<(String, OpCount)> = vec![
-        ("joint_rates".into(), ops("joint_rates")),
-        ("inverse_dynamics".into(), ops("inverse_dynamics")),
-        ("mass_matrix".into(), ops("mass_matrix")),
-        ("forward_dynamics".into(), ops("forward_dynamics")),
-        (
-            "forward_kinematics (per Newton step)".into(),
-            ops("newton_step"),
-        ),
-    ];
+    let wanted = |name: &str| {
+        !SELECTABLE.contains(&name) || only.is_none_or(|o| o.iter().any(|f| f == name))
+    };
+    let mut stats: Vec<(String, OpCount)> = SELECTABLE
+        .iter()
+        .filter(|n| wanted(n))
+        .map(|n| (n.to_string(), ops(n)))
+        .collect();
+    stats.push((
+        "forward_kinematics (per Newton step)".into(),
+        ops("newton_step"),
+    ));
+    let functions: Vec<Function<'_>> = functions.into_iter().filter(|f| wanted(f.name)).collect();
     let joint_names: Vec<String> = model.tree.joints.iter().map(|j| j.name.clone()).collect();
     let act_names: Vec<String> = plan
         .independent

@@ -138,7 +138,10 @@ pub fn compile(
                 Ok(generate_selected(&model, cfg, only.as_deref()))
             }
             spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
-            spec::Mechanism::Closed(model) => closed::generate(&model, cfg),
+            spec::Mechanism::Closed(model) => {
+                let only = spec::scene_functions(file_name, source);
+                closed::generate_selected(&model, cfg, only.as_deref())
+            }
         })
     }));
     let mut out = match generated {

@@ -162,3 +162,28 @@ fn scene_locked_joint_is_the_full_model_held_there() {
         }
     }
 }
+
+/// Closed loops: `functions` leaves out the unwanted dynamics functions (the assembly stays).
+#[test]
+fn scene_functions_for_closed_loops() {
+    let path = tests::pkm::spec_path("four_bar");
+    let src =
+        std::fs::read_to_string(&path).unwrap() + "\n[scene]\nfunctions = [\"inverse_dynamics\"]\n";
+    let g = codegen::compile("four_bar.toml", &src, &codegen::Config::default())
+        .unwrap_or_else(|d| panic!("{d}"));
+    assert!(g.code.contains("pub fn inverse_dynamics("));
+    assert!(g.code.contains("pub fn forward_kinematics("));
+    for f in ["joint_rates", "mass_matrix", "forward_dynamics"] {
+        assert!(!g.code.contains(&format!("pub fn {f}(")), "{f} was emitted");
+    }
+    // A parallel mechanism says it cannot.
+    let path = tests::pkm::spec_path("agile_eye");
+    let src =
+        std::fs::read_to_string(&path).unwrap() + "\n[scene]\nfunctions = [\"inverse_dynamics\"]\n";
+    let e = codegen::compile("agile_eye.toml", &src, &codegen::Config::default()).unwrap_err();
+    assert!(
+        e.render().contains("not supported for parallel"),
+        "{}",
+        e.render()
+    );
+}

@@ -315,13 +315,27 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
 
 fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostics) {
     for f in fs {
-        let ok = matches!(m, Mechanism::Tree(_)) && TREE_FUNCTIONS.contains(&f.name.as_str());
+        const CLOSED: [&str; 6] = [
+            "joint_rates",
+            "inverse_dynamics",
+            "mass_matrix",
+            "forward_dynamics",
+            "inverse_kinematics",
+            "forward_kinematics",
+        ];
+        let ok = match m {
+            Mechanism::Tree(_) => TREE_FUNCTIONS.contains(&f.name.as_str()),
+            Mechanism::Closed(_) => CLOSED.contains(&f.name.as_str()),
+            Mechanism::Parallel(_) => false,
+        };
         if !ok {
-            let hint = if matches!(m, Mechanism::Tree(_)) {
-                format!("a tree module offers {}", TREE_FUNCTIONS.join(", "))
-            } else {
-                "choosing functions is supported for trees only so far; remove scene.functions"
-                    .into()
+            let hint = match m {
+                Mechanism::Tree(_) => format!("a tree module offers {}", TREE_FUNCTIONS.join(", ")),
+                Mechanism::Closed(_) => format!(
+                    "a closed-loop module offers {} (the last two are always emitted)",
+                    CLOSED.join(", ")
+                ),
+                Mechanism::Parallel(_) => "choosing functions is not supported for parallel mechanisms yet; remove scene.functions".into(),
             };
             diags.push(
                 Diagnostic::error(format!("cannot select function {:?}", f.name))
