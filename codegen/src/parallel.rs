@@ -436,6 +436,9 @@ fn templates(cfg: &Config, plan: &Plan, _names: &[&str], revolute: &[bool]) -> T
                         p = i;
                     }
                 }
+                // `p < DOF` always; saying so lets the optimizer drop the bounds check (no-panic
+                // proof at opt-level "s").
+                let p = if p < DOF { p } else { DOF - 1 };
                 m.swap(k, p);
                 x.swap(k, p);
                 if !(best > 0.0 && best < f64::INFINITY) {
