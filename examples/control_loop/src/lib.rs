@@ -1,63 +1,142 @@
 //! A firmware-like control loop on nocdyn's generated dynamics: computed-torque control of the
 //! PUMA 560 ([`puma`]) and of the Gough–Stewart platform ([`gough_stewart`]) at a fixed
-//! 1 kHz step, each fed by a simulated plant.
+//! 1 kHz step, in single precision, each fed by a simulated plant ([`bench`]).
 //!
-//! The crate is `#![no_std]` and uses no heap: every quantity is a fixed-size array, every
+//! The controllers are `#![no_std]` and use no heap: every quantity is a fixed-size array, every
 //! generated function returns its result by value, and a singular configuration is an `Err`,
-//! never a panic. The part that would run on a microcontroller is `Controller::step`; `Plant`
-//! and `run` are the test bench (the plant integrates the *generated* forward dynamics by RK4
-//! at a finer step with the torque held between control ticks, as a zero-order hold does).
+//! never a panic. They are generic over the scalar ([`Real`]): `f32` runs on
+//! `mechanisms::f32::*` (what a microcontroller with a single-precision FPU would run), `f64` on
+//! the `f64` modules, for comparison. The part that would run on a microcontroller is
+//! `Controller::step`.
+//!
+//! [`bench`] (feature `bench`, on by default; std and heap) is the test bench: the plant is the
+//! *runtime's* generic `f64` evaluation of the same spec (`runtime::noc`,
+//! `runtime::parallel::noc`), integrated by RK4 at a finer step with the torque held between
+//! control ticks, as a zero-order hold does. Sensor readings are rounded to the controller's
+//! scalar, the torques widened back to `f64`.
 //!
 //! # Why the tracking error is what it is
 //!
-//! The plant here is the controller's own model, so with a continuous-time controller the error
-//! would obey `ë + kd·ė + kp·e = 0` and stay at zero from a start on the reference. The only
-//! error source is the zero-order hold: during a period `h` the torque is the one computed at the
-//! tick, while the ideal torque `τ_d(t)` moves on. The acceleration the plant misses is
-//! `∂FD/∂τ · τ̇_d · (t − t_k)`, a sawtooth whose mean over a period is
-//! `(h/2) · ∂FD/∂τ · τ̇_d`. The reference is slow next to the loop's natural frequency, so the
-//! error follows this forcing quasi-statically: `e ≈ (h / 2) · ∂FD/∂τ · τ̇_d / kp`
-//! ([`zoh_forcing`] gives `∂FD/∂τ · τ̇_d` along a reference). The tests check the simulated
-//! error against this figure.
+//! The plant is the controller's model (the same spec, evaluated by another route), so with a
+//! continuous-time controller in exact arithmetic the error would obey `ë + kd·ė + kp·e = 0`
+//! and stay at zero from a start on the reference. Two sources remain.
 //!
-//! The scalar type is [`F`]; an `f32` build changes it and the `mechanisms` module paths.
+//! * The zero-order hold: during a period `h` the torque is the one computed at the tick, while
+//!   the ideal torque `τ_d(t)` moves on. The acceleration the plant misses is
+//!   `∂FD/∂τ · τ̇_d · (t − t_k)`, a sawtooth whose mean over a period is
+//!   `(h/2) · ∂FD/∂τ · τ̇_d`. The reference is slow next to the loop's natural frequency, so
+//!   the error follows this forcing quasi-statically: `e ≈ (h / 2) · ∂FD/∂τ · τ̇_d / kp`
+//!   ([`bench::puma::predicted_max_error`], [`bench::gough_stewart::predicted_max_error`]).
+//! * Rounding (`f32`): the controller's torque differs from the exact one by `δτ` (sensor
+//!   readings, reference and arithmetic in `f32`), an acceleration error `d = M⁻¹ δτ`. With an
+//!   exact model the computed-torque loop decouples, `ëᵢ + kd·ėᵢ + kp·eᵢ = −dᵢ(t)`, and the
+//!   critically damped impulse response `t·e^{−ωt}` is non-negative with integral `1/ω² = 1/kp`,
+//!   so `|eᵢ| ≤ sup |dᵢ| / kp` whatever the sequence of rounding errors. The bench measures
+//!   `sup ‖M⁻¹ δτ‖∞` along the reference ([`bench::puma::rounding_floor`],
+//!   [`bench::gough_stewart::rounding_floor`]); the tests check the simulated `f32`−`f64`
+//!   error difference against it.
 #![no_std]
 
+#[cfg(feature = "bench")]
+extern crate std;
+
+#[cfg(feature = "bench")]
+pub mod bench;
 pub mod gough_stewart;
 pub mod puma;
 
-/// The scalar of the generated code and of the loop.
-pub type F = f64;
+use core::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
-/// The math the loop needs beyond `core` (through `runtime::math`: `libm` without std).
-pub mod math {
-    use super::F;
-    /// `(sin x, cos x)`.
-    pub fn sin_cos(x: F) -> (F, F) {
-        runtime::math::sin_cos(x)
-    }
+/// The controller's scalar: `f32` (firmware) or `f64`.
+pub trait Real:
+    Copy
+    + Default
+    + PartialOrd
+    + core::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+{
+    /// `0`.
+    const ZERO: Self;
+    /// `1`.
+    const ONE: Self;
+    /// The nearest value of this type (`as`).
+    fn from_f64(x: f64) -> Self;
+    /// Exact widening to `f64`.
+    fn to_f64(self) -> f64;
+    /// `(sin x, cos x)` (`runtime::math`: `libm` without std).
+    fn sin_cos(self) -> (Self, Self);
     /// `√x`.
-    pub fn sqrt(x: F) -> F {
-        runtime::math::sqrt(x)
+    fn sqrt(self) -> Self;
+    /// `|x|`.
+    fn abs(self) -> Self;
+}
+
+impl Real for f64 {
+    const ZERO: f64 = 0.0;
+    const ONE: f64 = 1.0;
+    fn from_f64(x: f64) -> f64 {
+        x
     }
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn sin_cos(self) -> (f64, f64) {
+        runtime::math::sin_cos(self)
+    }
+    fn sqrt(self) -> f64 {
+        runtime::math::sqrt(self)
+    }
+    fn abs(self) -> f64 {
+        f64::abs(self)
+    }
+}
+
+impl Real for f32 {
+    const ZERO: f32 = 0.0;
+    const ONE: f32 = 1.0;
+    fn from_f64(x: f64) -> f32 {
+        x as f32
+    }
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    fn sin_cos(self) -> (f32, f32) {
+        runtime::math::sin_cos_f32(self)
+    }
+    fn sqrt(self) -> f32 {
+        runtime::math::sqrt_f32(self)
+    }
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+}
+
+/// Every element converted to another scalar (`from_f64` of the exact `f64` value).
+pub fn cast<S: Real, T: Real, const N: usize>(v: &[S; N]) -> [T; N] {
+    core::array::from_fn(|i| T::from_f64(v[i].to_f64()))
 }
 
 /// Proportional and derivative gains of the computed-torque law (the same on every axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Gains {
+pub struct Gains<S> {
     /// `kp` (1/s²).
-    pub kp: F,
+    pub kp: S,
     /// `kd` (1/s).
-    pub kd: F,
+    pub kd: S,
 }
 
-impl Gains {
+impl<S: Real> Gains<S> {
     /// Critically damped error dynamics with natural frequency `hz`: `kp = ω²`, `kd = 2ω`.
-    pub fn critically_damped(hz: F) -> Gains {
-        let w = 2.0 * core::f64::consts::PI as F * hz;
+    pub fn critically_damped(hz: f64) -> Gains<S> {
+        let w = 2.0 * core::f64::consts::PI * hz;
         Gains {
-            kp: w * w,
-            kd: 2.0 * w,
+            kp: S::from_f64(w * w),
+            kd: S::from_f64(2.0 * w),
         }
     }
 }
@@ -66,7 +145,7 @@ impl Gains {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Timing {
     /// Control period (s); 1 kHz is `0.001`.
-    pub period: F,
+    pub period: f64,
     /// RK4 steps of the plant per control period.
     pub substeps: u32,
 }
@@ -83,14 +162,14 @@ impl Timing {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stats {
     /// The largest value seen.
-    pub max: F,
-    sum_sq: F,
+    pub max: f64,
+    sum_sq: f64,
     count: u32,
 }
 
 impl Stats {
     /// Add one sample.
-    pub fn add(&mut self, e: F) {
+    pub fn add(&mut self, e: f64) {
         // A NaN sticks, so a diverging run cannot look good.
         if e > self.max || e.is_nan() {
             self.max = e;
@@ -99,11 +178,11 @@ impl Stats {
         self.count += 1;
     }
     /// Root mean square of the samples (0 with none).
-    pub fn rms(&self) -> F {
+    pub fn rms(&self) -> f64 {
         if self.count == 0 {
             0.0
         } else {
-            math::sqrt(self.sum_sq / self.count as F)
+            runtime::math::sqrt(self.sum_sq / self.count as f64)
         }
     }
     /// Number of samples.
@@ -112,34 +191,14 @@ impl Stats {
     }
 }
 
-/// `a (1 − cos ω t)` and its first three derivatives: a smooth excursion that starts at rest.
-pub fn raised_cosine(a: F, w: F, t: F) -> [F; 4] {
-    let (s, c) = math::sin_cos(w * t);
-    [a * (1.0 - c), a * w * s, a * w * w * c, -a * w * w * w * s]
+/// `a (1 − cos ω t)` and its first two derivatives: a smooth excursion that starts at rest.
+pub fn raised_cosine<S: Real>(a: S, w: S, t: S) -> [S; 3] {
+    let (s, c) = (w * t).sin_cos();
+    [a * (S::ONE - c), a * w * s, a * w * w * c]
 }
 
 /// `∞`-norm of a vector.
-pub fn norm_inf(v: &[F]) -> F {
+pub fn norm_inf<S: Real>(v: &[S]) -> S {
     v.iter()
-        .fold(0.0, |m: F, x| if x.abs() > m { x.abs() } else { m })
-}
-
-/// Max over `[0, seconds]` (sampled every `dt`) of `|∂FD/∂τ · τ̇_d|`, componentwise, given
-/// `forcing(t)`, which returns that vector at `t`. See the crate docs.
-pub fn zoh_forcing<const N: usize, E>(
-    seconds: F,
-    dt: F,
-    mut forcing: impl FnMut(F) -> Result<[F; N], E>,
-) -> Result<[F; N], E> {
-    let mut out = [0.0; N];
-    let steps = (seconds / dt) as u32;
-    for k in 0..=steps {
-        let f = forcing(k as F * dt)?;
-        for i in 0..N {
-            if f[i].abs() > out[i] {
-                out[i] = f[i].abs();
-            }
-        }
-    }
-    Ok(out)
+        .fold(S::ZERO, |m, x| if x.abs() > m { x.abs() } else { m })
 }

@@ -1,83 +1,139 @@
-//! Runs the two 1 kHz computed-torque loops for a few seconds of simulated time and prints the
-//! tracking errors next to the zero-order-hold prediction (see the library docs).
+//! Runs the two 1 kHz computed-torque loops, with an `f32` and with an `f64` controller, for a
+//! few seconds of simulated time against the runtime's plant, and prints the tracking errors
+//! next to the zero-order-hold estimate and the `f32` rounding floor (see the library docs),
+//! the `f32`-vs-`f64` torque agreement, and the time of one control tick.
 //!
 //! `cargo run --release -p control-loop -- [seconds] [natural frequency, Hz]`
 
-use control_loop::{F, Gains, Timing, gough_stewart, puma};
-use std::time::Instant;
+use control_loop::bench::{self, Rounding};
+use control_loop::{Gains, Timing, cast, gough_stewart, puma};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// Mean time of `f` over `reps` calls.
+fn time(reps: u32, mut f: impl FnMut(u32)) -> Duration {
+    let start = Instant::now();
+    for k in 0..reps {
+        f(k);
+    }
+    start.elapsed() / reps
+}
+
+fn puma_tick<S: puma::Scalar>(reference: puma::Reference<f64>, gains: Gains<f64>) -> Duration {
+    let c = puma::Controller::<S> {
+        gains: Gains {
+            kp: S::from_f64(gains.kp),
+            kd: S::from_f64(gains.kd),
+        },
+        reference: reference.cast(),
+    };
+    let (q, qd, _) = c.reference.at(S::from_f64(0.5));
+    time(20_000, |k| {
+        black_box(c.step(black_box(S::from_f64(k as f64 * 1e-4)), &q, &qd));
+    })
+}
+
+fn gough_stewart_tick<S: gough_stewart::Scalar>(
+    reference: gough_stewart::Reference<f64>,
+    gains: Gains<f64>,
+) -> Duration {
+    let g = Gains {
+        kp: S::from_f64(gains.kp),
+        kd: S::from_f64(gains.kd),
+    };
+    let mut c = gough_stewart::Controller::<S>::new(g, reference.cast());
+    let (x, u, _) = reference.at(0.5);
+    c.estimate = cast(&x);
+    let lengths = mechanisms::gough_stewart::inverse_kinematics(&x).expect("pose in reach");
+    let (q, u): ([S; 6], [S; 6]) = (cast(&lengths), cast(&u));
+    time(20_000, |k| {
+        let t = black_box(S::from_f64(0.5 + k as f64 * 1e-7));
+        black_box(c.step(t, &q, &u).expect("tick"));
+    })
+}
+
+fn rounding(what: &str, r: &Rounding, kp: f64, unit: &str) {
+    println!(
+        "  {what}: f32 vs f64 torque along the reference: max |δτ| {:.2e} (relative {:.2e}); rounding floor max|M⁻¹δτ|/kp = {:.2e} {unit}",
+        r.torque_absolute,
+        r.torque_relative,
+        r.acceleration / kp
+    );
+}
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let seconds: F = args.next().map_or(5.0, |s| s.parse().expect("seconds"));
-    let hz: F = args
+    let seconds: f64 = args.next().map_or(5.0, |s| s.parse().expect("seconds"));
+    let hz: f64 = args
         .next()
         .map_or(8.0, |s| s.parse().expect("natural frequency (Hz)"));
-    let gains = Gains::critically_damped(hz);
+    let gains = Gains::<f64>::critically_damped(hz);
     let timing = Timing::KHZ;
     println!(
-        "computed torque at {} Hz, plant RK4 at {} Hz, kp = {:.1} 1/s², kd = {:.2} 1/s ({hz} Hz, critically damped), {seconds} s",
+        "computed torque at {} Hz, plant (runtime, f64) RK4 at {} Hz, kp = {:.1} 1/s², kd = {:.2} 1/s ({hz} Hz, critically damped), {seconds} s",
         1.0 / timing.period,
-        timing.substeps as F / timing.period,
+        timing.substeps as f64 / timing.period,
         gains.kp,
         gains.kd
     );
 
-    let c = puma::Controller {
-        gains,
-        reference: puma::Reference::DEMO,
-    };
-    let start = Instant::now();
-    let s = puma::run(&c, timing, seconds).expect("PUMA 560 loop");
-    let wall = start.elapsed();
-    let p = puma::predicted_max_error(&c, timing, seconds).expect("prediction");
-    println!(
-        "puma560       joint error  max {:.3e} rad  rms {:.3e} rad  (predicted max {:.3e} rad)  {} ticks in {:.0?}",
-        s.max,
-        s.rms(),
-        p,
-        s.count(),
-        wall
-    );
+    let r = puma::Reference::DEMO;
+    let p = bench::puma::predicted_max_error(gains, &r, timing, seconds).expect("prediction");
+    println!("puma560 joint error ‖q_d − q‖∞ (rad); hold estimate max {p:.3e}");
+    for (name, s) in [
+        (
+            "f32",
+            bench::puma::run::<f32>(gains, r, timing, seconds).expect("PUMA 560 loop, f32"),
+        ),
+        (
+            "f64",
+            bench::puma::run::<f64>(gains, r, timing, seconds).expect("PUMA 560 loop, f64"),
+        ),
+    ] {
+        println!(
+            "  {name} controller: max {:.3e}  rms {:.3e}  ({} ticks)",
+            s.max,
+            s.rms(),
+            s.count()
+        );
+    }
+    let f = bench::puma::rounding_floor(gains, &r, timing, seconds).expect("rounding");
+    rounding("puma560", &f, gains.kp, "rad");
 
     let r = gough_stewart::Reference::DEMO;
-    // The firmware part alone: one control tick (pose by forward kinematics for the platform).
-    let reps = 20_000;
-    let (q, qd, _) = c.reference.at(0.5);
-    let start = Instant::now();
-    for k in 0..reps {
-        std::hint::black_box(c.step(std::hint::black_box(k as F * 1e-4), &q, &qd));
-    }
-    let puma_tick = start.elapsed() / reps;
-    let mut gc = gough_stewart::Controller::new(gains, r);
-    let (x, u, _) = r.at(0.5);
-    let lengths = mechanisms::gough_stewart::inverse_kinematics(&x).expect("pose in reach");
-    let start = Instant::now();
-    for k in 0..reps {
-        let t = std::hint::black_box(0.5 + k as F * 1e-7);
-        std::hint::black_box(gc.step(t, &lengths, &u).expect("tick"));
-    }
-    let gs_tick = start.elapsed() / reps;
-    println!(
-        "control tick alone: puma560 {puma_tick:.2?}, gough_stewart {gs_tick:.2?} (of a 1 ms period)"
-    );
-
-    let start = Instant::now();
-    let t = gough_stewart::run(gains, &r, timing, seconds).expect("Gough–Stewart loop");
-    let wall = start.elapsed();
     let (pr, pt) =
-        gough_stewart::predicted_max_error(gains, &r, timing, seconds).expect("prediction");
+        bench::gough_stewart::predicted_max_error(gains, &r, timing, seconds).expect("prediction");
     println!(
-        "gough_stewart rotation     max {:.3e} rad  rms {:.3e} rad  (predicted max {:.3e} rad)",
-        t.rotation.max,
-        t.rotation.rms(),
-        pr
+        "gough_stewart pose error ‖δθ‖∞ (rad), ‖δp‖∞ (m); hold estimate max {pr:.3e} rad, {pt:.3e} m"
     );
+    for (name, t) in [
+        (
+            "f32",
+            bench::gough_stewart::run::<f32>(gains, r, timing, seconds).expect("loop, f32"),
+        ),
+        (
+            "f64",
+            bench::gough_stewart::run::<f64>(gains, r, timing, seconds).expect("loop, f64"),
+        ),
+    ] {
+        println!(
+            "  {name} controller: rotation max {:.3e} rms {:.3e} rad; translation max {:.3e} rms {:.3e} m",
+            t.rotation.max,
+            t.rotation.rms(),
+            t.translation.max,
+            t.translation.rms()
+        );
+    }
+    let (fr, ft) =
+        bench::gough_stewart::rounding_floor(gains, &r, timing, seconds).expect("rounding");
+    rounding("gough_stewart rotation", &fr, gains.kp, "rad");
+    rounding("gough_stewart translation", &ft, gains.kp, "m");
+
     println!(
-        "gough_stewart translation  max {:.3e} m    rms {:.3e} m    (predicted max {:.3e} m)  {} ticks in {:.0?}",
-        t.translation.max,
-        t.translation.rms(),
-        pt,
-        t.translation.count(),
-        wall
+        "control tick alone (this host): puma560 f32 {:.2?}, f64 {:.2?}; gough_stewart f32 {:.2?}, f64 {:.2?} (of a 1 ms period)",
+        puma_tick::<f32>(puma::Reference::DEMO, gains),
+        puma_tick::<f64>(puma::Reference::DEMO, gains),
+        gough_stewart_tick::<f32>(r, gains),
+        gough_stewart_tick::<f64>(r, gains),
     );
 }
