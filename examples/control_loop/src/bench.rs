@@ -33,6 +33,9 @@ pub struct Rounding {
     /// Largest `‖M⁻¹ (τ₃₂ − τ₆₄)‖∞` over the ticks (rad/s², or per component group for the
     /// platform: see [`gough_stewart::rounding_floor`]).
     pub acceleration: f64,
+    /// Platform only: the largest error of the `f32` controller's pose estimate (forward
+    /// kinematics) against the true pose (rad or m; 0 for the PUMA 560).
+    pub estimate: f64,
 }
 
 /// `max(‖a − b‖∞, …)` helper: `‖a − b‖∞`.
@@ -91,7 +94,12 @@ pub mod puma {
 
     impl Plant {
         /// `q̈ = FD(q, q̇, τ)` by the runtime.
-        fn acceleration(&self, q: &[f64; N], qd: &[f64; N], tau: &[f64; N]) -> Result<[f64; N], Error> {
+        fn acceleration(
+            &self,
+            q: &[f64; N],
+            qd: &[f64; N],
+            tau: &[f64; N],
+        ) -> Result<[f64; N], Error> {
             let a = runtime::noc::forward_dynamics(&self.model, q, qd, tau)
                 .map_err(|e| Error::Plant(format!("{e:?}")))?;
             Ok(core::array::from_fn(|i| a[i]))
@@ -149,7 +157,11 @@ pub mod puma {
                     },
                     reference: reference.cast(),
                 },
-                plant: Plant { model: model(), q, qd },
+                plant: Plant {
+                    model: model(),
+                    q,
+                    qd,
+                },
                 timing,
                 reference,
                 ticks: 0,
@@ -162,12 +174,11 @@ pub mod puma {
             let t = self.ticks as f64 * self.timing.period;
             let (q_d, _, _) = self.reference.at(t);
             let e = core::array::from_fn(|i| q_d[i] - self.plant.q[i]);
-            let tau = self.controller.step(
-                S::from_f64(t),
-                &cast(&self.plant.q),
-                &cast(&self.plant.qd),
-            );
-            self.plant.advance(&cast(&tau), self.timing.period, self.timing.substeps)?;
+            let tau =
+                self.controller
+                    .step(S::from_f64(t), &cast(&self.plant.q), &cast(&self.plant.qd));
+            self.plant
+                .advance(&cast(&tau), self.timing.period, self.timing.substeps)?;
             self.ticks += 1;
             Ok(e)
         }
@@ -324,7 +335,12 @@ pub mod gough_stewart {
 
     impl Plant {
         /// `u̇ = FD(x, u, τ)` by the runtime.
-        fn acceleration(&self, x: &[f64; NX], u: &[f64; N], tau: &[f64; N]) -> Result<[f64; N], Error> {
+        fn acceleration(
+            &self,
+            x: &[f64; NX],
+            u: &[f64; N],
+            tau: &[f64; N],
+        ) -> Result<[f64; N], Error> {
             let a = rt::forward_dynamics(&self.plan, x, u, tau)
                 .map_err(|e| Error::Plant(format!("{e}")))?;
             Ok(core::array::from_fn(|i| a[i]))
@@ -350,7 +366,8 @@ pub mod gough_stewart {
                 let (k3, a3) = (pose_rate(&x3, &u3), self.acceleration(&x3, &u3, tau)?);
                 let (x4, u4) = (pose_axpy(&x, h, &k3), axpy(&u, h, &a3));
                 let (k4, a4) = (pose_rate(&x4, &u4), self.acceleration(&x4, &u4, tau)?);
-                let dx = core::array::from_fn(|i| (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
+                let dx =
+                    core::array::from_fn(|i| (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
                 self.x = pose_axpy(&x, h, &dx);
                 for i in 0..N {
                     self.u[i] += h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i]);
@@ -407,7 +424,8 @@ pub mod gough_stewart {
                 .controller
                 .step(S::from_f64(t), &cast(&q), &cast(&self.plant.u))
                 .map_err(|f| Error::Controller(format!("{f:?}")))?;
-            self.plant.advance(&cast(&tau), self.timing.period, self.timing.substeps)?;
+            self.plant
+                .advance(&cast(&tau), self.timing.period, self.timing.substeps)?;
             self.ticks += 1;
             Ok(e)
         }
@@ -480,7 +498,7 @@ pub mod gough_stewart {
     /// rounded to `f32`; each controller's forward kinematics warm-started from its previous
     /// tick, as in the loop). Returns `(rotation, translation)`: the torque figures are the same
     /// in both, `acceleration` is `max ‖M⁻¹ δτ‖∞` over the rotation (rad/s²) and the translation
-    /// (m/s²) components of `u̇`.
+    /// (m/s²) components of `u̇`, `estimate` the `f32` pose estimate's error in each.
     pub fn rounding_floor(
         gains: Gains<f64>,
         reference: &Reference<f64>,
@@ -501,11 +519,13 @@ pub mod gough_stewart {
                 &c32.step(t as f32, &cast(&q), &cast(&u))
                     .map_err(|f| ctl(format!("{f:?}")))?,
             );
+            let est = pose_error(&x, &cast(&c32.estimate));
             let dtau = diff_inf(&tau32, &tau64);
             let rel = dtau / norm_inf(&tau64);
             let a32 = g::forward_dynamics(&x, &u, &tau32).map_err(plant)?;
             let a64 = g::forward_dynamics(&x, &u, &tau64).map_err(plant)?;
             for (r, range) in [(&mut rot, 0..3), (&mut trans, 3..6)] {
+                r.estimate = r.estimate.max(norm_inf(&est[range.clone()]));
                 r.torque_absolute = r.torque_absolute.max(dtau);
                 r.torque_relative = r.torque_relative.max(rel);
                 r.acceleration = r

@@ -128,6 +128,10 @@ fn main() {
         bench::gough_stewart::rounding_floor(gains, &r, timing, seconds).expect("rounding");
     rounding("gough_stewart rotation", &fr, gains.kp, "rad");
     rounding("gough_stewart translation", &ft, gains.kp, "m");
+    println!(
+        "  gough_stewart f32 pose estimate (forward kinematics) along the reference: max error {:.2e} rad, {:.2e} m",
+        fr.estimate, ft.estimate
+    );
 
     println!(
         "control tick alone (this host): puma560 f32 {:.2?}, f64 {:.2?}; gough_stewart f32 {:.2?}, f64 {:.2?} (of a 1 ms period)",
