@@ -1,6 +1,6 @@
 //! A firmware-like control loop on nocdyn's generated dynamics: computed-torque control of the
 //! PUMA 560 ([`puma`]) and of the Gough–Stewart platform ([`gough_stewart`]) at a fixed
-//! 1 kHz step, in single precision, each fed by a simulated plant ([`bench`]).
+//! 1 kHz step, in single precision, each fed by a simulated plant ([`mod@bench`]).
 //!
 //! The controllers are `#![no_std]` and use no heap: every quantity is a fixed-size array, every
 //! generated function returns its result by value, and a singular configuration is an `Err`,
@@ -9,7 +9,7 @@
 //! the `f64` modules, for comparison. The part that would run on a microcontroller is
 //! `Controller::step`.
 //!
-//! [`bench`] (feature `bench`, on by default; std and heap) is the test bench: the plant is the
+//! [`mod@bench`] (feature `bench`, on by default; std and heap) is the test bench: the plant is the
 //! *runtime's* generic `f64` evaluation of the same spec (`runtime::noc`,
 //! `runtime::parallel::noc`), integrated by RK4 at a finer step with the torque held between
 //! control ticks, as a zero-order hold does. Sensor readings are rounded to the controller's

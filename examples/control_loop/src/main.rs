@@ -1,22 +1,28 @@
-//! Runs the two 1 kHz computed-torque loops, with an `f32` and with an `f64` controller, for a
-//! few seconds of simulated time against the runtime's plant, and prints the tracking errors
+//! Runs the two 1 kHz computed-torque loops, with an `f32` and with an `f64` controller side by
+//! side, for a few seconds of simulated time against the runtime's plant, and prints the
+//! tracking errors and how far the two loops drift apart
 //! next to the zero-order-hold estimate and the `f32` rounding floor (see the library docs),
 //! the `f32`-vs-`f64` torque agreement, and the time of one control tick.
 //!
 //! `cargo run --release -p control-loop -- [seconds] [natural frequency, Hz]`
 
 use control_loop::bench::{self, Rounding};
-use control_loop::{Gains, Timing, cast, gough_stewart, puma};
+use control_loop::{Gains, Stats, Timing, cast, gough_stewart, norm_inf, puma};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-/// Mean time of `f` over `reps` calls.
+/// Time per call of `f`: the best of 7 batches of `reps` calls (the machine may be shared).
 fn time(reps: u32, mut f: impl FnMut(u32)) -> Duration {
-    let start = Instant::now();
-    for k in 0..reps {
-        f(k);
-    }
-    start.elapsed() / reps
+    (0..7)
+        .map(|_| {
+            let start = Instant::now();
+            for k in 0..reps {
+                f(k);
+            }
+            start.elapsed() / reps
+        })
+        .min()
+        .expect("7 batches")
 }
 
 fn puma_tick<S: puma::Scalar>(reference: puma::Reference<f64>, gains: Gains<f64>) -> Duration {
@@ -28,7 +34,7 @@ fn puma_tick<S: puma::Scalar>(reference: puma::Reference<f64>, gains: Gains<f64>
         reference: reference.cast(),
     };
     let (q, qd, _) = c.reference.at(S::from_f64(0.5));
-    time(20_000, |k| {
+    time(10_000, |k| {
         black_box(c.step(black_box(S::from_f64(k as f64 * 1e-4)), &q, &qd));
     })
 }
@@ -46,7 +52,7 @@ fn gough_stewart_tick<S: gough_stewart::Scalar>(
     c.estimate = cast(&x);
     let lengths = mechanisms::gough_stewart::inverse_kinematics(&x).expect("pose in reach");
     let (q, u): ([S; 6], [S; 6]) = (cast(&lengths), cast(&u));
-    time(20_000, |k| {
+    time(10_000, |k| {
         let t = black_box(S::from_f64(0.5 + k as f64 * 1e-7));
         black_box(c.step(t, &q, &u).expect("tick"));
     })
@@ -77,45 +83,61 @@ fn main() {
         gains.kd
     );
 
+    let ticks = (seconds / timing.period) as u32;
     let r = puma::Reference::DEMO;
     let p = bench::puma::predicted_max_error(gains, &r, timing, seconds).expect("prediction");
-    println!("puma560 joint error ‖q_d − q‖∞ (rad); hold estimate max {p:.3e}");
-    for (name, s) in [
-        (
-            "f32",
-            bench::puma::run::<f32>(gains, r, timing, seconds).expect("PUMA 560 loop, f32"),
-        ),
-        (
-            "f64",
-            bench::puma::run::<f64>(gains, r, timing, seconds).expect("PUMA 560 loop, f64"),
-        ),
-    ] {
+    let f = bench::puma::rounding_floor(gains, &r, timing, seconds).expect("rounding");
+    let (mut l32, mut l64) = (
+        bench::puma::Loop::<f32>::new(gains, r, timing),
+        bench::puma::Loop::<f64>::new(gains, r, timing),
+    );
+    let (mut s32, mut s64, mut drift) = (Stats::default(), Stats::default(), Stats::default());
+    for _ in 0..ticks {
+        let (e32, e64) = (l32.tick().expect("f32 loop"), l64.tick().expect("f64 loop"));
+        s32.add(norm_inf(&e32));
+        s64.add(norm_inf(&e64));
+        drift.add(norm_inf(&core::array::from_fn::<f64, 6, _>(|i| {
+            e32[i] - e64[i]
+        })));
+    }
+    println!("puma560 joint error ‖q_d − q‖∞ (rad), {ticks} ticks; hold estimate max {p:.3e}");
+    for (name, s) in [("f32", s32), ("f64", s64)] {
         println!(
-            "  {name} controller: max {:.3e}  rms {:.3e}  ({} ticks)",
+            "  {name} controller: max {:.3e}  rms {:.3e}",
             s.max,
-            s.rms(),
-            s.count()
+            s.rms()
         );
     }
-    let f = bench::puma::rounding_floor(gains, &r, timing, seconds).expect("rounding");
     rounding("puma560", &f, gains.kp, "rad");
+    println!(
+        "  f32 loop − f64 loop: max {:.3e} rad (bound: the rounding floor)",
+        drift.max
+    );
 
     let r = gough_stewart::Reference::DEMO;
     let (pr, pt) =
         bench::gough_stewart::predicted_max_error(gains, &r, timing, seconds).expect("prediction");
-    println!(
-        "gough_stewart pose error ‖δθ‖∞ (rad), ‖δp‖∞ (m); hold estimate max {pr:.3e} rad, {pt:.3e} m"
+    let (fr, ft) =
+        bench::gough_stewart::rounding_floor(gains, &r, timing, seconds).expect("rounding");
+    let (mut l32, mut l64) = (
+        bench::gough_stewart::Loop::<f32>::new(gains, r, timing),
+        bench::gough_stewart::Loop::<f64>::new(gains, r, timing),
     );
-    for (name, t) in [
-        (
-            "f32",
-            bench::gough_stewart::run::<f32>(gains, r, timing, seconds).expect("loop, f32"),
-        ),
-        (
-            "f64",
-            bench::gough_stewart::run::<f64>(gains, r, timing, seconds).expect("loop, f64"),
-        ),
-    ] {
+    let (mut t32, mut t64, mut drift) = (
+        bench::gough_stewart::Tracking::default(),
+        bench::gough_stewart::Tracking::default(),
+        bench::gough_stewart::Tracking::default(),
+    );
+    for _ in 0..ticks {
+        let (e32, e64) = (l32.tick().expect("f32 loop"), l64.tick().expect("f64 loop"));
+        t32.add(&e32);
+        t64.add(&e64);
+        drift.add(&core::array::from_fn(|i| e32[i] - e64[i]));
+    }
+    println!(
+        "gough_stewart pose error ‖δθ‖∞ (rad), ‖δp‖∞ (m), {ticks} ticks; hold estimate max {pr:.3e} rad, {pt:.3e} m"
+    );
+    for (name, t) in [("f32", t32), ("f64", t64)] {
         println!(
             "  {name} controller: rotation max {:.3e} rms {:.3e} rad; translation max {:.3e} rms {:.3e} m",
             t.rotation.max,
@@ -124,17 +146,19 @@ fn main() {
             t.translation.rms()
         );
     }
-    let (fr, ft) =
-        bench::gough_stewart::rounding_floor(gains, &r, timing, seconds).expect("rounding");
     rounding("gough_stewart rotation", &fr, gains.kp, "rad");
     rounding("gough_stewart translation", &ft, gains.kp, "m");
     println!(
-        "  gough_stewart f32 pose estimate (forward kinematics) along the reference: max error {:.2e} rad, {:.2e} m",
+        "  f32 pose estimate (forward kinematics) along the reference: max error {:.2e} rad, {:.2e} m",
         fr.estimate, ft.estimate
+    );
+    println!(
+        "  f32 loop − f64 loop: max {:.3e} rad, {:.3e} m (bound: the rounding floors)",
+        drift.rotation.max, drift.translation.max
     );
 
     println!(
-        "control tick alone (this host): puma560 f32 {:.2?}, f64 {:.2?}; gough_stewart f32 {:.2?}, f64 {:.2?} (of a 1 ms period)",
+        "control tick alone (this host, best of 7 batches): puma560 f32 {:.2?}, f64 {:.2?}; gough_stewart f32 {:.2?}, f64 {:.2?} (of a 1 ms period)",
         puma_tick::<f32>(puma::Reference::DEMO, gains),
         puma_tick::<f64>(puma::Reference::DEMO, gains),
         gough_stewart_tick::<f32>(r, gains),
