@@ -8,9 +8,9 @@
 //! In `f32` this estimate, not the arithmetic, sets the rounding floor: Newton stops as soon as
 //! the leg-length residual is within the rescaled tolerance `4.9e-6·(1 + max|q|)` (about 1e-5 m
 //! here), and returns a warm start that is already that close unchanged. Along the demo
-//! reference the `f32` estimate is off by up to about 4e-6 rad and 3e-6 m, against 1e-8 rad
-//! and 6e-8 m for the true pose rounded to `f32`. (A guess moved on by `h·u` makes it worse:
-//! every guess passes the test, and the estimate drifts by dead reckoning up to the tolerance.)
+//! reference the `f32` estimate is off by a few µm and µrad (the example prints it), where half
+//! an `f32` ulp of the pose is 6e-8 m. (A guess moved on by `h·u` makes it worse: every guess
+//! passes the test, and the estimate drifts by dead reckoning up to the tolerance.)
 
 use crate::{Gains, Real, raised_cosine};
 

@@ -1,8 +1,8 @@
 //! Runs the two 1 kHz computed-torque loops, with an `f32` and with an `f64` controller side by
 //! side, for a few seconds of simulated time against the runtime's plant, and prints the
-//! tracking errors and how far the two loops drift apart
-//! next to the zero-order-hold estimate and the `f32` rounding floor (see the library docs),
-//! the `f32`-vs-`f64` torque agreement, and the time of one control tick.
+//! tracking errors next to the zero-order-hold estimate, how far the two loops drift apart next
+//! to the `f32` rounding floor (see the library docs), the `f32`-vs-`f64` torque agreement, and
+//! the time of one control tick.
 //!
 //! `cargo run --release -p control-loop -- [seconds] [natural frequency, Hz]`
 
