@@ -113,6 +113,27 @@ impl Builder {
         self
     }
 
+    /// Apply the joints' friction (`damping`, `friction`; URDF `<dynamics>`) in every spec, as
+    /// `[scene] friction = true` does.
+    pub fn friction(&mut self, on: bool) -> &mut Self {
+        self.config.scene.friction = on;
+        self
+    }
+
+    /// Apply the joints' reflected rotor inertia (`armature`) in every spec, as
+    /// `[scene] rotor_inertia = true` does.
+    pub fn rotor_inertia(&mut self, on: bool) -> &mut Self {
+        self.config.scene.rotor_inertia = on;
+        self
+    }
+
+    /// Take near-exact angles and offsets as exact within `tol` in every spec, as
+    /// `[scene] snap = tol` does (each change is a warning).
+    pub fn snap(&mut self, tol: f64) -> &mut Self {
+        self.config.scene.snap = Some(tol);
+        self
+    }
+
     /// Module name of each spec (see the module docs), in the order added.
     pub fn module_names(&self) -> Vec<String> {
         self.specs

@@ -50,7 +50,7 @@
 //!   axial inertia `J_zz` optionally apart, resolved in the joint frame where it needs no
 //!   rotation back to the parent. The cheapest by marginal operation count is kept.
 
-use runtime::model::{JointKind, Mat3, Model, Vec3, mat_mul, mat_vec, transpose};
+use runtime::model::{Drive, JointKind, Mat3, Model, Vec3, mat_mul, mat_vec, transpose};
 
 use crate::sym::{Arg, ExprId, Graph, Node};
 
@@ -108,6 +108,8 @@ impl Link {
 pub struct Tree {
     links: Vec<Link>,
     gravity: Vec3,
+    /// Per joint: friction and rotor inertia (added after the rigid-body sweeps).
+    drives: Vec<Drive>,
 }
 
 /// A body in the canonical frames, before the origin choice: mass centre and inertia about it.
@@ -259,7 +261,9 @@ impl Tree {
     /// cheapest (see `Tree::choose`).
     pub fn new(model: &Model) -> Tree {
         let canon = Self::canonical(model);
-        Self::choose(&canon, model.gravity)
+        let mut tree = Self::choose(&canon, model.gravity);
+        tree.drives = model.joints.iter().map(|j| j.drive).collect();
+        tree
     }
 
     fn canonical(model: &Model) -> Vec<Canonical> {
@@ -349,7 +353,12 @@ impl Tree {
                 lumped: (0.0, 0.0),
             });
         }
-        let mut tree = Tree { links, gravity };
+        let drives = vec![Drive::NONE; links.len()];
+        let mut tree = Tree {
+            links,
+            gravity,
+            drives,
+        };
         tree.regroup(&choice.lump_xx);
         tree
     }
@@ -403,12 +412,7 @@ impl Tree {
     /// other functions are parts or consumers of these).
     fn cost(&self) -> usize {
         let mut g = Graph::new();
-        let all = Terms {
-            velocity: true,
-            acceleration: true,
-            gravity: true,
-        };
-        let id = inverse_dynamics(&mut g, self, all);
+        let id = inverse_dynamics(&mut g, self, Terms::ALL);
         let mm: Vec<ExprId> = mass_matrix(&mut g, self).concat();
         // Each function is scheduled on its own, so count each cone separately.
         let count = |roots: &[ExprId]| {
@@ -937,6 +941,64 @@ pub struct Terms {
     pub acceleration: bool,
     /// Gravity.
     pub gravity: bool,
+    /// Joint friction (the drives' dissipative efforts `δ(q̇)`; `q̇` is an input).
+    pub friction: bool,
+}
+
+impl Terms {
+    /// Everything: inverse dynamics.
+    pub const ALL: Terms = Terms {
+        velocity: true,
+        acceleration: true,
+        gravity: true,
+        friction: true,
+    };
+    /// Nothing (switch terms on with struct update syntax).
+    pub const NONE: Terms = Terms {
+        velocity: false,
+        acceleration: false,
+        gravity: false,
+        friction: false,
+    };
+}
+
+/// Adds the joint drives' efforts to `tau`: `I_a q̈` (rotor inertia; when `q̈` is on) and the
+/// friction `b q̇ + c q̇ / √(q̇² + v_s²)` (when friction is on) — the lecture's dissipative term
+/// `δ` beside `Tᵀ w`.
+pub fn add_drive_efforts(
+    g: &mut Graph,
+    drives: &[Drive],
+    terms: Terms,
+    tau: &mut [ExprId],
+    rate: impl Fn(&mut Graph, Arg, usize) -> ExprId,
+) {
+    for (i, d) in drives.iter().enumerate() {
+        if terms.acceleration && d.armature != 0.0 {
+            let qdd = rate(g, Arg::Qdd, i);
+            let e = g.scale(d.armature, qdd);
+            tau[i] = g.add(tau[i], e);
+        }
+        if terms.friction && (d.viscous != 0.0 || d.coulomb != 0.0) {
+            let qd = rate(g, Arg::Qd, i);
+            let f = friction_effort(g, d, qd);
+            tau[i] = g.add(tau[i], f);
+        }
+    }
+}
+
+/// `b q̇ + c q̇ / √(q̇² + v_s²)` for one joint ([`Drive::friction`]).
+pub fn friction_effort(g: &mut Graph, d: &Drive, qd: ExprId) -> ExprId {
+    let mut f = g.scale(d.viscous, qd);
+    if d.coulomb != 0.0 {
+        let sq = g.mul(qd, qd);
+        let vs2 = g.constant(d.coulomb_velocity * d.coulomb_velocity);
+        let den = g.add(sq, vs2);
+        let den = g.sqrt(den);
+        let c = g.scale(d.coulomb, qd);
+        let c = g.div(c, den);
+        f = g.add(f, c);
+    }
+    f
 }
 
 /// `Tᵀ (M ṫ + W M t − w^G)`: inverse dynamics (or its parts), one effort per joint.
@@ -1136,6 +1198,9 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
             moment[p] = s.add3(moment[p], nn);
         }
     }
+    add_drive_efforts(s.g, &tree.drives, terms, &mut tau, |g, arg, i| {
+        g.input(arg, i)
+    });
     tau
 }
 
@@ -1243,6 +1308,13 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
             i = p;
         }
     }
+    // Rotor inertia: `I_a` on the diagonal (the rotor turns with `q̇` times the gear ratio).
+    for (j, d) in tree.drives.iter().enumerate() {
+        if d.armature != 0.0 {
+            let a = s.c(d.armature);
+            h[j][j] = s.g.add(h[j][j], a);
+        }
+    }
     h
 }
 
@@ -1260,9 +1332,8 @@ pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
         g,
         tree,
         Terms {
-            velocity: true,
             acceleration: false,
-            gravity: true,
+            ..Terms::ALL
         },
     );
     let rhs: Vec<ExprId> = (0..n)

@@ -76,12 +76,14 @@ pub enum Float {
 }
 
 /// Generation options.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     /// Math backend for trigonometry and square roots.
     pub math: MathBackend,
     /// Scalar type of the generated code.
     pub float: Float,
+    /// Scene switches on top of the spec's `[scene]` (friction, rotor inertia).
+    pub scene: spec::SceneOverrides,
 }
 
 impl Default for Config {
@@ -89,6 +91,7 @@ impl Default for Config {
         Config {
             math: MathBackend::Libm,
             float: Float::F64,
+            scene: spec::SceneOverrides::default(),
         }
     }
 }
@@ -122,7 +125,7 @@ pub fn compile(
     source: &str,
     cfg: &Config,
 ) -> Result<Generated, diag::Diagnostics> {
-    let (mechanism, warnings) = spec::load_mechanism(file_name, source)?;
+    let (mechanism, warnings) = spec::load_mechanism_with(file_name, source, &cfg.scene)?;
     let error = |msg: String| {
         let mut d = diag::Diagnostics::new(file_name, source);
         d.push(diag::Diagnostic::error(msg).with_key("platform"));
@@ -179,6 +182,8 @@ pub struct Symbolic {
     pub inverse_dynamics: Vec<sym::ExprId>,
     /// `I⁻¹ (τ − C q̇ + γ)` with checked pivots.
     pub forward_dynamics: Vec<sym::ExprId>,
+    /// Joint friction `δ(q̇)`, when some joint's drive has friction (`[scene] friction`).
+    pub friction: Option<Vec<sym::ExprId>>,
 }
 
 /// Build the symbolic dynamics of a validated model.
@@ -187,31 +192,38 @@ pub fn symbolic(model: &Model) -> Symbolic {
     let mut g = Graph::new();
     let mm = dynamics::mass_matrix(&mut g, &tree);
     let mass_matrix: Vec<_> = mm.iter().flatten().copied().collect();
-    let all = Terms {
-        velocity: true,
-        acceleration: true,
-        gravity: true,
-    };
     let coriolis = dynamics::inverse_dynamics(
         &mut g,
         &tree,
         Terms {
-            acceleration: false,
-            gravity: false,
-            ..all
+            velocity: true,
+            ..Terms::NONE
         },
     );
     let gravity = dynamics::inverse_dynamics(
         &mut g,
         &tree,
         Terms {
-            velocity: false,
-            acceleration: false,
-            ..all
+            gravity: true,
+            ..Terms::NONE
         },
     );
-    let inverse_dynamics = dynamics::inverse_dynamics(&mut g, &tree, all);
+    let inverse_dynamics = dynamics::inverse_dynamics(&mut g, &tree, Terms::ALL);
     let forward_dynamics = dynamics::forward_dynamics(&mut g, &tree);
+    let friction = model
+        .joints
+        .iter()
+        .any(|j| j.drive.viscous != 0.0 || j.drive.coulomb != 0.0)
+        .then(|| {
+            dynamics::inverse_dynamics(
+                &mut g,
+                &tree,
+                Terms {
+                    friction: true,
+                    ..Terms::NONE
+                },
+            )
+        });
     Symbolic {
         graph: g,
         dof: tree.dof(),
@@ -220,6 +232,7 @@ pub fn symbolic(model: &Model) -> Symbolic {
         gravity,
         inverse_dynamics,
         forward_dynamics,
+        friction,
     }
 }
 
@@ -239,9 +252,10 @@ pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -
         gravity: grav,
         inverse_dynamics: id,
         forward_dynamics: fd,
+        friction,
     } = symbolic(model);
     type Spec = (&'static str, Vec<String>, Vec<Arg>, Vec<sym::ExprId>, Shape);
-    let specs: Vec<Spec> = vec![
+    let mut specs: Vec<Spec> = vec![
         (
             "mass_matrix",
             vec![
@@ -300,6 +314,20 @@ pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -
             Shape::FallibleVector,
         ),
     ];
+    if let Some(friction) = friction {
+        specs.push((
+            "friction",
+            vec![
+                "Joint friction efforts `δ(q̇) = b q̇ + c q̇ / √(q̇² + v_s²)` (viscous and \
+                 regularized Coulomb, `[scene] friction = true`); included in \
+                 `inverse_dynamics` and `forward_dynamics`."
+                    .into(),
+            ],
+            vec![Arg::Qd],
+            friction,
+            Shape::Vector,
+        ));
+    }
     let functions: Vec<Function<'_>> = specs
         .into_iter()
         .filter(|s| only.is_none_or(|o| o.iter().any(|f| f == s.0)))

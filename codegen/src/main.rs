@@ -61,6 +61,17 @@ struct Cli {
     /// Scalar type of the generated code (`f32`: single precision, thresholds rescaled).
     #[arg(long, value_enum, default_value = "f64")]
     float: FloatArg,
+    /// Apply the joints' viscous and Coulomb friction (as `[scene] friction = true`; for a URDF,
+    /// its `<dynamics damping friction>`).
+    #[arg(long)]
+    friction: bool,
+    /// Apply the joints' reflected rotor inertia (as `[scene] rotor_inertia = true`).
+    #[arg(long)]
+    rotor_inertia: bool,
+    /// Take angles within TOL (rad) of a multiple of π/2, rotation entries within TOL of 0/±1
+    /// and offsets within TOL (m) of 0 as exact, listing each change (as `[scene] snap`).
+    #[arg(long, value_name = "TOL")]
+    snap: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -148,6 +159,11 @@ fn main() -> ExitCode {
             float: match cli.float {
                 FloatArg::F64 => codegen::Float::F64,
                 FloatArg::F32 => codegen::Float::F32,
+            },
+            scene: codegen::spec::SceneOverrides {
+                friction: cli.friction,
+                rotor_inertia: cli.rotor_inertia,
+                snap: cli.snap,
             },
         },
     ) {

@@ -72,6 +72,7 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
     let cfg = Config {
         math: math.clone(),
         float,
+        scene: Default::default(),
     };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))

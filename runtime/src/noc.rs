@@ -300,7 +300,25 @@ pub fn mass_matrix(model: &Model, q: &[f64]) -> DMatrix<f64> {
     let k = kinematics(model, q, &zero);
     let t = assemble(model, &k, shaping_column);
     let m = extended_mass_of(model, &k);
-    t.transpose() * m * t
+    let mut i = t.transpose() * m * t;
+    for (j, joint) in model.joints.iter().enumerate() {
+        i[(j, j)] += joint.drive.armature;
+    }
+    i
+}
+
+/// Joint friction efforts `b q̇ + c q̇ / √(q̇² + v_s²)` of every joint's [`Drive`] (the lecture's
+/// dissipative term `δ`; zero unless the spec's `[scene]` turns friction on).
+pub fn friction(model: &Model, qd: &[f64]) -> DVector<f64> {
+    check_len(model, "q̇", qd);
+    DVector::from_iterator(
+        model.dof(),
+        model
+            .joints
+            .iter()
+            .zip(qd)
+            .map(|(j, v)| j.drive.friction(*v)),
+    )
 }
 
 /// The matrix of quadratic inertia terms `C = Tᵀ(MṪ + WMT)` (22).
@@ -323,10 +341,12 @@ pub fn gravity(model: &Model, q: &[f64]) -> DVector<f64> {
     -(twist_shaping(model, q).transpose() * gravity_wrench(model))
 }
 
-/// Inverse dynamics `τ = I q̈ + C q̇ − γ`, evaluated in the association of noc-method.md:
+/// Inverse dynamics `τ = I q̈ + C q̇ − γ + δ(q̇)`, evaluated in the association of noc-method.md:
 /// `Tᵀ ( M (T q̈ + Ṫ q̇) + W M (T q̇) − w^G )` — body twists `t = T q̇` (14) and twist rates
 /// `ṫ = T q̈ + Ṫ q̇` first, then the body Newton–Euler wrenches `M_i ṫ_i + W_i M_i t_i − w^G_i`
-/// (7)–(12), then one projection by `Tᵀ` (the constraint wrenches drop out, (15)–(20)).
+/// (7)–(12), then one projection by `Tᵀ` (the constraint wrenches drop out, (15)–(20)). The
+/// joints' [`Drive`](crate::model::Drive)s add `I_a q̈ + δ(q̇)` (rotor inertia and friction;
+/// none unless the spec's `[scene]` turns them on).
 pub fn inverse_dynamics(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> DVector<f64> {
     check_len(model, "q̈", qdd);
     let k = kinematics(model, q, qd);
@@ -337,9 +357,13 @@ pub fn inverse_dynamics(model: &Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> DV
     let qd = DVector::from_column_slice(qd);
     let qdd = DVector::from_column_slice(qdd);
     let twist = &t * &qd;
-    let twist_rate = &t * qdd + td * &qd;
+    let twist_rate = &t * &qdd + td * &qd;
     let wrench = &m * twist_rate + w * &m * twist - gravity_wrench(model);
-    t.transpose() * wrench
+    let mut tau = t.transpose() * wrench;
+    for (j, joint) in model.joints.iter().enumerate() {
+        tau[j] += joint.drive.effort(qd[j], qdd[j]);
+    }
+    tau
 }
 
 /// Forward dynamics: `q̈` from `I q̈ = τ − C q̇ + γ`, by an `LDLᵀ` factorization of `I` written
@@ -456,7 +480,8 @@ pub fn ldlt(a: &DMatrix<f64>) -> Result<Ldlt, Singular> {
     Ok(Ldlt { l, d })
 }
 
-/// Kinetic energy `½ Σ (m_i ċ_iᵀ ċ_i + ω_iᵀ I_i ω_i)` (= `½ q̇ᵀ I q̇`).
+/// Kinetic energy `½ Σ (m_i ċ_iᵀ ċ_i + ω_iᵀ I_i ω_i) + ½ Σ I_a q̇²` (= `½ q̇ᵀ I q̇`; the last
+/// sum is the rotors' energy, zero without rotor inertia).
 pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64]) -> f64 {
     let k = kinematics(model, q, qd);
     let mut e = 0.0;
@@ -464,6 +489,9 @@ pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64]) -> f64 {
         let w = &k.omega[i];
         let cd = &k.com_velocity[i];
         e += body.mass * cd.dot(cd) + w.dot(&(base_inertia(model, &k, i) * w));
+    }
+    for (j, joint) in model.joints.iter().enumerate() {
+        e += joint.drive.armature * qd[j] * qd[j];
     }
     0.5 * e
 }

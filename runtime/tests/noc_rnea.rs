@@ -92,6 +92,7 @@ fn joint(
         parent,
         origin: Transform::from_xyz_rpy(xyz, rpy),
         axis: normalize(axis),
+        drive: Default::default(),
     }
 }
 
@@ -258,6 +259,7 @@ fn random_tree(rng: &mut Rng, n: usize) -> Model {
             parent,
             origin: Transform::from_xyz_rpy(rng.v3(-0.5, 0.5), rng.v3(-3.0, 3.0)),
             axis: rng.unit_vector(),
+            drive: Default::default(),
         });
     }
     Model {

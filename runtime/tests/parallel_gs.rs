@@ -74,6 +74,7 @@ pub fn gough_stewart_at_yaw(yaw: f64) -> ParallelModel {
             parent,
             origin,
             axis,
+            drive: Default::default(),
         };
         legs.push(Leg {
             name: format!("s{i}"),

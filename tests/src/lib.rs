@@ -114,6 +114,7 @@ pub fn random_model(seed: u64, shape: Shape) -> Model {
             parent,
             origin: Transform::from_xyz_rpy(xyz, rpy),
             axis,
+            drive: Default::default(),
         });
         bodies.push(Body {
             name: format!("b{i}"),

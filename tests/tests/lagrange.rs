@@ -560,6 +560,7 @@ fn joint(kind: JointKind, origin: Transform, axis: Vec3, k: usize) -> Joint {
         parent: if k == 0 { None } else { Some(k - 1) },
         origin,
         axis,
+        drive: Default::default(),
     }
 }
 

@@ -47,6 +47,7 @@ fn dh_chain(seed: u64, n: usize) -> Model {
             parent: i.checked_sub(1),
             origin: Transform::from_xyz_rpy([a, -d * sa, d * ca], [alpha, 0.0, 0.0]),
             axis: [0.0, 0.0, 1.0],
+            drive: Default::default(),
         });
         let ix: f64 = r.random_range(0.01..1.0);
         let iy: f64 = r.random_range(0.01..1.0);

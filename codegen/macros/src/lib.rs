@@ -190,7 +190,11 @@ impl Args {
                 }
             },
         };
-        Ok(Config { math, float })
+        Ok(Config {
+            math,
+            float,
+            scene: Default::default(),
+        })
     }
 }
 

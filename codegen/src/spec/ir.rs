@@ -37,7 +37,7 @@ pub(crate) struct Named {
 }
 
 /// The `[scene]` table: model no more than the application needs.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub(crate) struct SceneSpec {
     /// Emit only these public functions (trees).
     pub functions: Option<Vec<Named>>,
@@ -49,6 +49,62 @@ pub(crate) struct SceneSpec {
     pub payload: Option<Payload>,
     /// Joints locked at a value (rad or m): they become fixed joints, their bodies merge.
     pub locked: Vec<(Named, f64)>,
+    /// `friction = true`: apply the joints' `damping` (viscous) and `friction` (Coulomb).
+    pub friction: bool,
+    /// `rotor_inertia = true`: apply the joints' `armature` (reflected rotor inertia).
+    pub rotor_inertia: bool,
+    /// `coulomb_velocity`: the speed scale `v_s` of the regularized Coulomb law (rad/s or m/s).
+    pub coulomb_velocity: f64,
+    /// `snap = TOL`: take near-exact angles and offsets as exact (see `spec::snap`).
+    pub snap: Option<f64>,
+}
+
+/// The default `v_s` of the regularized Coulomb law (rad/s or m/s): 99.5 % of the Coulomb
+/// level at 1e-3, the resolution of a typical joint speed estimate.
+pub(crate) const COULOMB_VELOCITY: f64 = 1e-4;
+
+impl Default for SceneSpec {
+    fn default() -> Self {
+        SceneSpec {
+            functions: None,
+            point_mass: Vec::new(),
+            massless: Vec::new(),
+            payload: None,
+            locked: Vec::new(),
+            friction: false,
+            rotor_inertia: false,
+            coulomb_velocity: COULOMB_VELOCITY,
+            snap: None,
+        }
+    }
+}
+
+impl SceneSpec {
+    /// The drive a joint gets in this scene: its written values, each effect only when the
+    /// scene turns it on (off by default).
+    pub fn drive(&self, d: &DriveSpec) -> runtime::model::Drive {
+        runtime::model::Drive {
+            viscous: if self.friction { d.damping } else { 0.0 },
+            coulomb: if self.friction { d.friction } else { 0.0 },
+            coulomb_velocity: if self.friction && d.friction != 0.0 {
+                self.coulomb_velocity
+            } else {
+                0.0
+            },
+            armature: if self.rotor_inertia { d.armature } else { 0.0 },
+        }
+    }
+}
+
+/// A joint's drive as written (`damping`, `friction`, `armature`; URDF `<dynamics>`), SI.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct DriveSpec {
+    /// Viscous coefficient (N·m·s/rad or N·s/m).
+    pub damping: f64,
+    /// Coulomb level (N·m or N).
+    pub friction: f64,
+    /// Reflected rotor inertia (kg·m² or kg).
+    pub armature: f64,
 }
 
 /// `[scene] payload = { body, mass, com, inertia }`: inertial data in the body's frame.
@@ -182,6 +238,8 @@ pub(crate) struct JointSpec {
     pub child_origin: Option<Transform>,
     /// Span of the `child_origin` key, when written.
     pub child_origin_span: Span,
+    /// Friction and rotor inertia as written (applied only when `[scene]` says so).
+    pub drive: DriveSpec,
 }
 
 /// The name of the fixed world in `parent`.

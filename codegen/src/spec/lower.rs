@@ -565,6 +565,7 @@ pub(super) fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnosti
                         parent: from.target,
                         origin,
                         axis: ax[0],
+                        drive: spec.scene.drive(&j.drive),
                     },
                     body.name.clone(),
                     ji,
@@ -599,6 +600,7 @@ pub(super) fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnosti
                         parent,
                         origin: o,
                         axis: ax[k],
+                        drive: spec.scene.drive(&j.drive),
                     };
                     parent = Some(m.add(joint, bname, ji));
                     o = Transform::IDENTITY;

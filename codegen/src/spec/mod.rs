@@ -17,6 +17,7 @@ mod ir;
 mod lower;
 mod parallel;
 mod read_toml;
+mod snap;
 #[cfg(feature = "urdf")]
 mod urdf;
 
@@ -88,7 +89,7 @@ impl Mechanism {
 /// any input. On success the warnings (e.g. an axis that was normalized) are returned beside
 /// the model; on failure all errors (and warnings) found, sorted by position.
 pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
-    let (mechanism, mut diags, platform) = load_any(file_name, source);
+    let (mechanism, mut diags, platform) = load_any(file_name, source, &SceneOverrides::default());
     if let Some(span) = platform {
         diags.push(
             Diagnostic::error("this spec describes a parallel mechanism (it has a [platform] table), which cannot be loaded as a tree")
@@ -121,7 +122,30 @@ pub fn load_mechanism(
     file_name: &str,
     source: &str,
 ) -> Result<(Mechanism, Diagnostics), Diagnostics> {
-    let (mechanism, diags, _) = load_any(file_name, source);
+    load_mechanism_with(file_name, source, &SceneOverrides::default())
+}
+
+/// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect
+/// on in addition to what the spec's `[scene]` says (a URDF has no `[scene]`; its
+/// `<dynamics damping friction>` apply only with `friction`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneOverrides {
+    /// Apply the joints' viscous (`damping`) and Coulomb (`friction`) friction.
+    pub friction: bool,
+    /// Apply the joints' reflected rotor inertia (`armature`).
+    pub rotor_inertia: bool,
+    /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
+    /// replaces the spec's value).
+    pub snap: Option<f64>,
+}
+
+/// [`load_mechanism`] with [`SceneOverrides`].
+pub fn load_mechanism_with(
+    file_name: &str,
+    source: &str,
+    overrides: &SceneOverrides,
+) -> Result<(Mechanism, Diagnostics), Diagnostics> {
+    let (mechanism, diags, _) = load_any(file_name, source, overrides);
     finish(mechanism, diags)
 }
 
@@ -129,6 +153,7 @@ pub fn load_mechanism(
 fn load_any(
     file_name: &str,
     source: &str,
+    overrides: &SceneOverrides,
 ) -> (
     Option<Mechanism>,
     Diagnostics,
@@ -154,6 +179,12 @@ fn load_any(
             read_toml::read(source, &mut d)
         };
         let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
+            s.scene.friction |= overrides.friction;
+            s.scene.rotor_inertia |= overrides.rotor_inertia;
+            if overrides.snap.is_some() {
+                s.scene.snap = overrides.snap;
+            }
+            snap::snap(&mut s, &mut d);
             apply_scene(&mut s, &mut d);
             s
         });
@@ -192,12 +223,13 @@ fn load_any(
 }
 
 /// The public functions a tree module has (`[scene] functions` picks among them).
-pub const TREE_FUNCTIONS: [&str; 5] = [
+pub const TREE_FUNCTIONS: [&str; 6] = [
     "mass_matrix",
     "coriolis",
     "gravity",
     "inverse_dynamics",
     "forward_dynamics",
+    "friction",
 ];
 
 /// `[scene]`: point masses and massless bodies replace the bodies' inertial data before

@@ -10,8 +10,8 @@ use toml::de::{DeTable, DeValue};
 
 use super::angle::{ANGLE_HINT, parse_angle};
 use super::ir::{
-    AxisSpec, BodySpec, Coordinates, Dh, JointSpec, Kind, Named, Payload, Placement, PlatformSpec,
-    SceneSpec, Spec,
+    AxisSpec, BodySpec, Coordinates, Dh, DriveSpec, JointSpec, Kind, Named, Payload, Placement,
+    PlatformSpec, SceneSpec, Spec,
 };
 use super::{sanitize_name, suggest_hint};
 use crate::diag::{Diagnostic, Diagnostics};
@@ -26,6 +26,10 @@ const SCENE_KEYS: &[&str] = &[
     "massless",
     "payload",
     "locked",
+    "friction",
+    "rotor_inertia",
+    "coulomb_velocity",
+    "snap",
 ];
 const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
@@ -44,6 +48,9 @@ const JOINT_KEYS: &[&str] = &[
     "mdh",
     "actuated",
     "child_origin",
+    "damping",
+    "friction",
+    "armature",
 ];
 const ORIGIN_KEYS: &[&str] = &["xyz", "rpy"];
 const DH_KEYS: &[&str] = &["a", "alpha", "d", "theta"];
@@ -64,6 +71,9 @@ const ALIASES: &[(&str, &str)] = &[
     ("center", "centre"),
     ("actuator", "actuated"),
     ("active", "actuated"),
+    ("viscous", "damping"),
+    ("coulomb", "friction"),
+    ("rotor_inertia", "armature"),
 ];
 
 /// Reads a TOML spec. `None` when the file could not be read far enough to validate it.
@@ -425,6 +435,40 @@ impl Reader<'_> {
             }
             if let Some(p) = get(t, "payload") {
                 scene.payload = self.payload(p);
+            }
+            if let Some(v) = get(t, "friction") {
+                scene.friction = self.boolean(v, "scene.friction").unwrap_or(false);
+            }
+            if let Some(v) = get(t, "rotor_inertia") {
+                scene.rotor_inertia = self.boolean(v, "scene.rotor_inertia").unwrap_or(false);
+            }
+            if let Some(v) = get(t, "coulomb_velocity")
+                && let Some(x) = self.number(v, "scene.coulomb_velocity")
+            {
+                if x > 0.0 && x.is_finite() {
+                    scene.coulomb_velocity = x;
+                } else {
+                    self.diags.push(
+                        Diagnostic::error("`coulomb_velocity` must be a positive number")
+                            .with_key("scene.coulomb_velocity")
+                            .with_span(Some(v.span()))
+                            .with_hint("the speed scale v_s of the Coulomb law c·q̇/√(q̇² + v_s²), in rad/s or m/s; the default is 1e-4"),
+                    );
+                }
+            }
+            if let Some(v) = get(t, "snap")
+                && let Some(x) = self.number(v, "scene.snap")
+            {
+                if x > 0.0 && x <= 1e-2 {
+                    scene.snap = Some(x);
+                } else {
+                    self.diags.push(
+                        Diagnostic::error("`snap` must be a tolerance in (0, 0.01]")
+                            .with_key("scene.snap")
+                            .with_span(Some(v.span()))
+                            .with_hint("angles within this many rad of a multiple of π/2, rotation entries within it of 0 or ±1 and offsets within it (m) of 0 are taken as exact; e.g. 1e-6"),
+                    );
+                }
             }
             if let Some(l) = get(t, "locked")
                 && let Some(lt) = self.table(l, "scene.locked")
@@ -921,6 +965,27 @@ impl Reader<'_> {
                 .boolean(v, &format!("{path}.actuated"))
                 .unwrap_or(false);
         }
+        let mut drive = DriveSpec::default();
+        for (k, slot) in [
+            ("damping", &mut drive.damping),
+            ("friction", &mut drive.friction),
+            ("armature", &mut drive.armature),
+        ] {
+            if let Some(v) = get(t, k)
+                && let Some(x) = self.number(v, &format!("{path}.{k}"))
+            {
+                if x >= 0.0 && x.is_finite() {
+                    *slot = x;
+                } else {
+                    self.diags.push(
+                        Diagnostic::error(format!("`{k}` must be a non-negative number"))
+                            .with_key(format!("{path}.{k}"))
+                            .with_span(Some(v.span()))
+                            .with_hint("damping in N·m·s/rad (N·s/m for a prismatic joint), friction in N·m (N), armature in kg·m² (kg); they apply only when [scene] sets friction = true or rotor_inertia = true"),
+                    );
+                }
+            }
+        }
         let child_origin_span = key_span(t, "child_origin");
         let child_origin = match get(t, "child_origin") {
             None => None,
@@ -952,6 +1017,7 @@ impl Reader<'_> {
             actuated_span,
             child_origin,
             child_origin_span,
+            drive,
         })
     }
 

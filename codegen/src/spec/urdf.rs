@@ -13,7 +13,7 @@ use std::ops::Range;
 use runtime::model::{Transform, rpy_to_matrix};
 
 use super::geom::rotate_inertia;
-use super::ir::{AxisSpec, BASE, BodySpec, JointSpec, Kind, Placement, Span, Spec};
+use super::ir::{AxisSpec, BASE, BodySpec, DriveSpec, JointSpec, Kind, Placement, Span, Spec};
 use super::{sanitize_name, suggest_hint};
 use crate::diag::{Diagnostic, Diagnostics};
 
@@ -626,6 +626,13 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
             actuated_span: None,
             child_origin: None,
             child_origin_span: None,
+            // `<dynamics damping friction>`: applied only when a scene turns friction on (a URDF
+            // has no scene, so never from the file alone). Negative values are not friction.
+            drive: DriveSpec {
+                damping: j.dynamics.as_ref().map_or(0.0, |d| d.damping.max(0.0)),
+                friction: j.dynamics.as_ref().map_or(0.0, |d| d.friction.max(0.0)),
+                armature: 0.0,
+            },
         });
     }
 

@@ -77,6 +77,8 @@ pub struct JointPlan {
     pub axis: Vec3,
     /// Body mass, mass centre, inertia (body frame).
     pub body: (f64, Vec3, Mat3),
+    /// Friction and rotor inertia at this joint (actuated or passive).
+    pub drive: crate::model::Drive,
 }
 
 /// One cut joint's constant data.
@@ -324,6 +326,7 @@ fn joint_plans(tree: &crate::model::Model) -> Vec<JointPlan> {
             origin: j.origin,
             axis: j.axis,
             body: (b.mass, b.com, b.inertia),
+            drive: j.drive,
         })
         .collect()
 }
@@ -855,7 +858,12 @@ pub fn generalized_force<R: Real>(
         xdd[j] = xdd_d[k];
     }
     let m = motions(plan, &c.kin, &xd, Some(&xdd));
-    let tau = tree_efforts(plan, &c.kin, &m, gravity);
+    let mut tau = tree_efforts(plan, &c.kin, &m, gravity);
+    // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
+    // with the rest (the lecture's dissipative term δ).
+    for (j, jp) in plan.joints.iter().enumerate() {
+        tau[j] = tau[j] + drive_effort(&jp.drive, xd[j], xdd[j]);
+    }
     let td: Vec<R> = plan.dependent.iter().map(|&j| tau[j]).collect();
     let y = c.lu.solve_t(&td);
     plan.independent
@@ -869,19 +877,39 @@ pub fn generalized_force<R: Real>(
         .collect()
 }
 
+/// [`Drive::effort`](crate::model::Drive::effort) over [`Real`]: `I_a q̈ + b q̇ + c q̇ / √(q̇² + v_s²)`
+/// (terms with zero coefficients are not formed).
+pub fn drive_effort<R: Real>(d: &crate::model::Drive, qd: R, qdd: R) -> R {
+    let mut e = R::c(0.0);
+    if d.armature != 0.0 {
+        e = e + R::c(d.armature) * qdd;
+    }
+    if d.viscous != 0.0 {
+        e = e + R::c(d.viscous) * qd;
+    }
+    if d.coulomb != 0.0 {
+        let vs = d.coulomb_velocity;
+        e = e + R::c(d.coulomb) * qd / (qd * qd + R::c(vs * vs)).sqrt();
+    }
+    e
+}
+
 /// The generalized inertia `I = Sᵀ M_T S` of the independent coordinates, from each body's
-/// twist per unit speed (exactly symmetric: the upper triangle mirrored).
+/// twist per unit speed (exactly symmetric: the upper triangle mirrored), plus the rotors'
+/// `Sᵀ diag(I_a) S`.
 pub fn generalized_inertia<R: Real>(plan: &Plan, c: &Config<R>) -> Vec<Vec<R>> {
     let d = plan.dof();
     let n = plan.nx();
     // Column k of S: the joint rates for u = e_k; the bodies' angular velocities and mass
     // centre velocities for it.
     let mut cols: Vec<Vec<(V<R>, V<R>)>> = Vec::with_capacity(d);
+    let mut rates: Vec<Vec<R>> = Vec::with_capacity(d);
     for k in 0..d {
         let mut e = vec![R::c(0.0); d];
         e[k] = R::c(1.0);
         let xd = joint_rates_generic(plan, c, &e);
         let m = motions(plan, &c.kin, &xd, None);
+        rates.push(xd);
         cols.push(
             (0..n)
                 .map(|b| {
@@ -904,6 +932,17 @@ pub fn generalized_inertia<R: Real>(plan: &Plan, c: &Config<R>) -> Vec<Vec<R>> {
                 let (wj, vj) = cols[j][b];
                 let v = R::c(mass) * dot(vi, vj) + inertia_quad(&c.kin.rot[b], &inertia, wi, wj);
                 out[i][j] = out[i][j] + v;
+            }
+        }
+    }
+    for (b, jp) in plan.joints.iter().enumerate() {
+        let a = jp.drive.armature;
+        if a == 0.0 {
+            continue;
+        }
+        for i in 0..d {
+            for j in i..d {
+                out[i][j] = out[i][j] + R::c(a) * rates[i][b] * rates[j][b];
             }
         }
     }
