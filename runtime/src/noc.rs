@@ -307,7 +307,7 @@ pub fn mass_matrix(model: &Model, q: &[f64]) -> DMatrix<f64> {
     i
 }
 
-/// Joint friction efforts `b q̇ + c q̇ / √(q̇² + v_s²)` of every joint's [`Drive`] (the lecture's
+/// Joint friction efforts `b q̇ + c q̇ / √(q̇² + v_s²)` of every joint's [`Drive`](crate::model::Drive) (the lecture's
 /// dissipative term `δ`; zero unless the spec's `[scene]` turns friction on).
 pub fn friction(model: &Model, qd: &[f64]) -> DVector<f64> {
     check_len(model, "q̇", qd);

@@ -5,6 +5,7 @@ pub mod closed;
 pub mod dd;
 
 pub mod pkm;
+pub mod variants;
 
 pub mod lagrange;
 

@@ -1,6 +1,8 @@
 //! Speed against accuracy, measured in one run (issue 4, "the chart"): for the PUMA 560 (a
-//! tree), the Gough–Stewart platform (a parallel mechanism) and the five-bar in joint
-//! coordinates (closed loops), every way nocdyn offers to compute the inverse dynamics, timed
+//! tree), the Gough–Stewart platform (a parallel mechanism), the five-bar in joint
+//! coordinates (closed loops) and a URDF with rounded angles (the iiwa 14, as written and
+//! snapped), every way nocdyn offers to compute the inverse dynamics — including fidelity
+//! levels and the `libm` math backend (modules from `tests/build.rs`) — timed
 //! (median over repeated batches of 256 random regular states, ns per call) and compared with a
 //! double-double evaluation of the same equations (`tests::dd`; the worst relative error in the
 //! ∞-norm over the states). Writes `PREFIX.csv`, `PREFIX.md` and `PREFIX.svg` (log–log).
@@ -109,6 +111,35 @@ fn puma(points: &mut Vec<Point>) {
         time(|i| s32(black_box(i))[0]),
         worst(s32, &reference),
     );
+    // The same module with `libm` trigonometry, and two fidelity levels (`[scene]`): their
+    // error is against the full model's reference, so it is the model error of the level.
+    let libm = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        tests::variants::puma_libm::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64, libm math",
+        time(|i| libm(black_box(i))[0]),
+        worst(libm, &reference),
+    );
+    let point = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        tests::variants::puma_point_wrist::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64, point-mass wrist (links 4–6)",
+        time(|i| point(black_box(i))[0]),
+        worst(point, &reference),
+    );
+    let massless = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        tests::variants::puma_massless_wrist::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64, massless wrist (links 4–6)",
+        time(|i| massless(black_box(i))[0]),
+        worst(massless, &reference),
+    );
     let noc = |i: usize| {
         let [q, qd, qdd] = &states[i];
         runtime::noc::inverse_dynamics(&model, q, qd, qdd)
@@ -216,6 +247,17 @@ fn gough_stewart(points: &mut Vec<Point>) {
         time(|i| s32(black_box(i))[0]),
         worst(s32, &reference),
     );
+    let point = |i: usize| {
+        let (x, u, ud) = arr(i);
+        tests::variants::gs_point_legs::inverse_dynamics(&x, &u, &ud)
+            .unwrap()
+            .to_vec()
+    };
+    add(
+        "generated f64, point-mass legs",
+        time(|i| point(black_box(i))[0]),
+        worst(point, &reference),
+    );
     let rt = |i: usize| {
         let (x, u, ud) = &states[i];
         noc::inverse_dynamics(&plan, x, u, ud).unwrap()
@@ -242,6 +284,66 @@ fn gough_stewart(points: &mut Vec<Point>) {
         "Newton–Euler + Lagrange multipliers",
         time(|i| lag(black_box(i))[0]),
         worst(lag, &reference),
+    );
+}
+
+/// A URDF with its quarter and half turns rounded to 5 digits (`1.5708`, `3.1416`), as many
+/// published files write them: generated as written, and snapped (`snap = 1e-4`). The reference
+/// is the file as written, so the snapped module's error is the model change the snap made.
+fn iiwa(points: &mut Vec<Point>) {
+    use tests::variants::{iiwa_rounded as w, iiwa_snapped as s};
+    let src = std::fs::read_to_string(tests::pkm::spec_path("iiwa14").with_extension("urdf"))
+        .unwrap()
+        .replace("1.5707963267948966", "1.5708")
+        .replace("3.141592653589793", "3.1416");
+    let (model, _) = codegen::spec::load("iiwa14.urdf", &src).unwrap();
+    let plan = runtime::closed::noc::Plan::tree(&model);
+    let mut rng = tests::rng(34);
+    let states: Vec<[[f64; 7]; 3]> = (0..STATES)
+        .map(|_| core::array::from_fn(|_| core::array::from_fn(|_| rng.random_range(-1.5..1.5))))
+        .collect();
+    let reference: Vec<Vec<f64>> = states
+        .iter()
+        .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
+        .collect();
+    let m = "iiwa 14 (URDF angles to 5 digits)";
+    let mut add = |candidate, ns, error| {
+        points.push(Point {
+            mechanism: m,
+            candidate,
+            ns,
+            error,
+        });
+    };
+    let g64 = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        w::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64",
+        time(|i| g64(black_box(i))[0]),
+        worst(g64, &reference),
+    );
+    let snapped = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        s::inverse_dynamics(q, qd, qdd).to_vec()
+    };
+    add(
+        "generated f64, snapped 1e-4",
+        time(|i| snapped(black_box(i))[0]),
+        worst(snapped, &reference),
+    );
+    let noc = |i: usize| {
+        let [q, qd, qdd] = &states[i];
+        runtime::noc::inverse_dynamics(&model, q, qd, qdd)
+            .iter()
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    add(
+        "runtime NOC (nalgebra)",
+        time(|i| noc(black_box(i))[0]),
+        worst(noc, &reference),
     );
 }
 
@@ -481,6 +583,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     puma(&mut points);
     gough_stewart(&mut points);
     five_bar(&mut points);
+    iiwa(&mut points);
     let mut csv = String::from("mechanism,candidate,ns_per_call,max_relative_error\n");
     let mut md = String::from(
         "| mechanism | candidate | ns per call | × generated f64 | worst relative error vs double-double |\n|---|---|---:|---:|---:|\n",
@@ -512,7 +615,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = SVGBackend::new(&svg, (900, 600)).into_drawing_area();
     root.fill(&WHITE)?;
     let (x0, x1) = (1.0f64, 1e8f64);
-    let (y0, y1) = (1e-17f64, 1e-3f64);
+    let (y0, y1) = (1e-17f64, 1e0f64);
     let mut chart = ChartBuilder::on(&root)
         .caption(
             "Inverse dynamics: time per call against error (one run)",
@@ -529,8 +632,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
-    let colours = [RED, BLUE, GREEN];
-    let mechs = ["PUMA 560", "Gough–Stewart", "five-bar (joint coordinates)"];
+    let colours = [RED, BLUE, GREEN, MAGENTA];
+    let mechs = [
+        "PUMA 560",
+        "Gough–Stewart",
+        "five-bar (joint coordinates)",
+        "iiwa 14 (URDF angles to 5 digits)",
+    ];
     for (k, m) in mechs.iter().enumerate() {
         let c = colours[k];
         let pts: Vec<&Point> = points.iter().filter(|p| p.mechanism == *m).collect();

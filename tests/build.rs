@@ -1,0 +1,98 @@
+//! Variants of bundled mechanisms for the speed/accuracy chart (`src/bin/chart.rs`): the same
+//! spec at other fidelity levels (`[scene]` point-mass and massless bodies), with another math
+//! backend (the `libm` crate instead of std), and a URDF with its angles rounded as published
+//! files write them, generated as written and snapped. Each lands in
+//! `$OUT_DIR/variants/<variant>/<module>.rs` and is declared in `src/variants.rs`.
+
+use std::path::{Path, PathBuf};
+
+use codegen::build_script::Builder;
+
+fn generate(out: &Path, variant: &str, spec: &Path, setup: impl FnOnce(&mut Builder)) {
+    let dir = out.join("variants").join(variant);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let mut b = Builder::new();
+    b.spec(spec)
+        .math(codegen::MathBackend::Runtime("runtime".into()))
+        .out_dir(&dir);
+    setup(&mut b);
+    b.compile().unwrap_or_else(|e| panic!("\n{e}"));
+}
+
+/// `spec` with `[scene]` lines added (before the first table), written to `$OUT_DIR/specs`.
+fn with_scene(out: &Path, spec: &str, name: &str, scene: &str) -> PathBuf {
+    let src = std::fs::read_to_string(spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
+    println!("cargo:rerun-if-changed={spec}");
+    let src = src.replacen(
+        "[mechanism]",
+        &format!("[scene]\n{scene}\n\n[mechanism]"),
+        1,
+    );
+    write(out, name, &src)
+}
+
+fn write(out: &Path, name: &str, src: &str) -> PathBuf {
+    let dir = out.join("specs").join(name);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let file = dir.join(spec_file(name));
+    codegen::build_script::write_if_changed(&file, src).unwrap_or_else(|e| panic!("{e}"));
+    file
+}
+
+/// The variant's spec file name: its module name comes from the file stem.
+fn spec_file(variant: &str) -> &'static str {
+    match variant {
+        v if v.starts_with("iiwa") => "iiwa14.urdf",
+        v if v.starts_with("gs") => "gough_stewart.toml",
+        _ => "puma560.toml",
+    }
+}
+
+fn main() {
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
+    let puma = "../mechanisms/specs/puma560.toml";
+    let gs = "../mechanisms/specs/gough_stewart.toml";
+    let iiwa = "../mechanisms/specs/iiwa14.urdf";
+    println!("cargo:rerun-if-changed=build.rs");
+
+    generate(&out, "libm", Path::new(puma), |b| {
+        b.math(codegen::MathBackend::Libm);
+    });
+    let wrist = r#""link4", "link5", "link6""#;
+    let p = with_scene(
+        &out,
+        puma,
+        "puma_point_wrist",
+        &format!("point_mass = [{wrist}]"),
+    );
+    generate(&out, "puma_point_wrist", &p, |_| {});
+    let p = with_scene(
+        &out,
+        puma,
+        "puma_massless_wrist",
+        &format!("massless = [{wrist}]"),
+    );
+    generate(&out, "puma_massless_wrist", &p, |_| {});
+    let legs: Vec<String> = (1..=6)
+        .flat_map(|k| [format!("\"cylinder{k}\""), format!("\"piston{k}\"")])
+        .collect();
+    let p = with_scene(
+        &out,
+        gs,
+        "gs_point_legs",
+        &format!("point_mass = [{}]", legs.join(", ")),
+    );
+    generate(&out, "gs_point_legs", &p, |_| {});
+
+    // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
+    let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
+    println!("cargo:rerun-if-changed={iiwa}");
+    let rounded = src
+        .replace("1.5707963267948966", "1.5708")
+        .replace("3.141592653589793", "3.1416");
+    let p = write(&out, "iiwa_rounded", &rounded);
+    generate(&out, "iiwa_rounded", &p, |_| {});
+    generate(&out, "iiwa_snapped", &p, |b| {
+        b.snap(1e-4);
+    });
+}
