@@ -48,6 +48,10 @@ fn spec_file(variant: &str) -> &'static str {
     }
 }
 
+/// Appended to the PUMA 560's spec for the run-time-parameter variant (also read by
+/// `tests/tests/params.rs`).
+const PARAMS_SCENE: &str = include_str!("src/params_scene.toml");
+
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
     let puma = "../mechanisms/specs/puma560.toml";
@@ -83,6 +87,12 @@ fn main() {
         &format!("point_mass = [{}]", legs.join(", ")),
     );
     generate(&out, "gs_point_legs", &p, |_| {});
+
+    // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
+    let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
+    let src = format!("{src}\n{PARAMS_SCENE}");
+    let p = write(&out, "puma_params", &src);
+    generate(&out, "puma_params", &p, |_| {});
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

@@ -78,6 +78,9 @@ struct Link {
     j: Mat3,
     /// Mass and axial first moment that `Tree::regroup` moved to the parent.
     lumped: (f64, f64),
+    /// The model's body frame → this link's frame: `x_link = A x_body − d e_z` as `(A, d)`
+    /// (run-time payloads are given in the body frame).
+    to_link: (Mat3, f64),
 }
 
 impl Link {
@@ -110,6 +113,44 @@ pub struct Tree {
     gravity: Vec3,
     /// Per joint: friction and rotor inertia (added after the rigid-body sweeps).
     drives: Vec<Drive>,
+    /// Run-time parameters (`[scene] parameters = "runtime"`): the payload's link and the
+    /// Coulomb speed scale; the drive coefficients are then inputs too.
+    params: Option<ParamLayout>,
+}
+
+/// What [`Tree::with_runtime_params`] makes an input.
+#[derive(Clone, Debug)]
+struct ParamLayout {
+    payload: Option<usize>,
+    coulomb_velocity: f64,
+}
+
+/// Index into the run-time parameter array (`Params::to_array`) of a `dof`-joint tree:
+/// `0` payload mass, `1..4` its mass centre, `4..10` its inertia `xx, xy, xz, yy, yz, zz` (body
+/// frame of the payload's body, about the mass centre), then per joint `damping`, `friction`,
+/// `armature` (`10 + kind·dof + joint`).
+pub fn param_index(kind: ParamKind, joint: usize, dof: usize) -> usize {
+    match kind {
+        ParamKind::Damping => 10 + joint,
+        ParamKind::Friction => 10 + dof + joint,
+        ParamKind::Armature => 10 + 2 * dof + joint,
+    }
+}
+
+/// The per-joint run-time parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamKind {
+    /// Viscous friction coefficient.
+    Damping,
+    /// Coulomb friction level.
+    Friction,
+    /// Reflected rotor inertia.
+    Armature,
+}
+
+/// Number of run-time parameters of a `dof`-joint tree.
+pub fn param_count(dof: usize) -> usize {
+    10 + 3 * dof
 }
 
 /// A body in the canonical frames, before the origin choice: mass centre and inertia about it.
@@ -122,6 +163,8 @@ struct Canonical {
     mass: f64,
     c: Vec3,
     ic: Mat3,
+    /// `Q_i`: the canonical body axes in the model's body frame (`e_z` along the axis).
+    q: Mat3,
 }
 
 /// The free choices of [`Tree::build`], per body: where its origin sits on its joint axis
@@ -266,6 +309,21 @@ impl Tree {
         tree
     }
 
+    /// The same tree with run-time parameters: the payload (on model body `payload`, if any)
+    /// and every joint's drive coefficients become inputs (`Arg::P`, see [`param_index`]).
+    pub fn with_runtime_params(mut self, payload: Option<usize>, coulomb_velocity: f64) -> Tree {
+        self.params = Some(ParamLayout {
+            payload,
+            coulomb_velocity,
+        });
+        self
+    }
+
+    /// Whether the tree takes run-time parameters.
+    pub fn has_runtime_params(&self) -> bool {
+        self.params.is_some()
+    }
+
     fn canonical(model: &Model) -> Vec<Canonical> {
         let qs: Vec<Mat3> = model
             .joints
@@ -294,6 +352,7 @@ impl Tree {
                 mass: body.mass,
                 c: mat_vec(&qt, &body.com),
                 ic: mat_mul(&qt, &mat_mul(&body.inertia, &qs[i])),
+                q: qs[i],
             });
         }
         links
@@ -351,6 +410,7 @@ impl Tree {
                 h: [m * c[0], m * c[1], m * c[2]],
                 j,
                 lumped: (0.0, 0.0),
+                to_link: (mat_mul(&transpose(&ti), &transpose(&b.q)), d),
             });
         }
         let drives = vec![Drive::NONE; links.len()];
@@ -358,6 +418,7 @@ impl Tree {
             links,
             gravity,
             drives,
+            params: None,
         };
         tree.regroup(&choice.lump_xx);
         tree
@@ -1178,6 +1239,24 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         moment.push(choice.0);
         extra_moment.push(choice.1);
     }
+    // A run-time payload on link b: its Newton–Euler wrench about the link origin (eq. 12),
+    // `f = m a + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × J ω + h × a`.
+    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
+        let (m, h, j) = payload_params(&mut s, b);
+        let (w, wd, a) = (omega[b], omegad[b], acc[b]);
+        let ma = s.scale3(m, a);
+        let u = s.u_matrix(w, wd);
+        let uh = s.mat_vec(&u, h);
+        let f = s.add3(ma, uh);
+        let jwd = s.mat_vec(&j, wd);
+        let jw = s.mat_vec(&j, w);
+        let gyro = s.cross(w, jw);
+        let ha = s.cross(h, a);
+        let nb = s.add3(jwd, gyro);
+        let nb = s.add3(nb, ha);
+        force[b] = s.add3(force[b], f);
+        moment[b] = s.add3(moment[b], nb);
+    }
     // Backward sweep: Tᵀ w, accumulated from the tips (eq. 24).
     let mut tau = vec![zero; n];
     for i in (0..n).rev() {
@@ -1198,10 +1277,91 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
             moment[p] = s.add3(moment[p], nn);
         }
     }
-    add_drive_efforts(s.g, &tree.drives, terms, &mut tau, |g, arg, i| {
-        g.input(arg, i)
-    });
+    match &tree.params {
+        None => add_drive_efforts(s.g, &tree.drives, terms, &mut tau, |g, arg, i| {
+            g.input(arg, i)
+        }),
+        Some(pl) => add_param_drive_efforts(s.g, n, pl.coulomb_velocity, terms, &mut tau),
+    }
     tau
+}
+
+/// [`add_drive_efforts`] with the coefficients read from the run-time parameters.
+fn add_param_drive_efforts(g: &mut Graph, n: usize, vs: f64, terms: Terms, tau: &mut [ExprId]) {
+    for i in 0..n {
+        if terms.acceleration {
+            let a = g.input(Arg::P, param_index(ParamKind::Armature, i, n));
+            let qdd = g.input(Arg::Qdd, i);
+            let e = g.mul(a, qdd);
+            tau[i] = g.add(tau[i], e);
+        }
+        if terms.friction {
+            let b = g.input(Arg::P, param_index(ParamKind::Damping, i, n));
+            let c = g.input(Arg::P, param_index(ParamKind::Friction, i, n));
+            let qd = g.input(Arg::Qd, i);
+            let v = g.mul(b, qd);
+            let sq = g.mul(qd, qd);
+            let vs2 = g.constant(vs * vs);
+            let den = g.add(sq, vs2);
+            let den = g.sqrt(den);
+            let cq = g.mul(c, qd);
+            let cf = g.div(cq, den);
+            let f = g.add(v, cf);
+            tau[i] = g.add(tau[i], f);
+        }
+    }
+}
+
+/// The run-time payload's inertial parameters in link `b`'s frame: mass, first moment `m c`
+/// and inertia about the link origin (`x_link = A x_body − d e_z`; parallel-axis theorem).
+fn payload_params(s: &mut Sym<'_>, b: usize) -> (ExprId, V3, M3) {
+    let (a, d) = s.tree.links[b].to_link;
+    let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, k);
+    let m = p(s, 0);
+    let cb = [p(s, 1), p(s, 2), p(s, 3)];
+    let ic_b = {
+        let (xx, xy, xz, yy, yz, zz) = (p(s, 4), p(s, 5), p(s, 6), p(s, 7), p(s, 8), p(s, 9));
+        [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+    };
+    let am = s.cm(&a);
+    let c = s.mat_vec(&am, cb);
+    let dz = s.c(d);
+    let c = [c[0], c[1], s.g.sub(c[2], dz)];
+    // A I Aᵀ, entry by entry (A is constant; mostly a signed permutation, so this folds).
+    let zero = s.g.zero();
+    let mut ic = [[zero; 3]; 3];
+    for r in 0..3 {
+        for k in r..3 {
+            let mut acc = zero;
+            for u in 0..3 {
+                for v in 0..3 {
+                    let coef = a[r][u] * a[k][v];
+                    if coef != 0.0 {
+                        let t = s.g.scale(coef, ic_b[u][v]);
+                        acc = s.g.add(acc, t);
+                    }
+                }
+            }
+            ic[r][k] = acc;
+            ic[k][r] = acc;
+        }
+    }
+    let h = s.scale3(m, c);
+    // J = I_c + m (c·c 1 − c cᵀ) = I_c + (h·c) 1 − h cᵀ.
+    let hc = s.dot(h, c);
+    let mut j = ic;
+    for r in 0..3 {
+        for k in r..3 {
+            let hck = s.g.mul(h[r], c[k]);
+            let mut v = s.g.sub(ic[r][k], hck);
+            if r == k {
+                v = s.g.add(v, hc);
+            }
+            j[r][k] = v;
+            j[k][r] = v;
+        }
+    }
+    (m, h, j)
 }
 
 /// Composite inertia of a subtree about its root body's origin, in its frame.
@@ -1225,6 +1385,22 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
             j: s.cm(&l.j),
         })
         .collect();
+    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
+        let (m, h, j) = payload_params(&mut s, b);
+        let c = comp[b];
+        let hs = s.add3(c.h, h);
+        let mut js = c.j;
+        for r in 0..3 {
+            for k in 0..3 {
+                js[r][k] = s.g.add(c.j[r][k], j[r][k]);
+            }
+        }
+        comp[b] = Composite {
+            m: s.g.add(c.m, m),
+            h: hs,
+            j: js,
+        };
+    }
     for i in (0..n).rev() {
         if let Some(p) = tree.links[i].parent {
             let c = comp[i];
@@ -1310,10 +1486,14 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
     }
     // Rotor inertia: `I_a` on the diagonal (the rotor turns with `q̇` times the gear ratio).
     for (j, d) in tree.drives.iter().enumerate() {
-        if d.armature != 0.0 {
-            let a = s.c(d.armature);
-            h[j][j] = s.g.add(h[j][j], a);
-        }
+        let a = if tree.params.is_some() {
+            s.g.input(Arg::P, param_index(ParamKind::Armature, j, n))
+        } else if d.armature != 0.0 {
+            s.c(d.armature)
+        } else {
+            continue;
+        };
+        h[j][j] = s.g.add(h[j][j], a);
     }
     h
 }

@@ -78,7 +78,7 @@ pub struct Function<'a> {
     pub sites: bool,
 }
 
-fn float_lit(v: f64) -> TokenStream {
+pub(crate) fn float_lit(v: f64) -> TokenStream {
     let lit = Literal::f64_unsuffixed(v.abs());
     if v.is_sign_negative() && v != 0.0 {
         quote!(-#lit)
@@ -421,6 +421,9 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
         .args
         .iter()
         .map(|a| {
+            if *a == Arg::P {
+                return quote!(p: &Params);
+            }
             let len = if *a == Arg::X {
                 quote!(NX)
             } else {
@@ -449,6 +452,15 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
     });
     let ops = format!(" Cost per call: {}.", f.schedule.ops);
     let body = body(g, cfg, f);
+    // Run-time parameters are read as one flat array (`dynamics::param_index`).
+    let body = if f.args.contains(&Arg::P) {
+        quote! {
+            let p = p.to_array();
+            #body
+        }
+    } else {
+        body
+    };
     let vis = if f.public { quote!(pub) } else { quote!() };
     quote! {
         #(#docs)*
@@ -470,6 +482,7 @@ pub fn module(
     dof: usize,
     joint_names: &[String],
     functions: &[Function<'_>],
+    extra: TokenStream,
 ) -> String {
     let dof_lit = Literal::usize_unsuffixed(dof);
     let names = joint_names.iter();
@@ -502,6 +515,7 @@ pub fn module(
         /// Joint names, in coordinate order.
         pub const JOINT_NAMES: [&str; DOF] = [#(#names),*];
         #singular
+        #extra
         #(#fns)*
         #indices
     };

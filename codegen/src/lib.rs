@@ -138,7 +138,8 @@ pub fn compile(
         scalar::with_precision(single, || match mechanism {
             spec::Mechanism::Tree(model) => {
                 let only = spec::scene_functions(file_name, source);
-                Ok(generate_selected(&model, cfg, only.as_deref()))
+                let params = spec::scene_params(file_name, source, &cfg.scene);
+                Ok(generate_with(&model, cfg, only.as_deref(), params.as_ref()))
             }
             spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
             spec::Mechanism::Closed(model) => {
@@ -188,7 +189,16 @@ pub struct Symbolic {
 
 /// Build the symbolic dynamics of a validated model.
 pub fn symbolic(model: &Model) -> Symbolic {
-    let tree = Tree::new(model);
+    symbolic_with(model, None)
+}
+
+/// [`symbolic`] with run-time parameters (`[scene] parameters = "runtime"`): every output also
+/// reads `Arg::P` (layout: [`dynamics::param_index`]).
+pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Symbolic {
+    let mut tree = Tree::new(model);
+    if let Some(rp) = params {
+        tree = tree.with_runtime_params(rp.payload.as_ref().map(|p| p.0), rp.coulomb_velocity);
+    }
     let mut g = Graph::new();
     let mm = dynamics::mass_matrix(&mut g, &tree);
     let mass_matrix: Vec<_> = mm.iter().flatten().copied().collect();
@@ -244,6 +254,132 @@ pub fn generate(model: &Model, cfg: &Config) -> Generated {
 /// [`generate`] with only the public functions named in `only` (`[scene] functions`; `None`:
 /// all of them). Functions not asked for are not emitted, so their operations cost nothing.
 pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -> Generated {
+    generate_with(model, cfg, only, None)
+}
+
+/// The `Params` struct of a module with run-time parameters: fields named for the user, its
+/// `DEFAULT` (the values the spec gives), and `to_array` in [`dynamics::param_index`]'s layout.
+fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::TokenStream {
+    use proc_macro2::Literal;
+    use quote::quote;
+    let n = model.dof();
+    let np = Literal::usize_unsuffixed(dynamics::param_count(n));
+    let arr = |f: &dyn Fn(&runtime::model::Drive) -> f64| {
+        let v: Vec<_> = model
+            .joints
+            .iter()
+            .map(|j| emit::float_lit(f(&j.drive)))
+            .collect();
+        quote!([#(#v),*])
+    };
+    let damping = arr(&|d| d.viscous);
+    let friction = arr(&|d| d.coulomb);
+    let armature = arr(&|d| d.armature);
+    let at = |k| Literal::usize_unsuffixed(dynamics::param_index(k, 0, n));
+    let (d0, f0, a0) = (
+        at(dynamics::ParamKind::Damping),
+        at(dynamics::ParamKind::Friction),
+        at(dynamics::ParamKind::Armature),
+    );
+    let (payload_fields, payload_default, payload_fill) = match &rp.payload {
+        None => (quote!(), quote!(), quote!()),
+        Some((b, m, c, i)) => {
+            let body = &model.bodies[*b].name;
+            let doc_m = format!(" Payload mass (kg), rigidly attached to body `{body}`.");
+            let doc_c = format!(" Payload mass centre in body `{body}`'s frame (m).");
+            let doc_i = format!(
+                " Payload inertia about its mass centre, body `{body}`'s axes (kg·m²), symmetric."
+            );
+            let m = emit::float_lit(*m);
+            let c: Vec<_> = c.iter().map(|v| emit::float_lit(*v)).collect();
+            let rows: Vec<_> = i
+                .iter()
+                .map(|r| {
+                    let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
+                    quote!([#(#r),*])
+                })
+                .collect();
+            (
+                quote! {
+                    #[doc = #doc_m]
+                    pub payload_mass: f64,
+                    #[doc = #doc_c]
+                    pub payload_com: [f64; 3],
+                    #[doc = #doc_i]
+                    pub payload_inertia: [[f64; 3]; 3],
+                },
+                quote! {
+                    payload_mass: #m,
+                    payload_com: [#(#c),*],
+                    payload_inertia: [#(#rows),*],
+                },
+                quote! {
+                    a[0] = self.payload_mass;
+                    a[1] = self.payload_com[0];
+                    a[2] = self.payload_com[1];
+                    a[3] = self.payload_com[2];
+                    a[4] = self.payload_inertia[0][0];
+                    a[5] = self.payload_inertia[0][1];
+                    a[6] = self.payload_inertia[0][2];
+                    a[7] = self.payload_inertia[1][1];
+                    a[8] = self.payload_inertia[1][2];
+                    a[9] = self.payload_inertia[2][2];
+                },
+            )
+        }
+    };
+    quote! {
+        /// Number of run-time parameters in [`Params::to_array`].
+        pub const NP: usize = #np;
+        /// Run-time parameters (`[scene] parameters = "runtime"`): every function takes them, so
+        /// one binary serves several payloads or drive calibrations. SI units.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Params {
+            #payload_fields
+            /// Viscous friction per joint (N·m·s/rad or N·s/m).
+            pub damping: [f64; DOF],
+            /// Coulomb friction level per joint (N·m or N), regularized as in the spec docs.
+            pub friction: [f64; DOF],
+            /// Reflected rotor inertia per joint (kg·m² or kg).
+            pub armature: [f64; DOF],
+        }
+        impl Params {
+            /// The values of the spec (what a module with constants would fold in).
+            pub const DEFAULT: Params = Params {
+                #payload_default
+                damping: #damping,
+                friction: #friction,
+                armature: #armature,
+            };
+            /// The flat layout the generated functions read.
+            pub fn to_array(&self) -> [f64; NP] {
+                let mut a = [0.0; NP];
+                #payload_fill
+                let mut i = 0;
+                while i < DOF {
+                    a[#d0 + i] = self.damping[i];
+                    a[#f0 + i] = self.friction[i];
+                    a[#a0 + i] = self.armature[i];
+                    i += 1;
+                }
+                a
+            }
+        }
+        impl Default for Params {
+            fn default() -> Self {
+                Self::DEFAULT
+            }
+        }
+    }
+}
+
+/// [`generate_selected`] with run-time parameters (`None`: constants).
+pub fn generate_with(
+    model: &Model,
+    cfg: &Config,
+    only: Option<&[String]>,
+    params: Option<&spec::RuntimeParams>,
+) -> Generated {
     let Symbolic {
         graph: g,
         dof: n,
@@ -253,7 +389,7 @@ pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -
         inverse_dynamics: id,
         forward_dynamics: fd,
         friction,
-    } = symbolic(model);
+    } = symbolic_with(model, params);
     type Spec = (&'static str, Vec<String>, Vec<Arg>, Vec<sym::ExprId>, Shape);
     let mut specs: Vec<Spec> = vec![
         (
@@ -328,6 +464,11 @@ pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -
             Shape::Vector,
         ));
     }
+    if params.is_some() {
+        for spec in &mut specs {
+            spec.2.push(Arg::P);
+        }
+    }
     let functions: Vec<Function<'_>> = specs
         .into_iter()
         .filter(|s| only.is_none_or(|o| o.iter().any(|f| f == s.0)))
@@ -367,7 +508,10 @@ pub fn generate_selected(model: &Model, cfg: &Config, only: Option<&[String]>) -
     ];
     header.extend(emit::stats_table(&stats, n));
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let code = emit::module(&g, cfg, &header, n, &joint_names, &functions);
+    let extra = params
+        .map(|rp| params_template(model, rp))
+        .unwrap_or_default();
+    let code = emit::module(&g, cfg, &header, n, &joint_names, &functions, extra);
     Generated {
         code,
         stats,

@@ -36,6 +36,9 @@ pub enum Arg {
     U,
     /// Platform speed rates (parallel mechanisms).
     Ud,
+    /// Run-time parameters (`[scene] parameters = "runtime"`): `p: &Params`, read through
+    /// `Params::to_array` (layout in `dynamics::param_index`).
+    P,
 }
 
 impl Arg {
@@ -49,6 +52,7 @@ impl Arg {
             Arg::X => "x",
             Arg::U => "u",
             Arg::Ud => "ud",
+            Arg::P => "p",
         }
     }
 }

@@ -27,6 +27,10 @@ pub mod gs_point_legs {
         "/variants/gs_point_legs/gough_stewart.rs"
     ));
 }
+/// The PUMA 560 with a tool and run-time parameters (`src/params_scene.toml`).
+pub mod puma_params {
+    include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));
+}
 /// The KUKA iiwa 14 with its angles rounded to 5 digits, generated as written.
 pub mod iiwa_rounded {
     include!(concat!(env!("OUT_DIR"), "/variants/iiwa_rounded/iiwa14.rs"));

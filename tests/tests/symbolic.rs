@@ -19,7 +19,7 @@ fn check(seed: u64, shape: Shape, states: usize) -> f64 {
             Arg::Qd => qd[i],
             Arg::Qdd => qdd[i],
             Arg::Tau => tau[i],
-            Arg::X | Arg::U | Arg::Ud => f64::NAN, // parallel mechanisms only
+            Arg::X | Arg::U | Arg::Ud | Arg::P => f64::NAN, // parallel, run-time parameters
         };
         let id = s.graph.eval(&s.inverse_dynamics, &input);
         let mm = s.graph.eval(&s.mass_matrix, &input);

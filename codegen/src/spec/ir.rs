@@ -57,6 +57,9 @@ pub(crate) struct SceneSpec {
     pub coulomb_velocity: f64,
     /// `snap = TOL`: take near-exact angles and offsets as exact (see `spec::snap`).
     pub snap: Option<f64>,
+    /// `parameters = "runtime"`: payload and drive coefficients in a generated `Params` struct
+    /// passed at run time (trees), instead of constants folded into the code.
+    pub runtime_params: bool,
 }
 
 /// The default `v_s` of the regularized Coulomb law (rad/s or m/s): 99.5 % of the Coulomb
@@ -75,6 +78,7 @@ impl Default for SceneSpec {
             rotor_inertia: false,
             coulomb_velocity: COULOMB_VELOCITY,
             snap: None,
+            runtime_params: false,
         }
     }
 }

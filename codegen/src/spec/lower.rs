@@ -14,6 +14,11 @@ use crate::diag::{Diagnostic, Diagnostics};
 /// Validates `spec` (a tree: no `[platform]`) and builds the model. Errors and warnings go to
 /// `diags`; `None` when there was any error.
 pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
+    lower_built(spec, diags).map(|b| b.model)
+}
+
+/// [`lower`] with the bookkeeping: where every spec body ended up.
+pub(super) fn lower_built(spec: &Spec, diags: &mut Diagnostics) -> Option<Built> {
     let axes = check_values(spec, diags);
     check_no_parallel_keys(spec, diags);
     let topo = check_topology(spec, diags, &Skip::none(spec));
@@ -26,7 +31,7 @@ pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
     if diags.has_errors() {
         None
     } else {
-        Some(built.model)
+        Some(built)
     }
 }
 

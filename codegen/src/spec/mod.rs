@@ -186,6 +186,14 @@ fn load_any(
             }
             snap::snap(&mut s, &mut d);
             apply_scene(&mut s, &mut d);
+            if s.scene.runtime_params && (s.platform.is_some() || closed::is_closed(&s)) {
+                d.push(
+                    Diagnostic::error("run-time parameters are for trees only")
+                        .with_key("scene.parameters")
+                        .with_span(s.anchor.clone())
+                        .with_hint("remove `parameters = \"runtime\"`: parallel and closed-loop modules take their parameters as constants"),
+                );
+            }
             s
         });
         let platform = spec
@@ -261,6 +269,7 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
     if let Some(p) = &scene.payload
         && let Some(i) = find(&p.body, diags)
     {
+        let runtime = scene.runtime_params;
         if !(p.mass.is_finite() && p.mass >= 0.0) {
             diags.push(
                 Diagnostic::error(format!(
@@ -270,7 +279,8 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
                 .with_key("scene.payload.mass")
                 .with_span(p.body.span.clone()),
             );
-        } else {
+        } else if !runtime {
+            // Run-time parameters keep the payload apart (`scene_params`).
             let b = &mut spec.bodies[i];
             let c = geom::MassProps::combine(&[
                 geom::MassProps {
@@ -388,6 +398,57 @@ pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
     let mut d = Diagnostics::new(file_name, source);
     let spec = read_toml::read(source, &mut d)?;
     Some(spec.bodies.into_iter().map(|b| b.name).collect())
+}
+
+/// The run-time parameters of a tree spec with `[scene] parameters = "runtime"` (`None`
+/// without). Pure: reads and lowers the spec again; call it on a spec that loads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeParams {
+    /// The payload: the model body it rides on, its mass (kg), mass centre (m) and inertia about
+    /// the mass centre (kg·m²), both in that body's frame.
+    pub payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
+    /// The speed scale `v_s` of the regularized Coulomb law (`[scene] coulomb_velocity`).
+    pub coulomb_velocity: f64,
+}
+
+/// See [`RuntimeParams`].
+pub fn scene_params(
+    file_name: &str,
+    source: &str,
+    overrides: &SceneOverrides,
+) -> Option<RuntimeParams> {
+    if is_urdf(file_name) {
+        return None;
+    }
+    let mut d = Diagnostics::new(file_name, source);
+    let mut spec = read_toml::read(source, &mut d)?;
+    if !spec.scene.runtime_params || spec.platform.is_some() || closed::is_closed(&spec) {
+        return None;
+    }
+    spec.scene.friction |= overrides.friction;
+    spec.scene.rotor_inertia |= overrides.rotor_inertia;
+    if overrides.snap.is_some() {
+        spec.scene.snap = overrides.snap;
+    }
+    snap::snap(&mut spec, &mut d);
+    apply_scene(&mut spec, &mut d);
+    let built = lower::lower_built(&spec, &mut d)?;
+    let payload = spec.scene.payload.as_ref().and_then(|p| {
+        let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
+        let at = built.attach[b]?;
+        let target = at.target?;
+        let m = geom::MassProps {
+            mass: p.mass,
+            com: p.com,
+            inertia: p.inertia,
+        }
+        .transformed(&at.pose);
+        Some((target, m.mass, m.com, m.inertia))
+    });
+    Some(RuntimeParams {
+        payload,
+        coulomb_velocity: spec.scene.coulomb_velocity,
+    })
 }
 
 /// The functions `[scene] functions` selects (`None`: all). Pure: reads the TOML again.

@@ -30,6 +30,7 @@ const SCENE_KEYS: &[&str] = &[
     "rotor_inertia",
     "coulomb_velocity",
     "snap",
+    "parameters",
 ];
 const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
@@ -454,6 +455,20 @@ impl Reader<'_> {
                             .with_span(Some(v.span()))
                             .with_hint("the speed scale v_s of the Coulomb law c·q̇/√(q̇² + v_s²), in rad/s or m/s; the default is 1e-4"),
                     );
+                }
+            }
+            if let Some(v) = get(t, "parameters")
+                && let Some(x) = self.string(v, "scene.parameters")
+            {
+                match x.as_str() {
+                    "constants" => {}
+                    "runtime" => scene.runtime_params = true,
+                    _ => self.diags.push(
+                        Diagnostic::error(format!("unknown parameter mode {x:?}"))
+                            .with_key("scene.parameters")
+                            .with_span(Some(v.span()))
+                            .with_hint("\"constants\" (the default: folded into the code) or \"runtime\" (a generated `Params` struct with the payload and the joints' damping, friction and armature, passed to every function)"),
+                    ),
                 }
             }
             if let Some(v) = get(t, "snap")

@@ -1,0 +1,204 @@
+//! `[scene] parameters = "runtime"`: the payload and the joints' drive coefficients become a
+//! generated `Params` struct passed at run time. Checked against the runtime on the same robot
+//! with the same values baked in as constants (the payload merged into its body by the
+//! parallel-axis theorem at spec level, the drives set on the model's joints) — a route that
+//! shares neither the payload's frame transformation nor its Newton–Euler terms with the
+//! generator. The PUMA 560 carries a tool on a rotated flange, so the payload's frame differs
+//! from the body's.
+
+use codegen::dynamics::{ParamKind, param_index};
+use codegen::spec::{Mechanism, SceneOverrides, load_mechanism, scene_params};
+use codegen::sym::Arg;
+use rand::Rng;
+use runtime::model::{Drive, Model};
+
+const PUMA: &str = include_str!("../../mechanisms/specs/puma560.toml");
+
+/// The PUMA with a tool on a flange turned by (0.3, π/2, −0.7) rpy, 0.1 m out along z6, and a
+/// payload on the tool; `mode` is `"runtime"` or `"constants"`.
+fn puma(mode: &str, mass: f64, com: [f64; 3], i: [f64; 6], friction: bool) -> String {
+    format!(
+        "{PUMA}\n[scene]\nparameters = \"{mode}\"\nfriction = {friction}\nrotor_inertia = {friction}\n\
+         payload = {{ body = \"tool\", mass = {mass}, com = [{}, {}, {}], inertia = {{ ixx = {}, ixy = {}, ixz = {}, iyy = {}, iyz = {}, izz = {} }} }}\n\
+         [[body]]\nname = \"tool\"\nmass = 0.0\n\
+         [[joint]]\nname = \"flange\"\nkind = \"fixed\"\nparent = \"link6\"\nchild = \"tool\"\n\
+         origin = {{ xyz = [0.0, 0.02, 0.1], rpy = [0.3, \"pi/2\", -0.7] }}\n",
+        com[0], com[1], com[2], i[0], i[1], i[2], i[3], i[4], i[5]
+    )
+}
+
+fn tree(src: &str) -> Model {
+    match load_mechanism("puma.toml", src) {
+        Ok((Mechanism::Tree(m), _)) => m,
+        Ok(_) => panic!("not a tree"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+#[test]
+fn runtime_parameters_match_the_same_values_as_constants() {
+    let mut r = tests::rng(41);
+    // The runtime-parameter model itself does not depend on the values.
+    let base = puma(
+        "runtime",
+        1.0,
+        [0.0; 3],
+        [0.01, 0.0, 0.0, 0.01, 0.0, 0.01],
+        true,
+    );
+    let model = tree(&base);
+    let sym = {
+        let rp = scene_params("puma.toml", &base, &SceneOverrides::default()).unwrap();
+        codegen::symbolic_with(&model, Some(&rp))
+    };
+    let n = model.dof();
+    let mut worst: f64 = 0.0;
+    for _ in 0..20 {
+        // A random physical payload (inertia from a random box, rotated) and random drives.
+        let mass = r.random_range(0.5..5.0);
+        let com = [
+            r.random_range(-0.1..0.1),
+            r.random_range(-0.1..0.1),
+            r.random_range(0.0..0.2),
+        ];
+        let ic = tests::inertia(&mut r);
+        let i6 = [ic[0][0], ic[0][1], ic[0][2], ic[1][1], ic[1][2], ic[2][2]];
+        let run = puma("runtime", mass, com, i6, true);
+        let rp = scene_params("puma.toml", &run, &SceneOverrides::default()).unwrap();
+        let (_, pm, pc, pi) = rp.payload.expect("a payload");
+        let drives: Vec<[f64; 3]> = (0..n)
+            .map(|_| {
+                [
+                    r.random_range(0.0..5.0),
+                    r.random_range(0.0..3.0),
+                    r.random_range(0.0..1.0),
+                ]
+            })
+            .collect();
+        let mut p = vec![0.0; codegen::dynamics::param_count(n)];
+        p[0] = pm;
+        p[1..4].copy_from_slice(&pc);
+        p[4..10].copy_from_slice(&[pi[0][0], pi[0][1], pi[0][2], pi[1][1], pi[1][2], pi[2][2]]);
+        for (j, d) in drives.iter().enumerate() {
+            p[param_index(ParamKind::Damping, j, n)] = d[0];
+            p[param_index(ParamKind::Friction, j, n)] = d[1];
+            p[param_index(ParamKind::Armature, j, n)] = d[2];
+        }
+        // The same robot with the values as constants.
+        let mut fixed = tree(&puma("constants", mass, com, i6, false));
+        for (j, d) in drives.iter().enumerate() {
+            fixed.joints[j].drive = Drive {
+                viscous: d[0],
+                coulomb: d[1],
+                coulomb_velocity: 1e-4,
+                armature: d[2],
+            };
+        }
+        for _ in 0..10 {
+            let (q, qd, qdd) = tests::random_state(&mut r, n);
+            let tau: Vec<f64> = (0..n).map(|_| r.random_range(-50.0..50.0)).collect();
+            let input = |a: Arg, i: usize| match a {
+                Arg::Q => q[i],
+                Arg::Qd => qd[i],
+                Arg::Qdd => qdd[i],
+                Arg::Tau => tau[i],
+                Arg::P => p[i],
+                _ => f64::NAN,
+            };
+            let id = sym.graph.eval(&sym.inverse_dynamics, &input);
+            let mm = sym.graph.eval(&sym.mass_matrix, &input);
+            let fd = sym.graph.eval(&sym.forward_dynamics, &input);
+            let grav = sym.graph.eval(&sym.gravity, &input);
+            let id_rt = runtime::noc::inverse_dynamics(&fixed, &q, &qd, &qdd);
+            let mm_rt = runtime::noc::mass_matrix(&fixed, &q);
+            let fd_rt = runtime::noc::forward_dynamics(&fixed, &q, &qd, &tau).unwrap();
+            let g_rt = runtime::noc::gravity(&fixed, &q);
+            // And the independent spatial-algebra route for the rigid part.
+            let zero = vec![0.0; n];
+            let rnea = runtime::rnea::inverse_dynamics(&fixed, &q, &zero, &zero);
+            worst = worst
+                .max(tests::rel_err(&id, id_rt.as_slice()))
+                .max(tests::rel_err(&mm, mm_rt.transpose().as_slice()))
+                .max(tests::rel_err(&fd, fd_rt.as_slice()))
+                .max(tests::rel_err(&grav, g_rt.as_slice()))
+                .max(tests::rel_err(&grav, rnea.as_slice()));
+        }
+    }
+    assert!(worst < 1e-11, "runtime parameters vs constants: {worst:e}");
+}
+
+#[test]
+fn the_module_takes_params_and_refuses_them_where_unsupported() {
+    let src = puma(
+        "runtime",
+        2.0,
+        [0.0, 0.0, 0.05],
+        [0.01, 0.0, 0.0, 0.01, 0.0, 0.005],
+        false,
+    );
+    let g = codegen::compile("puma.toml", &src, &codegen::Config::default()).unwrap();
+    assert!(g.code.contains("pub struct Params"));
+    let id = &g.code[g.code.find("pub fn inverse_dynamics(").unwrap()..];
+    assert!(id[..id.find('{').unwrap()].contains("p: &Params"));
+    assert!(g.code.contains("pub const DEFAULT: Params"));
+    // Constants by default: no Params.
+    let plain = codegen::compile("puma.toml", PUMA, &codegen::Config::default()).unwrap();
+    assert!(!plain.code.contains("Params"));
+    // Parallel mechanisms: a diagnostic.
+    let gs = include_str!("../../mechanisms/specs/gough_stewart.toml");
+    let bad = format!("{gs}\n[scene]\nparameters = \"runtime\"\n");
+    let err = codegen::spec::load_mechanism("gs.toml", &bad).unwrap_err();
+    assert!(err.render().contains("trees only"), "{}", err.render());
+}
+
+/// The compiled module (`tests/build.rs`, `src/params_scene.toml`): `Params::DEFAULT` is the
+/// spec's payload, and drive values set at run time take effect; checked against the runtime
+/// with the payload merged as constants.
+#[test]
+fn compiled_module_with_params() {
+    use tests::variants::puma_params as g;
+    let src = format!("{PUMA}\n{}", include_str!("../src/params_scene.toml"));
+    let fixed_src = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
+    let mut fixed = tree(&fixed_src);
+    let mut p = g::Params::DEFAULT;
+    let mut r = tests::rng(42);
+    let n = fixed.dof();
+    for j in 0..n {
+        p.damping[j] = r.random_range(0.0..5.0);
+        p.friction[j] = r.random_range(0.0..3.0);
+        p.armature[j] = r.random_range(0.0..1.0);
+        fixed.joints[j].drive = Drive {
+            viscous: p.damping[j],
+            coulomb: p.friction[j],
+            coulomb_velocity: 1e-4,
+            armature: p.armature[j],
+        };
+    }
+    let mut worst: f64 = 0.0;
+    for _ in 0..100 {
+        let (q, qd, qdd) = tests::random_state(&mut r, n);
+        let (q, qd, qdd): ([f64; 6], [f64; 6], [f64; 6]) = (
+            q.try_into().unwrap(),
+            qd.try_into().unwrap(),
+            qdd.try_into().unwrap(),
+        );
+        let id = g::inverse_dynamics(&q, &qd, &qdd, &p);
+        let id_rt = runtime::noc::inverse_dynamics(&fixed, &q, &qd, &qdd);
+        let back = g::forward_dynamics(&q, &qd, &id, &p).unwrap();
+        worst = worst
+            .max(tests::rel_err(&id, id_rt.as_slice()))
+            .max(tests::rel_err(&back, &qdd));
+    }
+    assert!(worst < 1e-10, "{worst:e}");
+    // A heavier payload at run time changes the efforts like the constant model does.
+    p.payload_mass *= 2.0;
+    let heavier = tree(&fixed_src.replace("mass = 2.5", "mass = 5.0"));
+    let q = [0.1, -0.5, 0.3, 0.2, 0.7, -0.4];
+    let mut p0 = p;
+    p0.damping = [0.0; 6];
+    p0.friction = [0.0; 6];
+    p0.armature = [0.0; 6];
+    let gq = g::gravity(&q, &p0);
+    let want = runtime::noc::gravity(&heavier, &q);
+    assert!(tests::rel_err(&gq, want.as_slice()) < 1e-12);
+}
