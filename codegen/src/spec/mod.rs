@@ -179,13 +179,7 @@ fn load_any(
             read_toml::read(source, &mut d)
         };
         let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
-            s.scene.friction |= overrides.friction;
-            s.scene.rotor_inertia |= overrides.rotor_inertia;
-            if overrides.snap.is_some() {
-                s.scene.snap = overrides.snap;
-            }
-            snap::snap(&mut s, &mut d);
-            apply_scene(&mut s, &mut d);
+            prepare(&mut s, overrides, &mut d);
             if s.scene.runtime_params && (s.platform.is_some() || closed::is_closed(&s)) {
                 d.push(
                     Diagnostic::error("run-time parameters are for trees only")
@@ -239,6 +233,18 @@ pub const TREE_FUNCTIONS: [&str; 6] = [
     "forward_dynamics",
     "friction",
 ];
+
+/// The passes between reading and lowering: the overrides on top of the spec's `[scene]`,
+/// snapping, then the scene's changes to the bodies and joints.
+fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {
+    spec.scene.friction |= overrides.friction;
+    spec.scene.rotor_inertia |= overrides.rotor_inertia;
+    if overrides.snap.is_some() {
+        spec.scene.snap = overrides.snap;
+    }
+    snap::snap(spec, diags);
+    apply_scene(spec, diags);
+}
 
 /// `[scene]`: point masses and massless bodies replace the bodies' inertial data before
 /// lowering (so everything downstream, fixed-joint merging included, sees the scene's model).
@@ -425,13 +431,7 @@ pub fn scene_params(
     if !spec.scene.runtime_params || spec.platform.is_some() || closed::is_closed(&spec) {
         return None;
     }
-    spec.scene.friction |= overrides.friction;
-    spec.scene.rotor_inertia |= overrides.rotor_inertia;
-    if overrides.snap.is_some() {
-        spec.scene.snap = overrides.snap;
-    }
-    snap::snap(&mut spec, &mut d);
-    apply_scene(&mut spec, &mut d);
+    prepare(&mut spec, overrides, &mut d);
     let built = lower::lower_built(&spec, &mut d)?;
     let payload = spec.scene.payload.as_ref().and_then(|p| {
         let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;

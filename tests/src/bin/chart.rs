@@ -82,23 +82,19 @@ fn puma(points: &mut Vec<Point>) {
         .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
         .collect();
     let m = "PUMA 560";
-    let mut add = |candidate, ns, error| {
+    let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {
             mechanism: m,
             candidate,
-            ns,
-            error,
+            ns: time(|i| f(black_box(i))[0]),
+            error: worst(f, &reference),
         });
     };
     let g64 = |i: usize| {
         let [q, qd, qdd] = &states[i];
         g::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64",
-        time(|i| g64(black_box(i))[0]),
-        worst(g64, &reference),
-    );
+    add("generated f64", &g64);
     let s32 = |i: usize| {
         let [q, qd, qdd] = states[i].map(|v| v.map(|x| x as f32));
         s::inverse_dynamics(&q, &qd, &qdd)
@@ -106,40 +102,24 @@ fn puma(points: &mut Vec<Point>) {
             .map(|&v| v as f64)
             .collect::<Vec<_>>()
     };
-    add(
-        "generated f32",
-        time(|i| s32(black_box(i))[0]),
-        worst(s32, &reference),
-    );
+    add("generated f32", &s32);
     // The same module with `libm` trigonometry, and two fidelity levels (`[scene]`): their
     // error is against the full model's reference, so it is the model error of the level.
     let libm = |i: usize| {
         let [q, qd, qdd] = &states[i];
         tests::variants::puma_libm::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64, libm math",
-        time(|i| libm(black_box(i))[0]),
-        worst(libm, &reference),
-    );
+    add("generated f64, libm math", &libm);
     let point = |i: usize| {
         let [q, qd, qdd] = &states[i];
         tests::variants::puma_point_wrist::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64, point-mass wrist (links 4–6)",
-        time(|i| point(black_box(i))[0]),
-        worst(point, &reference),
-    );
+    add("generated f64, point-mass wrist (links 4–6)", &point);
     let massless = |i: usize| {
         let [q, qd, qdd] = &states[i];
         tests::variants::puma_massless_wrist::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64, massless wrist (links 4–6)",
-        time(|i| massless(black_box(i))[0]),
-        worst(massless, &reference),
-    );
+    add("generated f64, massless wrist (links 4–6)", &massless);
     let noc = |i: usize| {
         let [q, qd, qdd] = &states[i];
         runtime::noc::inverse_dynamics(&model, q, qd, qdd)
@@ -147,11 +127,7 @@ fn puma(points: &mut Vec<Point>) {
             .copied()
             .collect::<Vec<_>>()
     };
-    add(
-        "runtime NOC (nalgebra)",
-        time(|i| noc(black_box(i))[0]),
-        worst(noc, &reference),
-    );
+    add("runtime NOC (nalgebra)", &noc);
     let rnea = |i: usize| {
         let [q, qd, qdd] = &states[i];
         runtime::rnea::inverse_dynamics(&model, q, qd, qdd)
@@ -159,11 +135,7 @@ fn puma(points: &mut Vec<Point>) {
             .copied()
             .collect::<Vec<_>>()
     };
-    add(
-        "RNEA (spatial algebra)",
-        time(|i| rnea(black_box(i))[0]),
-        worst(rnea, &reference),
-    );
+    add("RNEA (spatial algebra)", &rnea);
     let lag = |i: usize| {
         let [q, qd, qdd] = &states[i];
         let sys = tests::lagrange::from_tree(&model, q);
@@ -176,11 +148,7 @@ fn puma(points: &mut Vec<Point>) {
         .unwrap()
         .efforts
     };
-    add(
-        "Newton–Euler + Lagrange multipliers",
-        time(|i| lag(black_box(i))[0]),
-        worst(lag, &reference),
-    );
+    add("Newton–Euler + Lagrange multipliers", &lag);
 }
 
 fn gough_stewart(points: &mut Vec<Point>) {
@@ -204,12 +172,12 @@ fn gough_stewart(points: &mut Vec<Point>) {
         .map(|(x, u, ud)| tests::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
         .collect();
     let m = "Gough–Stewart";
-    let mut add = |candidate, ns, error| {
+    let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {
             mechanism: m,
             candidate,
-            ns,
-            error,
+            ns: time(|i| f(black_box(i))[0]),
+            error: worst(f, &reference),
         });
     };
     let arr = |i: usize| -> ([f64; 7], [f64; 6], [f64; 6]) {
@@ -224,11 +192,7 @@ fn gough_stewart(points: &mut Vec<Point>) {
         let (x, u, ud) = arr(i);
         g::inverse_dynamics(&x, &u, &ud).unwrap().to_vec()
     };
-    add(
-        "generated f64",
-        time(|i| g64(black_box(i))[0]),
-        worst(g64, &reference),
-    );
+    add("generated f64", &g64);
     let s32 = |i: usize| {
         let (x, u, ud) = arr(i);
         let (x, u, ud) = (
@@ -242,31 +206,19 @@ fn gough_stewart(points: &mut Vec<Point>) {
             .map(|&v| v as f64)
             .collect::<Vec<_>>()
     };
-    add(
-        "generated f32",
-        time(|i| s32(black_box(i))[0]),
-        worst(s32, &reference),
-    );
+    add("generated f32", &s32);
     let point = |i: usize| {
         let (x, u, ud) = arr(i);
         tests::variants::gs_point_legs::inverse_dynamics(&x, &u, &ud)
             .unwrap()
             .to_vec()
     };
-    add(
-        "generated f64, point-mass legs",
-        time(|i| point(black_box(i))[0]),
-        worst(point, &reference),
-    );
+    add("generated f64, point-mass legs", &point);
     let rt = |i: usize| {
         let (x, u, ud) = &states[i];
         noc::inverse_dynamics(&plan, x, u, ud).unwrap()
     };
-    add(
-        "runtime (leg-wise, f64)",
-        time(|i| rt(black_box(i))[0]),
-        worst(rt, &reference),
-    );
+    add("runtime (leg-wise, f64)", &rt);
     let lag = |i: usize| {
         let (x, u, ud) = &states[i];
         let legs = noc::leg_joint_positions(&plan, x).unwrap();
@@ -280,11 +232,7 @@ fn gough_stewart(points: &mut Vec<Point>) {
             .unwrap()
             .efforts
     };
-    add(
-        "Newton–Euler + Lagrange multipliers",
-        time(|i| lag(black_box(i))[0]),
-        worst(lag, &reference),
-    );
+    add("Newton–Euler + Lagrange multipliers", &lag);
 }
 
 /// A URDF with its quarter and half turns rounded to 5 digits (`1.5708`, `3.1416`), as many
@@ -307,32 +255,24 @@ fn iiwa(points: &mut Vec<Point>) {
         .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
         .collect();
     let m = "iiwa 14 (URDF angles to 5 digits)";
-    let mut add = |candidate, ns, error| {
+    let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {
             mechanism: m,
             candidate,
-            ns,
-            error,
+            ns: time(|i| f(black_box(i))[0]),
+            error: worst(f, &reference),
         });
     };
     let g64 = |i: usize| {
         let [q, qd, qdd] = &states[i];
         w::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64",
-        time(|i| g64(black_box(i))[0]),
-        worst(g64, &reference),
-    );
+    add("generated f64", &g64);
     let snapped = |i: usize| {
         let [q, qd, qdd] = &states[i];
         s::inverse_dynamics(q, qd, qdd).to_vec()
     };
-    add(
-        "generated f64, snapped 1e-4",
-        time(|i| snapped(black_box(i))[0]),
-        worst(snapped, &reference),
-    );
+    add("generated f64, snapped 1e-4", &snapped);
     let noc = |i: usize| {
         let [q, qd, qdd] = &states[i];
         runtime::noc::inverse_dynamics(&model, q, qd, qdd)
@@ -340,11 +280,7 @@ fn iiwa(points: &mut Vec<Point>) {
             .copied()
             .collect::<Vec<_>>()
     };
-    add(
-        "runtime NOC (nalgebra)",
-        time(|i| noc(black_box(i))[0]),
-        worst(noc, &reference),
-    );
+    add("runtime NOC (nalgebra)", &noc);
 }
 
 fn five_bar(points: &mut Vec<Point>) {
@@ -377,23 +313,19 @@ fn five_bar(points: &mut Vec<Point>) {
         .map(|(x, u, ud)| tests::dd::closed_inverse_dynamics_dd(&plan, x, u, ud).unwrap())
         .collect();
     let m = "five-bar (joint coordinates)";
-    let mut add = |candidate, ns, error| {
+    let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {
             mechanism: m,
             candidate,
-            ns,
-            error,
+            ns: time(|i| f(black_box(i))[0]),
+            error: worst(f, &reference),
         });
     };
     let g64 = |i: usize| {
         let (x, u, ud) = &states[i];
         g::inverse_dynamics(x, u, ud).unwrap().to_vec()
     };
-    add(
-        "generated f64",
-        time(|i| g64(black_box(i))[0]),
-        worst(g64, &reference),
-    );
+    add("generated f64", &g64);
     let s32 = |i: usize| {
         let (x, u, ud) = &states[i];
         let xi = [x[plan.independent[0]] as f32, x[plan.independent[1]] as f32];
@@ -405,20 +337,12 @@ fn five_bar(points: &mut Vec<Point>) {
             .collect::<Vec<_>>()
     };
     // The f32 time includes its own assembly (f32 states cannot hold the f64 closure).
-    add(
-        "generated f32 (+ f32 assembly)",
-        time(|i| s32(black_box(i))[0]),
-        worst(s32, &reference),
-    );
+    add("generated f32 (+ f32 assembly)", &s32);
     let rt = |i: usize| {
         let (x, u, ud) = &states[i];
         noc::inverse_dynamics(&plan, x, u, ud).unwrap()
     };
-    add(
-        "runtime (generic, f64)",
-        time(|i| rt(black_box(i))[0]),
-        worst(rt, &reference),
-    );
+    add("runtime (generic, f64)", &rt);
     let lag = |i: usize| {
         let (x, u, ud) = &states[i];
         let sys = tests::lagrange::from_closed(&model, x);
@@ -426,11 +350,7 @@ fn five_bar(points: &mut Vec<Point>) {
             .unwrap()
             .efforts
     };
-    add(
-        "Newton–Euler + Lagrange multipliers",
-        time(|i| lag(black_box(i))[0]),
-        worst(lag, &reference),
-    );
+    add("Newton–Euler + Lagrange multipliers", &lag);
 }
 
 /// The second chart: error against condition while walking the Gough–Stewart platform to its
