@@ -22,7 +22,7 @@ use crate::parallel::noc::{
     M, NoConvergence, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mv, rot, scale,
     solve_spd, sub, zero3,
 };
-use crate::parallel::real::{Real, Singular, Site};
+use crate::parallel::real::{Real, Singular, Site, drive_effort};
 
 /// Pivot threshold of `Φ_d`'s LU (columns scaled to unit norm): a pivot `|p| ≤ 1e-4` is a
 /// configuration where the independent coordinates (nearly) fail to determine the others. The
@@ -875,23 +875,6 @@ pub fn generalized_force<R: Real>(
                 .fold(tau[j], |s, (row, &yk)| s - row[j] * yk)
         })
         .collect()
-}
-
-/// [`Drive::effort`](crate::model::Drive::effort) over [`Real`]: `I_a q̈ + b q̇ + c q̇ / √(q̇² + v_s²)`
-/// (terms with zero coefficients are not formed).
-pub fn drive_effort<R: Real>(d: &crate::model::Drive, qd: R, qdd: R) -> R {
-    let mut e = R::c(0.0);
-    if d.armature != 0.0 {
-        e = e + R::c(d.armature) * qdd;
-    }
-    if d.viscous != 0.0 {
-        e = e + R::c(d.viscous) * qd;
-    }
-    if d.coulomb != 0.0 {
-        let vs = d.coulomb_velocity;
-        e = e + R::c(d.coulomb) * qd / (qd * qd + R::c(vs * vs)).sqrt();
-    }
-    e
 }
 
 /// The generalized inertia `I = Sᵀ M_T S` of the independent coordinates, from each body's

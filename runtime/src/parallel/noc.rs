@@ -34,7 +34,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::real::{Real, Singular, Site};
+use super::real::{Real, Singular, Site, drive_effort};
 use super::{LegEnd, LegKind, ParallelModel, PlatformMotion};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
 
@@ -153,6 +153,8 @@ pub struct LegPlan {
     pub bodies: Vec<(f64, Vec3, Mat3)>,
     /// Index of the actuated joint.
     pub actuated: usize,
+    /// Friction and rotor inertia of each leg joint (actuated or passive).
+    pub drives: Vec<crate::model::Drive>,
     /// Spherical end: the S centre at home (`L`); revolute end: the end axis at home (`L`).
     pub end_home: Vec3,
     /// The end point (S centre) or end axis in the platform frame.
@@ -274,6 +276,7 @@ impl Plan {
                     .map(|b| (b.mass, b.com, b.inertia))
                     .collect(),
                 actuated: leg.actuated,
+                drives: leg.joints.iter().map(|j| j.drive).collect(),
                 end_home,
                 end_platform,
                 u_centre,
@@ -871,6 +874,11 @@ pub fn generalized_force<R: Real>(
                 JointKind::Prismatic => dot(lk.e[k], force),
             };
         }
+        // The joints' drives, actuated and passive (the lecture's dissipative term δ and the
+        // rotors' inertia), act at the joints beside the bodies' efforts.
+        for k in 0..n {
+            tau[k] = tau[k] + drive_effort(&lp.drives[k], qd[k], qdd[k]);
+        }
         // End force (or moment) y = J⁻ᵀ τ, to the base frame, then Gᵀ y.
         let y_l = add(
             add(scale(tau[0], lk.jinv[0]), scale(tau[1], lk.jinv[1])),
@@ -1029,6 +1037,12 @@ pub fn generalized_inertia<R: Real>(
                     }
                     mj[i][j] = mj[i][j] + v;
                 }
+            }
+        }
+        // The joints' rotors: `I_a` on the diagonal of the leg's joint-space inertia.
+        for (k, d) in lp.drives.iter().enumerate().take(3) {
+            if d.armature != 0.0 {
+                mj[k][k] = mj[k][k] + R::c(d.armature);
             }
         }
         for i in 0..3 {

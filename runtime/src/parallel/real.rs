@@ -215,3 +215,20 @@ impl Real for f64 {
         }
     }
 }
+
+/// [`Drive::effort`](crate::model::Drive::effort) over [`Real`]: `I_a q̈ + b q̇ + c q̇ / √(q̇² + v_s²)`
+/// (terms with zero coefficients are not formed).
+pub fn drive_effort<R: Real>(d: &crate::model::Drive, qd: R, qdd: R) -> R {
+    let mut e = R::c(0.0);
+    if d.armature != 0.0 {
+        e = e + R::c(d.armature) * qdd;
+    }
+    if d.viscous != 0.0 {
+        e = e + R::c(d.viscous) * qd;
+    }
+    if d.coulomb != 0.0 {
+        let vs = d.coulomb_velocity;
+        e = e + R::c(d.coulomb) * qd / (qd * qd + R::c(vs * vs)).sqrt();
+    }
+    e
+}
