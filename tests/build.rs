@@ -87,6 +87,8 @@ fn main() {
         &format!("point_mass = [{}]", legs.join(", ")),
     );
     generate(&out, "gs_point_legs", &p, |_| {});
+    let p = with_scene(&out, gs, "gs_id_only", "functions = [\"inverse_dynamics\"]");
+    generate(&out, "gs_id_only", &p, |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

@@ -141,7 +141,10 @@ pub fn compile(
                 let params = spec::scene_params(file_name, source, &cfg.scene);
                 Ok(generate_with(&model, cfg, only.as_deref(), params.as_ref()))
             }
-            spec::Mechanism::Parallel(model) => parallel::generate(&model, cfg),
+            spec::Mechanism::Parallel(model) => {
+                let only = spec::scene_functions(file_name, source);
+                parallel::generate_selected(&model, cfg, only.as_deref())
+            }
             spec::Mechanism::Closed(model) => {
                 let only = spec::scene_functions(file_name, source);
                 closed::generate_selected(&model, cfg, only.as_deref())

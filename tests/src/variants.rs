@@ -31,6 +31,13 @@ pub mod gs_point_legs {
 pub mod puma_params {
     include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));
 }
+/// The Gough–Stewart platform with `[scene] functions = ["inverse_dynamics"]`.
+pub mod gs_id_only {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/gs_id_only/gough_stewart.rs"
+    ));
+}
 /// The KUKA iiwa 14 with its angles rounded to 5 digits, generated as written.
 pub mod iiwa_rounded {
     include!(concat!(env!("OUT_DIR"), "/variants/iiwa_rounded/iiwa14.rs"));

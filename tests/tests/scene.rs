@@ -176,14 +176,67 @@ fn scene_functions_for_closed_loops() {
     for f in ["joint_rates", "mass_matrix", "forward_dynamics"] {
         assert!(!g.code.contains(&format!("pub fn {f}(")), "{f} was emitted");
     }
-    // A parallel mechanism says it cannot.
+    // A parallel module keeps its kinematics; an unknown function is an error naming the others.
     let path = tests::pkm::spec_path("agile_eye");
     let src =
-        std::fs::read_to_string(&path).unwrap() + "\n[scene]\nfunctions = [\"inverse_dynamics\"]\n";
+        std::fs::read_to_string(&path).unwrap() + "\n[scene]\nfunctions = [\"inverse_dynamic\"]\n";
     let e = codegen::compile("agile_eye.toml", &src, &codegen::Config::default()).unwrap_err();
     assert!(
-        e.render().contains("not supported for parallel"),
+        e.render().contains("a parallel module offers"),
         "{}",
         e.render()
     );
+}
+
+/// Parallel mechanisms: `functions = ["inverse_dynamics"]` (the module compiled by
+/// `tests/build.rs`) emits the inverse dynamics with the kinematics and nothing else, with the
+/// same results as the full module.
+#[test]
+fn scene_functions_for_parallel_mechanisms() {
+    use mechanisms::gough_stewart as full;
+    use tests::variants::gs_id_only as only;
+    let path = tests::pkm::spec_path("gough_stewart");
+    let src =
+        std::fs::read_to_string(&path).unwrap() + "\n[scene]\nfunctions = [\"inverse_dynamics\"]\n";
+    let g = codegen::compile("gough_stewart.toml", &src, &codegen::Config::default()).unwrap();
+    for f in [
+        "inverse_dynamics",
+        "inverse_kinematics",
+        "forward_kinematics",
+    ] {
+        assert!(g.code.contains(&format!("pub fn {f}(")), "{f} is missing");
+    }
+    for f in [
+        "actuator_rates",
+        "mass_matrix",
+        "actuator_mass_matrix",
+        "forward_dynamics",
+    ] {
+        assert!(!g.code.contains(&format!("pub fn {f}(")), "{f} was emitted");
+    }
+    let names: Vec<&str> = g.stats.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "inverse_kinematics",
+            "inverse_dynamics",
+            "forward_kinematics (per Newton step)"
+        ]
+    );
+    let model = tests::pkm::model("gough_stewart");
+    let plan = runtime::parallel::noc::Plan::new(&model).unwrap();
+    let home = model.home_x();
+    let mut r = tests::rng(51);
+    for _ in 0..50 {
+        let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut r, 0.1, 0.02 * model.size());
+        let (x, u, ud): ([f64; 7], [f64; 6], [f64; 6]) = (
+            x.try_into().unwrap(),
+            u.try_into().unwrap(),
+            ud.try_into().unwrap(),
+        );
+        assert_eq!(
+            only::inverse_dynamics(&x, &u, &ud).unwrap(),
+            full::inverse_dynamics(&x, &u, &ud).unwrap()
+        );
+    }
 }

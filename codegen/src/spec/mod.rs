@@ -374,7 +374,7 @@ fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostic
         let ok = match m {
             Mechanism::Tree(_) => TREE_FUNCTIONS.contains(&f.name.as_str()),
             Mechanism::Closed(_) => CLOSED.contains(&f.name.as_str()),
-            Mechanism::Parallel(_) => false,
+            Mechanism::Parallel(_) => crate::parallel::SELECTABLE.contains(&f.name.as_str()),
         };
         if !ok {
             let hint = match m {
@@ -383,7 +383,10 @@ fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostic
                     "a closed-loop module offers {} (the last two are always emitted)",
                     CLOSED.join(", ")
                 ),
-                Mechanism::Parallel(_) => "choosing functions is not supported for parallel mechanisms yet; remove scene.functions".into(),
+                Mechanism::Parallel(_) => format!(
+                    "a parallel module offers {} (inverse_kinematics and forward_kinematics are always emitted)",
+                    crate::parallel::SELECTABLE.join(", ")
+                ),
             };
             diags.push(
                 Diagnostic::error(format!("cannot select function {:?}", f.name))
