@@ -408,14 +408,16 @@ fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, Vec<usize>) 
         }
         if let Some(m) = doc.child(j, "mimic") {
             let of = doc.tags[m].attr("joint").map_or("?", |a| a.value);
+            // Read as an independent joint, as Pinocchio's URDF parser does by default (so the
+            // coordinates match), with a warning: the coupling is not modelled.
             diags.push(
-                Diagnostic::error(format!(
-                    "joint \"{name}\": mimic joints are not supported (it mimics \"{of}\")"
+                Diagnostic::warning(format!(
+                    "joint \"{name}\" mimics \"{of}\": read as an independent joint"
                 ))
                 .with_key(format!("{jk}.mimic"))
                 .with_span(doc.tags[m].span.clone())
                 .with_hint(
-                    "a mimic joint is a coupling constraint; remove <mimic> to make it an independent joint",
+                    "the coupling q = multiplier·q_other + offset is not modelled: the joint has its own coordinate (as in Pinocchio's default reading); lock it with [scene] locked in a TOML spec, or drive it yourself",
                 ),
             );
         }
@@ -549,6 +551,32 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         }
     };
 
+    // A link named "base" that is not the root (ROS-Industrial robots have `base_link` as the
+    // root and a `base` frame on a fixed joint) would clash with nocdyn's name for the fixed
+    // world: it is read under another name, with a warning.
+    let alias = (root.as_deref() != Some(BASE) && r.links.iter().any(|l| l.name == BASE)).then(|| {
+        let mut a = format!("{BASE}_");
+        while r.links.iter().any(|l| l.name == a) {
+            a.push('_');
+        }
+        if let Some(i) = r.links.iter().position(|l| l.name == BASE) {
+            diags.push(
+                Diagnostic::warning(format!(
+                    "link \"{BASE}\" is read as \"{a}\": \"{BASE}\" names the fixed world (here the root link \"{}\")",
+                    root.as_deref().unwrap_or("?")
+                ))
+                .with_key(format!("link \"{BASE}\""))
+                .with_span(name_span(&link_tags, i)),
+            );
+        }
+        a
+    });
+    let rename = |n: &str| -> String {
+        match &alias {
+            Some(a) if n == BASE => a.clone(),
+            _ => n.to_owned(),
+        }
+    };
     let bodies: Vec<BodySpec> = r
         .links
         .iter()
@@ -563,7 +591,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
                 [it.ixz, it.iyz, it.izz],
             ];
             BodySpec {
-                name: l.name.clone(),
+                name: rename(&l.name),
                 key: format!("link \"{}\"", l.name),
                 span: name_span(&link_tags, i),
                 mass: inl.mass.value,
@@ -607,7 +635,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
             if Some(l) == root.as_deref() {
                 BASE.to_owned()
             } else {
-                l.to_owned()
+                rename(l)
             }
         };
         joints.push(JointSpec {
@@ -618,7 +646,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
             kind_span: attr_span(&joint_tags, i, &[], "type").or_else(|| name_span(&joint_tags, i)),
             parent: end(&j.parent.link),
             parent_span: attr_span(&joint_tags, i, &["parent"], "link"),
-            child: j.child.link.clone(),
+            child: rename(&j.child.link),
             child_span: attr_span(&joint_tags, i, &["child"], "link"),
             placement: Placement::Origin(Transform::from_xyz_rpy(j.origin.xyz.0, j.origin.rpy.0)),
             axes,

@@ -1,0 +1,62 @@
+mod robots {
+    include!(concat!(env!("OUT_DIR"), "/all.rs"));
+}
+
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+}
+
+macro_rules! check {
+    ($m:ident) => {{
+        use robots::$m as g;
+        const N: usize = g::DOF;
+        let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".txt")).unwrap();
+        let mut lines = text.lines();
+        let pin_names: Vec<&str> = lines.next().unwrap().split(' ').collect();
+        assert_eq!(pin_names.len(), N, "{} joint count", stringify!($m));
+        // perm[k] = our index of Pinocchio's joint k
+        let perm: Vec<usize> = pin_names.iter().map(|n| g::JOINT_NAMES.iter().position(|m| m == n).expect("name")).collect();
+        let (mut eid, mut emm, mut efd) = (0.0f64, 0.0f64, 0.0f64);
+        let mut t_gen = std::time::Duration::ZERO;
+        let mut count = 0;
+        for line in lines {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            let take = |k: usize| -> [f64; N] {
+                let mut o = [0.0; N];
+                for i in 0..N { o[perm[i]] = v[k * N + i]; }
+                o
+            };
+            let (q, qd, qdd, tau) = (take(0), take(1), take(2), take(3));
+            let mut mp = [[0.0; N]; N];
+            for i in 0..N { for j in 0..N { mp[perm[i]][perm[j]] = v[4 * N + i * N + j]; } }
+            let off = 4 * N + N * N;
+            let mut t2 = [0.0; N];
+            let mut fdp = [0.0; N];
+            for i in 0..N { t2[perm[i]] = v[off + i]; fdp[perm[i]] = v[off + N + i]; }
+            let t0 = std::time::Instant::now();
+            let id = std::hint::black_box(g::inverse_dynamics(&q, &qd, &qdd));
+            t_gen += t0.elapsed();
+            let mm = g::mass_matrix(&q);
+            let fd = g::forward_dynamics(&q, &qd, &t2).unwrap();
+            eid = eid.max(rel(&id, &tau));
+            emm = emm.max(rel(mm.as_flattened(), mp.as_flattened()));
+            efd = efd.max(rel(&fd, &fdp));
+            count += 1;
+        }
+        println!("{:16} dof {:2}  ID {:.1e}  M {:.1e}  FD {:.1e}  ({} states)", stringify!($m), N, eid, emm, efd, count);
+        let _ = t_gen;
+    }};
+}
+
+fn main() {
+    check!(ur5);
+    check!(ur10);
+    check!(panda);
+    check!(z1);
+    check!(kinova);
+    check!(xarm7);
+    check!(iiwa14);
+    check!(talos_left_arm);
+    check!(baxter);
+}
