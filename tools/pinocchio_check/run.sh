@@ -15,5 +15,11 @@ cp "$D/xarm_description/urdf/xarm7.urdf" urdf/xarm7.urdf
 cp "$D/talos_data/robots/talos_left_arm.urdf" urdf/talos_left_arm.urdf
 cp "$D/baxter_description/urdf/baxter.urdf" urdf/baxter.urdf
 cp ../../mechanisms/specs/iiwa14.urdf urdf/iiwa14.urdf
+cp "$D/pr2_description/urdf/pr2.urdf" urdf/pr2.urdf
+cp "$D/icub_description/robots/icub.urdf" urdf/icub.urdf
+cp "$D/tiago_description/robots/tiago.urdf" urdf/tiago.urdf
+cp "$D/anymal_b_simple_description/robots/anymal.urdf" urdf/anymal.urdf
+cp "$D/talos_data/robots/talos_full_v2.urdf" urdf/talos_full.urdf
+cp "$D/allegro_hand_description/urdf/allegro_right_hand.urdf" urdf/allegro.urdf
 python3 gen.py
 cargo run --release

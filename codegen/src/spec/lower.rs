@@ -160,11 +160,15 @@ fn check_body(b: &BodySpec, diags: &mut Diagnostics) {
                 .with_span(b.inertia_span.clone()),
         );
     } else if let Err((msg, hint)) = geom::check_inertia(&b.inertia) {
+        // A warning: published URDFs carry such tensors (Allegro hand, ANYmal, HyQ, PR2,
+        // TIAGo), and Pinocchio and RBDL take them as given; so does nocdyn.
         diags.push(
-            Diagnostic::error(msg)
+            Diagnostic::warning(msg)
                 .with_key(format!("{}.inertia", b.key))
                 .with_span(b.inertia_span.clone())
-                .with_hint(hint),
+                .with_hint(format!(
+                    "{hint}; the tensor is used as given (as Pinocchio does), but no rigid body has it, and forward dynamics fails where the mass matrix is not positive definite"
+                )),
         );
     }
 }

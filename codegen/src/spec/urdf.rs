@@ -25,6 +25,43 @@ struct Attr<'s> {
     span: Range<usize>,
 }
 
+/// The source with the elements nocdyn ignores blanked out — `<visual>`, `<collision>`,
+/// top-level `<material>`, `<gazebo>`, `<transmission>` — so that urdf-rs does not reject a file
+/// for them (e.g. a `<texture/>` without `filename`, as in iCub's URDF). Blanks keep every byte
+/// offset and line, so spans into the source stay right.
+fn strip_ignored(source: &str, doc: &Doc<'_>) -> String {
+    let mut out = source.as_bytes().to_vec();
+    for t in &doc.tags {
+        let top = t.parent == Some(doc.robot);
+        let ignored = matches!(t.name, "visual" | "collision")
+            || (top && matches!(t.name, "material" | "gazebo" | "transmission"));
+        if !ignored {
+            continue;
+        }
+        let start = t.span.start;
+        let self_closing = source[t.span.clone()].ends_with("/>");
+        let end = if self_closing {
+            t.span.end
+        } else {
+            let close = format!("</{}", t.name);
+            match source[t.span.end..].find(&close) {
+                Some(k) => match source[t.span.end + k..].find('>') {
+                    Some(g) => t.span.end + k + g + 1,
+                    None => continue,
+                },
+                None => continue,
+            }
+        };
+        for b in &mut out[start..end] {
+            if *b != b'\n' {
+                *b = b' ';
+            }
+        }
+    }
+    // Only ASCII bytes were replaced, by ASCII spaces, inside whole elements: still UTF-8.
+    String::from_utf8(out).unwrap_or_else(|_| source.to_owned())
+}
+
 /// One start (or empty-element) tag.
 #[derive(Clone, Debug)]
 struct Tag<'s> {
@@ -497,7 +534,8 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         return None;
     }
     let robot_span = doc.tags[robot].name_span();
-    let r = match urdf_rs::read_from_string(source) {
+    let stripped = strip_ignored(source, &doc);
+    let r = match urdf_rs::read_from_string(&stripped) {
         Ok(r) => r,
         Err(e) => {
             diags.push(

@@ -59,4 +59,10 @@ fn main() {
     check!(iiwa14);
     check!(talos_left_arm);
     check!(baxter);
+    check!(pr2);
+    check!(icub);
+    check!(tiago);
+    check!(anymal);
+    check!(talos_full);
+    check!(allegro);
 }
