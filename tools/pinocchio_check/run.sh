@@ -3,7 +3,7 @@
 # Needs network access for pip. Usage: bash tools/pinocchio_check/run.sh
 set -euo pipefail
 cd "$(dirname "$0")"
-python3 -m pip install --quiet pin example-robot-data
+python3 -m pip install --quiet pin example-robot-data cmeel-eigen cmeel-urdfdom-headers
 D=$(python3 -c "import site; print(site.getsitepackages()[0])")/cmeel.prefix/share/example-robot-data/robots
 mkdir -p urdf data
 cp "$D/ur_description/urdf/ur5_robot.urdf" urdf/ur5.urdf
@@ -23,3 +23,15 @@ cp "$D/talos_data/robots/talos_full_v2.urdf" urdf/talos_full.urdf
 cp "$D/allegro_hand_description/urdf/allegro_right_hand.urdf" urdf/allegro.urdf
 python3 gen.py
 cargo run --release
+# Pinocchio's own timing of the same URDFs (header-only build, -O3, the defines of its CMake
+# config), to set beside the `ns:` columns above.
+P=$(python3 -c "import site; print(site.getsitepackages()[0])")/cmeel.prefix
+g++ -O3 -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS -DBOOST_MPL_LIMIT_LIST_SIZE=30 \
+  -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 -DBOOST_FUSION_INVOKE_MAX_ARITY=12 -DPINOCCHIO_WITH_URDFDOM \
+  -DPINOCCHIO_URDFDOM_HEADERS_MAJOR_VERSION=3 -DPINOCCHIO_URDFDOM_HEADERS_MINOR_VERSION=0 \
+  -DPINOCCHIO_URDFDOM_HEADERS_PATCH_VERSION=0 bench.cpp -I"$P/include" -I"$P/include/eigen3" \
+  -I"$P/include/urdfdom_headers" -L"$P/lib" -lpinocchio_default -lpinocchio_parsers -lurdfdom_model \
+  -lboost_filesystem -Wl,-rpath,"$P/lib" -o pinocchio_bench
+./pinocchio_bench urdf/ur5.urdf urdf/ur10.urdf urdf/panda.urdf urdf/z1.urdf urdf/kinova.urdf \
+  urdf/xarm7.urdf urdf/iiwa14.urdf urdf/talos_left_arm.urdf urdf/baxter.urdf urdf/pr2.urdf \
+  urdf/icub.urdf urdf/tiago.urdf urdf/anymal.urdf urdf/talos_full.urdf urdf/allegro.urdf

@@ -44,8 +44,38 @@ macro_rules! check {
             efd = efd.max(rel(&fd, &fdp));
             count += 1;
         }
-        println!("{:16} dof {:2}  ID {:.1e}  M {:.1e}  FD {:.1e}  ({} states)", stringify!($m), N, eid, emm, efd, count);
         let _ = t_gen;
+        // Timing: median over 31 batches of all states, ns per call (as tools/pinocchio_check/bench.cpp).
+        let states: Vec<([f64; N], [f64; N], [f64; N])> = text
+            .lines()
+            .skip(1)
+            .map(|line| {
+                let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+                let take = |k: usize| -> [f64; N] {
+                    let mut o = [0.0; N];
+                    for i in 0..N { o[perm[i]] = v[k * N + i]; }
+                    o
+                };
+                (take(0), take(1), take(2))
+            })
+            .collect();
+        let time = |f: &dyn Fn(&([f64; N], [f64; N], [f64; N])) -> f64| {
+            let mut t: Vec<f64> = (0..31)
+                .map(|_| {
+                    let t0 = std::time::Instant::now();
+                    let mut sink = 0.0;
+                    for s in &states { sink += f(std::hint::black_box(s)); }
+                    std::hint::black_box(sink);
+                    t0.elapsed().as_nanos() as f64 / states.len() as f64
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[15]
+        };
+        let tid = time(&|(q, qd, qdd)| g::inverse_dynamics(q, qd, qdd)[0]);
+        let tmm = time(&|(q, _, _)| g::mass_matrix(q)[0][0]);
+        let tfd = time(&|(q, qd, qdd)| g::forward_dynamics(q, qd, qdd).map(|a| a[0]).unwrap_or(0.0));
+        println!("{:16} dof {:2}  ID {:.1e}  M {:.1e}  FD {:.1e}  ({} states)  ns: ID {:.0} M {:.0} FD {:.0}", stringify!($m), N, eid, emm, efd, count, tid, tmm, tfd);
     }};
 }
 
