@@ -64,17 +64,12 @@ pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<Close
                     .with_hint("loop-closing joints are revolute or spherical; put the other joint of the loop in the tree (without child_origin) and close the loop at a revolute or spherical joint"),
                 );
             }
-            if j.drive != Default::default() {
-                diags.push(
-                    Diagnostic::error(format!(
-                        "joint \"{}\" closes a loop: friction and rotor inertia are not modelled there",
-                        j.name
-                    ))
-                    .with_key(j.key.clone())
-                    .with_span(j.span.clone())
-                    .with_hint("drives (damping, friction, armature) apply to tree joints, whose rates are coordinates; close the loop at a joint without them"),
-                );
-            }
+            super::no_drive(
+                j,
+                "closes a loop",
+                "drives (damping, friction, armature) apply to tree joints, whose rates are coordinates; close the loop at a joint without them",
+                diags,
+            );
             if j.actuated {
                 diags.push(
                     Diagnostic::error(format!(

@@ -235,6 +235,22 @@ pub const TREE_FUNCTIONS: [&str; 6] = [
     "friction",
 ];
 
+/// An error when joint `j`, which `role` (e.g. "closes a loop"), has a drive: friction and rotor
+/// inertia are modelled only where the joint's rate is known.
+fn no_drive(j: &ir::JointSpec, role: &str, hint: &str, diags: &mut Diagnostics) {
+    if j.drive != Default::default() {
+        diags.push(
+            Diagnostic::error(format!(
+                "joint \"{}\" {role}: friction and rotor inertia are not modelled there",
+                j.name
+            ))
+            .with_key(j.key.clone())
+            .with_span(j.span.clone())
+            .with_hint(hint),
+        );
+    }
+}
+
 /// The passes between reading and lowering: the overrides on top of the spec's `[scene]`,
 /// snapping, then the scene's changes to the bodies and joints.
 fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {

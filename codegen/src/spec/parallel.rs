@@ -355,17 +355,12 @@ fn lower_checked(
         let (origin, _) = lower::placement_frames(&j.placement);
         let frame = compose(&pose_in_tip, &origin);
         let child_origin = j.child_origin.unwrap_or(Transform::IDENTITY);
-        if j.drive != Default::default() {
-            diags.push(
-                Diagnostic::error(format!(
-                    "joint \"{}\" meets the platform: friction and rotor inertia are not modelled there",
-                    j.name
-                ))
-                .with_key(j.key.clone())
-                .with_span(j.span.clone())
-                .with_hint("drives (damping, friction, armature) apply to the leg joints whose rates the leg Jacobian gives; remove them from the joint into the platform"),
-            );
-        }
+        super::no_drive(
+            j,
+            "meets the platform",
+            "drives (damping, friction, armature) apply to the leg joints whose rates the leg Jacobian gives; remove them from the joint into the platform",
+            diags,
+        );
         let end = match j.kind {
             // A planar point platform: the revolute joint at the point only ties the point.
             Kind::Revolute if motion == Coordinates::Planar => LegEnd::Spherical {
