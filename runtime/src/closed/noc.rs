@@ -1043,6 +1043,27 @@ pub fn generalized_effort(
     finite(generalized_force(plan, &c, u, ud, gravity))
 }
 
+/// The kept loop equations at `(x, ẋ)` for integrators in redundant coordinates (all the tree's
+/// joint coordinates): their values `Φ(x)`, the Jacobian `Φ_x` (one row per kept equation, `NX`
+/// columns) and the acceleration bias `Φ̇_x ẋ`, so that `Φ̈ = Φ_x ẍ + Φ̇_x ẋ`. No factorization:
+/// valid at singular configurations too.
+pub fn constraints(plan: &Plan, x: &[f64], xd: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>, Vec<f64>) {
+    let kin = kinematics(plan, x);
+    let m = motions(plan, &kin, xd, None);
+    let phi = plan.rows.iter().map(|r| row_value(plan, &kin, r)).collect();
+    let jac = plan
+        .rows
+        .iter()
+        .map(|r| jacobian_row(plan, &kin, r))
+        .collect();
+    let bias = plan
+        .rows
+        .iter()
+        .map(|r| row_bias(plan, &kin, &m, r))
+        .collect();
+    (phi, jac, bias)
+}
+
 /// The generalized inertia of the independent coordinates.
 pub fn mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
     check_finite(&[x])?;
