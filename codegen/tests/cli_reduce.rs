@@ -66,3 +66,34 @@ fn heavy_legs_stay_light_legs_lose_their_rotational_inertia() {
     codegen::compile("light.toml", &reduced, &codegen::Config::default())
         .unwrap_or_else(|d| panic!("{d}"));
 }
+
+/// `--time` compiles each row's inverse dynamics with rustc and times it on the same states: a
+/// `ns per call` column with positive numbers.
+#[test]
+fn time_column() {
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/planar_2r.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .args([
+            "reduce",
+            spec.to_str().unwrap(),
+            "--samples",
+            "20",
+            "--time",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(table.contains("| ns per call |"), "{table}");
+    let reference = table
+        .lines()
+        .find(|l| l.starts_with("| full model |"))
+        .unwrap();
+    let ns: f64 = reference.split('|').nth(3).unwrap().trim().parse().unwrap();
+    assert!(ns > 0.0 && ns < 1e6, "{reference}");
+}

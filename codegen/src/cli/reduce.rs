@@ -31,6 +31,72 @@ pub struct ReduceArgs {
     /// Write the reduced spec here (default: standard output).
     #[arg(short, long, value_name = "OUT.toml")]
     pub output: Option<PathBuf>,
+    /// Also time each row's generated inverse dynamics: compile it with `rustc -C opt-level=3`
+    /// (on PATH, or `$RUSTC`) into a small timing program run on the same states, and add an
+    /// `ns per call` column (median of 31 batches). Slower: one compilation per row.
+    #[arg(long)]
+    pub time: bool,
+}
+
+/// ns per call of the inverse dynamics generated from `src`, timed on `states` by a program
+/// compiled with rustc; `None` when rustc or the program fails (the column then says why not).
+fn time_generated(name: &str, src: &str, m: &Mechanism, states: &[State]) -> Option<f64> {
+    let cfg = codegen::Config {
+        math: codegen::MathBackend::Std,
+        ..Default::default()
+    };
+    let module = codegen::compile(name, src, &cfg).ok()?.code;
+    let dir = std::env::temp_dir().join(format!("nocdyn-reduce-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).ok()?;
+    let lit = |v: &[f64]| {
+        let items: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
+        format!("[{}]", items.join(", "))
+    };
+    let rows: Vec<String> = states
+        .iter()
+        .map(|(a, b, c)| format!("({}, {}, {})", lit(a), lit(b), lit(c)))
+        .collect();
+    let call = match m {
+        Mechanism::Tree(_) => "m::inverse_dynamics(a, b, c)[0]",
+        _ => "m::inverse_dynamics(a, b, c).map_or(0.0, |t| t[0])",
+    };
+    let main = format!(
+        "#![allow(warnings)]\nmod m {{ include!(\"module.rs\"); }}\n\
+         const S: &[([f64; {na}], [f64; {nb}], [f64; {nb}])] = &[{rows}];\n\
+         fn main() {{\n\
+             let mut t: Vec<f64> = (0..31).map(|_| {{\n\
+                 let t0 = std::time::Instant::now();\n\
+                 let mut sink = 0.0;\n\
+                 for (a, b, c) in std::hint::black_box(S) {{ sink += {call}; }}\n\
+                 std::hint::black_box(sink);\n\
+                 t0.elapsed().as_nanos() as f64 / S.len() as f64\n\
+             }}).collect();\n\
+             t.sort_by(f64::total_cmp);\n\
+             println!(\"{{}}\", t[15]);\n\
+         }}\n",
+        na = states[0].0.len(),
+        nb = states[0].1.len(),
+        rows = rows.join(", "),
+    );
+    std::fs::write(dir.join("module.rs"), module).ok()?;
+    std::fs::write(dir.join("main.rs"), main).ok()?;
+    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
+    let exe = dir.join("timing");
+    let ok = std::process::Command::new(rustc)
+        .args(["--edition", "2021", "-C", "opt-level=3", "-o"])
+        .arg(&exe)
+        .arg(dir.join("main.rs"))
+        .output()
+        .ok()?
+        .status
+        .success();
+    let out = if ok {
+        std::process::Command::new(&exe).output().ok()
+    } else {
+        None
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    String::from_utf8(out?.stdout).ok()?.trim().parse().ok()
 }
 
 /// A fidelity level: which bodies are point masses, which massless.
@@ -248,6 +314,18 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
         let (worst, rms) = errors(&m, &samples, &reference)?;
         Some((flops(level)?, worst, rms))
     };
+    let ns = |level: &Level| -> String {
+        if !args.time {
+            return String::new();
+        }
+        let src = format!("{source}{}", level.scene());
+        match time_generated(&name, &src, &full, &samples) {
+            Some(t) => format!(" {t:.0} |"),
+            None => " (rustc failed) |".into(),
+        }
+    };
+    let ns_head = if args.time { " ns per call |" } else { "" };
+    let ns_rule = if args.time { "---:|" } else { "" };
     let mut current = Level::default();
     let Some((mut cost, _, _)) = evaluate(&current) else {
         eprintln!("error: {name}: the full model cannot be generated");
@@ -261,10 +339,14 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
         args.tolerance
     );
     println!(
-        "| fidelity | inverse dynamics flops | max relative error | RMS relative error | accepted |"
+        "| fidelity | inverse dynamics flops |{ns_head} max relative error | RMS relative error | accepted |"
     );
-    println!("|---|---:|---:|---:|---|");
-    println!("| {} | {cost} | 0 | 0 | (reference) |", current.describe());
+    println!("|---|---:|{ns_rule}---:|---:|---|");
+    println!(
+        "| {} | {cost} |{} 0 | 0 | (reference) |",
+        current.describe(),
+        ns(&current)
+    );
     loop {
         let mut best: Option<(Level, usize, f64, f64)> = None;
         for g in &groups {
@@ -293,8 +375,9 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
                 };
                 let ok = worst <= args.tolerance && f < cost;
                 println!(
-                    "| {} | {f} | {worst:.2e} | {rms:.2e} | {} |",
+                    "| {} | {f} |{} {worst:.2e} | {rms:.2e} | {} |",
                     l.describe(),
+                    ns(&l),
                     if ok { "yes" } else { "no" }
                 );
                 if ok && best.as_ref().is_none_or(|b| f < b.1) {
