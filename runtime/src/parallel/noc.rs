@@ -23,6 +23,12 @@
 //!    `f = I u̇ + C u − γ` of the speeds `u`.
 //! 6. Actuator efforts `τ = A⁻ᵀ f` where `q̇ = A u` stacks the actuated rows of the `J_J⁻¹ G`
 //!    (eqs. 66–72); [`lu_solve`] factorizes `A` with partial pivoting.
+//!
+//! A UPS leg with a perpendicular U whose second axis is perpendicular to the leg (and a
+//! massless cross) takes a closed form instead of steps 3–5 and of `J_J⁻¹` in `A`
+//! ([`UpsPlan`], `ups_force`; Khalil & Guegan 2004): its frame follows from the leg direction
+//! `s`, its row of `A` is `[(R p) × s; s]`, and its force on the platform comes from a few scalar
+//! equations in that frame. The generic route still gives its inertia (`generalized_inertia`).
 
 // Index loops read like the equations; negated float comparisons make NaN fail the test.
 #![allow(
@@ -185,7 +191,7 @@ pub struct UpsBody {
 }
 
 /// The constants of the closed-form UPS leg (Khalil & Guegan, IEEE T-RO 20(4), 2004, §III;
-/// derivation in [`ups_force`]). It applies when the U's two axes are perpendicular, its second
+/// derivation at `ups_force`). It applies when the U's two axes are perpendicular, its second
 /// axis is perpendicular to the prismatic axis (so the three make the leg frame below) and the
 /// U's cross is massless.
 ///
@@ -197,8 +203,6 @@ pub struct UpsBody {
 pub struct UpsPlan {
     /// The U's first axis `e₀` (base frame, unit).
     pub e0: Vec3,
-    /// The U centre (base frame).
-    pub centre: Vec3,
     /// The leg's massive bodies after the U's cross (cylinder, piston, …).
     pub bodies: Vec<UpsBody>,
     /// The home leg length (the sliding bodies' mass centres are given there).
@@ -322,7 +326,6 @@ fn ups_plan(lp: &LegPlan) -> Option<UpsPlan> {
     let f = &lp.frame;
     Some(UpsPlan {
         e0: snap([mat_vec(&f.rotation, &e0), [0.0; 3], [0.0; 3]])[0],
-        centre: f.apply(&lp.u_centre),
         bodies,
         length: lp.length,
     })
@@ -645,11 +648,11 @@ pub struct LegKin<R> {
 /// The configuration of a closed-form UPS leg (base frame; see [`UpsPlan`]).
 #[derive(Clone, Copy, Debug)]
 pub struct UpsKin<R> {
-    /// Leg length `ρ` (U centre to S centre) and its inverse.
+    /// Leg length `ρ` (U centre to S centre).
     pub rho: R,
     /// `1/ρ`.
     pub inv_rho: R,
-    /// `c/d` (cotangent of the angle between the leg and the U's first axis) and `1/d`.
+    /// `c/d`.
     pub cot: R,
     /// `1/d`.
     pub inv_d: R,
