@@ -295,3 +295,63 @@ fn singular_home_is_rejected() {
     assert!(e.contains("singular at its home pose"), "{e}");
     assert!(Plan::new(&gough_stewart_at_yaw(0.3)).is_ok());
 }
+
+/// The closed-form UPS leg (`noc::UpsPlan`) against the generic route (chain recursion, adjugate
+/// inverse of `J_J`): the same generalized force and actuation matrix, for the platform above,
+/// for one with off-axis mass centres and full inertia matrices, and for U joints whose axes
+/// are swapped (the other branch of the leg frame, `d < 0`).
+#[test]
+fn closed_form_ups_leg_matches_generic_route() {
+    let plain = gough_stewart();
+    let mut skew = gough_stewart();
+    for leg in skew.legs.iter_mut() {
+        leg.bodies[1].com = [0.013, -0.021, 0.47];
+        leg.bodies[1].inertia = [
+            [0.006, 0.0004, -0.0003],
+            [0.0004, 0.007, 0.0002],
+            [-0.0003, 0.0002, 0.002],
+        ];
+        leg.bodies[2].com[0] = -0.017;
+        leg.bodies[2].com[1] = 0.008;
+        leg.bodies[2].inertia[0][2] = 0.0005;
+        leg.bodies[2].inertia[2][0] = 0.0005;
+    }
+    let mut swapped = skew.clone();
+    for leg in swapped.legs.iter_mut() {
+        leg.joints[0].axis = [0.0, 1.0, 0.0];
+        leg.joints[1].axis = [1.0, 0.0, 0.0];
+    }
+    for m in [plain, skew, swapped] {
+        let plan = Plan::new(&m).unwrap();
+        assert!(plan.legs.iter().all(|l| l.ups.is_some()));
+        let mut generic = plan.clone();
+        for l in generic.legs.iter_mut() {
+            l.ups = None;
+        }
+        let mut s = 5u64;
+        let mut worst: f64 = 0.0;
+        for _ in 0..50 {
+            let x = pose(
+                [0.2 * lcg(&mut s), 0.2 * lcg(&mut s), 0.3 * lcg(&mut s)],
+                [0.2 * lcg(&mut s), 0.2 * lcg(&mut s), 0.2 * lcg(&mut s)],
+            );
+            let u: Vec<f64> = (0..6).map(|_| lcg(&mut s)).collect();
+            let ud: Vec<f64> = (0..6).map(|_| lcg(&mut s)).collect();
+            let a = noc::generalized_effort(&plan, &x, &u, &ud).unwrap();
+            let b = noc::generalized_effort(&generic, &x, &u, &ud).unwrap();
+            let big = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for k in 0..6 {
+                worst = worst.max((a[k] - b[k]).abs() / big);
+            }
+            let aa = noc::actuation(&plan, &x).unwrap();
+            let ab = noc::actuation(&generic, &x).unwrap();
+            for r in 0..6 {
+                for c in 0..6 {
+                    worst = worst.max((aa[r][c] - ab[r][c]).abs());
+                }
+            }
+        }
+        println!("closed form vs generic: worst {worst:.1e}");
+        assert!(worst < 1e-13, "{}: {worst:e}", m.name);
+    }
+}

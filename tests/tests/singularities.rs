@@ -524,24 +524,25 @@ fn reference_agrees_with_runtime_at_generic_states() {
 ///
 /// | δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) | runtime, static | runtime, dynamic (worst) | generated, static | generated, dynamic (worst) |
 /// |---:|---:|---:|---:|---|---|---|---|
-/// | 1e-1 | 3.54e2 | 5.27e3 | 7.94e3 | Ok 8.6e-14 | Ok 8.6e-14 | Ok 8.6e-14 | Ok 8.6e-14 |
-/// | 1e-2 | 3.55e3 | 5.27e4 | 7.96e4 | Ok 4.4e-13 | Ok 4.4e-13 | Ok 4.4e-13 | Ok 4.4e-13 |
-/// | 1e-3 | 3.55e4 | 5.27e5 | 7.96e5 | Ok 3.0e-13 | Ok 3.0e-13 | Ok 3.0e-13 | Ok 3.0e-13 |
-/// | 1e-4 | 3.55e5 | 5.27e6 | 7.96e6 | Ok 1.9e-10 | Ok 1.9e-10 | Ok 1.9e-10 | Ok 1.9e-10 |
-/// | 1e-5 | 3.55e6 | 5.27e7 | 7.96e7 | Ok 6.0e-10 | Ok 6.0e-10 | Ok 6.0e-10 | Ok 6.0e-10 |
-/// | 1e-6 | 3.55e7 | 5.27e8 | 7.96e8 | Ok 2.2e-10 | Ok 2.2e-10 | Ok 2.2e-10 | Ok 2.2e-10 |
+/// | 1e-1 | 3.54e2 | 5.27e3 | 7.94e3 | Ok 7.8e-14 | Ok 7.8e-14 | Ok 7.8e-14 | Ok 7.8e-14 |
+/// | 1e-2 | 3.55e3 | 5.27e4 | 7.96e4 | Ok 7.3e-13 | Ok 7.3e-13 | Ok 7.3e-13 | Ok 7.3e-13 |
+/// | 1e-3 | 3.55e4 | 5.27e5 | 7.96e5 | Ok 1.9e-12 | Ok 1.9e-12 | Ok 1.9e-12 | Ok 1.9e-12 |
+/// | 1e-4 | 3.55e5 | 5.27e6 | 7.96e6 | Ok 1.4e-10 | Ok 1.4e-10 | Ok 1.4e-10 | Ok 1.4e-10 |
+/// | 1e-5 | 3.55e6 | 5.27e7 | 7.96e7 | Ok 4.6e-10 | Ok 4.6e-10 | Ok 4.6e-10 | Ok 4.6e-10 |
+/// | 1e-6 | 3.55e7 | 5.27e8 | 7.96e8 | Ok 3.3e-9 | Ok 3.3e-9 | Ok 3.3e-9 | Ok 3.3e-9 |
 /// | 1e-7 | 3.55e8 | 5.27e9 | 7.96e9 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 |
 /// | 1e-8 | 3.55e9 | 5.27e10 | 7.96e10 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 |
 /// | 1e-9 | 3.55e10 | 5.27e11 | 7.96e11 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 |
 /// | 1e-10 | 3.55e11 | 5.27e12 | 7.96e12 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 |
-/// | 1e-11 | 3.55e12 | 5.27e13 | 7.95e13 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 | Err Act(5) 3.5e12 |
-/// | 1e-12 | 3.55e13 | 5.27e14 | 7.95e14 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 | Err Act(5) 3.5e13 |
-/// | 0 | 1.80e16 | 2.68e17 | 4.04e17 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 | Err Act(5) 8.4e15 |
+/// | 1e-11 | 3.55e12 | 5.27e13 | 7.95e13 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 |
+/// | 1e-12 | 3.56e13 | 5.28e14 | 7.97e14 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 |
+/// | 0 | 5.54e31 | 8.23e32 | 3.45e33 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 |
 ///
 /// The conditioning grows exactly like 1/δ (pivot ratio ≈ 35.5/δ°), so the singularity is at
-/// 90° to within the rounding of the spec's constants (at δ = 0 even double-double sees a
-/// pivot ratio of only 1.8e16, not an exactly singular `A`). Both `f64` routes are accurate to
-/// ≤ 6e-10 while they answer and switch to `Err(Actuation(5))` between δ = 1e-6° and 1e-7°
+/// 90° to within the rounding of the spec's constants (at δ = 0 double-double sees a pivot
+/// ratio of 5.5e31: `A`'s rows, `[(R p_i) × s_i; s_i]` in the closed-form UPS leg, are singular
+/// to its precision). Both `f64` routes are accurate to ≤ 3.3e-9 (about `ε` times the pivot
+/// ratio) while they answer and switch to `Err(Actuation(5))` between δ = 1e-6° and 1e-7°
 /// (the 1e-8 pivot-ratio tolerance), with condition estimates that track the double-double
 /// pivot ratio. The relative error is the same for every state: near the singularity `τ` is
 /// dominated by its component along the null direction of `Aᵀ`, whose relative error is that of

@@ -23,6 +23,12 @@
 //!    `f = I u̇ + C u − γ` of the speeds `u`.
 //! 6. Actuator efforts `τ = A⁻ᵀ f` where `q̇ = A u` stacks the actuated rows of the `J_J⁻¹ G`
 //!    (eqs. 66–72); [`lu_solve`] factorizes `A` with partial pivoting.
+//!
+//! A UPS leg with a perpendicular U whose second axis is perpendicular to the leg (and a
+//! massless cross) takes a closed form instead of steps 3–5 and of `J_J⁻¹` in `A`
+//! ([`UpsPlan`], `ups_force`; Khalil & Guegan 2004): its frame follows from the leg direction
+//! `s`, its row of `A` is `[(R p) × s; s]`, and its force on the platform comes from a few scalar
+//! equations in that frame. The generic route still gives its inertia (`generalized_inertia`).
 
 // Index loops read like the equations; negated float comparisons make NaN fail the test.
 #![allow(
@@ -167,6 +173,42 @@ pub struct LegPlan {
     pub sigma_u: f64,
     /// Branch of the first joint's subproblem (PUS, RUS) or the prismatic direction (UPS).
     pub sigma_first: f64,
+    /// The closed form of a UPS leg (see [`UpsPlan`]); `None` for other legs, or a UPS leg
+    /// whose geometry it does not cover (those take the generic route).
+    pub ups: Option<UpsPlan>,
+}
+
+/// One body of a closed-form UPS leg, resolved in the leg frame `(t, e₁′, s)` (see
+/// [`UpsPlan`]).
+#[derive(Clone, Debug)]
+pub struct UpsBody {
+    /// Mass.
+    pub mass: f64,
+    /// Mass centre relative to the U centre at home length (leg frame).
+    pub com: Vec3,
+    /// Inertia about the mass centre (leg frame, constant).
+    pub inertia: Mat3,
+    /// The body rides on the prismatic joint (its mass centre moves by `ρ − ρ_home` along `s`).
+    pub slides: bool,
+}
+
+/// The constants of the closed-form UPS leg (Khalil & Guegan, IEEE T-RO 20(4), 2004, §III;
+/// derivation at `ups_force`). It applies when the U's two axes are perpendicular, its second
+/// axis is perpendicular to the prismatic axis (so the three make the leg frame below) and the
+/// U's cross is massless.
+///
+/// The leg frame `(t, e₁′, s)` is fixed in the cylinder: `s` the unit leg direction (U centre →
+/// S centre), `e₁′` the U's second axis, `t = e₁′ × s`. With `e₀` the U's first (base-fixed)
+/// axis, `c = e₀·s` and `d = ±√(1 − c²)` (the branch `sigma_u`), `e₀ = d t + c s`, so
+/// `e₁′ = −(e₀ × s)/d` and `t = (e₀ − c s)/d`: the frame follows from `s` alone.
+#[derive(Clone, Debug)]
+pub struct UpsPlan {
+    /// The U's first axis `e₀` (base frame, unit).
+    pub e0: Vec3,
+    /// The leg's massive bodies after the U's cross (cylinder, piston, …).
+    pub bodies: Vec<UpsBody>,
+    /// The home leg length (the sliding bodies' mass centres are given there).
+    pub length: f64,
 }
 
 /// The constant data of a whole mechanism: what the evaluators need, prepared once.
@@ -213,6 +255,82 @@ fn meet(p: &Vec3, e: &Vec3, q: &Vec3, f: &Vec3) -> Vec3 {
 
 fn sign(x: f64) -> f64 {
     if x < 0.0 { -1.0 } else { 1.0 }
+}
+
+/// `x` with the entries below `1e-14` of its largest set to zero (constants of the leg frame
+/// that are zero but for the rounding of a rotation: they fold away in generated code).
+fn snap(mut m: Mat3) -> Mat3 {
+    let big = m.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+    for v in m.iter_mut().flatten() {
+        if v.abs() <= 1e-14 * big {
+            *v = 0.0;
+        }
+    }
+    m
+}
+
+/// The closed form's constants for a UPS leg, or `None` when its geometry is not covered
+/// (see [`UpsPlan`]).
+fn ups_plan(lp: &LegPlan) -> Option<UpsPlan> {
+    let (e0, e1) = (lp.axes[0], lp.axes[1]);
+    let sh = sub3(&lp.end_home, &lp.u_centre);
+    let sh = [sh[0] / lp.length, sh[1] / lp.length, sh[2] / lp.length];
+    let massless = |k: usize| {
+        let (m, _, i) = lp.bodies[k];
+        m == 0.0 && i.iter().flatten().all(|&x| x == 0.0)
+    };
+    if dot3(&e0, &e1).abs() > 1e-12
+        || dot3(&e1, &sh).abs() > 1e-12
+        || !massless(0)
+        || lp.actuated != 2
+    {
+        return None;
+    }
+    // The leg frame at home (L): t = (e₀ − c s)/d, e₁′ = s × t (= e₁), s.
+    let c = dot3(&e0, &sh);
+    let d = dot3(&cross3(&e0, &e1), &sh);
+    let t = [
+        (e0[0] - c * sh[0]) / d,
+        (e0[1] - c * sh[1]) / d,
+        (e0[2] - c * sh[2]) / d,
+    ];
+    let y = cross3(&sh, &t);
+    // Leg-frame coordinates of an L vector: Bᵀ x with B = [t e₁′ s].
+    let bt = snap([t, y, sh]);
+    let to_leg = |x: &Vec3| mat_vec(&bt, x);
+    let bodies = (1..lp.bodies.len())
+        .filter(|&k| !massless(k))
+        .map(|k| {
+            let (mass, com, inertia) = lp.bodies[k];
+            let h = &lp.homes[k];
+            let q = snap(crate::model::mat_mul(&bt, &h.rotation));
+            let isotropic = inertia[0][0] == inertia[1][1]
+                && inertia[1][1] == inertia[2][2]
+                && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
+                && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3];
+            let inertia = if isotropic {
+                inertia
+            } else {
+                snap(crate::model::mat_mul(
+                    &crate::model::mat_mul(&q, &inertia),
+                    &crate::model::transpose(&q),
+                ))
+            };
+            let rel = sub3(&h.apply(&com), &lp.u_centre);
+            UpsBody {
+                mass,
+                com: snap([to_leg(&rel), [0.0; 3], [0.0; 3]])[0],
+                inertia,
+                slides: k >= 2,
+            }
+        })
+        .collect();
+    let f = &lp.frame;
+    Some(UpsPlan {
+        e0: snap([mat_vec(&f.rotation, &e0), [0.0; 3], [0.0; 3]])[0],
+        bodies,
+        length: lp.length,
+    })
 }
 
 impl Plan {
@@ -283,6 +401,7 @@ impl Plan {
                 length: 0.0,
                 sigma_u: 1.0,
                 sigma_first: 1.0,
+                ups: None,
             };
             match kind {
                 LegKind::Ups => {
@@ -290,6 +409,7 @@ impl Plan {
                     plan.length = libm::sqrt(dot3(&d, &d));
                     plan.sigma_first = sign(dot3(&d, &axes[2]));
                     plan.sigma_u = sign(dot3(&d, &k));
+                    plan.ups = ups_plan(&plan);
                 }
                 LegKind::Pus => {
                     let d = sub3(&end_home, &u_centre);
@@ -524,6 +644,27 @@ pub struct LegKin<R> {
     pub frame: M<R>,
     /// The end point relative to the platform origin, base frame (spherical end; zero else).
     pub arm: V<R>,
+    /// The closed-form UPS leg's frame (when [`LegPlan::ups`] is set).
+    pub ups: Option<UpsKin<R>>,
+}
+
+/// The configuration of a closed-form UPS leg (base frame; see [`UpsPlan`]).
+#[derive(Clone, Copy, Debug)]
+pub struct UpsKin<R> {
+    /// Leg length `ρ` (U centre to S centre).
+    pub rho: R,
+    /// `1/ρ`.
+    pub inv_rho: R,
+    /// `c/d`.
+    pub cot: R,
+    /// `1/d`.
+    pub inv_d: R,
+    /// The leg frame: `t`, `e₁′`, `s` (base frame, unit).
+    pub t: V<R>,
+    /// `e₁′`.
+    pub e1: V<R>,
+    /// `s`.
+    pub s: V<R>,
 }
 
 /// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`.
@@ -537,27 +678,56 @@ pub fn leg_kinematics<R: Real>(
     let ft: V<R> = cv(&lp.frame.translation);
     let n = lp.joints.len();
     // The end target in L.
-    let (target, arm) = match lp.kind {
+    let (target, arm, end_base) = match lp.kind {
         LegKind::SphericalRr => {
             let axis = mv(&pl.rot, cv(&lp.end_platform));
-            (mtv(&fr, axis), zero3())
+            (mtv(&fr, axis), zero3(), zero3())
+        }
+        LegKind::Ups => {
+            // The target is not needed: the leg vector is formed in the base frame.
+            let arm = mv(&pl.rot, cv(&lp.end_platform));
+            (zero3(), arm, add(pl.origin, arm))
         }
         _ => {
             let arm = mv(&pl.rot, cv(&lp.end_platform));
             let a = add(pl.origin, arm);
-            (mtv(&fr, sub(a, ft)), arm)
+            (mtv(&fr, sub(a, ft)), arm, a)
         }
     };
     // Closed-form inverse kinematics.
     let mut q: Vec<JointPos<R>> = Vec::with_capacity(n);
+    let mut ups = None;
     match lp.kind {
         LegKind::Ups => {
-            let r = sub(target, cv(&lp.u_centre));
+            // The leg vector U centre → S centre in the base frame (the same as in L, rotated).
+            let r = sub(end_base, cv(&lp.frame.apply(&lp.u_centre)));
             let rr = dot(r, r);
             let rr = R::check(rr, R::c(0.0), R::c(1.0), Site::Reach(k), false)?;
             let rho = rr.sqrt();
             let d = R::c(lp.sigma_first) * (rho - R::c(lp.length));
-            let dir = scale(R::c(1.0) / rho, r);
+            let inv_rho = R::c(1.0) / rho;
+            let s = scale(inv_rho, r);
+            if let Some(up) = &lp.ups {
+                // The leg frame (UpsPlan): c = e₀·s, d² = |e₀ × s|² (= 1 − c², formed so that
+                // it keeps its relative accuracy near the U's singularity d → 0, where e₀ ∥ s;
+                // the same test as `two_axes`' γ² ≤ 0).
+                let e0 = cv::<R>(&up.e0);
+                let c = dot(e0, s);
+                let m = cross(e0, s);
+                let d2 = R::check(dot(m, m), R::c(0.0), R::c(1.0), Site::Leg(k), false)?;
+                let dd = R::c(lp.sigma_u) * d2.sqrt();
+                let inv_d = R::c(1.0) / dd;
+                ups = Some(UpsKin {
+                    rho,
+                    inv_rho,
+                    cot: c * inv_d,
+                    inv_d,
+                    t: scale(inv_d, sub(e0, scale(c, s))),
+                    e1: scale(-inv_d, m),
+                    s,
+                });
+            }
+            let dir = mtv(&fr, s);
             let p = sub3(&lp.end_home, &lp.u_centre);
             let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
             let [a, b] = two_axes(&lp.axes[0], &lp.axes[1], cv(&p), dir, lp.sigma_u, k)?;
@@ -695,6 +865,7 @@ pub fn leg_kinematics<R: Real>(
         jinv: [scale(id, r0), scale(id, r1), scale(id, r2)],
         frame: fr,
         arm,
+        ups,
     })
 }
 
@@ -729,8 +900,12 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
         .iter()
         .zip(legs)
         .map(|(lp, lk)| {
-            // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a.
-            let g = mv(&lk.frame, lk.jinv[lp.actuated]);
+            // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a; for a
+            // closed-form UPS leg the prismatic rate is ±ρ̇ = ±s·v_end.
+            let g = match &lk.ups {
+                Some(uk) => scale(R::c(lp.sigma_first), uk.s),
+                None => mv(&lk.frame, lk.jinv[lp.actuated]),
+            };
             match plan.motion {
                 PlatformMotion::Pose => {
                     let m = cross(lk.arm, g);
@@ -834,6 +1009,15 @@ pub fn generalized_force<R: Real>(
                 ([u[0], u[1], z], [ud[0], ud[1], z])
             }
         };
+        if let (Some(up), Some(uk)) = (&lp.ups, &lk.ups) {
+            let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
+            let m = cross(lk.arm, y);
+            for i in 0..3 {
+                f[i] = f[i] + m[i];
+                f[3 + i] = f[3 + i] + y[i];
+            }
+            continue;
+        }
         let v_l = mtv(&lk.frame, v_end);
         let a_l = mtv(&lk.frame, a_end);
         // Joint rates θ̇ = J⁻¹ v_end.
@@ -932,6 +1116,85 @@ pub fn generalized_force<R: Real>(
         }
     }
     f
+}
+
+/// The force `y` (base frame) that a closed-form UPS leg ([`UpsPlan`]) needs at its S centre to
+/// move with it: `y = J_J⁻ᵀ τ_J`, the leg's part of `f` before `Gᵀ`, for the S centre's velocity
+/// `v` and acceleration `a` (base frame) and gravity `g` — the same quantity as the generic
+/// route's (chain recursion, adjugate inverse), in closed form (Khalil & Guegan, "Inverse and
+/// direct dynamic modeling of Gough–Stewart robots", IEEE T-RO 20(4):754–762, 2004, §III:
+/// the leg's joint rates from `v`, eqs. (8)–(13); its dynamics projected on the S point,
+/// eqs. (20)–(25); here with the U's spin kept, as the U allows it).
+///
+/// Everything is resolved in the leg frame `(t, e₁′, s)` (x, y, z; fixed in the cylinder), in
+/// which the U's first axis is `e₀ = (d, 0, c)`, the U normal `n = e₀ × e₁′ = (−c, 0, d)`, and
+/// the S centre is at `ρ ẑ` from the U centre. With the leg's angular velocity `ω` (the
+/// cylinder's and the piston's):
+/// 1. Velocity, `v = ω × ρẑ + ρ̇ ẑ`: `v_x = ρ ω_y`, `v_y = −ρ ω_x`, `v_z = ρ̇`; the U admits no
+///    rotation about `n`, `ω·n = 0`, so `ω_z = (c/d) ω_x` (the spin `θ̇₀ c`, `θ̇₀ = ω_x/d`).
+/// 2. Acceleration, `a = α × ρẑ + ω × (ω × ρẑ) + 2ρ̇ ω × ẑ + ρ̈ ẑ`:
+///    `a_x = ρ(α_y + ω_x ω_z) + 2ρ̇ ω_y`, `a_y = ρ(−α_x + ω_y ω_z) − 2ρ̇ ω_x`,
+///    `a_z = ρ̈ − ρ(ω_x² + ω_y²)`; and `d/dt (ω·n) = 0` with `ṅ = θ̇₀ e₀ × n` gives
+///    `α·n = θ̇₀ ω_y`, i.e. `α_z = (c/d) α_x + ω_x ω_y / d²`.
+/// 3. One Newton–Euler wrench per body (`f_b = m_b (a_b − g)`, `n_b = I_b α + ω × I_b ω`, `I_b`
+///    constant in the leg frame), `a_b = α × r_b + ω × (ω × r_b)` plus, for the bodies on the
+///    prismatic joint, `ρ̈ ẑ + 2ρ̇ ω × ẑ`; `N = Σ n_b + r_b × f_b` (about the U centre) and
+///    `F_z = Σ_{sliding} f_b·ẑ`.
+/// 4. Joint efforts `τ₀ = e₀·N = d N_x + c N_z`, `τ₁ = e₁′·N = N_y`, `τ_P = ±F_z`; the leg
+///    Jacobian's columns are `∂v/∂θ̇₀ = ρ e₀ × ẑ = −ρ d ŷ`, `∂v/∂θ̇₁ = ρ x̂`, `∂v/∂q̇_P = ±ẑ`, so
+///    `y = J⁻ᵀ τ = (N_y/ρ, −(N_x + (c/d) N_z)/ρ, F_z)`, then `y_x t + y_y e₁′ + y_z s`.
+fn ups_force<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, v: V<R>, a: V<R>, g: V<R>) -> V<R> {
+    let to_leg = |x: V<R>| [dot(uk.t, x), dot(uk.e1, x), dot(uk.s, x)];
+    let (vl, al, gl) = (to_leg(v), to_leg(a), to_leg(g));
+    let ip = uk.inv_rho;
+    // 1. ω and ρ̇.
+    let wx = -(vl[1] * ip);
+    let wy = vl[0] * ip;
+    let w = [wx, wy, uk.cot * wx];
+    let rd2 = R::c(2.0) * vl[2];
+    // 2. α and ρ̈.
+    let ax = w[1] * w[2] - (al[1] + rd2 * w[0]) * ip;
+    let ay = (al[0] - rd2 * w[1]) * ip - w[0] * w[2];
+    let alpha = [ax, ay, uk.cot * ax + w[0] * w[1] * (uk.inv_d * uk.inv_d)];
+    let rdd = al[2] + uk.rho * (w[0] * w[0] + w[1] * w[1]);
+    // 3. Body wrenches, the moment about the U centre and the prismatic joint's force.
+    let mut nsum = zero3::<R>();
+    let mut fz = R::c(0.0);
+    for b in &up.bodies {
+        let mut r = cv::<R>(&b.com);
+        if b.slides {
+            r[2] = r[2] + (uk.rho - R::c(up.length));
+        }
+        let mut acc = add(cross(alpha, r), cross(w, cross(w, r)));
+        if b.slides {
+            // ρ̈ ẑ + 2ρ̇ ω × ẑ, ω × ẑ = (ω_y, −ω_x, 0).
+            acc = add(acc, [rd2 * w[1], -(rd2 * w[0]), rdd]);
+        }
+        let fb = scale(R::c(b.mass), sub(acc, gl));
+        let nb = euler_const(&b.inertia, w, alpha);
+        nsum = add(nsum, add(nb, cross(r, fb)));
+        if b.slides {
+            fz = fz + fb[2];
+        }
+    }
+    // 4. y = J⁻ᵀ τ, to the base frame.
+    let yx = nsum[1] * ip;
+    let yy = -((nsum[0] + uk.cot * nsum[2]) * ip);
+    add(add(scale(yx, uk.t), scale(yy, uk.e1)), scale(fz, uk.s))
+}
+
+/// Euler's equation `I ω̇ + ω × I ω` for a constant inertia `inertia` (in the frame of `w`,
+/// `wd`); `c ω̇` for an isotropic one.
+fn euler_const<R: Real>(inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
+    let c = inertia[0][0];
+    if [inertia[1][1], inertia[2][2]] == [c; 2]
+        && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
+        && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3]
+    {
+        return scale(R::c(c), wd);
+    }
+    let i = cm::<R>(inertia);
+    add(mv(&i, wd), cross(w, mv(&i, w)))
 }
 
 /// Euler's equation `I ω̇ + ω × I ω` (eq. 12's rotational row) for a body with rotation `rot`
