@@ -283,6 +283,8 @@ fn ups_plan(lp: &LegPlan) -> Option<UpsPlan> {
         || dot3(&e1, &sh).abs() > 1e-12
         || !massless(0)
         || lp.actuated != 2
+        // Joint drives (friction, rotor inertia) act at the leg joints: the generic route.
+        || lp.drives.iter().any(|d| !d.is_none())
     {
         return None;
     }
