@@ -124,31 +124,18 @@ pub fn simulate(
     };
     for step in 0..steps {
         let f = |x: &[f64], xd: &[f64]| accel(plan, tree, x, xd, alpha, beta);
-        let Some(a1) = f(&x, &xd) else {
-            run.stopped = Some(format!(
-                "singular KKT matrix at t = {:.3} s",
-                step as f64 * dt
-            ));
-            return run;
-        };
-        let (x2, v2) = (axpy(&x, 0.5 * dt, &xd), axpy(&xd, 0.5 * dt, &a1));
-        let Some(a2) = f(&x2, &v2) else {
-            run.stopped = Some(format!(
-                "singular KKT matrix at t = {:.3} s",
-                step as f64 * dt
-            ));
-            return run;
-        };
-        let (x3, v3) = (axpy(&x, 0.5 * dt, &v2), axpy(&xd, 0.5 * dt, &a2));
-        let Some(a3) = f(&x3, &v3) else {
-            run.stopped = Some(format!(
-                "singular KKT matrix at t = {:.3} s",
-                step as f64 * dt
-            ));
-            return run;
-        };
-        let (x4, v4) = (axpy(&x, dt, &v3), axpy(&xd, dt, &a3));
-        let Some(a4) = f(&x4, &v4) else {
+        // One classical RK4 step; `None` when a stage meets a singular KKT matrix.
+        let stages = (|| {
+            let a1 = f(&x, &xd)?;
+            let (x2, v2) = (axpy(&x, 0.5 * dt, &xd), axpy(&xd, 0.5 * dt, &a1));
+            let a2 = f(&x2, &v2)?;
+            let (x3, v3) = (axpy(&x, 0.5 * dt, &v2), axpy(&xd, 0.5 * dt, &a2));
+            let a3 = f(&x3, &v3)?;
+            let (x4, v4) = (axpy(&x, dt, &v3), axpy(&xd, dt, &a3));
+            let a4 = f(&x4, &v4)?;
+            Some((a1, a2, a3, a4, v2, v3, v4))
+        })();
+        let Some((a1, a2, a3, a4, v2, v3, v4)) = stages else {
             run.stopped = Some(format!(
                 "singular KKT matrix at t = {:.3} s",
                 step as f64 * dt
