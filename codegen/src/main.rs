@@ -4,7 +4,7 @@
 //! ```text
 //! cargo run -p codegen -- SPEC.(toml|urdf) [-o OUT.rs] [--check] [--stats] [--math libm|std|runtime]
 //! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
-//! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S]
+//! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
 //! ```
 //! Exit codes: 0 success, 2 invalid spec or arguments (diagnostics on stderr, nothing written),
 //! 1 I/O error. A spec file literally named `map` or `isotropy` must be written `./map`.

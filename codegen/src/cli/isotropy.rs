@@ -10,6 +10,10 @@
 //!   component in `±range` m);
 //! * trees: every joint in `±π` (revolute) or `±range` (prismatic).
 //!
+//! With `--design NAME=LO:HI` one number of the spec (see [`super::design`]) is a further search
+//! variable in `[LO, HI]`: the search then finds designs and points together, and the table has
+//! a column for the design value.
+//!
 //! Points where the runtime returns `Err(Singular)` reject the step. Local minima closer than
 //! 1e-4 of the box are merged. A point is reported as isotropic when its dimensionless `ψ` is at
 //! most `--tolerance`; when there is none, the best local minima are listed instead, marked as
@@ -26,6 +30,7 @@ use runtime::indices::{Normalization, Weights};
 use runtime::model::JointKind;
 use runtime::parallel::PlatformMotion;
 
+use super::design::Design;
 use super::map::fmt_g;
 use super::{Rng, SpaceArg, Target, progress};
 
@@ -67,6 +72,10 @@ pub struct IsotropyArgs {
     /// How many local minima to list when no isotropic point is found.
     #[arg(long, default_value_t = 5)]
     pub top: usize,
+    /// Also search one number of the spec, named by its TOML path, within `LO:HI`
+    /// (e.g. `body.distal_a.mass=0.1:1`).
+    #[arg(long, value_name = "NAME=LO:HI")]
+    pub design: Option<String>,
 }
 
 /// A local minimum.
@@ -74,6 +83,8 @@ pub struct IsotropyArgs {
 pub struct Minimum {
     /// Search parameters.
     pub p: Vec<f64>,
+    /// The design number's value, with `--design`.
+    pub design: Option<f64>,
     /// Coordinates `x` (platform coordinates or joint positions).
     pub x: Vec<f64>,
     /// `σ = tr M / n`.
@@ -88,26 +99,48 @@ pub struct Minimum {
 
 struct Problem<'a> {
     target: &'a Target,
-    base: Vec<f64>,
+    /// The design number and the middle of its range (its search variable is the offset).
+    design: Option<(&'a Design, f64)>,
     half: Vec<f64>,
     norm: Normalization,
 }
 
+/// The coordinates at the search parameters `p` (offsets from home).
+fn coordinates(target: &Target, p: &[f64]) -> Vec<f64> {
+    match target {
+        // Trees: p are the joint positions; closed loops: p moves the independent joints from
+        // home, where they are zero.
+        Target::Tree(_) | Target::Closed { .. } => p.to_vec(),
+        Target::Parallel { model, .. } => {
+            runtime::parallel::noc::retract(model.motion, &model.home_x(), p)
+        }
+    }
+}
+
 impl Problem<'_> {
-    fn x(&self, p: &[f64]) -> Vec<f64> {
-        match self.target {
-            Target::Tree(_) => p.to_vec(),
-            // Closed loops: p moves the independent joints from home.
-            Target::Closed { .. } => self.base.iter().zip(p).map(|(a, b)| a + b).collect(),
-            Target::Parallel { model, .. } => {
-                runtime::parallel::noc::retract(model.motion, &self.base, p)
+    /// The design value, the coordinates and the inertia at `p` (`None` where the spec is
+    /// refused or the point fails).
+    fn point(&self, p: &[f64]) -> Option<(Option<f64>, Vec<f64>, DMatrix<f64>)> {
+        match self.design {
+            None => {
+                let x = coordinates(self.target, p);
+                let m = self.target.matrix(&x).ok()?;
+                Some((None, x, m))
+            }
+            Some((design, mid)) => {
+                let (last, coords) = p.split_last()?;
+                let value = mid + last;
+                let target = design.target(value).ok()?;
+                let x = coordinates(&target, coords);
+                let m = target.matrix(&x).ok()?;
+                Some((Some(value), x, m))
             }
         }
     }
 
     /// `r = √(w/2) e` over the upper triangle, or `None` where the point fails.
     fn residuals(&self, p: &[f64]) -> Option<DVector<f64>> {
-        let m = self.target.matrix(&self.x(p)).ok()?;
+        let (_, _, m) = self.point(p)?;
         let n = m.nrows();
         let tr: f64 = m.trace();
         let (sigma, div) = match self.norm {
@@ -223,9 +256,24 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let (base, half, names): (Vec<f64>, Vec<f64>, Vec<String>) = match &target {
+    let design = match &args.design {
+        None => None,
+        Some(arg) => {
+            let file = args.spec.to_string_lossy().into_owned();
+            let parsed = std::fs::read_to_string(&args.spec)
+                .map_err(|e| e.to_string())
+                .and_then(|source| Design::parse(arg, &file, &source, args.space));
+            match parsed {
+                Ok(d) => Some(d),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            }
+        }
+    };
+    let (mut half, mut names): (Vec<f64>, Vec<String>) = match &target {
         Target::Tree(model) => (
-            vec![0.0; model.dof()],
             model
                 .joints
                 .iter()
@@ -240,7 +288,6 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
             model.joints.iter().map(|j| j.name.clone()).collect(),
         ),
         Target::Closed { model, plan } => (
-            vec![0.0; plan.dof()],
             plan.independent
                 .iter()
                 .map(|&j| {
@@ -267,20 +314,21 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
                 }
                 PlatformMotion::PlanarPoint { .. } => (vec![args.range; 2], vec!["px", "py"]),
             };
-            (
-                model.home_x(),
-                half,
-                names.into_iter().map(String::from).collect(),
-            )
+            (half, names.into_iter().map(String::from).collect())
         }
     };
+    let coordinate_names = names.clone();
+    if let Some(d) = &design {
+        half.push(0.5 * (d.hi - d.lo));
+        names.push(d.name.clone());
+    }
     let norm = match args.normalization {
         NormArg::Dimensionless => Normalization::Dimensionless,
         NormArg::Trace => Normalization::Trace,
     };
     let problem = Problem {
         target: &target,
-        base,
+        design: design.as_ref().map(|d| (d, 0.5 * (d.lo + d.hi))),
         half: half.clone(),
         norm,
     };
@@ -294,13 +342,13 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         .into_par_iter()
         .filter_map(|s| {
             let out = problem.descend(s).and_then(|p| {
-                let x = problem.x(&p);
-                let m = target.matrix(&x).ok()?;
+                let (design, x, m) = problem.point(&p)?;
                 let w = Weights::frobenius(m.nrows());
                 let d1 = runtime::indices::dci(&m, Normalization::Trace, &w).ok()?;
                 let d2 = runtime::indices::dci(&m, Normalization::Dimensionless, &w).ok()?;
                 Some(Minimum {
                     p,
+                    design,
                     x,
                     sigma: d1.sigma,
                     psi_trace: d1.psi,
@@ -359,6 +407,15 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         },
         elapsed.as_secs_f64()
     );
+    if let Some(d) = &design {
+        println!(
+            "design: {} in [{}, {}] (the spec has {}), searched with the coordinates",
+            d.name,
+            fmt_g(d.lo),
+            fmt_g(d.hi),
+            fmt_g(d.written)
+        );
+    }
     let rows: Vec<&Minimum> = if isotropic.is_empty() {
         println!(
             "no isotropic point found (psi2 <= {:e}); the {} best local minima of psi:",
@@ -374,29 +431,39 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         );
         isotropic
     };
-    let joint_words = match &target {
-        Target::Parallel { plan, .. } => Some(plan),
-        Target::Tree(_) | Target::Closed { .. } => None,
-    };
+    let design_head = design
+        .as_ref()
+        .map(|d| (format!(" {} |", d.name), "---:|"))
+        .unwrap_or_default();
     println!(
-        "| point | coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
-        names.join(", ")
+        "| point |{} coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
+        design_head.0,
+        coordinate_names.join(", ")
     );
-    println!("|---|---|---|---:|---:|---:|");
+    println!("|---|{}---|---|---:|---:|---:|", design_head.1);
     for (k, m) in rows.iter().enumerate() {
         let coords =
             m.x.iter()
                 .map(|v| fixed6(*v))
                 .collect::<Vec<_>>()
                 .join(", ");
-        let q = match joint_words {
-            Some(plan) => runtime::parallel::noc::inverse_kinematics(plan, &m.x)
+        // The actuated joints of a parallel mechanism, with the row's design.
+        let redesigned = match (&design, m.design) {
+            (Some(d), Some(v)) => d.target(v).ok(),
+            _ => None,
+        };
+        let q = match redesigned.as_ref().unwrap_or(&target) {
+            Target::Parallel { plan, .. } => runtime::parallel::noc::inverse_kinematics(plan, &m.x)
                 .map(|q| q.iter().map(|v| fixed6(*v)).collect::<Vec<_>>().join(", "))
                 .unwrap_or_else(|_| "-".into()),
-            None => coords.clone(),
+            Target::Tree(_) | Target::Closed { .. } => coords.clone(),
         };
+        let design_cell = m
+            .design
+            .map(|v| format!(" {} |", fixed6(v)))
+            .unwrap_or_default();
         println!(
-            "| {} | ({coords}) | ({q}) | {} | {} | {} |",
+            "| {} |{design_cell} ({coords}) | ({q}) | {} | {} | {} |",
             k + 1,
             fmt_g(m.sigma),
             fmt_g(m.psi_trace),

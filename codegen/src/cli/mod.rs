@@ -7,6 +7,7 @@
 //!   speeds), through [`runtime::indices::parallel_indices`]. Where the runtime returns
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
+pub mod design;
 pub mod isotropy;
 pub mod map;
 pub mod reduce;
@@ -143,47 +144,56 @@ pub enum Target {
 }
 
 impl Target {
-    /// Load a spec for the tools. Errors are printed; the exit code is returned.
+    /// Load a spec for the tools. Errors and warnings are printed; the exit code is returned.
     pub fn load(spec: &std::path::Path, space: SpaceArg) -> Result<Target, ExitCode> {
         let source = std::fs::read_to_string(spec).map_err(|e| {
             eprintln!("error: cannot read {}: {e}", spec.display());
             ExitCode::from(1)
         })?;
         let name = spec.to_string_lossy().into_owned();
-        let (mechanism, warnings) = codegen::spec::load_mechanism(&name, &source).map_err(|d| {
-            eprint!("{}", d.render());
+        let (target, warnings) = Target::compile(&name, &source, space).map_err(|e| {
+            eprint!("{e}");
             ExitCode::from(2)
         })?;
         if !warnings.is_empty() {
-            eprint!("{}", warnings.render());
+            eprint!("{warnings}");
         }
-        match mechanism {
-            Mechanism::Tree(model) => Ok(Target::Tree(model)),
+        Ok(target)
+    }
+
+    /// A spec's text for the tools (no I/O), with the rendered warnings. The error is the
+    /// rendered diagnostics, or the runtime's refusal of the model.
+    pub fn compile(name: &str, source: &str, space: SpaceArg) -> Result<(Target, String), String> {
+        let (mechanism, warnings) =
+            codegen::spec::load_mechanism(name, source).map_err(|d| d.render())?;
+        let warnings = if warnings.is_empty() {
+            String::new()
+        } else {
+            warnings.render()
+        };
+        let target = match mechanism {
+            Mechanism::Tree(model) => Target::Tree(model),
             Mechanism::Parallel(model) => {
-                let plan = Plan::new(&model).map_err(|e| {
-                    eprintln!("error: {name}: {e}");
-                    ExitCode::from(2)
-                })?;
-                Ok(Target::Parallel {
+                let plan = Plan::new(&model).map_err(|e| format!("error: {name}: {e}\n"))?;
+                Target::Parallel {
                     model: Box::new(model),
                     plan: Box::new(plan),
                     space: match space {
                         SpaceArg::Actuator => Space::Actuator,
                         SpaceArg::Platform => Space::Platform,
                     },
-                })
+                }
             }
             Mechanism::Closed(model) => {
-                let plan = runtime::closed::Plan::new(&model).map_err(|e| {
-                    eprintln!("error: {name}: {e}");
-                    ExitCode::from(2)
-                })?;
-                Ok(Target::Closed {
+                let plan = runtime::closed::Plan::new(&model)
+                    .map_err(|e| format!("error: {name}: {e}\n"))?;
+                Target::Closed {
                     model: Box::new(model),
                     plan: Box::new(plan),
-                })
+                }
             }
-        }
+        };
+        Ok((target, warnings))
     }
 
     /// Degrees of freedom.
