@@ -127,6 +127,8 @@ macro_rules! closed {
             let plan = Plan::new(&model).unwrap();
             let mut rng = tests::rng(23);
             let mut worst: f64 = 0.0;
+            let mut worst_assembly: f64 = 0.0;
+            let mut worst_function: f64 = 0.0;
             let mut skipped = 0;
             let mut fk_failures = 0;
             for _ in 0..200 {
@@ -158,7 +160,24 @@ macro_rules! closed {
                 };
                 let xi: [f64; N] = core::array::from_fn(|k| xi32[k] as f64);
                 let xr = d::forward_kinematics(&xi, &x.clone().try_into().unwrap()).unwrap();
-                worst = worst.max(rel(&to64(&x32), &xr));
+                let assembly = rel(&to64(&x32), &xr);
+                worst_assembly = worst_assembly.max(assembly);
+                worst = worst.max(assembly);
+                // The functions alone: the f32 module at the f64 assembly rounded to f32 (the
+                // f64 module refuses that input: its loops are open by the rounding) against
+                // the f64 module at the f64 assembly.
+                {
+                    let xa: [f32; NX] = to32::<NX>(&xr);
+                    let (ua, uda) = (to32::<N>(&u), to32::<N>(&ud));
+                    let ua64: [f64; N] = core::array::from_fn(|i| ua[i] as f64);
+                    let uda64: [f64; N] = core::array::from_fn(|i| uda[i] as f64);
+                    let t = d::inverse_dynamics(&xr, &ua64, &uda64).unwrap();
+                    let t32 = s::inverse_dynamics(&xa, &ua, &uda).unwrap();
+                    worst_function = worst_function.max(rel(&to64(&t32), &t));
+                    let m = d::mass_matrix(&xr).unwrap();
+                    let m32 = s::mass_matrix(&xa).unwrap();
+                    worst_function = worst_function.max(rel(&to64(&m32.concat()), &m.concat()));
+                }
                 let (u32_, ud32) = (to32::<N>(&u), to32::<N>(&ud));
                 let ur: [f64; N] = core::array::from_fn(|i| u32_[i] as f64);
                 let udr: [f64; N] = core::array::from_fn(|i| ud32[i] as f64);
@@ -169,7 +188,7 @@ macro_rules! closed {
                 let m32 = s::mass_matrix(&x32).unwrap();
                 worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
             }
-            println!("{name}: f32 vs f64, worst relative error {worst:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
+            println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
             assert!(skipped < 100, "{name}: {skipped}");
             assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
             // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
