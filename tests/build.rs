@@ -51,6 +51,8 @@ fn spec_file(variant: &str) -> &'static str {
 /// Appended to the PUMA 560's spec for the run-time-parameter variant (also read by
 /// `tests/tests/params.rs`).
 const PARAMS_SCENE: &str = include_str!("src/params_scene.toml");
+/// The same for the Gough–Stewart platform: a payload on a tool fixed to the platform.
+const PARAMS_SCENE_GS: &str = include_str!("src/params_scene_gs.toml");
 
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
@@ -95,6 +97,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE}");
     let p = write(&out, "puma_params", &src);
     generate(&out, "puma_params", &p, |_| {});
+    let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
+    let src = format!("{src}\n{PARAMS_SCENE_GS}");
+    let p = write(&out, "gs_params", &src);
+    generate(&out, "gs_params", &p, |_| {});
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

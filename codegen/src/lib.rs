@@ -143,7 +143,8 @@ pub fn compile(
             }
             spec::Mechanism::Parallel(model) => {
                 let only = spec::scene_functions(file_name, source);
-                parallel::generate_selected(&model, cfg, only.as_deref())
+                let params = spec::scene_params(file_name, source, &cfg.scene);
+                parallel::generate_with(&model, cfg, only.as_deref(), params.as_ref())
             }
             spec::Mechanism::Closed(model) => {
                 let only = spec::scene_functions(file_name, source);
@@ -287,48 +288,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
     let (payload_fields, payload_default, payload_fill) = match &rp.payload {
         None => (quote!(), quote!(), quote!()),
         Some((b, m, c, i)) => {
-            let body = &model.bodies[*b].name;
-            let doc_m = format!(" Payload mass (kg), rigidly attached to body `{body}`.");
-            let doc_c = format!(" Payload mass centre in body `{body}`'s frame (m).");
-            let doc_i = format!(
-                " Payload inertia about its mass centre, body `{body}`'s axes (kg·m²), symmetric."
-            );
-            let m = emit::float_lit(*m);
-            let c: Vec<_> = c.iter().map(|v| emit::float_lit(*v)).collect();
-            let rows: Vec<_> = i
-                .iter()
-                .map(|r| {
-                    let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
-                    quote!([#(#r),*])
-                })
-                .collect();
-            (
-                quote! {
-                    #[doc = #doc_m]
-                    pub payload_mass: f64,
-                    #[doc = #doc_c]
-                    pub payload_com: [f64; 3],
-                    #[doc = #doc_i]
-                    pub payload_inertia: [[f64; 3]; 3],
-                },
-                quote! {
-                    payload_mass: #m,
-                    payload_com: [#(#c),*],
-                    payload_inertia: [#(#rows),*],
-                },
-                quote! {
-                    a[0] = self.payload_mass;
-                    a[1] = self.payload_com[0];
-                    a[2] = self.payload_com[1];
-                    a[3] = self.payload_com[2];
-                    a[4] = self.payload_inertia[0][0];
-                    a[5] = self.payload_inertia[0][1];
-                    a[6] = self.payload_inertia[0][2];
-                    a[7] = self.payload_inertia[1][1];
-                    a[8] = self.payload_inertia[1][2];
-                    a[9] = self.payload_inertia[2][2];
-                },
-            )
+            payload_params(&format!("body `{}`", model.bodies[*b].name), *m, c, i)
         }
     };
     quote! {
@@ -374,6 +334,61 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
             }
         }
     }
+}
+
+/// The payload's fields of a `Params` struct, their `DEFAULT` values and their part of
+/// `to_array` (entries 0–9: mass, mass centre, inertia `xx, xy, xz, yy, yz, zz`); `on` names the
+/// frame's owner ("body `link6`", "the platform").
+pub(crate) fn payload_params(
+    on: &str,
+    m: f64,
+    c: &runtime::model::Vec3,
+    i: &runtime::model::Mat3,
+) -> (
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+) {
+    use quote::quote;
+    let doc_m = format!(" Payload mass (kg), rigidly attached to {on}.");
+    let doc_c = format!(" Payload mass centre in {on}'s frame (m).");
+    let doc_i = format!(" Payload inertia about its mass centre, {on}'s axes (kg·m²), symmetric.");
+    let m = emit::float_lit(m);
+    let c: Vec<_> = c.iter().map(|v| emit::float_lit(*v)).collect();
+    let rows: Vec<_> = i
+        .iter()
+        .map(|r| {
+            let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
+            quote!([#(#r),*])
+        })
+        .collect();
+    (
+        quote! {
+            #[doc = #doc_m]
+            pub payload_mass: f64,
+            #[doc = #doc_c]
+            pub payload_com: [f64; 3],
+            #[doc = #doc_i]
+            pub payload_inertia: [[f64; 3]; 3],
+        },
+        quote! {
+            payload_mass: #m,
+            payload_com: [#(#c),*],
+            payload_inertia: [#(#rows),*],
+        },
+        quote! {
+            a[0] = self.payload_mass;
+            a[1] = self.payload_com[0];
+            a[2] = self.payload_com[1];
+            a[3] = self.payload_com[2];
+            a[4] = self.payload_inertia[0][0];
+            a[5] = self.payload_inertia[0][1];
+            a[6] = self.payload_inertia[0][2];
+            a[7] = self.payload_inertia[1][1];
+            a[8] = self.payload_inertia[1][2];
+            a[9] = self.payload_inertia[2][2];
+        },
+    )
 }
 
 /// [`generate_selected`] with run-time parameters (`None`: constants).

@@ -41,11 +41,29 @@ pub struct Kernels {
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
 /// input: a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan));
+    kernels_with(plan, false)
+}
+
+/// [`kernels`] with a run-time payload on the platform (`payload`): its mass properties are the
+/// inputs `Arg::P` 0–9 (mass, mass centre, inertia `xx, xy, xz, yy, yz, zz`; platform frame, the
+/// layout of the generated `Params::to_array`), added by [`noc::payload_force`] and
+/// [`noc::payload_inertia`].
+pub fn kernels_with(plan: &Plan, payload: bool) -> Result<Kernels, Singular> {
+    let (r, graph) = in_fresh_graph(|| build(plan, payload));
     r.map(|k| Kernels { graph, ..k })
 }
 
-fn build(plan: &Plan) -> Result<Kernels, Singular> {
+/// The payload of the `Arg::P` inputs.
+fn payload_inputs() -> noc::Payload<Sx> {
+    let p = inputs(Arg::P, 10);
+    noc::Payload {
+        mass: p[0],
+        com: [p[1], p[2], p[3]],
+        inertia: [[p[4], p[5], p[6]], [p[5], p[7], p[8]], [p[6], p[8], p[9]]],
+    }
+}
+
+fn build(plan: &Plan, with_payload: bool) -> Result<Kernels, Singular> {
     let n = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, n);
@@ -62,9 +80,20 @@ fn build(plan: &Plan) -> Result<Kernels, Singular> {
                 .fold(Sx::c(0.0), |s, (&aij, &uj)| s + aij * uj)
         })
         .collect();
-    let f = noc::generalized_force(plan, &pl, &legs, &u, &ud, true);
-    let i = noc::generalized_inertia(plan, &pl, &legs);
-    let fd = noc::forward_dynamics_generic(plan, &x, &u, &tau)?;
+    let mut f = noc::generalized_force(plan, &pl, &legs, &u, &ud, true);
+    let mut i = noc::generalized_inertia(plan, &pl, &legs);
+    let payload = with_payload.then(payload_inputs);
+    if let Some(p) = &payload {
+        let fp = noc::payload_force(plan, &pl, p, &u, &ud, true);
+        let ip = noc::payload_inertia(plan, &pl, p);
+        for r in 0..n {
+            f[r] = f[r] + fp[r];
+            for c in 0..n {
+                i[r][c] = i[r][c] + ip[r][c];
+            }
+        }
+    }
+    let fd = noc::forward_dynamics_with_payload(plan, &x, &u, &tau, payload.as_ref())?;
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
     Ok(Kernels {
         graph: Graph::new(),
@@ -150,11 +179,25 @@ pub fn generate_selected(
     cfg: &Config,
     only: Option<&[String]>,
 ) -> Result<Generated, String> {
+    generate_with(model, cfg, only, None)
+}
+
+/// [`generate_selected`] with run-time parameters (`[scene] parameters = "runtime"`: the
+/// platform's payload, [`crate::spec::scene_params`]); `None`: constants. The functions whose
+/// values depend on the masses (`inverse_dynamics`, `mass_matrix`, `actuator_mass_matrix`,
+/// `forward_dynamics`) then take `p: &Params` last.
+pub fn generate_with(
+    model: &ParallelModel,
+    cfg: &Config,
+    only: Option<&[String]>,
+    params: Option<&crate::spec::RuntimeParams>,
+) -> Result<Generated, String> {
+    let payload = params.and_then(|p| p.payload);
     let want = |name: &str| {
         !SELECTABLE.contains(&name) || only.is_none_or(|o| o.iter().any(|f| f == name))
     };
     let plan = Plan::new(model)?;
-    let k = kernels(&plan).map_err(|e| {
+    let k = kernels_with(&plan, payload.is_some()).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
     let g = &k.graph;
@@ -171,6 +214,13 @@ pub fn generate_selected(
         PlatformMotion::PlanarPoint { .. } => {
             "`x = [px, py]` (the point where the legs meet, m, base frame); `u = [vx, vy]` (m/s)"
         }
+    };
+    // The functions of the masses read the run-time payload.
+    let with_p = |mut args: Vec<Arg>| {
+        if payload.is_some() {
+            args.push(Arg::P);
+        }
+        args
     };
     let make = |name: &'static str,
                 doc: Vec<String>,
@@ -210,7 +260,7 @@ pub fn generate_selected(
         make(
             "id_parts",
             vec!["Kernel of `inverse_dynamics`: the actuation matrix `A` and the generalized force `f = I u̇ + C u − γ`.".into()],
-            vec![Arg::X, Arg::U, Arg::Ud],
+            with_p(vec![Arg::X, Arg::U, Arg::Ud]),
             k.id_parts.clone(),
             fallible(&[Part::Matrix, Part::Vector]),
             false,
@@ -218,7 +268,7 @@ pub fn generate_selected(
         make(
             "mass_matrix",
             vec!["Generalized inertia `I = TᵀMT` of the speeds `u` (symmetric positive definite away from singularities; kg·m², kg·m, kg).".into()],
-            vec![Arg::X],
+            with_p(vec![Arg::X]),
             k.mass_matrix.clone(),
             fallible(&[Part::Matrix]),
             true,
@@ -226,7 +276,7 @@ pub fn generate_selected(
         make(
             "inertia_parts",
             vec!["Kernel of `actuator_mass_matrix`: `A` and `I`.".into()],
-            vec![Arg::X],
+            with_p(vec![Arg::X]),
             k.inertia_parts.clone(),
             fallible(&[Part::Matrix, Part::Matrix]),
             false,
@@ -234,7 +284,7 @@ pub fn generate_selected(
         make(
             "forward_dynamics",
             vec!["Speed rates `u̇` with `I u̇ = Aᵀ τ − (C u − γ)` for the actuator efforts `tau` (N or N·m); `Err` at a leg singularity or when a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
-            vec![Arg::X, Arg::U, Arg::Tau],
+            with_p(vec![Arg::X, Arg::U, Arg::Tau]),
             k.forward_dynamics.clone(),
             fallible(&[Part::Vector]),
             true,
@@ -305,6 +355,12 @@ pub fn generate_selected(
         },
         "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
     ];
+    if payload.is_some() {
+        header.insert(
+            3,
+            "Run-time parameters: the platform's payload (`Params`, `[scene] parameters = \"runtime\"`).".into(),
+        );
+    }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
     let fns: Vec<TokenStream> = functions
         .iter()
@@ -320,7 +376,41 @@ pub fn generate_selected(
         .iter()
         .map(|l| l.joints[l.actuated] == JointKind::Revolute)
         .collect();
-    let items = templates(cfg, &plan, &revolute, &want);
+    let items = templates(cfg, &plan, &revolute, &want, payload.is_some());
+    let params_items = match payload {
+        None => quote!(),
+        Some((_, m, c, i)) => {
+            let (fields, default, fill) = crate::payload_params("the platform", m, &c, &i);
+            quote! {
+                /// Number of run-time parameters in [`Params::to_array`].
+                pub const NP: usize = 10;
+                /// Run-time parameters (`[scene] parameters = "runtime"`): the payload on the
+                /// platform, so one binary serves several tools. SI units. The functions of the
+                /// masses take them last; the kinematics do not.
+                #[derive(Clone, Copy, Debug, PartialEq)]
+                pub struct Params {
+                    #fields
+                }
+                impl Params {
+                    /// The values of the spec (what a module with constants would fold in).
+                    pub const DEFAULT: Params = Params {
+                        #default
+                    };
+                    /// The flat layout the generated functions read.
+                    pub fn to_array(&self) -> [f64; NP] {
+                        let mut a = [0.0; NP];
+                        #fill
+                        a
+                    }
+                }
+                impl Default for Params {
+                    fn default() -> Self {
+                        Self::DEFAULT
+                    }
+                }
+            }
+        }
+    };
     let nx_lit = Literal::usize_unsuffixed(nx);
     let n_lit = Literal::usize_unsuffixed(n);
     let indices = crate::indices::template(cfg);
@@ -331,6 +421,7 @@ pub fn generate_selected(
         pub const DOF: usize = #n_lit;
         /// The actuated joints, in the order of `q` and `tau`.
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#names),*];
+        #params_items
         #items
         #(#fns)*
         #indices
@@ -352,7 +443,14 @@ fn templates(
     plan: &Plan,
     revolute: &[bool],
     want: &dyn Fn(&str) -> bool,
+    params: bool,
 ) -> TokenStream {
+    // With run-time parameters the wrappers take and pass on `p: &Params`.
+    let (p_arg, p_pass) = if params {
+        (quote!(, p: &Params), quote!(, p))
+    } else {
+        (quote!(), quote!())
+    };
     let sqrt = emit::math_call(cfg, "sqrt", quote!(s));
     let sqrt_n = emit::math_call(cfg, "sqrt", quote!(n));
     let sqrt_a = emit::math_call(cfg, "sqrt", quote!(a2));
@@ -401,8 +499,8 @@ fn templates(
         /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
         /// the platform motion `(x, u, ud)`; `Err` at a leg or parallel singularity.
         #[inline]
-        pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
-            let (a, f) = id_parts(x, u, ud)?;
+        pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF] #p_arg) -> Result<[f64; DOF], Singular> {
+            let (a, f) = id_parts(x, u, ud #p_pass)?;
             lu_solve(&a, &f, true)
         }
 
@@ -424,8 +522,8 @@ fn templates(
 
         /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
         #[allow(clippy::all)]
-        pub fn actuator_mass_matrix(x: &[f64; NX]) -> Result<[[f64; DOF]; DOF], Singular> {
-            let (a, i) = inertia_parts(x)?;
+        pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
+            let (a, i) = inertia_parts(x #p_pass)?;
             let ai = lu_inverse(&a)?;
             // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
             let mut b = [[0.0; DOF]; DOF];

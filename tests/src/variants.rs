@@ -31,6 +31,13 @@ pub mod gs_point_legs {
 pub mod puma_params {
     include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));
 }
+/// The Gough–Stewart platform with a tool and a run-time payload (`src/params_scene_gs.toml`).
+pub mod gs_params {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/gs_params/gough_stewart.rs"
+    ));
+}
 /// The Gough–Stewart platform with `[scene] functions = ["inverse_dynamics"]`.
 pub mod gs_id_only {
     include!(concat!(

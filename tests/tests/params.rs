@@ -144,11 +144,141 @@ fn the_module_takes_params_and_refuses_them_where_unsupported() {
     // Constants by default: no Params.
     let plain = codegen::compile("puma.toml", PUMA, &codegen::Config::default()).unwrap();
     assert!(!plain.code.contains("Params"));
-    // Parallel mechanisms: a diagnostic.
+    // Parallel mechanisms: the run-time parameters are the platform's payload, so a scene
+    // without one, or with one on a leg body, is a diagnostic.
     let gs = include_str!("../../mechanisms/specs/gough_stewart.toml");
     let bad = format!("{gs}\n[scene]\nparameters = \"runtime\"\n");
     let err = codegen::spec::load_mechanism("gs.toml", &bad).unwrap_err();
-    assert!(err.render().contains("trees only"), "{}", err.render());
+    assert!(err.render().contains("declares none"), "{}", err.render());
+    let leg = format!(
+        "{gs}\n[scene]\nparameters = \"runtime\"\npayload = {{ body = \"piston1\", mass = 1.0 }}\n"
+    );
+    let err = codegen::spec::load_mechanism("gs.toml", &leg).unwrap_err();
+    assert!(
+        err.render().contains("must ride on the platform"),
+        "{}",
+        err.render()
+    );
+    // Closed loops in joint coordinates: a diagnostic.
+    let four = include_str!("../../mechanisms/specs/four_bar.toml");
+    let bad = format!("{four}\n[scene]\nparameters = \"runtime\"\n");
+    let err = codegen::spec::load_mechanism("four_bar.toml", &bad).unwrap_err();
+    assert!(err.render().contains("closed loops"), "{}", err.render());
+}
+
+const GS: &str = include_str!("../../mechanisms/specs/gough_stewart.toml");
+const GS_SCENE: &str = include_str!("../src/params_scene_gs.toml");
+
+fn parallel(src: &str) -> runtime::parallel::ParallelModel {
+    match load_mechanism("gs.toml", src) {
+        Ok((Mechanism::Parallel(m), _)) => m,
+        Ok(_) => panic!("not a parallel mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+/// The payload line of a scene: on `body`, inertia `[xx, xy, xz, yy, yz, zz]`.
+fn payload_line(body: &str, mass: f64, com: [f64; 3], i: [f64; 6]) -> String {
+    format!(
+        "payload = {{ body = \"{body}\", mass = {mass:e}, com = [{:e}, {:e}, {:e}], inertia = {{ ixx = {:e}, ixy = {:e}, ixz = {:e}, iyy = {:e}, iyz = {:e}, izz = {:e} }} }}",
+        com[0], com[1], com[2], i[0], i[1], i[2], i[3], i[4], i[5]
+    )
+}
+
+/// A parallel mechanism's platform payload at run time (the compiled `gs_params` module of
+/// `tests/build.rs`): against the runtime on the same spec with the payload as constants,
+/// merged into the platform at spec level by the parallel-axis theorem (a route that shares
+/// neither [`runtime::parallel::noc::payload_force`] nor the payload's frame change with the
+/// generator). `Params::DEFAULT` is the spec's payload on the turned tool; random payloads set
+/// at run time are compared with the same payload written on the platform.
+#[test]
+fn parallel_payload_at_run_time_matches_constants() {
+    use runtime::parallel::Plan;
+    use runtime::parallel::noc;
+    use tests::variants::gs_params as g;
+    const N: usize = g::DOF;
+    let src = format!("{GS}\n{GS_SCENE}");
+    let constants = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
+    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+        let model = parallel(spec);
+        let plan = Plan::new(&model).unwrap();
+        let home = model.home_x();
+        let mut worst: f64 = 0.0;
+        for _ in 0..50 {
+            let (x, u, ud) = tests::pkm::random_state(&plan, &home, r, 0.3, 0.1);
+            let xa: [f64; 7] = x.clone().try_into().unwrap();
+            let ua: [f64; N] = u.clone().try_into().unwrap();
+            let uda: [f64; N] = ud.clone().try_into().unwrap();
+            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+            let want = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            worst = worst.max(tests::pkm::rel(&tau, &want));
+            let m = g::mass_matrix(&xa, p).unwrap();
+            let want = noc::mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+            let ma = g::actuator_mass_matrix(&xa, p).unwrap();
+            let want = noc::actuator_mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&ma.concat(), &want.concat()));
+            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+            worst = worst.max(tests::pkm::rel(&back, &ud));
+        }
+        worst
+    };
+    let mut r = tests::rng(43);
+    // The spec's payload, on the tool, by default.
+    let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
+    // Random payloads set at run time, in the platform frame.
+    for _ in 0..5 {
+        let mass = r.random_range(0.5..20.0);
+        let com = [
+            r.random_range(-0.1..0.1),
+            r.random_range(-0.1..0.1),
+            r.random_range(-0.2..0.1),
+        ];
+        let d = [
+            r.random_range(0.01..0.3),
+            r.random_range(0.01..0.3),
+            r.random_range(0.01..0.3),
+        ];
+        let off = [
+            r.random_range(-0.005..0.005),
+            r.random_range(-0.005..0.005),
+            r.random_range(-0.005..0.005),
+        ];
+        let i6 = [d[0], off[0], off[1], d[1], off[2], d[2]];
+        let p = g::Params {
+            payload_mass: mass,
+            payload_com: com,
+            payload_inertia: [
+                [i6[0], i6[1], i6[2]],
+                [i6[1], i6[3], i6[4]],
+                [i6[2], i6[4], i6[5]],
+            ],
+        };
+        let start = constants.find("payload = ").unwrap();
+        let end = start + constants[start..].find('\n').unwrap();
+        let spec = format!(
+            "{}{}{}",
+            &constants[..start],
+            payload_line("platform", mass, com, i6),
+            &constants[end..]
+        );
+        worst = worst.max(check(&p, &spec, &mut r));
+    }
+    println!("run-time payload vs constants: worst relative error {worst:.1e}");
+    assert!(worst < 1e-10, "run-time payload vs constants: {worst:e}");
+    // A payload changes the efforts (the check can fail).
+    let bare = parallel(GS);
+    let plan = Plan::new(&bare).unwrap();
+    let home = bare.home_x();
+    let tau0 = noc::inverse_dynamics(&plan, &home, &[0.0; N], &[0.0; N]).unwrap();
+    let tau = g::inverse_dynamics(
+        &home.clone().try_into().unwrap(),
+        &[0.0; N],
+        &[0.0; N],
+        &g::Params::DEFAULT,
+    )
+    .unwrap();
+    assert!(tests::pkm::rel(&tau, &tau0) > 1e-2);
 }
 
 /// The compiled module (`tests/build.rs`, `src/params_scene.toml`): `Params::DEFAULT` is the

@@ -60,6 +60,8 @@ pub(crate) struct SceneSpec {
     /// `parameters = "runtime"`: payload and drive coefficients in a generated `Params` struct
     /// passed at run time (trees), instead of constants folded into the code.
     pub runtime_params: bool,
+    /// Span of the `parameters` value.
+    pub runtime_params_span: Span,
 }
 
 /// The default `v_s` of the regularized Coulomb law (rad/s or m/s): 99.5 % of the Coulomb
@@ -79,6 +81,7 @@ impl Default for SceneSpec {
             coulomb_velocity: COULOMB_VELOCITY,
             snap: None,
             runtime_params: false,
+            runtime_params_span: None,
         }
     }
 }

@@ -181,13 +181,38 @@ fn load_any(
         };
         let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
             prepare(&mut s, overrides, &mut d);
-            if s.scene.runtime_params && (s.platform.is_some() || closed::is_closed(&s)) {
+            if s.scene.runtime_params && s.platform.is_none() && closed::is_closed(&s) {
                 d.push(
-                    Diagnostic::error("run-time parameters are for trees only")
+                    Diagnostic::error("run-time parameters are not available for closed loops in joint coordinates")
                         .with_key("scene.parameters")
-                        .with_span(s.anchor.clone())
-                        .with_hint("remove `parameters = \"runtime\"`: parallel and closed-loop modules take their parameters as constants"),
+                        .with_span(s.scene.runtime_params_span.clone().or(s.anchor.clone()))
+                        .with_hint("remove `parameters = \"runtime\"`: closed-loop modules take their parameters as constants"),
                 );
+            }
+            if s.scene.runtime_params && s.platform.is_some() {
+                // Parallel mechanisms: the run-time parameters are the platform's payload.
+                match &s.scene.payload {
+                    None => d.push(
+                        Diagnostic::error("run-time parameters of a parallel mechanism are its platform payload, but the scene declares none")
+                            .with_key("scene.parameters")
+                            .with_span(s.scene.runtime_params_span.clone().or(s.anchor.clone()))
+                            .with_hint("add `payload = { body = \"<platform>\", mass = …, com = […], inertia = { … } }` to [scene], or remove `parameters = \"runtime\"` (drive coefficients of parallel mechanisms are constants)"),
+                    ),
+                    Some(p) if parallel::pose_on_platform(&s, &p.body.name).is_none()
+                        && s.bodies.iter().any(|b| b.name == p.body.name) =>
+                    {
+                        d.push(
+                            Diagnostic::error(format!(
+                                "a run-time payload must ride on the platform, but body {:?} is not the platform or fixed to it",
+                                p.body.name
+                            ))
+                            .with_key("scene.payload.body")
+                            .with_span(p.body.span.clone())
+                            .with_hint("name the platform body, or a body attached to it by fixed joints; a payload on a leg body is possible only as constants"),
+                        );
+                    }
+                    Some(_) => {}
+                }
             }
             s
         });
@@ -431,7 +456,8 @@ pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct RuntimeParams {
     /// The payload: the model body it rides on, its mass (kg), mass centre (m) and inertia about
-    /// the mass centre (kg·m²), both in that body's frame.
+    /// the mass centre (kg·m²), both in that body's frame. For a parallel mechanism the body is
+    /// the platform (index 0) and the values are in the platform frame.
     pub payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
     /// The speed scale `v_s` of the regularized Coulomb law (`[scene] coulomb_velocity`).
     pub coulomb_velocity: f64,
@@ -448,7 +474,25 @@ pub fn scene_params(
     }
     let mut d = Diagnostics::new(file_name, source);
     let mut spec = read_toml::read(source, &mut d)?;
-    if !spec.scene.runtime_params || spec.platform.is_some() || closed::is_closed(&spec) {
+    if !spec.scene.runtime_params {
+        return None;
+    }
+    if spec.platform.is_some() {
+        prepare(&mut spec, overrides, &mut d);
+        let p = spec.scene.payload.as_ref()?;
+        let pose = parallel::pose_on_platform(&spec, &p.body.name)?;
+        let m = geom::MassProps {
+            mass: p.mass,
+            com: p.com,
+            inertia: p.inertia,
+        }
+        .transformed(&pose);
+        return Some(RuntimeParams {
+            payload: Some((0, m.mass, m.com, m.inertia)),
+            coulomb_velocity: spec.scene.coulomb_velocity,
+        });
+    }
+    if closed::is_closed(&spec) {
         return None;
     }
     prepare(&mut spec, overrides, &mut d);

@@ -790,3 +790,25 @@ fn validate_diagnostic(
         None => d.with_key("platform").with_span(ps.span.clone()),
     }
 }
+
+/// The pose in the platform frame of `body` when it is the platform or hangs from it by fixed
+/// joints (`None` otherwise): where a run-time payload on it enters the platform's inertia.
+pub(crate) fn pose_on_platform(spec: &Spec, body: &str) -> Option<Transform> {
+    let platform = spec.platform.as_ref()?.body.as_deref()?;
+    let mut at = body;
+    let mut pose = Transform::IDENTITY;
+    // At most one step per joint: a loop of fixed joints cannot trap the walk.
+    for _ in 0..=spec.joints.len() {
+        if at == platform {
+            return Some(pose);
+        }
+        let j = spec.joints.iter().find(|j| j.child == at)?;
+        if j.kind != Kind::Fixed {
+            return None;
+        }
+        let (origin, offset) = lower::placement_frames(&j.placement);
+        pose = compose(&compose(&origin, &offset), &pose);
+        at = j.parent.as_str();
+    }
+    None
+}

@@ -462,7 +462,10 @@ impl Reader<'_> {
             {
                 match x.as_str() {
                     "constants" => {}
-                    "runtime" => scene.runtime_params = true,
+                    "runtime" => {
+                        scene.runtime_params = true;
+                        scene.runtime_params_span = Some(v.span());
+                    }
                     _ => self.diags.push(
                         Diagnostic::error(format!("unknown parameter mode {x:?}"))
                             .with_key("scene.parameters")

@@ -1120,6 +1120,120 @@ pub fn generalized_force<R: Real>(
     f
 }
 
+/// A rigid body carried by the platform whose mass properties are scalars of the evaluator, not
+/// constants of the plan: a generated module's run-time payload (`[scene] parameters =
+/// "runtime"`), where they are symbolic inputs. The platform's own mass properties stay in the
+/// [`Plan`].
+#[derive(Clone, Copy, Debug)]
+pub struct Payload<R> {
+    /// Mass (kg).
+    pub mass: R,
+    /// Mass centre in the platform frame (m). Ignored by a planar point platform (a point).
+    pub com: V<R>,
+    /// Inertia about the mass centre, platform axes (kg·m²), symmetric. Ignored by a planar
+    /// point platform.
+    pub inertia: M<R>,
+}
+
+impl<R: Real> Payload<R> {
+    /// A payload of `f64` values.
+    pub fn from_f64(mass: f64, com: Vec3, inertia: Mat3) -> Payload<R> {
+        Payload {
+            mass: R::c(mass),
+            com: cv(&com),
+            inertia: cm(&inertia),
+        }
+    }
+}
+
+/// The payload's part of the generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`):
+/// the platform's own term of [`generalized_force`] (Newton–Euler of one rigid body moving with
+/// the platform, eq. 12, mapped by its twist-shaping block `T_Pᵀ`) with the payload's values.
+pub fn payload_force<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    payload: &Payload<R>,
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    let n = plan.dof();
+    let mut f = vec![R::c(0.0); n];
+    let g: V<R> = cv(&if gravity { plan.gravity } else { [0.0; 3] });
+    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+        for i in 0..2 {
+            f[i] = payload.mass * (ud[i] - g[i]);
+        }
+        return f;
+    }
+    let (w, wd) = ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]);
+    let a0 = match plan.motion {
+        PlatformMotion::Pose => [ud[3], ud[4], ud[5]],
+        _ => zero3::<R>(),
+    };
+    let r = mv(&pl.rot, payload.com);
+    let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
+    let fp = scale(payload.mass, sub(a, g));
+    // Euler's equation in the platform frame, then to the base frame.
+    let (wb, ab) = (mtv(&pl.rot, w), mtv(&pl.rot, wd));
+    let nb = add(
+        mv(&payload.inertia, ab),
+        cross(wb, mv(&payload.inertia, wb)),
+    );
+    let np = add(mv(&pl.rot, nb), cross(r, fp));
+    f[..3].copy_from_slice(&np);
+    if let PlatformMotion::Pose = plan.motion {
+        f[3..6].copy_from_slice(&fp);
+    }
+    f
+}
+
+/// The payload's part of the generalized inertia `I` (exactly symmetric): `T_Pᵀ M T_P` of
+/// [`generalized_inertia`]'s platform term with the payload's values.
+pub fn payload_inertia<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    payload: &Payload<R>,
+) -> Vec<Vec<R>> {
+    let n = plan.dof();
+    let z = R::c(0.0);
+    let mut out = vec![vec![z; n]; n];
+    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+        for (i, row) in out.iter_mut().enumerate() {
+            row[i] = payload.mass;
+        }
+        return out;
+    }
+    let rc = mv(&pl.rot, payload.com);
+    let unit = |j: usize| {
+        let mut e = zero3::<R>();
+        e[j] = R::c(1.0);
+        e
+    };
+    // ω columns e_j (mass-centre velocity e_j × r_c); v columns (pose) e_j.
+    let cols: Vec<(Option<V<R>>, V<R>)> = (0..n)
+        .map(|j| {
+            if j < 3 {
+                (Some(unit(j)), cross(unit(j), rc))
+            } else {
+                (None, unit(j - 3))
+            }
+        })
+        .collect();
+    for i in 0..n {
+        for j in i..n {
+            let mut v = payload.mass * dot(cols[i].1, cols[j].1);
+            if let (Some(a), Some(b)) = (cols[i].0, cols[j].0) {
+                let (ab, bb) = (mtv(&pl.rot, a), mtv(&pl.rot, b));
+                v = v + dot(ab, mv(&payload.inertia, bb));
+            }
+            out[i][j] = v;
+            out[j][i] = v;
+        }
+    }
+    out
+}
+
 /// The force `y` (base frame) that a closed-form UPS leg ([`UpsPlan`]) needs at its S centre to
 /// move with it: `y = J_J⁻ᵀ τ_J`, the leg's part of `f` before `Gᵀ`, for the S centre's velocity
 /// `v` and acceleration `a` (base frame) and gravity `g` — the same quantity as the generic
@@ -1456,10 +1570,27 @@ pub fn forward_dynamics_generic<R: Real>(
     u: &[R],
     tau: &[R],
 ) -> Result<Vec<R>, Singular> {
+    forward_dynamics_with_payload(plan, x, u, tau, None)
+}
+
+/// [`forward_dynamics_generic`] with a [`Payload`] on the platform.
+pub fn forward_dynamics_with_payload<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    u: &[R],
+    tau: &[R],
+    payload: Option<&Payload<R>>,
+) -> Result<Vec<R>, Singular> {
     let (pl, legs) = kinematics(plan, x)?;
     let n = plan.dof();
     let zero = vec![R::c(0.0); n];
-    let h = generalized_force(plan, &pl, &legs, u, &zero, true);
+    let mut h = generalized_force(plan, &pl, &legs, u, &zero, true);
+    if let Some(p) = payload {
+        let hp = payload_force(plan, &pl, p, u, &zero, true);
+        for i in 0..n {
+            h[i] = h[i] + hp[i];
+        }
+    }
     let a = actuation_matrix(plan, &legs);
     let rhs: Vec<R> = (0..n)
         .map(|i| {
@@ -1470,7 +1601,15 @@ pub fn forward_dynamics_generic<R: Real>(
             s
         })
         .collect();
-    let m = generalized_inertia(plan, &pl, &legs);
+    let mut m = generalized_inertia(plan, &pl, &legs);
+    if let Some(p) = payload {
+        let mp = payload_inertia(plan, &pl, p);
+        for i in 0..n {
+            for j in 0..n {
+                m[i][j] = m[i][j] + mp[i][j];
+            }
+        }
+    }
     solve_spd(&m, &rhs)
 }
 
