@@ -297,7 +297,7 @@ fn singular_home_is_rejected() {
 }
 
 /// The closed-form UPS leg (`noc::UpsPlan`) against the generic route (chain recursion, adjugate
-/// inverse of `J_J`): the same generalized force and actuation matrix, for the platform above,
+/// inverse of `J_J`): the same generalized force, mass matrix and actuation matrix, for the platform above,
 /// for one with off-axis mass centres and full inertia matrices, and for U joints whose axes
 /// are swapped (the other branch of the leg frame, `d < 0`).
 #[test]
@@ -342,6 +342,15 @@ fn closed_form_ups_leg_matches_generic_route() {
             let big = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for k in 0..6 {
                 worst = worst.max((a[k] - b[k]).abs() / big);
+            }
+            // The mass matrix: the closed-form end-point inertia of each leg.
+            let ma = noc::mass_matrix(&plan, &x).unwrap();
+            let mb = noc::mass_matrix(&generic, &x).unwrap();
+            let big = mb.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            for r in 0..6 {
+                for c in 0..6 {
+                    worst = worst.max((ma[r][c] - mb[r][c]).abs() / big);
+                }
             }
             let aa = noc::actuation(&plan, &x).unwrap();
             let ab = noc::actuation(&generic, &x).unwrap();

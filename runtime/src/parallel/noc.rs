@@ -1261,7 +1261,16 @@ pub fn payload_inertia<R: Real>(
 ///    `y = J⁻ᵀ τ = (N_y/ρ, −(N_x + (c/d) N_z)/ρ, F_z)`, then `y_x t + y_y e₁′ + y_z s`.
 fn ups_force<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, v: V<R>, a: V<R>, g: V<R>) -> V<R> {
     let to_leg = |x: V<R>| [dot(uk.t, x), dot(uk.e1, x), dot(uk.s, x)];
-    let (vl, al, gl) = (to_leg(v), to_leg(a), to_leg(g));
+    let y = ups_force_leg(up, uk, to_leg(v), to_leg(a), to_leg(g));
+    add(
+        add(scale(y[0], uk.t), scale(y[1], uk.e1)),
+        scale(y[2], uk.s),
+    )
+}
+
+/// [`ups_force`] in the leg frame `(t, e₁, s)`: `v`, `a`, `g` and the result are components
+/// along `t`, `e₁` and `s`.
+fn ups_force_leg<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, vl: V<R>, al: V<R>, gl: V<R>) -> V<R> {
     let ip = uk.inv_rho;
     // 1. ω and ρ̇.
     let wx = -(vl[1] * ip);
@@ -1293,10 +1302,41 @@ fn ups_force<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, v: V<R>, a: V<R>, g: V<R>) -
             fz = fz + fb[2];
         }
     }
-    // 4. y = J⁻ᵀ τ, to the base frame.
+    // 4. y = J⁻ᵀ τ (leg frame).
     let yx = nsum[1] * ip;
     let yy = -((nsum[0] + uk.cot * nsum[2]) * ip);
-    add(add(scale(yx, uk.t), scale(yy, uk.e1)), scale(fz, uk.s))
+    [yx, yy, fz]
+}
+
+/// The end-point inertia `Λ = J_J⁻ᵀ M_J J_J⁻¹` (base frame, exactly symmetric) of a
+/// closed-form UPS leg: `y = Λ a` is [`ups_force`] at rest without gravity, linear in the S
+/// centre's acceleration `a`, so column `j` of `Λ` in the leg frame is [`ups_force_leg`] of
+/// `a = e_j` (the same closed form as the leg's inverse dynamics; its constants fold in a
+/// generated module). Then `Λ = Q Λ_L Qᵀ` with `Q = [t e₁ s]`.
+fn ups_inertia<R: Real>(up: &UpsPlan, uk: &UpsKin<R>) -> M<R> {
+    let z = R::c(0.0);
+    let col: [V<R>; 3] = core::array::from_fn(|j| {
+        let mut e = [z; 3];
+        e[j] = R::c(1.0);
+        ups_force_leg(up, uk, [z; 3], e, [z; 3])
+    });
+    // Λ_L[i][j] = col[j][i], its upper triangle mirrored.
+    let ll = |i: usize, j: usize| if i <= j { col[j][i] } else { col[i][j] };
+    let q = [uk.t, uk.e1, uk.s];
+    let b: [V<R>; 3] = core::array::from_fn(|i| {
+        add(
+            add(scale(ll(i, 0), q[0]), scale(ll(i, 1), q[1])),
+            scale(ll(i, 2), q[2]),
+        )
+    });
+    let mut lam = [[z; 3]; 3];
+    for r in 0..3 {
+        for c in r..3 {
+            lam[r][c] = q[0][r] * b[0][c] + q[1][r] * b[1][c] + q[2][r] * b[2][c];
+            lam[c][r] = lam[r][c];
+        }
+    }
+    lam
 }
 
 /// Euler's equation `I ω̇ + ω × I ω` for a constant inertia `inertia` (in the frame of `w`,
@@ -1391,63 +1431,10 @@ pub fn generalized_inertia<R: Real>(
     let mut out = vec![vec![z; n]; n];
     let pose = matches!(plan.motion, PlatformMotion::Pose);
     for (lp, lk) in plan.legs.iter().zip(legs) {
-        let nj = lp.joints.len();
-        // Joint-space inertia of the leg's open chain (bodies k ≥ max(i, j)).
-        let mut mj = [[z; 3]; 3];
-        for k in 0..nj {
-            let (mass, _, inertia) = lp.bodies[k];
-            let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
-            if massless {
-                continue;
-            }
-            let c = lk.com[k];
-            // Twist columns of body k at its mass centre: (angular, linear).
-            let cols: Vec<(Option<V<R>>, V<R>)> = (0..=k)
-                .map(|j| match lp.joints[j] {
-                    JointKind::Revolute => (Some(lk.e[j]), cross(lk.e[j], sub(c, lk.o[j]))),
-                    JointKind::Prismatic => (None, lk.e[j]),
-                })
-                .collect();
-            for i in 0..=k {
-                for j in i..=k {
-                    let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);
-                    if let (Some(a), Some(b)) = (cols[i].0, cols[j].0) {
-                        v = v + inertia_quad(&lk.rot[k], &inertia, a, b);
-                    }
-                    mj[i][j] = mj[i][j] + v;
-                }
-            }
-        }
-        // The joints' rotors: `I_a` on the diagonal of the leg's joint-space inertia.
-        for (k, d) in lp.drives.iter().enumerate().take(3) {
-            if d.armature != 0.0 {
-                mj[k][k] = mj[k][k] + R::c(d.armature);
-            }
-        }
-        for i in 0..3 {
-            for j in 0..i {
-                mj[i][j] = mj[j][i];
-            }
-        }
-        // Λ = Wᵀ... with the rows of J⁻¹ in the base frame: Λ = Σ_ij M_J[i][j] w_i w_jᵀ.
-        let w: [V<R>; 3] = [
-            mv(&lk.frame, lk.jinv[0]),
-            mv(&lk.frame, lk.jinv[1]),
-            mv(&lk.frame, lk.jinv[2]),
-        ];
-        let b: [V<R>; 3] = core::array::from_fn(|i| {
-            add(
-                add(scale(mj[i][0], w[0]), scale(mj[i][1], w[1])),
-                scale(mj[i][2], w[2]),
-            )
-        });
-        let mut lam = [[z; 3]; 3];
-        for r in 0..3 {
-            for c in r..3 {
-                lam[r][c] = w[0][r] * b[0][c] + w[1][r] * b[1][c] + w[2][r] * b[2][c];
-                lam[c][r] = lam[r][c];
-            }
-        }
+        let lam = match (&lp.ups, &lk.ups) {
+            (Some(up), Some(uk)) => ups_inertia(up, uk),
+            _ => leg_end_inertia(lp, lk),
+        };
         if pose {
             // G = [−[r]×, 1]: I_vv = Λ, I_ωv = [r]× Λ, I_ωω = [r]× Λ [r]×ᵀ.
             let r = lk.arm;
@@ -1516,6 +1503,71 @@ pub fn generalized_inertia<R: Real>(
         }
     }
     out
+}
+
+/// The end-point inertia `Λ = J_J⁻ᵀ M_J J_J⁻¹` (base frame, exactly symmetric) of a leg by the
+/// generic route: the joint-space inertia `M_J` of its open chain, rotors included, then the
+/// rows of `J_J⁻¹`.
+fn leg_end_inertia<R: Real>(lp: &LegPlan, lk: &LegKin<R>) -> M<R> {
+    let z = R::c(0.0);
+    let nj = lp.joints.len();
+    // Joint-space inertia of the leg's open chain (bodies k ≥ max(i, j)).
+    let mut mj = [[z; 3]; 3];
+    for k in 0..nj {
+        let (mass, _, inertia) = lp.bodies[k];
+        let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
+        if massless {
+            continue;
+        }
+        let c = lk.com[k];
+        // Twist columns of body k at its mass centre: (angular, linear).
+        let cols: Vec<(Option<V<R>>, V<R>)> = (0..=k)
+            .map(|j| match lp.joints[j] {
+                JointKind::Revolute => (Some(lk.e[j]), cross(lk.e[j], sub(c, lk.o[j]))),
+                JointKind::Prismatic => (None, lk.e[j]),
+            })
+            .collect();
+        for i in 0..=k {
+            for j in i..=k {
+                let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);
+                if let (Some(a), Some(b)) = (cols[i].0, cols[j].0) {
+                    v = v + inertia_quad(&lk.rot[k], &inertia, a, b);
+                }
+                mj[i][j] = mj[i][j] + v;
+            }
+        }
+    }
+    // The joints' rotors: `I_a` on the diagonal of the leg's joint-space inertia.
+    for (k, d) in lp.drives.iter().enumerate().take(3) {
+        if d.armature != 0.0 {
+            mj[k][k] = mj[k][k] + R::c(d.armature);
+        }
+    }
+    for i in 0..3 {
+        for j in 0..i {
+            mj[i][j] = mj[j][i];
+        }
+    }
+    // Λ = Wᵀ... with the rows of J⁻¹ in the base frame: Λ = Σ_ij M_J[i][j] w_i w_jᵀ.
+    let w: [V<R>; 3] = [
+        mv(&lk.frame, lk.jinv[0]),
+        mv(&lk.frame, lk.jinv[1]),
+        mv(&lk.frame, lk.jinv[2]),
+    ];
+    let b: [V<R>; 3] = core::array::from_fn(|i| {
+        add(
+            add(scale(mj[i][0], w[0]), scale(mj[i][1], w[1])),
+            scale(mj[i][2], w[2]),
+        )
+    });
+    let mut lam = [[z; 3]; 3];
+    for r in 0..3 {
+        for c in r..3 {
+            lam[r][c] = w[0][r] * b[0][c] + w[1][r] * b[1][c] + w[2][r] * b[2][c];
+            lam[c][r] = lam[r][c];
+        }
+    }
+    lam
 }
 
 /// Solve `m x = b` for a symmetric positive definite `m` by `LDLᵀ` (no pivoting), each pivot
