@@ -41,16 +41,88 @@ pub struct Kernels {
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
 /// input: a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    kernels_with(plan, false)
+    kernels_with(plan, &Layout::default())
 }
 
-/// [`kernels`] with a run-time payload on the platform (`payload`): its mass properties are the
-/// inputs `Arg::P` 0–9 (mass, mass centre, inertia `xx, xy, xz, yy, yz, zz`; platform frame, the
-/// layout of the generated `Params::to_array`), added by [`noc::payload_force`] and
-/// [`noc::payload_inertia`].
-pub fn kernels_with(plan: &Plan, payload: bool) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, payload));
+/// Which values of a parallel module are run-time parameters (`Arg::P`), and where they sit in
+/// the generated `Params::to_array`: entries 0–9 the platform payload (mass, mass centre,
+/// inertia `xx, xy, xz, yy, yz, zz`, platform frame; reserved even without one), then, per leg
+/// joint `3·leg + k`, the viscous coefficients and the Coulomb levels (with `friction`), then
+/// the rotor inertias (with `rotor_inertia`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Layout {
+    /// The platform payload.
+    pub payload: bool,
+    /// The leg joints' viscous and Coulomb friction.
+    pub friction: bool,
+    /// The leg joints' rotor inertias.
+    pub rotor_inertia: bool,
+    /// `v_s` of the regularized Coulomb law.
+    pub coulomb_velocity: f64,
+}
+
+impl Layout {
+    /// The layout of a module's run-time parameters (`None`: constants).
+    pub fn of(params: Option<&crate::spec::RuntimeParams>) -> Layout {
+        match params {
+            None => Layout::default(),
+            Some(p) => Layout {
+                payload: p.payload.is_some(),
+                friction: p.leg_friction,
+                rotor_inertia: p.leg_rotor_inertia,
+                coulomb_velocity: p.coulomb_velocity,
+            },
+        }
+    }
+
+    /// Whether the module takes `Params`.
+    pub fn any(&self) -> bool {
+        self.payload || self.drives()
+    }
+
+    /// Whether the leg joints' drives are run-time parameters.
+    pub fn drives(&self) -> bool {
+        self.friction || self.rotor_inertia
+    }
+
+    /// First index of the viscous coefficients, the Coulomb levels and the rotor inertias of
+    /// `nlj` leg joints (`None` where absent), and the total count.
+    pub fn offsets(&self, nlj: usize) -> (Option<usize>, Option<usize>, Option<usize>, usize) {
+        let mut at = 10;
+        let mut take = |on: bool| {
+            on.then(|| {
+                let k = at;
+                at += nlj;
+                k
+            })
+        };
+        let v = take(self.friction);
+        let c = take(self.friction);
+        let a = take(self.rotor_inertia);
+        (v, c, a, at)
+    }
+}
+
+/// [`kernels`] with run-time parameters: the payload's mass properties are added by
+/// [`noc::payload_force`] and [`noc::payload_inertia`], the drives enter as
+/// [`noc::LegDrives`].
+pub fn kernels_with(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
+    let (r, graph) = in_fresh_graph(|| build(plan, layout));
     r.map(|k| Kernels { graph, ..k })
+}
+
+/// The leg drives of the `Arg::P` inputs.
+fn drive_inputs(plan: &Plan, layout: &Layout) -> noc::LegDrives<Sx> {
+    let nlj = 3 * plan.legs.len();
+    let (v, c, a, np) = layout.offsets(nlj);
+    let p = inputs(Arg::P, np);
+    let at = |k: Option<usize>| k.map(|k| p[k..k + nlj].to_vec());
+    noc::LegDrives {
+        viscous: at(v),
+        coulomb: at(c),
+        armature: at(a),
+        coulomb_velocity: layout.coulomb_velocity,
+    }
 }
 
 /// The payload of the `Arg::P` inputs.
@@ -63,7 +135,7 @@ fn payload_inputs() -> noc::Payload<Sx> {
     }
 }
 
-fn build(plan: &Plan, with_payload: bool) -> Result<Kernels, Singular> {
+fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let n = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, n);
@@ -80,9 +152,10 @@ fn build(plan: &Plan, with_payload: bool) -> Result<Kernels, Singular> {
                 .fold(Sx::c(0.0), |s, (&aij, &uj)| s + aij * uj)
         })
         .collect();
-    let mut f = noc::generalized_force(plan, &pl, &legs, &u, &ud, true);
-    let mut i = noc::generalized_inertia(plan, &pl, &legs);
-    let payload = with_payload.then(payload_inputs);
+    let drives = layout.drives().then(|| drive_inputs(plan, layout));
+    let mut f = noc::generalized_force_with(plan, &pl, &legs, &u, &ud, true, drives.as_ref());
+    let mut i = noc::generalized_inertia_with(plan, &pl, &legs, drives.as_ref());
+    let payload = layout.payload.then(payload_inputs);
     if let Some(p) = &payload {
         let fp = noc::payload_force(plan, &pl, p, &u, &ud, true);
         let ip = noc::payload_inertia(plan, &pl, p);
@@ -93,7 +166,7 @@ fn build(plan: &Plan, with_payload: bool) -> Result<Kernels, Singular> {
             }
         }
     }
-    let fd = noc::forward_dynamics_with_payload(plan, &x, &u, &tau, payload.as_ref())?;
+    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, payload.as_ref(), drives.as_ref())?;
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
     Ok(Kernels {
         graph: Graph::new(),
@@ -193,11 +266,12 @@ pub fn generate_with(
     params: Option<&crate::spec::RuntimeParams>,
 ) -> Result<Generated, String> {
     let payload = params.and_then(|p| p.payload);
+    let layout = Layout::of(params);
     let want = |name: &str| {
         !SELECTABLE.contains(&name) || only.is_none_or(|o| o.iter().any(|f| f == name))
     };
     let plan = Plan::new(model)?;
-    let k = kernels_with(&plan, payload.is_some()).map_err(|e| {
+    let k = kernels_with(&plan, &layout).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
     let g = &k.graph;
@@ -217,7 +291,7 @@ pub fn generate_with(
     };
     // The functions of the masses read the run-time payload.
     let with_p = |mut args: Vec<Arg>| {
-        if payload.is_some() {
+        if layout.any() {
             args.push(Arg::P);
         }
         args
@@ -355,10 +429,15 @@ pub fn generate_with(
         },
         "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
     ];
-    if payload.is_some() {
+    if layout.any() {
+        let what = match (layout.payload, layout.drives()) {
+            (true, true) => "the platform's payload and the leg joints' drives",
+            (true, false) => "the platform's payload",
+            _ => "the leg joints' drives",
+        };
         header.insert(
             3,
-            "Run-time parameters: the platform's payload (`Params`, `[scene] parameters = \"runtime\"`).".into(),
+            format!("Run-time parameters: {what} (`Params`, `[scene] parameters = \"runtime\"`)."),
         );
     }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
@@ -376,17 +455,93 @@ pub fn generate_with(
         .iter()
         .map(|l| l.joints[l.actuated] == JointKind::Revolute)
         .collect();
-    let items = templates(cfg, &plan, &revolute, &want, payload.is_some());
-    let params_items = match payload {
-        None => quote!(),
-        Some((_, m, c, i)) => {
-            let (fields, default, fill) = crate::payload_params("the platform", m, &c, &i);
+    let items = templates(cfg, &plan, &revolute, &want, layout.any());
+    let params_items = if !layout.any() {
+        quote!()
+    } else {
+        let (mut fields, mut default, mut fill) = match payload {
+            Some((_, m, c, i)) => crate::payload_params("the platform", m, &c, &i),
+            None => (quote!(), quote!(), quote!()),
+        };
+        let nlj = 3 * model.legs.len();
+        let (v0, c0, a0, np) = layout.offsets(nlj);
+        let joint_names: Vec<&str> = model
+            .legs
+            .iter()
+            .flat_map(|l| l.joints.iter().take(3).map(|j| j.name.as_str()))
+            .collect();
+        let nlj_lit = Literal::usize_unsuffixed(nlj);
+        let mut drive_field =
+            |at: Option<usize>,
+             name: &str,
+             doc: &str,
+             value: &dyn Fn(&runtime::model::Drive) -> f64| {
+                let Some(at) = at else { return };
+                let ident = proc_macro2::Ident::new(name, proc_macro2::Span::call_site());
+                let vals: Vec<_> = model
+                    .legs
+                    .iter()
+                    .flat_map(|l| {
+                        l.joints
+                            .iter()
+                            .take(3)
+                            .map(|j| emit::float_lit(value(&j.drive)))
+                    })
+                    .collect();
+                let at = Literal::usize_unsuffixed(at);
+                let doc = format!(" {doc}, per leg joint (`LEG_JOINT_NAMES` order).");
+                fields.extend(quote! {
+                    #[doc = #doc]
+                    pub #ident: [f64; LEG_JOINTS],
+                });
+                default.extend(quote!(#ident: [#(#vals),*],));
+                fill.extend(quote! {
+                    let mut i = 0;
+                    while i < LEG_JOINTS {
+                        a[#at + i] = self.#ident[i];
+                        i += 1;
+                    }
+                });
+            };
+        drive_field(
+            v0,
+            "damping",
+            "Viscous friction (N·m·s/rad or N·s/m)",
+            &|d| d.viscous,
+        );
+        drive_field(
+            c0,
+            "friction",
+            "Coulomb friction level (N·m or N), regularized as in the spec docs",
+            &|d| d.coulomb,
+        );
+        drive_field(
+            a0,
+            "armature",
+            "Reflected rotor inertia (kg·m² or kg)",
+            &|d| d.armature,
+        );
+        let np = Literal::usize_unsuffixed(np);
+        let leg_items = if layout.drives() {
             quote! {
+                /// Number of leg joints (three per leg, base outwards), whose drives are run-time
+                /// parameters.
+                pub const LEG_JOINTS: usize = #nlj_lit;
+                /// The leg joints, in the order of the drive arrays of [`Params`].
+                pub const LEG_JOINT_NAMES: [&str; LEG_JOINTS] = [#(#joint_names),*];
+            }
+        } else {
+            quote!()
+        };
+        {
+            quote! {
+                #leg_items
                 /// Number of run-time parameters in [`Params::to_array`].
-                pub const NP: usize = 10;
+                pub const NP: usize = #np;
                 /// Run-time parameters (`[scene] parameters = "runtime"`): the payload on the
-                /// platform, so one binary serves several tools. SI units. The functions of the
-                /// masses take them last; the kinematics do not.
+                /// platform and the leg joints' drives the scene models, so one binary serves
+                /// several tools or drive calibrations. SI units. The functions of the masses take
+                /// them last; the kinematics do not.
                 #[derive(Clone, Copy, Debug, PartialEq)]
                 pub struct Params {
                     #fields

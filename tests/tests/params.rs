@@ -149,7 +149,11 @@ fn the_module_takes_params_and_refuses_them_where_unsupported() {
     let gs = include_str!("../../mechanisms/specs/gough_stewart.toml");
     let bad = format!("{gs}\n[scene]\nparameters = \"runtime\"\n");
     let err = codegen::spec::load_mechanism("gs.toml", &bad).unwrap_err();
-    assert!(err.render().contains("declares none"), "{}", err.render());
+    assert!(
+        err.render().contains("declares no payload"),
+        "{}",
+        err.render()
+    );
     let leg = format!(
         "{gs}\n[scene]\nparameters = \"runtime\"\npayload = {{ body = \"piston1\", mass = 1.0 }}\n"
     );
@@ -185,12 +189,13 @@ fn payload_line(body: &str, mass: f64, com: [f64; 3], i: [f64; 6]) -> String {
     )
 }
 
-/// A parallel mechanism's platform payload at run time (the compiled `gs_params` module of
-/// `tests/build.rs`): against the runtime on the same spec with the payload as constants,
-/// merged into the platform at spec level by the parallel-axis theorem (a route that shares
-/// neither [`runtime::parallel::noc::payload_force`] nor the payload's frame change with the
-/// generator). `Params::DEFAULT` is the spec's payload on the turned tool; random payloads set
-/// at run time are compared with the same payload written on the platform.
+/// A parallel mechanism's platform payload and leg drives at run time (the compiled `gs_params`
+/// module of `tests/build.rs`): against the runtime on the same spec with the payload as
+/// constants, merged into the platform at spec level by the parallel-axis theorem (a route that
+/// shares neither [`runtime::parallel::noc::payload_force`] nor the payload's frame change with
+/// the generator), and the drives set on the model's leg joints. `Params::DEFAULT` is the
+/// spec's payload on the turned tool (no drives); random payloads and drives set at run time
+/// are compared with the same payload written on the platform and the same drives.
 #[test]
 fn parallel_payload_at_run_time_matches_constants() {
     use runtime::parallel::Plan;
@@ -200,7 +205,19 @@ fn parallel_payload_at_run_time_matches_constants() {
     let src = format!("{GS}\n{GS_SCENE}");
     let constants = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
     let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
-        let model = parallel(spec);
+        let mut model = parallel(spec);
+        // The drives of `p` as the model's constants, leg joint `3·leg + k`.
+        for (l, leg) in model.legs.iter_mut().enumerate() {
+            for (k, j) in leg.joints.iter_mut().enumerate().take(3) {
+                let i = 3 * l + k;
+                j.drive = Drive {
+                    viscous: p.damping[i],
+                    coulomb: p.friction[i],
+                    coulomb_velocity: 1e-4,
+                    armature: p.armature[i],
+                };
+            }
+        }
         let plan = Plan::new(&model).unwrap();
         let home = model.home_x();
         let mut worst: f64 = 0.0;
@@ -253,6 +270,9 @@ fn parallel_payload_at_run_time_matches_constants() {
                 [i6[1], i6[3], i6[4]],
                 [i6[2], i6[4], i6[5]],
             ],
+            damping: core::array::from_fn(|_| r.random_range(0.0..50.0)),
+            friction: core::array::from_fn(|_| r.random_range(0.0..20.0)),
+            armature: core::array::from_fn(|_| r.random_range(0.0..2.0)),
         };
         let start = constants.find("payload = ").unwrap();
         let end = start + constants[start..].find('\n').unwrap();
@@ -264,8 +284,11 @@ fn parallel_payload_at_run_time_matches_constants() {
         );
         worst = worst.max(check(&p, &spec, &mut r));
     }
-    println!("run-time payload vs constants: worst relative error {worst:.1e}");
-    assert!(worst < 1e-10, "run-time payload vs constants: {worst:e}");
+    println!("run-time payload and drives vs constants: worst relative error {worst:.1e}");
+    assert!(
+        worst < 1e-10,
+        "run-time payload and drives vs constants: {worst:e}"
+    );
     // A payload changes the efforts (the check can fail).
     let bare = parallel(GS);
     let plan = Plan::new(&bare).unwrap();

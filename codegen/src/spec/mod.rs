@@ -192,11 +192,12 @@ fn load_any(
             if s.scene.runtime_params && s.platform.is_some() {
                 // Parallel mechanisms: the run-time parameters are the platform's payload.
                 match &s.scene.payload {
+                    None if s.scene.friction || s.scene.rotor_inertia => {}
                     None => d.push(
-                        Diagnostic::error("run-time parameters of a parallel mechanism are its platform payload, but the scene declares none")
+                        Diagnostic::error("run-time parameters of a parallel mechanism are its platform payload and the leg joints' drives, but the scene declares no payload and has neither `friction` nor `rotor_inertia` on")
                             .with_key("scene.parameters")
                             .with_span(s.scene.runtime_params_span.clone().or(s.anchor.clone()))
-                            .with_hint("add `payload = { body = \"<platform>\", mass = …, com = […], inertia = { … } }` to [scene], or remove `parameters = \"runtime\"` (drive coefficients of parallel mechanisms are constants)"),
+                            .with_hint("add `payload = { body = \"<platform>\", mass = …, com = […], inertia = { … } }` or `friction = true` / `rotor_inertia = true` to [scene], or remove `parameters = \"runtime\"`"),
                     ),
                     Some(p) if parallel::pose_on_platform(&s, &p.body.name).is_none()
                         && s.bodies.iter().any(|b| b.name == p.body.name) =>
@@ -461,6 +462,12 @@ pub struct RuntimeParams {
     pub payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
     /// The speed scale `v_s` of the regularized Coulomb law (`[scene] coulomb_velocity`).
     pub coulomb_velocity: f64,
+    /// Parallel mechanisms: the leg joints' viscous and Coulomb friction are run-time
+    /// parameters (the scene's `friction` is on). Trees take every drive at run time.
+    pub leg_friction: bool,
+    /// Parallel mechanisms: the leg joints' rotor inertias are run-time parameters (the scene's
+    /// `rotor_inertia` is on).
+    pub leg_rotor_inertia: bool,
 }
 
 /// See [`RuntimeParams`].
@@ -479,17 +486,28 @@ pub fn scene_params(
     }
     if spec.platform.is_some() {
         prepare(&mut spec, overrides, &mut d);
-        let p = spec.scene.payload.as_ref()?;
-        let pose = parallel::pose_on_platform(&spec, &p.body.name)?;
-        let m = geom::MassProps {
-            mass: p.mass,
-            com: p.com,
-            inertia: p.inertia,
+        let payload = match spec.scene.payload.as_ref() {
+            None => None,
+            Some(p) => {
+                let pose = parallel::pose_on_platform(&spec, &p.body.name)?;
+                let m = geom::MassProps {
+                    mass: p.mass,
+                    com: p.com,
+                    inertia: p.inertia,
+                }
+                .transformed(&pose);
+                Some((0, m.mass, m.com, m.inertia))
+            }
+        };
+        let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
+        if payload.is_none() && !friction && !rotor {
+            return None;
         }
-        .transformed(&pose);
         return Some(RuntimeParams {
-            payload: Some((0, m.mass, m.com, m.inertia)),
+            payload,
             coulomb_velocity: spec.scene.coulomb_velocity,
+            leg_friction: friction,
+            leg_rotor_inertia: rotor,
         });
     }
     if closed::is_closed(&spec) {
@@ -512,6 +530,8 @@ pub fn scene_params(
     Some(RuntimeParams {
         payload,
         coulomb_velocity: spec.scene.coulomb_velocity,
+        leg_friction: false,
+        leg_rotor_inertia: false,
     })
 }
 

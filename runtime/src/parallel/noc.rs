@@ -984,6 +984,54 @@ pub fn generalized_force<R: Real>(
     ud: &[R],
     gravity: bool,
 ) -> Vec<R> {
+    generalized_force_with(plan, pl, legs, u, ud, gravity, None)
+}
+
+/// The drive coefficients of every leg joint as scalars of the evaluator, in place of the
+/// plan's constants: a generated module's run-time drive parameters, where they are symbolic
+/// inputs. Entry `3·leg + k` is joint `k` of leg `leg`; an effect that is `None` is absent.
+/// The effort law is [`drive_effort`]'s.
+#[derive(Clone, Debug)]
+pub struct LegDrives<R> {
+    /// Viscous coefficients (N·m·s/rad or N·s/m).
+    pub viscous: Option<Vec<R>>,
+    /// Coulomb levels (N·m or N).
+    pub coulomb: Option<Vec<R>>,
+    /// Reflected rotor inertias (kg·m² or kg).
+    pub armature: Option<Vec<R>>,
+    /// The speed scale `v_s` of the regularized Coulomb law.
+    pub coulomb_velocity: f64,
+}
+
+impl<R: Real> LegDrives<R> {
+    /// The drive effort of leg joint `i` at the rate `qd` and acceleration `qdd`.
+    pub fn effort(&self, i: usize, qd: R, qdd: R) -> R {
+        let mut e = R::c(0.0);
+        if let Some(a) = &self.armature {
+            e = e + a[i] * qdd;
+        }
+        if let Some(b) = &self.viscous {
+            e = e + b[i] * qd;
+        }
+        if let Some(c) = &self.coulomb {
+            let vs = self.coulomb_velocity;
+            e = e + c[i] * qd / (qd * qd + R::c(vs * vs)).sqrt();
+        }
+        e
+    }
+}
+
+/// [`generalized_force`] with the leg joints' drives from `drives` instead of the plan (closed-form
+/// UPS legs then take the generic route, where the joint efforts are formed).
+pub fn generalized_force_with<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+    drives: Option<&LegDrives<R>>,
+) -> Vec<R> {
     let dof = plan.dof();
     let mut f: Vec<R> = vec![R::c(0.0); dof];
     let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
@@ -994,7 +1042,7 @@ pub fn generalized_force<R: Real>(
     } else {
         ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
     };
-    for (lp, lk) in plan.legs.iter().zip(legs) {
+    for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
         let n = lp.joints.len();
         // End velocity and acceleration (base frame), then in L.
         let (v_end, a_end) = match plan.motion {
@@ -1011,7 +1059,7 @@ pub fn generalized_force<R: Real>(
                 ([u[0], u[1], z], [ud[0], ud[1], z])
             }
         };
-        if let (Some(up), Some(uk)) = (&lp.ups, &lk.ups) {
+        if let (Some(up), Some(uk), None) = (&lp.ups, &lk.ups, drives) {
             let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
             let m = cross(lk.arm, y);
             for i in 0..3 {
@@ -1063,7 +1111,11 @@ pub fn generalized_force<R: Real>(
         // The joints' drives, actuated and passive (the lecture's dissipative term δ and the
         // rotors' inertia), act at the joints beside the bodies' efforts.
         for k in 0..n {
-            tau[k] = tau[k] + drive_effort(&lp.drives[k], qd[k], qdd[k]);
+            tau[k] = tau[k]
+                + match drives {
+                    Some(d) => d.effort(3 * li + k, qd[k], qdd[k]),
+                    None => drive_effort(&lp.drives[k], qd[k], qdd[k]),
+                };
         }
         // End force (or moment) y = J⁻ᵀ τ, to the base frame, then Gᵀ y.
         let y_l = add(
@@ -1426,14 +1478,32 @@ pub fn generalized_inertia<R: Real>(
     pl: &Platform<R>,
     legs: &[LegKin<R>],
 ) -> Vec<Vec<R>> {
+    generalized_inertia_with(plan, pl, legs, None)
+}
+
+/// [`generalized_inertia`] with the leg joints' rotor inertias from `drives` instead of the
+/// plan (closed-form UPS legs then take the generic route).
+pub fn generalized_inertia_with<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    drives: Option<&LegDrives<R>>,
+) -> Vec<Vec<R>> {
     let n = plan.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
     let pose = matches!(plan.motion, PlatformMotion::Pose);
-    for (lp, lk) in plan.legs.iter().zip(legs) {
-        let lam = match (&lp.ups, &lk.ups) {
-            (Some(up), Some(uk)) => ups_inertia(up, uk),
-            _ => leg_end_inertia(lp, lk),
+    for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
+        let armature: [Option<R>; 3] = match drives {
+            Some(d) => core::array::from_fn(|k| d.armature.as_ref().map(|a| a[3 * li + k])),
+            None => core::array::from_fn(|k| {
+                let a = lp.drives.get(k).map_or(0.0, |d| d.armature);
+                (a != 0.0).then(|| R::c(a))
+            }),
+        };
+        let lam = match (&lp.ups, &lk.ups, drives) {
+            (Some(up), Some(uk), None) => ups_inertia(up, uk),
+            _ => leg_end_inertia(lp, lk, &armature),
         };
         if pose {
             // G = [−[r]×, 1]: I_vv = Λ, I_ωv = [r]× Λ, I_ωω = [r]× Λ [r]×ᵀ.
@@ -1508,7 +1578,7 @@ pub fn generalized_inertia<R: Real>(
 /// The end-point inertia `Λ = J_J⁻ᵀ M_J J_J⁻¹` (base frame, exactly symmetric) of a leg by the
 /// generic route: the joint-space inertia `M_J` of its open chain, rotors included, then the
 /// rows of `J_J⁻¹`.
-fn leg_end_inertia<R: Real>(lp: &LegPlan, lk: &LegKin<R>) -> M<R> {
+fn leg_end_inertia<R: Real>(lp: &LegPlan, lk: &LegKin<R>, armature: &[Option<R>; 3]) -> M<R> {
     let z = R::c(0.0);
     let nj = lp.joints.len();
     // Joint-space inertia of the leg's open chain (bodies k ≥ max(i, j)).
@@ -1538,9 +1608,9 @@ fn leg_end_inertia<R: Real>(lp: &LegPlan, lk: &LegKin<R>) -> M<R> {
         }
     }
     // The joints' rotors: `I_a` on the diagonal of the leg's joint-space inertia.
-    for (k, d) in lp.drives.iter().enumerate().take(3) {
-        if d.armature != 0.0 {
-            mj[k][k] = mj[k][k] + R::c(d.armature);
+    for (k, a) in armature.iter().enumerate() {
+        if let Some(a) = a {
+            mj[k][k] = mj[k][k] + *a;
         }
     }
     for i in 0..3 {
@@ -1622,21 +1692,23 @@ pub fn forward_dynamics_generic<R: Real>(
     u: &[R],
     tau: &[R],
 ) -> Result<Vec<R>, Singular> {
-    forward_dynamics_with_payload(plan, x, u, tau, None)
+    forward_dynamics_with(plan, x, u, tau, None, None)
 }
 
-/// [`forward_dynamics_generic`] with a [`Payload`] on the platform.
-pub fn forward_dynamics_with_payload<R: Real>(
+/// [`forward_dynamics_generic`] with a [`Payload`] on the platform and the leg joints' drives
+/// from `drives` (see [`generalized_force_with`]).
+pub fn forward_dynamics_with<R: Real>(
     plan: &Plan,
     x: &[R],
     u: &[R],
     tau: &[R],
     payload: Option<&Payload<R>>,
+    drives: Option<&LegDrives<R>>,
 ) -> Result<Vec<R>, Singular> {
     let (pl, legs) = kinematics(plan, x)?;
     let n = plan.dof();
     let zero = vec![R::c(0.0); n];
-    let mut h = generalized_force(plan, &pl, &legs, u, &zero, true);
+    let mut h = generalized_force_with(plan, &pl, &legs, u, &zero, true, drives);
     if let Some(p) = payload {
         let hp = payload_force(plan, &pl, p, u, &zero, true);
         for i in 0..n {
@@ -1653,7 +1725,7 @@ pub fn forward_dynamics_with_payload<R: Real>(
             s
         })
         .collect();
-    let mut m = generalized_inertia(plan, &pl, &legs);
+    let mut m = generalized_inertia_with(plan, &pl, &legs, drives);
     if let Some(p) = payload {
         let mp = payload_inertia(plan, &pl, p);
         for i in 0..n {
