@@ -44,6 +44,7 @@ fn spec_file(variant: &str) -> &'static str {
     match variant {
         v if v.starts_with("iiwa") => "iiwa14.urdf",
         v if v.starts_with("gs") => "gough_stewart.toml",
+        v if v.starts_with("closed") => "spherical_five_bar.toml",
         _ => "puma560.toml",
     }
 }
@@ -53,6 +54,8 @@ fn spec_file(variant: &str) -> &'static str {
 const PARAMS_SCENE: &str = include_str!("src/params_scene.toml");
 /// The same for the Gough–Stewart platform: a payload on a tool fixed to the platform.
 const PARAMS_SCENE_GS: &str = include_str!("src/params_scene_gs.toml");
+/// The same for a closed-loop mechanism (the spherical five-bar).
+const PARAMS_SCENE_CLOSED: &str = include_str!("src/params_scene_closed.toml");
 
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
@@ -101,6 +104,12 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
     generate(&out, "gs_params", &p, |_| {});
+    let sfb = "../mechanisms/specs/spherical_five_bar.toml";
+    println!("cargo:rerun-if-changed={sfb}");
+    let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
+    let src = format!("{src}\n{PARAMS_SCENE_CLOSED}");
+    let p = write(&out, "closed_params", &src);
+    generate(&out, "closed_params", &p, |_| {});
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

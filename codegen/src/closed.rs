@@ -11,6 +11,7 @@ use runtime::closed::noc::{self, Plan};
 use runtime::parallel::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
+use crate::parallel::{Layout, drive_inputs, params_items, payload_inputs};
 use crate::scalar::{flat, ids, in_fresh_graph, inputs};
 use crate::schedule::{OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
@@ -38,21 +39,38 @@ pub struct Kernels {
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan));
+    kernels_with(plan, &Layout::default(), None)
+}
+
+/// [`kernels`] with run-time parameters in [`Layout`]'s layout: a payload on tree body
+/// `payload_body` (entries 0–9, that body's frame) and the drives of every tree joint, through
+/// [`noc::Extras`].
+pub fn kernels_with(
+    plan: &Plan,
+    layout: &Layout,
+    payload_body: Option<usize>,
+) -> Result<Kernels, Singular> {
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body));
     r.map(|k| Kernels { graph, ..k })
 }
 
-fn build(plan: &Plan) -> Result<Kernels, Singular> {
+fn build(plan: &Plan, layout: &Layout, payload_body: Option<usize>) -> Result<Kernels, Singular> {
     let d = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, d);
     let ud = inputs(Arg::Ud, d);
     let tau = inputs(Arg::Tau, d);
     let c = noc::configuration(plan, &x, true)?;
+    let extras = noc::Extras {
+        payload: payload_body
+            .filter(|_| layout.payload)
+            .map(|b| (b, payload_inputs())),
+        drives: layout.drives().then(|| drive_inputs(plan.nx(), layout)),
+    };
     let rates = noc::joint_rates_generic(plan, &c, &u);
-    let f = noc::generalized_force(plan, &c, &u, &ud, true);
-    let m = noc::generalized_inertia(plan, &c);
-    let fd = noc::forward_dynamics_generic(plan, &x, &u, &tau)?;
+    let f = noc::generalized_force_with(plan, &c, &u, &ud, true, &extras);
+    let m = noc::generalized_inertia_with(plan, &c, &extras);
+    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, &extras)?;
     let (step, kept, full) = noc::newton_step(plan, &x)?;
     let mut newton = ids(&step);
     newton.push(kept.0);
@@ -88,14 +106,36 @@ pub fn generate_selected(
     cfg: &Config,
     only: Option<&[String]>,
 ) -> Result<Generated, String> {
+    generate_with(model, cfg, only, None)
+}
+
+/// [`generate_selected`] with run-time parameters (`[scene] parameters = "runtime"`: a payload
+/// on a tree body and the tree joints' drives, [`crate::spec::scene_params`]); `None`:
+/// constants. `inverse_dynamics`, `mass_matrix` and `forward_dynamics` then take `p: &Params`
+/// last.
+pub fn generate_with(
+    model: &ClosedModel,
+    cfg: &Config,
+    only: Option<&[String]>,
+    params: Option<&crate::spec::RuntimeParams>,
+) -> Result<Generated, String> {
     let plan = Plan::new(model)?;
-    let k = kernels(&plan).map_err(|e| {
+    let layout = Layout::of(params);
+    let payload = params.and_then(|p| p.payload);
+    let k = kernels_with(&plan, &layout, payload.map(|p| p.0)).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the loop geometry")
     })?;
     let g = &k.graph;
     let n = plan.dof();
     let nx = plan.nx();
     let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
+    // The functions of the masses read the run-time parameters.
+    let with_p = |mut args: Vec<Arg>| {
+        if layout.any() {
+            args.push(Arg::P);
+        }
+        args
+    };
     let make = |name: &'static str,
                 doc: Vec<String>,
                 args: Vec<Arg>,
@@ -135,7 +175,7 @@ pub fn generate_selected(
             vec![format!(
                 "Generalized forces of the independent coordinates, `f = Sᵀ τ_tree = I u̇ + C u − γ` (N or N·m, gravity included): the efforts of the actuated joints that produce the motion `(x, u, ud)`. {coords}."
             )],
-            vec![Arg::X, Arg::U, Arg::Ud],
+            with_p(vec![Arg::X, Arg::U, Arg::Ud]),
             k.inverse_dynamics.clone(),
             fallible(&[Part::Vector]),
             true,
@@ -143,7 +183,7 @@ pub fn generate_selected(
         make(
             "mass_matrix",
             vec!["Generalized inertia `I = Sᵀ M S` of the independent coordinates (symmetric positive definite away from singularities).".into()],
-            vec![Arg::X],
+            with_p(vec![Arg::X]),
             k.mass_matrix.clone(),
             fallible(&[Part::Matrix]),
             true,
@@ -151,7 +191,7 @@ pub fn generate_selected(
         make(
             "forward_dynamics",
             vec!["Rates `u̇` of the independent speeds with `I u̇ = τ − (C u − γ)` for the actuator efforts `tau`; `Err` where the method fails or a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
-            vec![Arg::X, Arg::U, Arg::Tau],
+            with_p(vec![Arg::X, Arg::U, Arg::Tau]),
             k.forward_dynamics.clone(),
             fallible(&[Part::Vector]),
             true,
@@ -212,6 +252,12 @@ pub fn generate_selected(
         "Operation counts per call (the LU of `Φ_d` included; `cmp` counts its pivot selections):"
             .into(),
     ];
+    if layout.any() {
+        header.insert(
+            3,
+            "Run-time parameters: the scene's payload and joint drives (`Params`, `[scene] parameters = \"runtime\"`).".into(),
+        );
+    }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
     let fns: Vec<TokenStream> = functions
         .iter()
@@ -230,6 +276,19 @@ pub fn generate_selected(
         .map(|&j| model.tree.joints[j].kind == runtime::model::JointKind::Revolute)
         .collect();
     let items = templates();
+    let params = if layout.any() {
+        let drives: Vec<&runtime::model::Drive> =
+            model.tree.joints.iter().map(|j| &j.drive).collect();
+        params_items(
+            &layout,
+            payload.map(|(b, m, c, i)| (format!("body `{}`", model.tree.bodies[b].name), m, c, i)),
+            &drives,
+            ("NX", "tree joint (`JOINT_NAMES` order)"),
+            "a payload on a body and the joints' drives the scene models",
+        )
+    } else {
+        quote!()
+    };
     let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of position coordinates `x`: every joint of the spanning tree.
@@ -244,6 +303,7 @@ pub fn generate_selected(
         pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
         /// Which independent coordinates are angles.
         const REVOLUTE: [bool; DOF] = [#(#revolute),*];
+        #params
         #items
         #(#fns)*
         #indices

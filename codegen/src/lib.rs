@@ -148,7 +148,8 @@ pub fn compile(
             }
             spec::Mechanism::Closed(model) => {
                 let only = spec::scene_functions(file_name, source);
-                closed::generate_selected(&model, cfg, only.as_deref())
+                let params = spec::scene_params(file_name, source, &cfg.scene);
+                closed::generate_with(&model, cfg, only.as_deref(), params.as_ref())
             }
         })
     }));

@@ -105,19 +105,21 @@ impl Layout {
 
 /// [`kernels`] with run-time parameters: the payload's mass properties are added by
 /// [`noc::payload_force`] and [`noc::payload_inertia`], the drives enter as
-/// [`noc::LegDrives`].
+/// [`runtime::parallel::real::DriveInputs`].
 pub fn kernels_with(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let (r, graph) = in_fresh_graph(|| build(plan, layout));
     r.map(|k| Kernels { graph, ..k })
 }
 
-/// The leg drives of the `Arg::P` inputs.
-fn drive_inputs(plan: &Plan, layout: &Layout) -> noc::LegDrives<Sx> {
-    let nlj = 3 * plan.legs.len();
+/// The drives of `nlj` joints of the `Arg::P` inputs.
+pub(crate) fn drive_inputs(
+    nlj: usize,
+    layout: &Layout,
+) -> runtime::parallel::real::DriveInputs<Sx> {
     let (v, c, a, np) = layout.offsets(nlj);
     let p = inputs(Arg::P, np);
     let at = |k: Option<usize>| k.map(|k| p[k..k + nlj].to_vec());
-    noc::LegDrives {
+    runtime::parallel::real::DriveInputs {
         viscous: at(v),
         coulomb: at(c),
         armature: at(a),
@@ -125,8 +127,8 @@ fn drive_inputs(plan: &Plan, layout: &Layout) -> noc::LegDrives<Sx> {
     }
 }
 
-/// The payload of the `Arg::P` inputs.
-fn payload_inputs() -> noc::Payload<Sx> {
+/// The payload of the `Arg::P` inputs (entries 0–9).
+pub(crate) fn payload_inputs() -> noc::Payload<Sx> {
     let p = inputs(Arg::P, 10);
     noc::Payload {
         mass: p[0],
@@ -152,7 +154,9 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
                 .fold(Sx::c(0.0), |s, (&aij, &uj)| s + aij * uj)
         })
         .collect();
-    let drives = layout.drives().then(|| drive_inputs(plan, layout));
+    let drives = layout
+        .drives()
+        .then(|| drive_inputs(3 * plan.legs.len(), layout));
     let mut f = noc::generalized_force_with(plan, &pl, &legs, &u, &ud, true, drives.as_ref());
     let mut i = noc::generalized_inertia_with(plan, &pl, &legs, drives.as_ref());
     let payload = layout.payload.then(payload_inputs);
@@ -459,69 +463,17 @@ pub fn generate_with(
     let params_items = if !layout.any() {
         quote!()
     } else {
-        let (mut fields, mut default, mut fill) = match payload {
-            Some((_, m, c, i)) => crate::payload_params("the platform", m, &c, &i),
-            None => (quote!(), quote!(), quote!()),
-        };
-        let nlj = 3 * model.legs.len();
-        let (v0, c0, a0, np) = layout.offsets(nlj);
+        let drives: Vec<&runtime::model::Drive> = model
+            .legs
+            .iter()
+            .flat_map(|l| l.joints.iter().take(3).map(|j| &j.drive))
+            .collect();
         let joint_names: Vec<&str> = model
             .legs
             .iter()
             .flat_map(|l| l.joints.iter().take(3).map(|j| j.name.as_str()))
             .collect();
-        let nlj_lit = Literal::usize_unsuffixed(nlj);
-        let mut drive_field =
-            |at: Option<usize>,
-             name: &str,
-             doc: &str,
-             value: &dyn Fn(&runtime::model::Drive) -> f64| {
-                let Some(at) = at else { return };
-                let ident = proc_macro2::Ident::new(name, proc_macro2::Span::call_site());
-                let vals: Vec<_> = model
-                    .legs
-                    .iter()
-                    .flat_map(|l| {
-                        l.joints
-                            .iter()
-                            .take(3)
-                            .map(|j| emit::float_lit(value(&j.drive)))
-                    })
-                    .collect();
-                let at = Literal::usize_unsuffixed(at);
-                let doc = format!(" {doc}, per leg joint (`LEG_JOINT_NAMES` order).");
-                fields.extend(quote! {
-                    #[doc = #doc]
-                    pub #ident: [f64; LEG_JOINTS],
-                });
-                default.extend(quote!(#ident: [#(#vals),*],));
-                fill.extend(quote! {
-                    let mut i = 0;
-                    while i < LEG_JOINTS {
-                        a[#at + i] = self.#ident[i];
-                        i += 1;
-                    }
-                });
-            };
-        drive_field(
-            v0,
-            "damping",
-            "Viscous friction (N·m·s/rad or N·s/m)",
-            &|d| d.viscous,
-        );
-        drive_field(
-            c0,
-            "friction",
-            "Coulomb friction level (N·m or N), regularized as in the spec docs",
-            &|d| d.coulomb,
-        );
-        drive_field(
-            a0,
-            "armature",
-            "Reflected rotor inertia (kg·m² or kg)",
-            &|d| d.armature,
-        );
-        let np = Literal::usize_unsuffixed(np);
+        let nlj_lit = Literal::usize_unsuffixed(drives.len());
         let leg_items = if layout.drives() {
             quote! {
                 /// Number of leg joints (three per leg, base outwards), whose drives are run-time
@@ -533,37 +485,16 @@ pub fn generate_with(
         } else {
             quote!()
         };
-        {
-            quote! {
-                #leg_items
-                /// Number of run-time parameters in [`Params::to_array`].
-                pub const NP: usize = #np;
-                /// Run-time parameters (`[scene] parameters = "runtime"`): the payload on the
-                /// platform and the leg joints' drives the scene models, so one binary serves
-                /// several tools or drive calibrations. SI units. The functions of the masses take
-                /// them last; the kinematics do not.
-                #[derive(Clone, Copy, Debug, PartialEq)]
-                pub struct Params {
-                    #fields
-                }
-                impl Params {
-                    /// The values of the spec (what a module with constants would fold in).
-                    pub const DEFAULT: Params = Params {
-                        #default
-                    };
-                    /// The flat layout the generated functions read.
-                    pub fn to_array(&self) -> [f64; NP] {
-                        let mut a = [0.0; NP];
-                        #fill
-                        a
-                    }
-                }
-                impl Default for Params {
-                    fn default() -> Self {
-                        Self::DEFAULT
-                    }
-                }
-            }
+        let items = params_items(
+            &layout,
+            payload.map(|(_, m, c, i)| ("the platform".to_string(), m, c, i)),
+            &drives,
+            ("LEG_JOINTS", "leg joint (`LEG_JOINT_NAMES` order)"),
+            "the payload on the platform and the leg joints' drives the scene models",
+        );
+        quote! {
+            #leg_items
+            #items
         }
     };
     let nx_lit = Literal::usize_unsuffixed(nx);
@@ -589,6 +520,96 @@ pub fn generate_with(
         warnings: crate::diag::Diagnostics::new("", ""),
         per: "DOF",
     })
+}
+
+/// The `NP` constant and the `Params` struct of a module with run-time parameters (parallel
+/// mechanisms and closed loops, in [`Layout`]'s layout): the payload's fields (on `payload.0`,
+/// its values in that frame), then one array per drive effect over `drives`, of length
+/// `per.0` (a constant of the module), each entry a `per.1`.
+pub(crate) fn params_items(
+    layout: &Layout,
+    payload: Option<(String, f64, runtime::model::Vec3, runtime::model::Mat3)>,
+    drives: &[&runtime::model::Drive],
+    per: (&str, &str),
+    what: &str,
+) -> TokenStream {
+    let (mut fields, mut default, mut fill) = match &payload {
+        Some((on, m, c, i)) => crate::payload_params(on, *m, c, i),
+        None => (quote!(), quote!(), quote!()),
+    };
+    let (v0, c0, a0, np) = layout.offsets(drives.len());
+    let len = proc_macro2::Ident::new(per.0, proc_macro2::Span::call_site());
+    let mut drive_field =
+        |at: Option<usize>,
+         name: &str,
+         doc: &str,
+         value: &dyn Fn(&runtime::model::Drive) -> f64| {
+            let Some(at) = at else { return };
+            let ident = proc_macro2::Ident::new(name, proc_macro2::Span::call_site());
+            let vals: Vec<_> = drives.iter().map(|d| emit::float_lit(value(d))).collect();
+            let at = Literal::usize_unsuffixed(at);
+            let doc = format!(" {doc}, per {}.", per.1);
+            fields.extend(quote! {
+                #[doc = #doc]
+                pub #ident: [f64; #len],
+            });
+            default.extend(quote!(#ident: [#(#vals),*],));
+            fill.extend(quote! {
+                let mut i = 0;
+                while i < #len {
+                    a[#at + i] = self.#ident[i];
+                    i += 1;
+                }
+            });
+        };
+    drive_field(
+        v0,
+        "damping",
+        "Viscous friction (N·m·s/rad or N·s/m)",
+        &|d| d.viscous,
+    );
+    drive_field(
+        c0,
+        "friction",
+        "Coulomb friction level (N·m or N), regularized as in the spec docs",
+        &|d| d.coulomb,
+    );
+    drive_field(
+        a0,
+        "armature",
+        "Reflected rotor inertia (kg·m² or kg)",
+        &|d| d.armature,
+    );
+    let np = Literal::usize_unsuffixed(np);
+    let doc = format!(
+        " Run-time parameters (`[scene] parameters = \"runtime\"`): {what}, so one binary serves several tools or drive calibrations. SI units. The functions of the masses take them last; the kinematics do not."
+    );
+    quote! {
+        /// Number of run-time parameters in [`Params::to_array`].
+        pub const NP: usize = #np;
+        #[doc = #doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Params {
+            #fields
+        }
+        impl Params {
+            /// The values of the spec (what a module with constants would fold in).
+            pub const DEFAULT: Params = Params {
+                #default
+            };
+            /// The flat layout the generated functions read.
+            pub fn to_array(&self) -> [f64; NP] {
+                let mut a = [0.0; NP];
+                #fill
+                a
+            }
+        }
+        impl Default for Params {
+            fn default() -> Self {
+                Self::DEFAULT
+            }
+        }
+    }
 }
 
 /// The fixed items of every parallel module: error types, the LU of `A`, and the public

@@ -38,6 +38,14 @@ pub mod gs_params {
         "/variants/gs_params/gough_stewart.rs"
     ));
 }
+/// The spherical five-bar with a payload and joint drives at run time
+/// (`src/params_scene_closed.toml`).
+pub mod closed_params {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/closed_params/spherical_five_bar.rs"
+    ));
+}
 /// The Gough–Stewart platform with `[scene] functions = ["inverse_dynamics"]`.
 pub mod gs_id_only {
     include!(concat!(

@@ -355,3 +355,108 @@ fn compiled_module_with_params() {
     let want = runtime::noc::gravity(&heavier, &q);
     assert!(tests::rel_err(&gq, want.as_slice()) < 1e-12);
 }
+
+const SFB: &str = include_str!("../../mechanisms/specs/spherical_five_bar.toml");
+const CLOSED_SCENE: &str = include_str!("../src/params_scene_closed.toml");
+
+/// Closed loops in joint coordinates with run-time parameters (the compiled `closed_params`
+/// module of `tests/build.rs`: the spherical five-bar with a payload on its camera link and the
+/// drives of every tree joint): against the runtime on the same spec with the payload as
+/// constants (merged into the body at spec level) and the drives set on the model's joints.
+#[test]
+fn closed_loop_payload_and_drives_at_run_time_match_constants() {
+    use runtime::closed::noc::{self as cnoc, Plan};
+    use tests::variants::closed_params as g;
+    const N: usize = g::DOF;
+    const NX: usize = g::NX;
+    let src = format!("{SFB}\n{CLOSED_SCENE}");
+    let constants = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
+    let closed = |spec: &str| match load_mechanism("sfb.toml", spec) {
+        Ok((Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("not a closed-loop spec"),
+        Err(d) => panic!("{d}"),
+    };
+    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+        let mut model = closed(spec);
+        for (j, joint) in model.tree.joints.iter_mut().enumerate() {
+            joint.drive = Drive {
+                viscous: p.damping[j],
+                coulomb: p.friction[j],
+                coulomb_velocity: 1e-4,
+                armature: p.armature[j],
+            };
+        }
+        let plan = Plan::new(&model).unwrap();
+        let mut worst: f64 = 0.0;
+        for _ in 0..50 {
+            let (x, u, ud) =
+                tests::closed::random_state(&plan, r, tests::closed::reach("spherical_five_bar"));
+            let xa: [f64; NX] = x.clone().try_into().unwrap();
+            let ua: [f64; N] = u.clone().try_into().unwrap();
+            let uda: [f64; N] = ud.clone().try_into().unwrap();
+            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+            let want = cnoc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            worst = worst.max(tests::pkm::rel(&tau, &want));
+            let m = g::mass_matrix(&xa, p).unwrap();
+            let want = cnoc::mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+            worst = worst.max(tests::pkm::rel(&back, &ud));
+        }
+        worst
+    };
+    let mut r = tests::rng(44);
+    // The spec's payload by default (no drives).
+    let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
+    for _ in 0..5 {
+        let mass = r.random_range(0.05..1.0);
+        let com = [
+            r.random_range(-0.05..0.05),
+            r.random_range(-0.05..0.05),
+            r.random_range(0.0..0.1),
+        ];
+        let d = [
+            r.random_range(1e-4..1e-3),
+            r.random_range(1e-4..1e-3),
+            r.random_range(1e-4..1e-3),
+        ];
+        let off = [
+            r.random_range(-2e-5..2e-5),
+            r.random_range(-2e-5..2e-5),
+            r.random_range(-2e-5..2e-5),
+        ];
+        let i6 = [d[0], off[0], off[1], d[1], off[2], d[2]];
+        let p = g::Params {
+            payload_mass: mass,
+            payload_com: com,
+            payload_inertia: [
+                [i6[0], i6[1], i6[2]],
+                [i6[1], i6[3], i6[4]],
+                [i6[2], i6[4], i6[5]],
+            ],
+            damping: core::array::from_fn(|_| r.random_range(0.0..0.05)),
+            friction: core::array::from_fn(|_| r.random_range(0.0..0.02)),
+            armature: core::array::from_fn(|_| r.random_range(0.0..1e-3)),
+        };
+        let start = constants.find("payload = ").unwrap();
+        let end = start + constants[start..].find('\n').unwrap();
+        let spec = format!(
+            "{}{}{}",
+            &constants[..start],
+            payload_line("distal_a", mass, com, i6),
+            &constants[end..]
+        );
+        worst = worst.max(check(&p, &spec, &mut r));
+    }
+    println!(
+        "closed loops, run-time payload and drives vs constants: worst relative error {worst:.1e}"
+    );
+    assert!(worst < 1e-10, "{worst:e}");
+    // The payload changes the efforts (the check can fail).
+    let bare = closed(SFB);
+    let plan = Plan::new(&bare).unwrap();
+    let x = [0.0; NX];
+    let tau0 = cnoc::inverse_dynamics(&plan, &x, &[0.0; N], &[0.0; N]).unwrap();
+    let tau = g::inverse_dynamics(&x, &[0.0; N], &[0.0; N], &g::Params::DEFAULT).unwrap();
+    assert!(tests::pkm::rel(&tau, &tau0) > 1e-2);
+}

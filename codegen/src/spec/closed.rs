@@ -24,6 +24,15 @@ pub(crate) fn is_closed(spec: &Spec) -> bool {
 
 /// Validate a closed-loop spec and build its model; `None` when there was any error.
 pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<ClosedModel> {
+    lower_closed_attached(spec, diags).map(|(m, _)| m)
+}
+
+/// [`lower_closed`], also returning where each spec body went in the tree (`lower::Attach`:
+/// the model body and the pose in its frame; a run-time payload's place).
+pub(crate) fn lower_closed_attached(
+    spec: &Spec,
+    diags: &mut Diagnostics,
+) -> Option<(ClosedModel, Vec<Option<lower::Attach>>)> {
     let axes = lower::check_values(spec, diags);
     let mut skip = Skip::none(spec);
     // A joint with `child_origin` closes a loop only when its child is also reached by a tree
@@ -107,6 +116,7 @@ pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<Close
         return None;
     }
     let model = built.model;
+    let attach = built.attach;
     // Independent coordinates: the model joint of each actuated spec joint.
     let mut independent = Vec::new();
     for (ji, j) in spec.joints.iter().enumerate() {
@@ -127,7 +137,7 @@ pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<Close
                 return Some((None, Transform::IDENTITY));
             }
             let b = spec.bodies.iter().position(|b| b.name == name)?;
-            let a = built.attach[b]?;
+            let a = attach[b]?;
             Some((a.target, a.pose))
         };
         let (Some((pa, pose_a)), Some((cb, pose_b))) = (body_of(&j.parent), body_of(&j.child))
@@ -172,5 +182,5 @@ pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<Close
         diags.push(d);
         return None;
     }
-    Some(closed)
+    Some((closed, attach))
 }

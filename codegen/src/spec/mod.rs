@@ -181,12 +181,18 @@ fn load_any(
         };
         let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
             prepare(&mut s, overrides, &mut d);
-            if s.scene.runtime_params && s.platform.is_none() && closed::is_closed(&s) {
+            if s.scene.runtime_params
+                && s.platform.is_none()
+                && closed::is_closed(&s)
+                && s.scene.payload.is_none()
+                && !s.scene.friction
+                && !s.scene.rotor_inertia
+            {
                 d.push(
-                    Diagnostic::error("run-time parameters are not available for closed loops in joint coordinates")
+                    Diagnostic::error("run-time parameters of closed loops are a payload and the joints' drives, but the scene declares no payload and has neither `friction` nor `rotor_inertia` on")
                         .with_key("scene.parameters")
                         .with_span(s.scene.runtime_params_span.clone().or(s.anchor.clone()))
-                        .with_hint("remove `parameters = \"runtime\"`: closed-loop modules take their parameters as constants"),
+                        .with_hint("add `payload = { body = \"…\", mass = …, com = […], inertia = { … } }` or `friction = true` / `rotor_inertia = true` to [scene], or remove `parameters = \"runtime\"`"),
                 );
             }
             if s.scene.runtime_params && s.platform.is_some() {
@@ -458,15 +464,17 @@ pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
 pub struct RuntimeParams {
     /// The payload: the model body it rides on, its mass (kg), mass centre (m) and inertia about
     /// the mass centre (kg·m²), both in that body's frame. For a parallel mechanism the body is
-    /// the platform (index 0) and the values are in the platform frame.
+    /// the platform (index 0) and the values are in the platform frame; for closed loops it is
+    /// the body of the spanning tree.
     pub payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
     /// The speed scale `v_s` of the regularized Coulomb law (`[scene] coulomb_velocity`).
     pub coulomb_velocity: f64,
-    /// Parallel mechanisms: the leg joints' viscous and Coulomb friction are run-time
-    /// parameters (the scene's `friction` is on). Trees take every drive at run time.
+    /// Parallel mechanisms (leg joints) and closed loops (tree joints): the joints' viscous and
+    /// Coulomb friction are run-time parameters (the scene's `friction` is on). Trees take every
+    /// drive at run time.
     pub leg_friction: bool,
-    /// Parallel mechanisms: the leg joints' rotor inertias are run-time parameters (the scene's
-    /// `rotor_inertia` is on).
+    /// Parallel mechanisms and closed loops: the joints' rotor inertias are run-time parameters
+    /// (the scene's `rotor_inertia` is on).
     pub leg_rotor_inertia: bool,
 }
 
@@ -511,7 +519,31 @@ pub fn scene_params(
         });
     }
     if closed::is_closed(&spec) {
-        return None;
+        prepare(&mut spec, overrides, &mut d);
+        let (_, attach) = closed::lower_closed_attached(&spec, &mut d)?;
+        // A payload on a body fixed to the base moves with nothing: it is left out.
+        let payload = spec.scene.payload.as_ref().and_then(|p| {
+            let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
+            let at = attach[b]?;
+            let target = at.target?;
+            let m = geom::MassProps {
+                mass: p.mass,
+                com: p.com,
+                inertia: p.inertia,
+            }
+            .transformed(&at.pose);
+            Some((target, m.mass, m.com, m.inertia))
+        });
+        let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
+        if payload.is_none() && !friction && !rotor {
+            return None;
+        }
+        return Some(RuntimeParams {
+            payload,
+            coulomb_velocity: spec.scene.coulomb_velocity,
+            leg_friction: friction,
+            leg_rotor_inertia: rotor,
+        });
     }
     prepare(&mut spec, overrides, &mut d);
     let built = lower::lower_built(&spec, &mut d)?;

@@ -18,11 +18,12 @@ use alloc::vec::Vec;
 
 use super::{ClosedModel, CutKind, ancestry, perpendiculars};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+use crate::parallel::noc::Payload;
 use crate::parallel::noc::{
-    M, NoConvergence, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mv, rot, scale,
-    solve_spd, sub, zero3,
+    M, NoConvergence, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mtv, mv, rot,
+    scale, solve_spd, sub, zero3,
 };
-use crate::parallel::real::{Real, Singular, Site, drive_effort};
+use crate::parallel::real::{DriveInputs, Real, Singular, Site, drive_effort};
 
 /// Pivot threshold of `Φ_d`'s LU (columns scaled to unit norm): a pivot `|p| ≤ 1e-4` is a
 /// configuration where the independent coordinates (nearly) fail to determine the others. The
@@ -797,6 +798,39 @@ pub fn tree_efforts<R: Real>(
     m: &[BodyMotion<R>],
     gravity: bool,
 ) -> Vec<R> {
+    tree_efforts_with(plan, k, m, gravity, None)
+}
+
+/// Values of a closed-loop mechanism given at run time in place of the plan's constants (a
+/// generated module's `Params`, where they are symbolic inputs).
+#[derive(Clone, Debug)]
+pub struct Extras<R> {
+    /// A payload rigidly attached to tree body `.0` (its mass centre and inertia in that body's
+    /// frame).
+    pub payload: Option<(usize, Payload<R>)>,
+    /// The drives of every tree joint (entry `j`: tree joint `j`), replacing the plan's.
+    pub drives: Option<DriveInputs<R>>,
+}
+
+impl<R> Extras<R> {
+    /// No run-time values: the plan's constants.
+    pub fn none() -> Extras<R> {
+        Extras {
+            payload: None,
+            drives: None,
+        }
+    }
+}
+
+/// [`tree_efforts`] with a [`Payload`] on tree body `payload.0` (Newton–Euler of the payload,
+/// eq. 12, added to that body's wrench).
+pub fn tree_efforts_with<R: Real>(
+    plan: &Plan,
+    k: &Kin<R>,
+    m: &[BodyMotion<R>],
+    gravity: bool,
+    payload: Option<&(usize, Payload<R>)>,
+) -> Vec<R> {
     let n = plan.nx();
     let g: V<R> = if gravity { cv(&plan.gravity) } else { zero3() };
     // Subtree force and moment about the base origin.
@@ -813,6 +847,18 @@ pub fn tree_efforts<R: Real>(
             let nc = euler(&k.rot[i], &inertia, m[i].w, m[i].alpha);
             force[i] = add(force[i], f);
             moment[i] = add(moment[i], add(nc, cross(c, f)));
+        }
+        if let Some((b, p)) = payload
+            && *b == i
+        {
+            let c = add(k.pos[i], mv(&k.rot[i], p.com));
+            let a = m[i].accel_at(k.o[i], c);
+            let f = scale(p.mass, sub(a, g));
+            let rot = &k.rot[i];
+            let (wb, ab) = (mtv(rot, m[i].w), mtv(rot, m[i].alpha));
+            let nb = add(mv(&p.inertia, ab), cross(wb, mv(&p.inertia, wb)));
+            force[i] = add(force[i], f);
+            moment[i] = add(moment[i], add(mv(rot, nb), cross(c, f)));
         }
         tau[i] = match plan.joints[i].kind {
             JointKind::Revolute => dot(k.e[i], sub(moment[i], cross(k.o[i], force[i]))),
@@ -834,6 +880,18 @@ pub fn generalized_force<R: Real>(
     u: &[R],
     ud: &[R],
     gravity: bool,
+) -> Vec<R> {
+    generalized_force_with(plan, c, u, ud, gravity, &Extras::none())
+}
+
+/// [`generalized_force`] with run-time [`Extras`].
+pub fn generalized_force_with<R: Real>(
+    plan: &Plan,
+    c: &Config<R>,
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+    extras: &Extras<R>,
 ) -> Vec<R> {
     let xd = joint_rates_generic(plan, c, u);
     let bias_m = motions(plan, &c.kin, &xd, None);
@@ -858,11 +916,15 @@ pub fn generalized_force<R: Real>(
         xdd[j] = xdd_d[k];
     }
     let m = motions(plan, &c.kin, &xd, Some(&xdd));
-    let mut tau = tree_efforts(plan, &c.kin, &m, gravity);
+    let mut tau = tree_efforts_with(plan, &c.kin, &m, gravity, extras.payload.as_ref());
     // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
     // with the rest (the lecture's dissipative term δ).
     for (j, jp) in plan.joints.iter().enumerate() {
-        tau[j] = tau[j] + drive_effort(&jp.drive, xd[j], xdd[j]);
+        tau[j] = tau[j]
+            + match &extras.drives {
+                Some(d) => d.effort(j, xd[j], xdd[j]),
+                None => drive_effort(&jp.drive, xd[j], xdd[j]),
+            };
     }
     let td: Vec<R> = plan.dependent.iter().map(|&j| tau[j]).collect();
     let y = c.lu.solve_t(&td);
@@ -881,17 +943,32 @@ pub fn generalized_force<R: Real>(
 /// twist per unit speed (exactly symmetric: the upper triangle mirrored), plus the rotors'
 /// `Sᵀ diag(I_a) S`.
 pub fn generalized_inertia<R: Real>(plan: &Plan, c: &Config<R>) -> Vec<Vec<R>> {
+    generalized_inertia_with(plan, c, &Extras::none())
+}
+
+/// [`generalized_inertia`] with run-time [`Extras`].
+pub fn generalized_inertia_with<R: Real>(
+    plan: &Plan,
+    c: &Config<R>,
+    extras: &Extras<R>,
+) -> Vec<Vec<R>> {
     let d = plan.dof();
     let n = plan.nx();
     // Column k of S: the joint rates for u = e_k; the bodies' angular velocities and mass
     // centre velocities for it.
     let mut cols: Vec<Vec<(V<R>, V<R>)>> = Vec::with_capacity(d);
     let mut rates: Vec<Vec<R>> = Vec::with_capacity(d);
+    // The payload's angular velocity and mass-centre velocity per column.
+    let mut payload_cols: Vec<(V<R>, V<R>)> = Vec::new();
     for k in 0..d {
         let mut e = vec![R::c(0.0); d];
         e[k] = R::c(1.0);
         let xd = joint_rates_generic(plan, c, &e);
         let m = motions(plan, &c.kin, &xd, None);
+        if let Some((b, p)) = &extras.payload {
+            let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
+            payload_cols.push((m[*b].w, m[*b].vel_at(c.kin.o[*b], cw)));
+        }
         rates.push(xd);
         cols.push(
             (0..n)
@@ -918,14 +995,30 @@ pub fn generalized_inertia<R: Real>(plan: &Plan, c: &Config<R>) -> Vec<Vec<R>> {
             }
         }
     }
-    for (b, jp) in plan.joints.iter().enumerate() {
-        let a = jp.drive.armature;
-        if a == 0.0 {
-            continue;
-        }
+    if let Some((b, p)) = &extras.payload {
+        let rot = &c.kin.rot[*b];
         for i in 0..d {
             for j in i..d {
-                out[i][j] = out[i][j] + R::c(a) * rates[i][b] * rates[j][b];
+                let (wi, vi) = payload_cols[i];
+                let (wj, vj) = payload_cols[j];
+                let (wbi, wbj) = (mtv(rot, wi), mtv(rot, wj));
+                let v = p.mass * dot(vi, vj) + dot(wbi, mv(&p.inertia, wbj));
+                out[i][j] = out[i][j] + v;
+            }
+        }
+    }
+    for (b, jp) in plan.joints.iter().enumerate() {
+        let a = match &extras.drives {
+            Some(dr) => match &dr.armature {
+                Some(a) => a[b],
+                None => continue,
+            },
+            None if jp.drive.armature == 0.0 => continue,
+            None => R::c(jp.drive.armature),
+        };
+        for i in 0..d {
+            for j in i..d {
+                out[i][j] = out[i][j] + a * rates[i][b] * rates[j][b];
             }
         }
     }
@@ -944,12 +1037,23 @@ pub fn forward_dynamics_generic<R: Real>(
     u: &[R],
     tau: &[R],
 ) -> Result<Vec<R>, Singular> {
+    forward_dynamics_with(plan, x, u, tau, &Extras::none())
+}
+
+/// [`forward_dynamics_generic`] with run-time [`Extras`].
+pub fn forward_dynamics_with<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    u: &[R],
+    tau: &[R],
+    extras: &Extras<R>,
+) -> Result<Vec<R>, Singular> {
     let c = configuration(plan, x, true)?;
     let d = plan.dof();
     let zero = vec![R::c(0.0); d];
-    let h = generalized_force(plan, &c, u, &zero, true);
+    let h = generalized_force_with(plan, &c, u, &zero, true, extras);
     let rhs: Vec<R> = (0..d).map(|i| tau[i] - h[i]).collect();
-    let m = generalized_inertia(plan, &c);
+    let m = generalized_inertia_with(plan, &c, extras);
     solve_spd(&m, &rhs)
 }
 

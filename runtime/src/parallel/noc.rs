@@ -40,7 +40,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::real::{Real, Singular, Site, drive_effort};
+use super::real::{DriveInputs, Real, Singular, Site, drive_effort};
 use super::{LegEnd, LegKind, ParallelModel, PlatformMotion};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
 
@@ -987,40 +987,6 @@ pub fn generalized_force<R: Real>(
     generalized_force_with(plan, pl, legs, u, ud, gravity, None)
 }
 
-/// The drive coefficients of every leg joint as scalars of the evaluator, in place of the
-/// plan's constants: a generated module's run-time drive parameters, where they are symbolic
-/// inputs. Entry `3·leg + k` is joint `k` of leg `leg`; an effect that is `None` is absent.
-/// The effort law is [`drive_effort`]'s.
-#[derive(Clone, Debug)]
-pub struct LegDrives<R> {
-    /// Viscous coefficients (N·m·s/rad or N·s/m).
-    pub viscous: Option<Vec<R>>,
-    /// Coulomb levels (N·m or N).
-    pub coulomb: Option<Vec<R>>,
-    /// Reflected rotor inertias (kg·m² or kg).
-    pub armature: Option<Vec<R>>,
-    /// The speed scale `v_s` of the regularized Coulomb law.
-    pub coulomb_velocity: f64,
-}
-
-impl<R: Real> LegDrives<R> {
-    /// The drive effort of leg joint `i` at the rate `qd` and acceleration `qdd`.
-    pub fn effort(&self, i: usize, qd: R, qdd: R) -> R {
-        let mut e = R::c(0.0);
-        if let Some(a) = &self.armature {
-            e = e + a[i] * qdd;
-        }
-        if let Some(b) = &self.viscous {
-            e = e + b[i] * qd;
-        }
-        if let Some(c) = &self.coulomb {
-            let vs = self.coulomb_velocity;
-            e = e + c[i] * qd / (qd * qd + R::c(vs * vs)).sqrt();
-        }
-        e
-    }
-}
-
 /// [`generalized_force`] with the leg joints' drives from `drives` instead of the plan (closed-form
 /// UPS legs then take the generic route, where the joint efforts are formed).
 pub fn generalized_force_with<R: Real>(
@@ -1030,7 +996,7 @@ pub fn generalized_force_with<R: Real>(
     u: &[R],
     ud: &[R],
     gravity: bool,
-    drives: Option<&LegDrives<R>>,
+    drives: Option<&DriveInputs<R>>,
 ) -> Vec<R> {
     let dof = plan.dof();
     let mut f: Vec<R> = vec![R::c(0.0); dof];
@@ -1487,7 +1453,7 @@ pub fn generalized_inertia_with<R: Real>(
     plan: &Plan,
     pl: &Platform<R>,
     legs: &[LegKin<R>],
-    drives: Option<&LegDrives<R>>,
+    drives: Option<&DriveInputs<R>>,
 ) -> Vec<Vec<R>> {
     let n = plan.dof();
     let z = R::c(0.0);
@@ -1703,7 +1669,7 @@ pub fn forward_dynamics_with<R: Real>(
     u: &[R],
     tau: &[R],
     payload: Option<&Payload<R>>,
-    drives: Option<&LegDrives<R>>,
+    drives: Option<&DriveInputs<R>>,
 ) -> Result<Vec<R>, Singular> {
     let (pl, legs) = kinematics(plan, x)?;
     let n = plan.dof();
