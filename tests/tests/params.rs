@@ -189,6 +189,48 @@ fn payload_line(body: &str, mass: f64, com: [f64; 3], i: [f64; 6]) -> String {
     )
 }
 
+/// A random payload: mass in `mass`, mass centre within `reach` (m, z shifted by `z`), an
+/// inertia `[xx, xy, xz, yy, yz, zz]` with diagonal entries in `diag` and small products.
+fn random_payload(
+    r: &mut rand::rngs::StdRng,
+    mass: std::ops::Range<f64>,
+    reach: f64,
+    z: f64,
+    diag: std::ops::Range<f64>,
+) -> (f64, [f64; 3], [f64; 6]) {
+    let m = r.random_range(mass);
+    let com = [
+        r.random_range(-reach..reach),
+        r.random_range(-reach..reach),
+        z + r.random_range(-reach..reach),
+    ];
+    let off = 0.02 * diag.start;
+    let d: [f64; 3] = core::array::from_fn(|_| r.random_range(diag.clone()));
+    let o: [f64; 3] = core::array::from_fn(|_| r.random_range(-off..off));
+    (m, com, [d[0], o[0], o[1], d[1], o[2], d[2]])
+}
+
+/// The symmetric matrix of `[xx, xy, xz, yy, yz, zz]`.
+fn inertia3(i6: [f64; 6]) -> [[f64; 3]; 3] {
+    [
+        [i6[0], i6[1], i6[2]],
+        [i6[1], i6[3], i6[4]],
+        [i6[2], i6[4], i6[5]],
+    ]
+}
+
+/// `spec` with its `payload = …` line replaced by one on `body`.
+fn with_payload(spec: &str, body: &str, mass: f64, com: [f64; 3], i6: [f64; 6]) -> String {
+    let start = spec.find("payload = ").unwrap();
+    let end = start + spec[start..].find('\n').unwrap();
+    format!(
+        "{}{}{}",
+        &spec[..start],
+        payload_line(body, mass, com, i6),
+        &spec[end..]
+    )
+}
+
 /// A parallel mechanism's platform payload and leg drives at run time (the compiled `gs_params`
 /// module of `tests/build.rs`): against the runtime on the same spec with the payload as
 /// constants, merged into the platform at spec level by the parallel-axis theorem (a route that
@@ -245,43 +287,16 @@ fn parallel_payload_at_run_time_matches_constants() {
     let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
     // Random payloads set at run time, in the platform frame.
     for _ in 0..5 {
-        let mass = r.random_range(0.5..20.0);
-        let com = [
-            r.random_range(-0.1..0.1),
-            r.random_range(-0.1..0.1),
-            r.random_range(-0.2..0.1),
-        ];
-        let d = [
-            r.random_range(0.01..0.3),
-            r.random_range(0.01..0.3),
-            r.random_range(0.01..0.3),
-        ];
-        let off = [
-            r.random_range(-0.005..0.005),
-            r.random_range(-0.005..0.005),
-            r.random_range(-0.005..0.005),
-        ];
-        let i6 = [d[0], off[0], off[1], d[1], off[2], d[2]];
+        let (mass, com, i6) = random_payload(&mut r, 0.5..20.0, 0.1, -0.05, 0.01..0.3);
         let p = g::Params {
             payload_mass: mass,
             payload_com: com,
-            payload_inertia: [
-                [i6[0], i6[1], i6[2]],
-                [i6[1], i6[3], i6[4]],
-                [i6[2], i6[4], i6[5]],
-            ],
+            payload_inertia: inertia3(i6),
             damping: core::array::from_fn(|_| r.random_range(0.0..50.0)),
             friction: core::array::from_fn(|_| r.random_range(0.0..20.0)),
             armature: core::array::from_fn(|_| r.random_range(0.0..2.0)),
         };
-        let start = constants.find("payload = ").unwrap();
-        let end = start + constants[start..].find('\n').unwrap();
-        let spec = format!(
-            "{}{}{}",
-            &constants[..start],
-            payload_line("platform", mass, com, i6),
-            &constants[end..]
-        );
+        let spec = with_payload(&constants, "platform", mass, com, i6);
         worst = worst.max(check(&p, &spec, &mut r));
     }
     println!("run-time payload and drives vs constants: worst relative error {worst:.1e}");
@@ -409,43 +424,16 @@ fn closed_loop_payload_and_drives_at_run_time_match_constants() {
     // The spec's payload by default (no drives).
     let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
     for _ in 0..5 {
-        let mass = r.random_range(0.05..1.0);
-        let com = [
-            r.random_range(-0.05..0.05),
-            r.random_range(-0.05..0.05),
-            r.random_range(0.0..0.1),
-        ];
-        let d = [
-            r.random_range(1e-4..1e-3),
-            r.random_range(1e-4..1e-3),
-            r.random_range(1e-4..1e-3),
-        ];
-        let off = [
-            r.random_range(-2e-5..2e-5),
-            r.random_range(-2e-5..2e-5),
-            r.random_range(-2e-5..2e-5),
-        ];
-        let i6 = [d[0], off[0], off[1], d[1], off[2], d[2]];
+        let (mass, com, i6) = random_payload(&mut r, 0.05..1.0, 0.05, 0.05, 1e-4..1e-3);
         let p = g::Params {
             payload_mass: mass,
             payload_com: com,
-            payload_inertia: [
-                [i6[0], i6[1], i6[2]],
-                [i6[1], i6[3], i6[4]],
-                [i6[2], i6[4], i6[5]],
-            ],
+            payload_inertia: inertia3(i6),
             damping: core::array::from_fn(|_| r.random_range(0.0..0.05)),
             friction: core::array::from_fn(|_| r.random_range(0.0..0.02)),
             armature: core::array::from_fn(|_| r.random_range(0.0..1e-3)),
         };
-        let start = constants.find("payload = ").unwrap();
-        let end = start + constants[start..].find('\n').unwrap();
-        let spec = format!(
-            "{}{}{}",
-            &constants[..start],
-            payload_line("distal_a", mass, com, i6),
-            &constants[end..]
-        );
+        let spec = with_payload(&constants, "distal_a", mass, com, i6);
         worst = worst.max(check(&p, &spec, &mut r));
     }
     println!(

@@ -492,31 +492,36 @@ pub fn scene_params(
     if !spec.scene.runtime_params {
         return None;
     }
+    // Parallel mechanisms and closed loops: the payload (if any) placed on its model body, and
+    // the drives the scene models.
+    let placed = |spec: &ir::Spec, body: usize, pose: &runtime::model::Transform| {
+        let p = spec.scene.payload.as_ref()?;
+        let m = geom::MassProps {
+            mass: p.mass,
+            com: p.com,
+            inertia: p.inertia,
+        }
+        .transformed(pose);
+        Some((body, m.mass, m.com, m.inertia))
+    };
+    let with_drives =
+        |spec: &ir::Spec,
+         payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>| {
+            let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
+            (payload.is_some() || friction || rotor).then_some(RuntimeParams {
+                payload,
+                coulomb_velocity: spec.scene.coulomb_velocity,
+                leg_friction: friction,
+                leg_rotor_inertia: rotor,
+            })
+        };
     if spec.platform.is_some() {
         prepare(&mut spec, overrides, &mut d);
         let payload = match spec.scene.payload.as_ref() {
             None => None,
-            Some(p) => {
-                let pose = parallel::pose_on_platform(&spec, &p.body.name)?;
-                let m = geom::MassProps {
-                    mass: p.mass,
-                    com: p.com,
-                    inertia: p.inertia,
-                }
-                .transformed(&pose);
-                Some((0, m.mass, m.com, m.inertia))
-            }
+            Some(p) => placed(&spec, 0, &parallel::pose_on_platform(&spec, &p.body.name)?),
         };
-        let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
-        if payload.is_none() && !friction && !rotor {
-            return None;
-        }
-        return Some(RuntimeParams {
-            payload,
-            coulomb_velocity: spec.scene.coulomb_velocity,
-            leg_friction: friction,
-            leg_rotor_inertia: rotor,
-        });
+        return with_drives(&spec, payload);
     }
     if closed::is_closed(&spec) {
         prepare(&mut spec, overrides, &mut d);
@@ -525,25 +530,9 @@ pub fn scene_params(
         let payload = spec.scene.payload.as_ref().and_then(|p| {
             let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
             let at = attach[b]?;
-            let target = at.target?;
-            let m = geom::MassProps {
-                mass: p.mass,
-                com: p.com,
-                inertia: p.inertia,
-            }
-            .transformed(&at.pose);
-            Some((target, m.mass, m.com, m.inertia))
+            placed(&spec, at.target?, &at.pose)
         });
-        let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
-        if payload.is_none() && !friction && !rotor {
-            return None;
-        }
-        return Some(RuntimeParams {
-            payload,
-            coulomb_velocity: spec.scene.coulomb_velocity,
-            leg_friction: friction,
-            leg_rotor_inertia: rotor,
-        });
+        return with_drives(&spec, payload);
     }
     prepare(&mut spec, overrides, &mut d);
     let built = lower::lower_built(&spec, &mut d)?;
