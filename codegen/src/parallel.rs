@@ -812,9 +812,10 @@ fn templates(
                         p = i;
                     }
                 }
-                // `p < DOF` always; saying so lets the optimizer drop the bounds check (no-panic
-                // proof at opt-level "s").
-                let p = if p < DOF { p } else { DOF - 1 };
+                // `p < DOF` always; the remainder says so in a form the optimizer keeps (range
+                // metadata), so it drops the bounds checks of the swaps (no panic path at
+                // opt-level "s").
+                let p = p % DOF;
                 m.swap(k, p);
                 x.swap(k, p);
                 if !(best > 0.0 && best < f64::INFINITY) {
