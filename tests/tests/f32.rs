@@ -129,6 +129,7 @@ macro_rules! closed {
             let mut worst: f64 = 0.0;
             let mut worst_assembly: f64 = 0.0;
             let mut worst_function: f64 = 0.0;
+            let mut worst_arith: f64 = 0.0;
             let mut skipped = 0;
             let mut fk_failures = 0;
             for _ in 0..200 {
@@ -174,6 +175,12 @@ macro_rules! closed {
                     let t = d::inverse_dynamics(&xr, &ua64, &uda64).unwrap();
                     let t32 = s::inverse_dynamics(&xa, &ua, &uda).unwrap();
                     worst_function = worst_function.max(rel(&to64(&t32), &t));
+                    // The same input in f64 arithmetic: the runtime's evaluator without its
+                    // closure check (the f64 module refuses the rounded, slightly open loops).
+                    let xa64: Vec<f64> = xa.iter().map(|&v| v as f64).collect();
+                    let c = runtime::closed::noc::configuration(&plan, &xa64, false).unwrap();
+                    let same = runtime::closed::noc::generalized_force(&plan, &c, &ua64, &uda64, true);
+                    worst_arith = worst_arith.max(rel(&to64(&t32), &same));
                     let m = d::mass_matrix(&xr).unwrap();
                     let m32 = s::mass_matrix(&xa).unwrap();
                     worst_function = worst_function.max(rel(&to64(&m32.concat()), &m.concat()));
@@ -188,7 +195,7 @@ macro_rules! closed {
                 let m32 = s::mass_matrix(&x32).unwrap();
                 worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
             }
-            println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
+            println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e}, of which f32 arithmetic (inverse dynamics against f64 at the same rounded input) {worst_arith:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
             assert!(skipped < 100, "{name}: {skipped}");
             assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
             // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
