@@ -104,6 +104,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
     generate(&out, "gs_params", &p, |_| {});
+    // A generic leg (Newton inverse kinematics): `tests/tests/parallel.rs`.
+    let generic = Path::new("../codegen/tests/data/good_parallel/generic_leg.toml");
+    println!("cargo:rerun-if-changed={}", generic.display());
+    generate(&out, "generic_leg", generic, |_| {});
     let sfb = "../mechanisms/specs/spherical_five_bar.toml";
     println!("cargo:rerun-if-changed={sfb}");
     let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));

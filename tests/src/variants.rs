@@ -46,6 +46,14 @@ pub mod closed_params {
         "/variants/closed_params/spherical_five_bar.rs"
     ));
 }
+/// A Gough–Stewart platform with one generic leg (its prismatic axis off the U–S line), whose
+/// inverse kinematics is by Newton (`codegen/tests/data/good_parallel/generic_leg.toml`).
+pub mod generic_leg {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/generic_leg/generic_leg.rs"
+    ));
+}
 /// The Gough–Stewart platform with `[scene] functions = ["inverse_dynamics"]`.
 pub mod gs_id_only {
     include!(concat!(

@@ -1226,3 +1226,68 @@ fn universal_joint_matches_its_expansion() {
     eprintln!("U joint vs its expansion: worst {worst:.1e}");
     assert!(worst <= TOL, "{worst:e}");
 }
+
+/// A generic leg (`LegKind::Generic`: inverse kinematics by Newton): the hexapod above with
+/// each U split into two revolutes whose axes are `δ = 0.03 m` apart (along the leg), so that
+/// no closed form applies. The runtime's leg joint positions close every loop in the
+/// Lagrange model (`closure_residual`, an independent check of the Newton solution) and its
+/// actuator efforts agree with Newton–Euler plus Lagrange multipliers; the generator accepts
+/// the mechanism, and an unreachable pose is an error.
+#[test]
+fn generic_leg_by_newton_agrees() {
+    use runtime::parallel::LegKind;
+    use runtime::parallel::noc as pn;
+    const DELTA: f64 = 0.03;
+    let mut hx = hexapod();
+    for leg in hx.model.legs.iter_mut() {
+        leg.joints[1].origin.translation = [0.0, 0.0, DELTA];
+        if let LegEnd::Spherical { on_leg, .. } = &mut leg.end {
+            on_leg[2] -= DELTA;
+        }
+    }
+    let kinds = hx.model.validate().expect("a valid generic-leg hexapod");
+    assert!(kinds.iter().all(|k| *k == LegKind::Generic), "{kinds:?}");
+    let plan = pn::Plan::new(&hx.model).expect("plan");
+    let mut r = rng(77);
+    let (mut worst_closure, mut worst_tau) = (0.0f64, 0.0f64);
+    for case in 0..8 {
+        let angle = 0.04 * case as f64;
+        let hx0 = home_x(&hx.model);
+        let q = matrix_quaternion(&mm(&rot(unit(&mut r), angle), &hx.model.home.rotation));
+        let x = vec![
+            hx0[0] + r.random_range(-0.05..0.05),
+            hx0[1] + r.random_range(-0.05..0.05),
+            hx0[2] + r.random_range(-0.05..0.05),
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+        ];
+        let u: Vec<f64> = (0..6).map(|_| r.random_range(-1.0..1.0)).collect();
+        let ud: Vec<f64> = (0..6).map(|_| r.random_range(-3.0..3.0)).collect();
+        let leg_q = pn::leg_joint_positions(&plan, &x).expect("generic IK");
+        let sys = from_parallel(&hx.model, &leg_q, &x);
+        worst_closure = worst_closure.max(closure_residual(&sys));
+        let sol = solve(
+            &sys,
+            &Prescribed::Pose {
+                body: 18,
+                point: [x[0], x[1], x[2]],
+            },
+            &u,
+            &ud,
+        );
+        let tau = pn::inverse_dynamics(&plan, &x, &u, &ud).expect("generic ID");
+        worst_tau = worst_tau.max(rel_err(&tau, &sol.efforts));
+    }
+    eprintln!("generic legs: closure {worst_closure:.1e} m, τ vs Lagrange {worst_tau:.1e}");
+    assert!(worst_closure < 1e-12, "{worst_closure:e}");
+    assert!(worst_tau <= TOL, "{worst_tau:e}");
+    // Far outside the workspace: an error, not a NaN.
+    let mut far = home_x(&hx.model);
+    far[2] += 5.0;
+    assert!(pn::inverse_dynamics(&plan, &far, &[0.0; 6], &[0.0; 6]).is_err());
+    // The generator takes it, and its inverse dynamics is the runtime's.
+    let g = codegen::parallel::generate(&hx.model, &codegen::Config::default()).expect("generated");
+    assert!(g.code.contains("generic (Newton)"));
+}

@@ -5,6 +5,7 @@
 //! The independent route (Newton–Euler of every body with Lagrange multipliers) is in
 //! `tests/lagrange.rs`.
 
+use rand::Rng;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion};
 use tests::pkm::{home_x, model, random_state, rel};
@@ -257,3 +258,76 @@ against_lagrange!(lagrange_sliding_hexapod, sliding_hexapod);
 against_lagrange!(lagrange_rus_hexapod, rus_hexapod);
 against_lagrange!(lagrange_agile_eye, agile_eye);
 against_lagrange!(lagrange_planar_five_bar, planar_five_bar);
+
+/// A generic leg (`LegKind::Generic`, inverse kinematics by a fixed number of Newton steps),
+/// compiled (`tests/build.rs`, `codegen/tests/data/good_parallel/generic_leg.toml`): the
+/// generated functions against the runtime on random states, the forward/inverse kinematics
+/// round trip from a perturbed guess, and an error far outside the workspace. (The runtime's
+/// generic leg is checked against Newton–Euler with Lagrange multipliers in
+/// `tests/tests/lagrange.rs`.)
+#[test]
+fn generic_leg_module_matches_runtime() {
+    use runtime::parallel::noc;
+    use tests::variants::generic_leg as g;
+    let path = "../codegen/tests/data/good_parallel/generic_leg.toml";
+    let src = std::fs::read_to_string(path).unwrap();
+    let Ok((codegen::spec::Mechanism::Parallel(model), _)) =
+        codegen::spec::load_mechanism(path, &src)
+    else {
+        panic!("{path} is a parallel mechanism")
+    };
+    let kinds = model.validate().unwrap();
+    assert!(
+        kinds.contains(&runtime::parallel::LegKind::Generic),
+        "{kinds:?}"
+    );
+    let plan = noc::Plan::new(&model).unwrap();
+    let home = model.home_x();
+    let mut r = tests::rng(91);
+    let mut worst: f64 = 0.0;
+    for _ in 0..200 {
+        let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut r, 0.2, 0.05);
+        let xa: [f64; 7] = arr(&x);
+        let q = g::inverse_kinematics(&xa).unwrap();
+        worst = worst.max(tests::pkm::rel(
+            &q,
+            &noc::inverse_kinematics(&plan, &x).unwrap(),
+        ));
+        let tau = g::inverse_dynamics(&xa, &arr(&u), &arr(&ud)).unwrap();
+        let want = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+        worst = worst.max(tests::pkm::rel(&tau, &want));
+        let back = g::forward_dynamics(&xa, &arr(&u), &tau).unwrap();
+        worst = worst.max(tests::pkm::rel(&back, &ud));
+        // Forward kinematics from a perturbed guess returns the pose.
+        let mut guess = xa;
+        for v in guess.iter_mut().take(3) {
+            *v += 0.01;
+        }
+        let xf = g::forward_kinematics(&q, &guess).unwrap();
+        let sign = if xf[3] * xa[3] < 0.0 { -1.0 } else { 1.0 };
+        for i in 0..7 {
+            let s = if i < 3 { 1.0 } else { sign };
+            assert!((s * xf[i] - xa[i]).abs() < 1e-9, "{xf:?} vs {xa:?}");
+        }
+    }
+    println!("generic leg: generated vs runtime {worst:.1e}");
+    assert!(worst < 1e-11, "{worst:e}");
+    // Far from home (rotations to 2 rad, translations to 1 m), where the Newton steps from
+    // home may not converge: a finite result or an error, never NaN.
+    let (mut ok, mut err) = (0, 0);
+    for _ in 0..500 {
+        let d: Vec<f64> = (0..6)
+            .map(|i| if i < 3 { 2.0 } else { 1.0 } * r.random_range(-1.0..1.0))
+            .collect();
+        let x: [f64; 7] = arr(&noc::retract(plan.motion, &home, &d));
+        match g::inverse_dynamics(&x, &[0.1; 6], &[0.2; 6]) {
+            Ok(t) => {
+                assert!(t.iter().all(|v| v.is_finite()), "{x:?}: {t:?}");
+                ok += 1;
+            }
+            Err(_) => err += 1,
+        }
+    }
+    println!("far poses: {ok} finite, {err} errors");
+    assert_eq!(ok + err, 500);
+}

@@ -39,7 +39,7 @@ const SUPPORTED_POSE: &[&[JointKind]] = &[
     ],
 ];
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
-const SUPPORTED_HINT: &str = "supported legs: UPS, PUS and RUS for coordinates = \"pose\" (a U joint may also be written as two revolutes with intersecting axes); R-R-R with every axis through the centre for coordinates = \"orientation\"";
+const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"";
 
 /// Validates a spec with a `[platform]` table and builds the parallel model. Errors and
 /// warnings go to `diags`; `None` when there was any error.

@@ -127,7 +127,8 @@ pub struct ParallelModel {
     pub legs: Vec<Leg>,
 }
 
-/// The leg types with closed-form inverse kinematics, recognised from the joint geometry.
+/// The leg types, recognised from the joint geometry: five with closed-form inverse
+/// kinematics, and any other three-joint leg to a spherical joint by Newton's method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LegKind {
     /// U (two revolutes with intersecting axes) at the base, then a prismatic joint along the
@@ -143,6 +144,11 @@ pub enum LegKind {
     /// Two revolutes with axes along the plane normal, to the point of a planar point platform:
     /// the leg of a planar five-bar.
     PlanarRr,
+    /// Any other chain of three one-DOF joints (revolute or prismatic, any axes) ending in a
+    /// spherical joint at a 6-DOF platform: inverse kinematics by a fixed number of Newton
+    /// steps from the home configuration (`noc::GENERIC_IK_ITERATIONS`), checked against
+    /// `noc::GENERIC_IK_TOLERANCE` (the home branch).
+    Generic,
 }
 
 impl LegKind {
@@ -154,6 +160,7 @@ impl LegKind {
             LegKind::Rus => "RUS",
             LegKind::SphericalRr => "spherical RRR",
             LegKind::PlanarRr => "planar RR",
+            LegKind::Generic => "generic (Newton)",
         }
     }
 }
@@ -282,40 +289,19 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
     }
     let kind = match (m.motion, leg.end, kinds.as_slice()) {
         (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, P]) => {
-            if !meet(0, 1) {
-                return Err(format!(
-                    "leg {name} (U, P, S): the two revolute axes of the U joint do not intersect"
-                ));
-            }
             // The prismatic axis must run through the U centre towards the S centre.
             let tip = leg_tip_home(leg);
-            let u = ax[1].1;
-            let d = sub(&tip, &u);
-            let e = ax[2].0;
-            let off = cross(&d, &e);
-            if norm(&off) > tol {
-                return Err(format!(
-                    "leg {name} (U, P, S): the prismatic axis must lie on the line from the U centre to the S centre"
-                ));
+            let d = sub(&tip, &ax[1].1);
+            let on_line = norm(&cross(&d, &ax[2].0)) <= tol;
+            if meet(0, 1) && on_line {
+                LegKind::Ups
+            } else {
+                LegKind::Generic
             }
-            LegKind::Ups
         }
-        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [P, R, R]) => {
-            if !meet(1, 2) {
-                return Err(format!(
-                    "leg {name} (P, U, S): the two revolute axes of the U joint do not intersect"
-                ));
-            }
-            LegKind::Pus
-        }
-        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, R]) => {
-            if !meet(1, 2) {
-                return Err(format!(
-                    "leg {name} (R, U, S): the two revolute axes of the U joint do not intersect"
-                ));
-            }
-            LegKind::Rus
-        }
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [P, R, R]) if meet(1, 2) => LegKind::Pus,
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, R]) if meet(1, 2) => LegKind::Rus,
+        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [_, _, _]) => LegKind::Generic,
         (PlatformMotion::Orientation { centre }, LegEnd::Revolute { .. }, [R, R]) => {
             for (k, (e, p)) in ax.iter().enumerate() {
                 let off = cross(&sub(&centre, p), e);
@@ -360,7 +346,7 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
                 .map(|k| if *k == R { "R" } else { "P" })
                 .collect();
             return Err(format!(
-                "leg {name}: joints {} are not a supported leg type (supported: UPS, PUS, RUS for a 6-DOF platform; RRR with every axis through the centre for an orientation platform; RR about z for a planar point)",
+                "leg {name}: joints {} are not a supported leg type (supported: any three revolute or prismatic joints to a spherical joint for a 6-DOF platform, in closed form for UPS, PUS and RUS and by Newton otherwise; RRR with every axis through the centre for an orientation platform; RR about z for a planar point)",
                 word.join("-")
             ));
         }
