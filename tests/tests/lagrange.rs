@@ -1095,17 +1095,7 @@ fn parallel_noc_agrees() {
     let mut worst = [0.0f64; 4];
     for case in 0..8 {
         let angle = 0.05 * case as f64;
-        let hx0 = home_x(&hx.model);
-        let q = matrix_quaternion(&mm(&rot(unit(&mut r), angle), &hx.model.home.rotation));
-        let x = vec![
-            hx0[0] + r.random_range(-0.05..0.05),
-            hx0[1] + r.random_range(-0.05..0.05),
-            hx0[2] + r.random_range(-0.05..0.05),
-            q[0],
-            q[1],
-            q[2],
-            q[3],
-        ];
+        let x = random_pose(&mut r, &hx.model, angle);
         let u: Vec<f64> = (0..6).map(|_| r.random_range(-1.0..1.0)).collect();
         let ud: Vec<f64> = (0..6).map(|_| r.random_range(-3.0..3.0)).collect();
         let leg_q = hx.leg_q(&x);
@@ -1141,6 +1131,18 @@ fn parallel_noc_agrees() {
     for (k, w) in worst.iter().enumerate() {
         assert!(*w <= TOL, "check {k}: {w:e} > {TOL:e}");
     }
+}
+
+/// A pose of a 6-DOF platform: home turned by `angle` about a random axis and moved up to
+/// 0.05 m per coordinate.
+fn random_pose(r: &mut rand::rngs::StdRng, model: &ParallelModel, angle: f64) -> Vec<f64> {
+    let hx0 = home_x(model);
+    let q = matrix_quaternion(&mm(&rot(unit(r), angle), &model.home.rotation));
+    let mut x: Vec<f64> = (0..3)
+        .map(|i| hx0[i] + r.random_range(-0.05..0.05))
+        .collect();
+    x.extend(q);
+    x
 }
 
 /// The hexapod with every expanded U (two revolutes and a massless cross) replaced by one
@@ -1252,17 +1254,7 @@ fn generic_leg_by_newton_agrees() {
     let (mut worst_closure, mut worst_tau) = (0.0f64, 0.0f64);
     for case in 0..8 {
         let angle = 0.04 * case as f64;
-        let hx0 = home_x(&hx.model);
-        let q = matrix_quaternion(&mm(&rot(unit(&mut r), angle), &hx.model.home.rotation));
-        let x = vec![
-            hx0[0] + r.random_range(-0.05..0.05),
-            hx0[1] + r.random_range(-0.05..0.05),
-            hx0[2] + r.random_range(-0.05..0.05),
-            q[0],
-            q[1],
-            q[2],
-            q[3],
-        ];
+        let x = random_pose(&mut r, &hx.model, angle);
         let u: Vec<f64> = (0..6).map(|_| r.random_range(-1.0..1.0)).collect();
         let ud: Vec<f64> = (0..6).map(|_| r.random_range(-3.0..3.0)).collect();
         let leg_q = pn::leg_joint_positions(&plan, &x).expect("generic IK");

@@ -1314,6 +1314,26 @@ pub fn payload_force<R: Real>(
     f
 }
 
+/// The twist columns of a body moving with the platform, `n` speeds: `(Some(e_j), e_j × r_c)`
+/// for the angular speeds (`r_c` the mass centre from the platform origin, base frame) and
+/// `(None, e_j)` for the linear ones (pose).
+fn platform_columns<R: Real>(n: usize, rc: V<R>) -> Vec<(Option<V<R>>, V<R>)> {
+    let unit = |j: usize| {
+        let mut e = zero3::<R>();
+        e[j] = R::c(1.0);
+        e
+    };
+    (0..n)
+        .map(|j| {
+            if j < 3 {
+                (Some(unit(j)), cross(unit(j), rc))
+            } else {
+                (None, unit(j - 3))
+            }
+        })
+        .collect()
+}
+
 /// The payload's part of the generalized inertia `I` (exactly symmetric): `T_Pᵀ M T_P` of
 /// [`generalized_inertia`]'s platform term with the payload's values.
 pub fn payload_inertia<R: Real>(
@@ -1330,22 +1350,7 @@ pub fn payload_inertia<R: Real>(
         }
         return out;
     }
-    let rc = mv(&pl.rot, payload.com);
-    let unit = |j: usize| {
-        let mut e = zero3::<R>();
-        e[j] = R::c(1.0);
-        e
-    };
-    // ω columns e_j (mass-centre velocity e_j × r_c); v columns (pose) e_j.
-    let cols: Vec<(Option<V<R>>, V<R>)> = (0..n)
-        .map(|j| {
-            if j < 3 {
-                (Some(unit(j)), cross(unit(j), rc))
-            } else {
-                (None, unit(j - 3))
-            }
-        })
-        .collect();
+    let cols = platform_columns(n, mv(&pl.rot, payload.com));
     for i in 0..n {
         for j in i..n {
             let mut v = payload.mass * dot(cols[i].1, cols[j].1);
@@ -1616,21 +1621,7 @@ pub fn generalized_inertia_with<R: Real>(
     }
     // The platform: ω columns e_j with mass-centre velocity e_j × r_c; v columns (pose) e_j.
     let (mass, com, inertia) = plan.platform;
-    let rc = mv(&pl.rot, cv::<R>(&com));
-    let unit = |j: usize| {
-        let mut e = zero3::<R>();
-        e[j] = R::c(1.0);
-        e
-    };
-    let cols: Vec<(Option<V<R>>, V<R>)> = (0..n)
-        .map(|j| {
-            if j < 3 {
-                (Some(unit(j)), cross(unit(j), rc))
-            } else {
-                (None, unit(j - 3))
-            }
-        })
-        .collect();
+    let cols = platform_columns(n, mv(&pl.rot, cv::<R>(&com)));
     for i in 0..n {
         for j in i..n {
             let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);
