@@ -130,6 +130,7 @@ macro_rules! closed {
             let mut worst_assembly: f64 = 0.0;
             let mut worst_function: f64 = 0.0;
             let mut worst_arith: f64 = 0.0;
+            let (mut loss32, mut loss64): (f64, f64) = (0.0, 0.0);
             let mut skipped = 0;
             let mut fk_failures = 0;
             for _ in 0..200 {
@@ -181,6 +182,11 @@ macro_rules! closed {
                     let c = runtime::closed::noc::configuration(&plan, &xa64, false).unwrap();
                     let same = runtime::closed::noc::generalized_force(&plan, &c, &ua64, &uda64, true);
                     worst_arith = worst_arith.max(rel(&to64(&t32), &same));
+                    // Against double-double at the same input: how many units of its own
+                    // rounding each precision loses (f32: 2⁻²⁴, f64: 2⁻⁵³).
+                    let dd = tests::dd::closed_inverse_dynamics_dd(&plan, &xa64, &ua64, &uda64).unwrap();
+                    loss32 = loss32.max(rel(&to64(&t32), &dd) / f32::EPSILON as f64 * 2.0);
+                    loss64 = loss64.max(rel(&same, &dd) / f64::EPSILON * 2.0);
                     let m = d::mass_matrix(&xr).unwrap();
                     let m32 = s::mass_matrix(&xa).unwrap();
                     worst_function = worst_function.max(rel(&to64(&m32.concat()), &m.concat()));
@@ -195,7 +201,7 @@ macro_rules! closed {
                 let m32 = s::mass_matrix(&x32).unwrap();
                 worst = worst.max(rel(&to64(&m32.concat()), &m.concat()));
             }
-            println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e}, of which f32 arithmetic (inverse dynamics against f64 at the same rounded input) {worst_arith:.1e} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
+            println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e}, of which f32 arithmetic (inverse dynamics against f64 at the same rounded input) {worst_arith:.1e}; worst error in units of rounding against double-double: f32 {loss32:.0}, f64 {loss64:.0} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times)");
             assert!(skipped < 100, "{name}: {skipped}");
             assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
             // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
