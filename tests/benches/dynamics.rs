@@ -110,12 +110,16 @@ macro_rules! bench_mechanism {
 bench_mechanism!(puma560, puma560, "puma560.toml", 560);
 bench_mechanism!(chain7, chain7, "chain7.toml", 7);
 
-/// A bundled parallel mechanism: generated vs the runtime evaluator (`runtime::parallel::noc`,
-/// the same equations in `f64` with `Vec`s), for inverse and forward dynamics.
+/// A bundled parallel mechanism: generated vs the runtime evaluators, for inverse and forward
+/// dynamics: `runtime_noc` is `runtime::parallel::noc` (the association the generator expands,
+/// leg by leg, in `f64` with `Vec`s), `runtime_literal` is `runtime::parallel::literal` (the
+/// lecture's dense `TᵀMT`, `Tᵀ(MṪ + WMT)` and `A⁻ᵀ`, the parallel counterpart of the trees'
+/// literal NOC).
 macro_rules! bench_parallel {
     ($fn_name:ident, $module:ident) => {
         fn $fn_name(c: &mut Criterion) {
             use mechanisms::$module as generated;
+            use runtime::parallel::literal;
             use runtime::parallel::noc::{self, Plan};
             const NX: usize = generated::NX;
             const N: usize = generated::DOF;
@@ -151,6 +155,16 @@ macro_rules! bench_parallel {
                     )
                 })
             });
+            g.bench_function("runtime_literal", |b| {
+                b.iter(|| {
+                    literal::inverse_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&ud),
+                    )
+                })
+            });
             g.finish();
 
             let mut g = c.benchmark_group(format!("{name}/forward_dynamics"));
@@ -162,6 +176,16 @@ macro_rules! bench_parallel {
             g.bench_function("runtime_noc", |b| {
                 b.iter(|| {
                     noc::forward_dynamics(
+                        black_box(&plan),
+                        black_box(&x),
+                        black_box(&u),
+                        black_box(&tau),
+                    )
+                })
+            });
+            g.bench_function("runtime_literal", |b| {
+                b.iter(|| {
+                    literal::forward_dynamics(
                         black_box(&plan),
                         black_box(&x),
                         black_box(&u),

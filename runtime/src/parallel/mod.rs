@@ -22,6 +22,7 @@ use alloc::vec::Vec;
 
 use crate::model::{Body, Joint, JointKind, Transform, Vec3, mat_vec};
 
+pub mod literal;
 pub mod noc;
 pub mod real;
 

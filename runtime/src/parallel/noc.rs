@@ -1032,15 +1032,18 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
 /// material point at the joint point `o_k` (velocities of points are not needed: the
 /// accelerations carry them in their `ω × (ω × r)` and Coriolis terms).
 #[derive(Clone, Copy, Debug)]
-struct BodyMotion<R> {
-    w: V<R>,
-    alpha: V<R>,
-    a: V<R>,
+pub(crate) struct BodyMotion<R> {
+    /// Angular velocity.
+    pub(crate) w: V<R>,
+    /// Angular acceleration.
+    pub(crate) alpha: V<R>,
+    /// Acceleration of the material point at the joint point `o_k`.
+    pub(crate) a: V<R>,
 }
 
 impl<R: Real> BodyMotion<R> {
     /// Acceleration of the body's material point at `x`, knowing it at `o`.
-    fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
+    pub(crate) fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
         let r = sub(x, o);
         add(
             add(self.a, cross(self.alpha, r)),
@@ -1081,6 +1084,36 @@ fn chain<R: Real>(lp: &LegPlan, lk: &LegKin<R>, qd: &[R], qdd: Option<&[R]>) -> 
         });
     }
     out
+}
+
+/// Steps 3–4 for one leg: joint rates `θ̇ = J⁻¹ v_end`, joint accelerations
+/// `θ̈ = J⁻¹ (a_end − J̇ θ̇)` (the end's acceleration with `θ̈ = 0` first) and the leg bodies'
+/// motions by the chain recursion, all in the leg frame `L`. `v_end`, `a_end`: the end point's
+/// velocity and acceleration (or the platform's angular velocity and acceleration for a
+/// spherical leg), base frame.
+pub(crate) fn leg_motion<R: Real>(
+    lp: &LegPlan,
+    lk: &LegKin<R>,
+    v_end: V<R>,
+    a_end: V<R>,
+) -> (Vec<R>, Vec<R>, Vec<BodyMotion<R>>) {
+    let n = lp.joints.len();
+    let v_l = mtv(&lk.frame, v_end);
+    let a_l = mtv(&lk.frame, a_end);
+    let qd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], v_l)).collect();
+    let bias = chain(lp, lk, &qd, None);
+    let last = n - 1;
+    let bias_end = match lp.kind {
+        LegKind::SphericalRr => {
+            // ω_P = θ̇0 e0 + θ̇1 e1 + θ̇2 e_end; e_end turns with body 1.
+            add(bias[last].alpha, scale(qd[2], cross(bias[last].w, lk.end)))
+        }
+        _ => bias[last].accel_at(lk.o[last], lk.end),
+    };
+    let rhs = sub(a_l, bias_end);
+    let qdd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], rhs)).collect();
+    let motion = chain(lp, lk, &qd, Some(&qdd));
+    (qd, qdd, motion)
 }
 
 /// The generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`) of the speeds `u`.
@@ -1142,23 +1175,7 @@ pub fn generalized_force_with<R: Real>(
             }
             continue;
         }
-        let v_l = mtv(&lk.frame, v_end);
-        let a_l = mtv(&lk.frame, a_end);
-        // Joint rates θ̇ = J⁻¹ v_end.
-        let qd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], v_l)).collect();
-        // Joint accelerations θ̈ = J⁻¹ (a_end − J̇ θ̇): the end's acceleration with θ̈ = 0 first.
-        let bias = chain(lp, lk, &qd, None);
-        let last = n - 1;
-        let bias_end = match lp.kind {
-            LegKind::SphericalRr => {
-                // ω_P = θ̇0 e0 + θ̇1 e1 + θ̇2 e_end; e_end turns with body 1.
-                add(bias[last].alpha, scale(qd[2], cross(bias[last].w, lk.end)))
-            }
-            _ => bias[last].accel_at(lk.o[last], lk.end),
-        };
-        let rhs = sub(a_l, bias_end);
-        let qdd: Vec<R> = (0..3).map(|i| dot(lk.jinv[i], rhs)).collect();
-        let motion = chain(lp, lk, &qd, Some(&qdd));
+        let (qd, qdd, motion) = leg_motion(lp, lk, v_end, a_end);
         // Body wrenches (about each mass centre) and the leg's joint efforts.
         let g_l = mtv(&lk.frame, cv::<R>(&g_world));
         let mut force = zero3::<R>();
