@@ -52,6 +52,8 @@ fn spec_file(variant: &str) -> &'static str {
 /// Appended to the PUMA 560's spec for the run-time-parameter variant (also read by
 /// `tests/tests/params.rs`).
 const PARAMS_SCENE: &str = include_str!("src/params_scene.toml");
+/// The same with every body's inertial parameters at run time (`runtime_inertia = "all"`).
+const PARAMS_SCENE_INERTIA: &str = include_str!("src/params_scene_inertia.toml");
 /// The same for the Gough–Stewart platform: a payload on a tool fixed to the platform.
 const PARAMS_SCENE_GS: &str = include_str!("src/params_scene_gs.toml");
 /// The same for a closed-loop mechanism (the spherical five-bar).
@@ -100,6 +102,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE}");
     let p = write(&out, "puma_params", &src);
     generate(&out, "puma_params", &p, |_| {});
+    let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
+    let src = format!("{src}\n{PARAMS_SCENE_INERTIA}");
+    let p = write(&out, "puma_inertia", &src);
+    generate(&out, "puma_inertia", &p, |_| {});
     let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);

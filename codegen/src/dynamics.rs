@@ -113,22 +113,27 @@ pub struct Tree {
     gravity: Vec3,
     /// Per joint: friction and rotor inertia (added after the rigid-body sweeps).
     drives: Vec<Drive>,
-    /// Run-time parameters (`[scene] parameters = "runtime"`): the payload's link and the
-    /// Coulomb speed scale; the drive coefficients are then inputs too.
+    /// Run-time parameters (`[scene] parameters = "runtime"`): the links of the payload and of
+    /// the run-time bodies, and the Coulomb speed scale; the drive coefficients are then inputs
+    /// too.
     params: Option<ParamLayout>,
 }
 
 /// What [`Tree::with_runtime_params`] makes an input.
 #[derive(Clone, Debug)]
 struct ParamLayout {
-    payload: Option<usize>,
+    /// Rigid bodies with run-time inertial parameters: `(link, first index)` of the payload
+    /// (index 0) and of each run-time body ([`body_param_index`]). Each enters as a payload on
+    /// its link.
+    rigid: Vec<(usize, usize)>,
     coulomb_velocity: f64,
 }
 
 /// Index into the run-time parameter array (`Params::to_array`) of a `dof`-joint tree:
 /// `0` payload mass, `1..4` its mass centre, `4..10` its inertia `xx, xy, xz, yy, yz, zz` (body
 /// frame of the payload's body, about the mass centre), then per joint `damping`, `friction`,
-/// `armature` (`10 + kind·dof + joint`).
+/// `armature` (`10 + kind·dof + joint`), then ten entries per run-time body
+/// ([`body_param_index`], in the same order as the payload's).
 pub fn param_index(kind: ParamKind, joint: usize, dof: usize) -> usize {
     match kind {
         ParamKind::Damping => 10 + joint,
@@ -148,9 +153,21 @@ pub enum ParamKind {
     Armature,
 }
 
-/// Number of run-time parameters of a `dof`-joint tree.
+/// Number of run-time parameters of a `dof`-joint tree without run-time bodies.
 pub fn param_count(dof: usize) -> usize {
     10 + 3 * dof
+}
+
+/// Number of run-time parameters of a `dof`-joint tree with `bodies` run-time bodies
+/// (`[scene] runtime_inertia`).
+pub fn param_count_with(dof: usize, bodies: usize) -> usize {
+    param_count(dof) + 10 * bodies
+}
+
+/// First index of run-time body `k`'s ten parameters in a `dof`-joint tree: after the drives,
+/// mass, mass centre (3), inertia about it `xx, xy, xz, yy, yz, zz`, as the payload's.
+pub fn body_param_index(k: usize, dof: usize) -> usize {
+    param_count(dof) + 10 * k
 }
 
 /// A body in the canonical frames, before the origin choice: mass centre and inertia about it.
@@ -313,9 +330,26 @@ impl Tree {
     /// and every joint's drive coefficients become inputs (`Arg::P`, see [`param_index`]).
     pub fn with_runtime_params(mut self, payload: Option<usize>, coulomb_velocity: f64) -> Tree {
         self.params = Some(ParamLayout {
-            payload,
+            rigid: payload.map(|b| (b, 0)).into_iter().collect(),
             coulomb_velocity,
         });
+        self
+    }
+
+    /// Run-time inertial parameters of rigid bodies (`[scene] runtime_inertia`; call after
+    /// [`Tree::with_runtime_params`]): entry `k` rides on model body `bodies[k]` and reads its
+    /// ten parameters from [`body_param_index`]`(k, dof)`, exactly as a run-time payload there.
+    /// The bodies' constants must already be zero in the model.
+    pub fn with_runtime_bodies(mut self, bodies: &[usize]) -> Tree {
+        let n = self.dof();
+        if let Some(p) = &mut self.params {
+            p.rigid.extend(
+                bodies
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &b)| (b, body_param_index(k, n))),
+            );
+        }
         self
     }
 
@@ -1239,10 +1273,11 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         moment.push(choice.0);
         extra_moment.push(choice.1);
     }
-    // A run-time payload on link b: its Newton–Euler wrench about the link origin (eq. 12),
-    // `f = m a + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × J ω + h × a`.
-    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
-        let (m, h, j) = payload_params(&mut s, b);
+    // A run-time payload or body on link b: its Newton–Euler wrench about the link origin
+    // (eq. 12), `f = m a + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × J ω + h × a`.
+    let rigid = tree.params.as_ref().map_or(&[][..], |p| &p.rigid[..]);
+    for &(b, at) in rigid {
+        let (m, h, j) = payload_params(&mut s, b, at);
         let (w, wd, a) = (omega[b], omegad[b], acc[b]);
         let ma = s.scale3(m, a);
         let u = s.u_matrix(w, wd);
@@ -1312,11 +1347,12 @@ fn add_param_drive_efforts(g: &mut Graph, n: usize, vs: f64, terms: Terms, tau: 
     }
 }
 
-/// The run-time payload's inertial parameters in link `b`'s frame: mass, first moment `m c`
-/// and inertia about the link origin (`x_link = A x_body − d e_z`; parallel-axis theorem).
-fn payload_params(s: &mut Sym<'_>, b: usize) -> (ExprId, V3, M3) {
+/// The inertial parameters of a run-time payload or body (`Arg::P` entries `at..at + 10`) in
+/// link `b`'s frame: mass, first moment `m c` and inertia about the link origin
+/// (`x_link = A x_body − d e_z`; parallel-axis theorem).
+fn payload_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
     let (a, d) = s.tree.links[b].to_link;
-    let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, k);
+    let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, at + k);
     let m = p(s, 0);
     let cb = [p(s, 1), p(s, 2), p(s, 3)];
     let ic_b = {
@@ -1385,8 +1421,9 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
             j: s.cm(&l.j),
         })
         .collect();
-    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
-        let (m, h, j) = payload_params(&mut s, b);
+    let rigid = tree.params.as_ref().map_or(&[][..], |p| &p.rigid[..]);
+    for &(b, at) in rigid {
+        let (m, h, j) = payload_params(&mut s, b, at);
         let c = comp[b];
         let hs = s.add3(c.h, h);
         let mut js = c.j;

@@ -31,6 +31,14 @@ pub mod gs_point_legs {
 pub mod puma_params {
     include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));
 }
+/// The PUMA 560 with every body's inertial parameters at run time
+/// (`src/params_scene_inertia.toml`).
+pub mod puma_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/puma_inertia/puma560.rs"
+    ));
+}
 /// The Gough–Stewart platform with a tool and a run-time payload (`src/params_scene_gs.toml`).
 pub mod gs_params {
     include!(concat!(
