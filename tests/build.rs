@@ -59,6 +59,12 @@ const PARAMS_SCENE_GS: &str = include_str!("src/params_scene_gs.toml");
 /// The same for a closed-loop mechanism (the spherical five-bar).
 const PARAMS_SCENE_CLOSED: &str = include_str!("src/params_scene_closed.toml");
 
+/// `scene` (one of the `PARAMS_SCENE*` texts) with every body's inertial parameters at run time
+/// as well (also in `tests/tests/params.rs`).
+fn with_runtime_inertia(scene: &str) -> String {
+    scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
+}
+
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
     let puma = "../mechanisms/specs/puma560.toml";
@@ -110,6 +116,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
     generate(&out, "gs_params", &p, |_| {});
+    let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
+    let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_GS));
+    let p = write(&out, "gs_inertia", &src);
+    generate(&out, "gs_inertia", &p, |_| {});
     // A generic leg (Newton inverse kinematics): `tests/tests/parallel.rs`.
     let generic = Path::new("../codegen/tests/data/good_parallel/generic_leg.toml");
     println!("cargo:rerun-if-changed={}", generic.display());
@@ -120,6 +130,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE_CLOSED}");
     let p = write(&out, "closed_params", &src);
     generate(&out, "closed_params", &p, |_| {});
+    let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
+    let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_CLOSED));
+    let p = write(&out, "closed_inertia", &src);
+    generate(&out, "closed_inertia", &p, |_| {});
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

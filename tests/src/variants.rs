@@ -54,6 +54,21 @@ pub mod closed_params {
         "/variants/closed_params/spherical_five_bar.rs"
     ));
 }
+/// `gs_params` with the platform's own inertia at run time as well (`runtime_inertia = "all"`).
+pub mod gs_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/gs_inertia/gough_stewart.rs"
+    ));
+}
+/// `closed_params` with every body's inertial parameters at run time as well
+/// (`runtime_inertia = "all"`).
+pub mod closed_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/closed_inertia/spherical_five_bar.rs"
+    ));
+}
 /// A Gough–Stewart platform with one generic leg (its prismatic axis off the U–S line), whose
 /// inverse kinematics is by Newton (`codegen/tests/data/good_parallel/generic_leg.toml`).
 pub mod generic_leg {

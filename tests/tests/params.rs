@@ -733,3 +733,195 @@ fn runtime_inertia_on_random_trees() {
     println!("runtime_inertia on random trees: worst relative error {worst:.1e}");
     assert!(worst <= 1e-11, "runtime inertia on random trees: {worst:e}");
 }
+
+/// `scene` (a `src/params_scene*.toml` text) with `runtime_inertia = "all"` added, as
+/// `tests/build.rs` writes the `*_inertia` variants.
+fn with_runtime_inertia(scene: &str) -> String {
+    scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
+}
+
+/// The constants counterpart of a run-time spec: `parameters = "constants"`, no
+/// `runtime_inertia`; `keep_payload: false` also drops the payload line (the bodies' own values
+/// are then the model's).
+fn as_constants(spec: &str, keep_payload: bool) -> String {
+    spec.replace("parameters = \"runtime\"", "parameters = \"constants\"")
+        .replace("runtime_inertia = \"all\"\n", "")
+        .lines()
+        .filter(|l| keep_payload || !l.starts_with("payload = "))
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
+
+/// Random physical mass properties: mass in `mass` (kg), mass centre within `reach` (m),
+/// rotated principal moments with the triangle inequality scaled by `scale · mass` (kg·m²).
+fn random_props(
+    r: &mut rand::rngs::StdRng,
+    mass: std::ops::Range<f64>,
+    reach: f64,
+    scale: f64,
+) -> Props {
+    let m = r.random_range(mass);
+    let c = core::array::from_fn(|_| r.random_range(-reach..reach));
+    let i = tests::inertia(r).map(|row| row.map(|x| scale * m * x));
+    (m, c, i)
+}
+
+/// Closed loops with every tree body's inertial parameters at run time besides the payload and
+/// the drives (the compiled `closed_inertia` module: the spherical five-bar): random parameter
+/// sets written into the spec as constants, against the runtime, with the same values (each
+/// body's, in its tree body's frame as lowered) through `Params`.
+#[test]
+fn closed_loop_runtime_inertia_matches_constants() {
+    use runtime::closed::noc::{self as cnoc, Plan};
+    use tests::variants::closed_inertia as g;
+    const N: usize = g::DOF;
+    const NX: usize = g::NX;
+    let src = format!("{SFB}\n{}", with_runtime_inertia(CLOSED_SCENE));
+    let constants = as_constants(&src, true);
+    let closed = |spec: &str| match load_mechanism("sfb.toml", spec) {
+        Ok((Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("not a closed-loop spec"),
+        Err(d) => panic!("{d}"),
+    };
+    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+        let mut model = closed(spec);
+        for (j, joint) in model.tree.joints.iter_mut().enumerate() {
+            joint.drive = Drive {
+                viscous: p.damping[j],
+                coulomb: p.friction[j],
+                coulomb_velocity: 1e-4,
+                armature: p.armature[j],
+            };
+        }
+        let plan = Plan::new(&model).unwrap();
+        let mut worst: f64 = 0.0;
+        for _ in 0..50 {
+            let (x, u, ud) =
+                tests::closed::random_state(&plan, r, tests::closed::reach("spherical_five_bar"));
+            let xa: [f64; NX] = x.clone().try_into().unwrap();
+            let ua: [f64; N] = u.clone().try_into().unwrap();
+            let uda: [f64; N] = ud.clone().try_into().unwrap();
+            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+            let want = cnoc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            worst = worst.max(tests::pkm::rel(&tau, &want));
+            let m = g::mass_matrix(&xa, p).unwrap();
+            let want = cnoc::mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+            worst = worst.max(tests::pkm::rel(&back, &ud));
+        }
+        worst
+    };
+    assert_eq!(
+        g::RUNTIME_BODY_NAMES,
+        ["proximal_a", "distal_a", "proximal_b", "distal_b"]
+    );
+    let mut r = tests::rng(46);
+    // The spec's values by default.
+    let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
+    let mut changed = f64::INFINITY;
+    for _ in 0..5 {
+        let values: Vec<(&str, Props)> = g::RUNTIME_BODY_NAMES
+            .iter()
+            .map(|&name| (name, random_props(&mut r, 0.05..2.0, 0.1, 0.01)))
+            .collect();
+        let spec = with_body_constants(&constants, &values);
+        // The bodies' own values in their tree bodies' frames: the model without the payload.
+        let bare = closed(&with_body_constants(&as_constants(&src, false), &values));
+        let mut p = g::Params::DEFAULT;
+        for (k, name) in g::RUNTIME_BODY_NAMES.iter().enumerate() {
+            let b = bare.tree.bodies.iter().find(|b| b.name == *name).unwrap();
+            (p.body_mass[k], p.body_com[k], p.body_inertia[k]) = (b.mass, b.com, b.inertia);
+        }
+        p.damping = core::array::from_fn(|_| r.random_range(0.0..0.05));
+        p.friction = core::array::from_fn(|_| r.random_range(0.0..0.02));
+        p.armature = core::array::from_fn(|_| r.random_range(0.0..1e-3));
+        worst = worst.max(check(&p, &spec, &mut r));
+        let x = [0.0; NX];
+        let a = g::inverse_dynamics(&x, &[0.0; N], &[0.0; N], &p).unwrap();
+        let mut d = g::Params::DEFAULT;
+        (d.damping, d.friction, d.armature) = (p.damping, p.friction, p.armature);
+        let b = g::inverse_dynamics(&x, &[0.0; N], &[0.0; N], &d).unwrap();
+        changed = changed.min(tests::pkm::rel(&a, &b));
+    }
+    println!(
+        "closed loops, runtime_inertia vs constants: worst relative error {worst:.1e}, smallest change of the efforts {changed:.1e}"
+    );
+    assert!(worst <= 1e-11, "{worst:e}");
+    assert!(changed > 1e-2, "the run-time values change the efforts: {changed:e}");
+}
+
+/// A parallel mechanism with the platform's own inertia at run time besides the payload and
+/// the leg drives (the compiled `gs_inertia` module; the constant platform is massless there):
+/// random platform parameters written into the spec as constants, against the runtime.
+#[test]
+fn parallel_platform_inertia_at_run_time_matches_constants() {
+    use runtime::parallel::Plan;
+    use runtime::parallel::noc;
+    use tests::variants::gs_inertia as g;
+    const N: usize = g::DOF;
+    let src = format!("{GS}\n{}", with_runtime_inertia(GS_SCENE));
+    let constants = as_constants(&src, true);
+    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+        let mut model = parallel(spec);
+        for (l, leg) in model.legs.iter_mut().enumerate() {
+            for (k, j) in leg.joints.iter_mut().enumerate().take(3) {
+                let i = 3 * l + k;
+                j.drive = Drive {
+                    viscous: p.damping[i],
+                    coulomb: p.friction[i],
+                    coulomb_velocity: 1e-4,
+                    armature: p.armature[i],
+                };
+            }
+        }
+        let plan = Plan::new(&model).unwrap();
+        let home = model.home_x();
+        let mut worst: f64 = 0.0;
+        for _ in 0..50 {
+            let (x, u, ud) = tests::pkm::random_state(&plan, &home, r, 0.3, 0.1);
+            let xa: [f64; 7] = x.clone().try_into().unwrap();
+            let ua: [f64; N] = u.clone().try_into().unwrap();
+            let uda: [f64; N] = ud.clone().try_into().unwrap();
+            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+            let want = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+            worst = worst.max(tests::pkm::rel(&tau, &want));
+            let m = g::mass_matrix(&xa, p).unwrap();
+            let want = noc::mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+            let ma = g::actuator_mass_matrix(&xa, p).unwrap();
+            let want = noc::actuator_mass_matrix(&plan, &x).unwrap();
+            worst = worst.max(tests::pkm::rel(&ma.concat(), &want.concat()));
+            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+            worst = worst.max(tests::pkm::rel(&back, &ud));
+        }
+        worst
+    };
+    assert_eq!(g::RUNTIME_BODY_NAMES, ["platform"]);
+    let mut r = tests::rng(47);
+    let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
+    let mut changed = f64::INFINITY;
+    for _ in 0..5 {
+        let values = [("platform", random_props(&mut r, 0.5..20.0, 0.1, 0.05))];
+        let spec = with_body_constants(&constants, &values);
+        let bare = parallel(&with_body_constants(&as_constants(&src, false), &values));
+        let mut p = g::Params::DEFAULT;
+        let b = &bare.platform;
+        (p.body_mass[0], p.body_com[0], p.body_inertia[0]) = (b.mass, b.com, b.inertia);
+        p.damping = core::array::from_fn(|_| r.random_range(0.0..50.0));
+        p.friction = core::array::from_fn(|_| r.random_range(0.0..20.0));
+        p.armature = core::array::from_fn(|_| r.random_range(0.0..2.0));
+        worst = worst.max(check(&p, &spec, &mut r));
+        let home: [f64; 7] = bare.home_x().try_into().unwrap();
+        let a = g::inverse_dynamics(&home, &[0.0; N], &[0.0; N], &p).unwrap();
+        let mut d = g::Params::DEFAULT;
+        (d.damping, d.friction, d.armature) = (p.damping, p.friction, p.armature);
+        let b = g::inverse_dynamics(&home, &[0.0; N], &[0.0; N], &d).unwrap();
+        changed = changed.min(tests::pkm::rel(&a, &b));
+    }
+    println!(
+        "parallel, platform inertia at run time vs constants: worst relative error {worst:.1e}, smallest change of the efforts {changed:.1e}"
+    );
+    assert!(worst <= 1e-10, "{worst:e}");
+    assert!(changed > 1e-2, "the run-time values change the efforts: {changed:e}");
+}
