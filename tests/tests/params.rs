@@ -848,7 +848,10 @@ fn closed_loop_runtime_inertia_matches_constants() {
         "closed loops, runtime_inertia vs constants: worst relative error {worst:.1e}, smallest change of the efforts {changed:.1e}"
     );
     assert!(worst <= 1e-11, "{worst:e}");
-    assert!(changed > 1e-2, "the run-time values change the efforts: {changed:e}");
+    assert!(
+        changed > 1e-2,
+        "the run-time values change the efforts: {changed:e}"
+    );
 }
 
 /// A parallel mechanism with the platform's own inertia at run time besides the payload and
@@ -923,5 +926,8 @@ fn parallel_platform_inertia_at_run_time_matches_constants() {
         "parallel, platform inertia at run time vs constants: worst relative error {worst:.1e}, smallest change of the efforts {changed:.1e}"
     );
     assert!(worst <= 1e-10, "{worst:e}");
-    assert!(changed > 1e-2, "the run-time values change the efforts: {changed:e}");
+    assert!(
+        changed > 1e-2,
+        "the run-time values change the efforts: {changed:e}"
+    );
 }
