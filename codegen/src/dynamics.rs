@@ -974,7 +974,7 @@ impl<'a> Sym<'a> {
 }
 
 /// Nodes already needed (their cost is sunk), indexed by node id.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct Paid(Vec<bool>);
 
 impl Paid {
@@ -1098,6 +1098,12 @@ pub fn friction_effort(g: &mut Graph, d: &Drive, qd: ExprId) -> ExprId {
 
 /// `Tᵀ (M ṫ + W M t − w^G)`: inverse dynamics (or its parts), one effort per joint.
 pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId> {
+    inverse_dynamics_sunk(g, tree, terms, &[])
+}
+
+/// [`inverse_dynamics`] in a function that also needs the nodes of `sunk` (forward dynamics:
+/// the mass matrix), which the run-time bodies' choice of wrench form counts as paid.
+fn inverse_dynamics_sunk(g: &mut Graph, tree: &Tree, terms: Terms, sunk: &[ExprId]) -> Vec<ExprId> {
     let n = tree.dof();
     let mut s = Sym::new(g, tree);
     let zero = s.g.zero();
@@ -1289,6 +1295,36 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         let ha = s.cross(h, a);
         let nb = s.add3(jwd, gyro);
         let nb = s.add3(nb, ha);
+        let (f, nb) = if at == 0 {
+            (f, nb)
+        } else {
+            // A run-time body: the same wrench formed about its mass centre,
+            // `f = m (a + U c)`, `n = I_c ω̇ + ω × I_c ω + c × f`, needs no inertia about the
+            // origin; keep the cheaper form (the payload keeps the first).
+            let (m, c, ic) = centre_params(&mut s, b, at);
+            let uc = s.mat_vec(&u, c);
+            let ac = s.add3(a, uc);
+            let fc = s.scale3(m, ac);
+            let iwd = s.mat_vec(&ic, wd);
+            let iw = s.mat_vec(&ic, w);
+            let gyro = s.cross(w, iw);
+            let cf = s.cross(c, fc);
+            let nc = s.add3(iwd, gyro);
+            let nc = s.add3(nc, cf);
+            let mut known = paid.clone();
+            known.pay(s.g, sunk);
+            let cost = |s: &Sym<'_>, f: &V3, n: &V3| {
+                marginal_flops(s.g, &[f[0], f[1], f[2], n[0], n[1], n[2]], &known)
+            };
+            let chosen = if cost(&s, &fc, &nc) < cost(&s, &f, &nb) {
+                (fc, nc)
+            } else {
+                (f, nb)
+            };
+            let (f, n) = chosen;
+            paid.pay(s.g, &[f[0], f[1], f[2], n[0], n[1], n[2]]);
+            chosen
+        };
         force[b] = s.add3(force[b], f);
         moment[b] = s.add3(moment[b], nb);
     }
@@ -1351,6 +1387,28 @@ fn add_param_drive_efforts(g: &mut Graph, n: usize, vs: f64, terms: Terms, tau: 
 /// link `b`'s frame: mass, first moment `m c` and inertia about the link origin
 /// (`x_link = A x_body − d e_z`; parallel-axis theorem).
 fn payload_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
+    let (m, c, ic) = centre_params(s, b, at);
+    let h = s.scale3(m, c);
+    // J = I_c + m (c·c 1 − c cᵀ) = I_c + (h·c) 1 − h cᵀ.
+    let hc = s.dot(h, c);
+    let mut j = ic;
+    for r in 0..3 {
+        for k in r..3 {
+            let hck = s.g.mul(h[r], c[k]);
+            let mut v = s.g.sub(ic[r][k], hck);
+            if r == k {
+                v = s.g.add(v, hc);
+            }
+            j[r][k] = v;
+            j[k][r] = v;
+        }
+    }
+    (m, h, j)
+}
+
+/// The inertial parameters of a run-time payload or body (`Arg::P` entries `at..at + 10`) in
+/// link `b`'s frame: mass, mass centre and inertia about it (`x_link = A x_body − d e_z`).
+fn centre_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
     let (a, d) = s.tree.links[b].to_link;
     let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, at + k);
     let m = p(s, 0);
@@ -1382,22 +1440,7 @@ fn payload_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
             ic[k][r] = acc;
         }
     }
-    let h = s.scale3(m, c);
-    // J = I_c + m (c·c 1 − c cᵀ) = I_c + (h·c) 1 − h cᵀ.
-    let hc = s.dot(h, c);
-    let mut j = ic;
-    for r in 0..3 {
-        for k in r..3 {
-            let hck = s.g.mul(h[r], c[k]);
-            let mut v = s.g.sub(ic[r][k], hck);
-            if r == k {
-                v = s.g.add(v, hc);
-            }
-            j[r][k] = v;
-            j[k][r] = v;
-        }
-    }
-    (m, h, j)
+    (m, c, ic)
 }
 
 /// Composite inertia of a subtree about its root body's origin, in its frame.
@@ -1545,13 +1588,14 @@ pub const PIVOT_TOLERANCE: f64 = 1e-12;
 pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
     let n = tree.dof();
     let m = mass_matrix(g, tree);
-    let bias = inverse_dynamics(
+    let bias = inverse_dynamics_sunk(
         g,
         tree,
         Terms {
             acceleration: false,
             ..Terms::ALL
         },
+        &m.concat(),
     );
     let rhs: Vec<ExprId> = (0..n)
         .map(|i| {
