@@ -931,3 +931,85 @@ fn parallel_platform_inertia_at_run_time_matches_constants() {
         "the run-time values change the efforts: {changed:e}"
     );
 }
+
+/// A run-time body merged into another by a fixed joint: the PUMA 560 with a tool on a flange
+/// turned by (0.3, π/2, −0.7) rpy, `runtime_inertia = ["tool", "link6"]` (two entries on the
+/// model body `link6`, the tool's in `link6`'s frame). Random tool and link-6 values written
+/// into the spec: the run-time parameters `scene_params` places (what `Params::DEFAULT` holds)
+/// through the DAG interpreter against the runtime with the values as constants; the spec
+/// loads without warnings (the zeroed constants are not "massless" bodies).
+#[test]
+fn runtime_inertia_of_a_body_on_a_turned_flange() {
+    use codegen::dynamics::{body_param_index, param_count_with};
+    let spec = |mode: &str, tool: Props, link6: Props| {
+        let tool_body = with_body_constants(
+            "[[body]]\nname = \"tool\"\nmass = 0.0\ncom = [0.0, 0.0, 0.0]\ninertia = { ixx = 0.0, iyy = 0.0, izz = 0.0 }\n",
+            &[("tool", tool)],
+        );
+        let scene = if mode == "runtime" {
+            "[scene]\nparameters = \"runtime\"\nruntime_inertia = [\"tool\", \"link6\"]\n"
+        } else {
+            ""
+        };
+        format!(
+            "{}\n{scene}\n{tool_body}\n[[joint]]\nname = \"flange\"\nkind = \"fixed\"\nparent = \"link6\"\nchild = \"tool\"\n\
+             origin = {{ xyz = [0.0, 0.02, 0.1], rpy = [0.3, \"pi/2\", -0.7] }}\n",
+            with_body_constants(PUMA, &[("link6", link6)])
+        )
+    };
+    let mut r = tests::rng(48);
+    let mut worst: f64 = 0.0;
+    for _ in 0..5 {
+        let tool = random_props(&mut r, 0.1..10.0, 0.1, 0.02);
+        let link6 = random_props(&mut r, 0.1..10.0, 0.1, 0.02);
+        let run = spec("runtime", tool, link6);
+        let (m, warnings) = match load_mechanism("puma.toml", &run) {
+            Ok((Mechanism::Tree(m), w)) => (m, w),
+            _ => panic!("the run-time spec loads"),
+        };
+        assert!(warnings.is_empty(), "{}", warnings.render());
+        let rp = scene_params("puma.toml", &run, &SceneOverrides::default()).unwrap();
+        let names: Vec<&str> = rp.bodies.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["tool", "link6"]);
+        assert!(rp.bodies.iter().all(|b| b.body == 5));
+        let n = m.dof();
+        let mut p = vec![0.0; param_count_with(n, rp.bodies.len())];
+        for (k, b) in rp.bodies.iter().enumerate() {
+            let (at, i) = (body_param_index(k, n), &b.inertia);
+            p[at] = b.mass;
+            p[at + 1..at + 4].copy_from_slice(&b.com);
+            p[at + 4..at + 10]
+                .copy_from_slice(&[i[0][0], i[0][1], i[0][2], i[1][1], i[1][2], i[2][2]]);
+        }
+        let sym = codegen::symbolic_with(&m, Some(&rp));
+        let fixed = tree(&spec("constants", tool, link6));
+        for _ in 0..20 {
+            let (q, qd, qdd) = tests::random_state(&mut r, n);
+            let input = |a: Arg, i: usize| match a {
+                Arg::Q => q[i],
+                Arg::Qd => qd[i],
+                Arg::Qdd => qdd[i],
+                Arg::P => p[i],
+                _ => f64::NAN,
+            };
+            let id = sym.graph.eval(&sym.inverse_dynamics, &input);
+            let mm = sym.graph.eval(&sym.mass_matrix, &input);
+            let id_rt = runtime::rnea::inverse_dynamics(&fixed, &q, &qd, &qdd);
+            let mm_rt = runtime::rnea::mass_matrix(&fixed, &q);
+            worst = worst
+                .max(tests::rel_err(&id, id_rt.as_slice()))
+                .max(tests::rel_err(&mm, mm_rt.transpose().as_slice()));
+        }
+    }
+    // Every body at run time: no body is "massless" either.
+    let all = format!(
+        "{PUMA}\n{}",
+        include_str!("../src/params_scene_inertia.toml")
+    );
+    match load_mechanism("puma.toml", &all) {
+        Ok((_, w)) => assert!(w.is_empty(), "{}", w.render()),
+        Err(e) => panic!("{}", e.render()),
+    }
+    println!("runtime_inertia of a body on a turned flange: worst relative error {worst:.1e}");
+    assert!(worst <= 1e-11, "{worst:e}");
+}

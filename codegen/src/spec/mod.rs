@@ -487,7 +487,7 @@ fn resolve_runtime_inertia(
                     ));
                 } else if !on_platform(&n.name) {
                     diags.push(error(
-                        format!("body {:?} is a leg body: leg bodies' inertia is constant; only the platform's can be a run-time parameter", n.name),
+                        format!("body {:?} is not the platform or fixed to it: leg bodies' inertia is constant; only the platform's can be a run-time parameter", n.name),
                         "name the platform body (or a body fixed to it), or drop this body from `runtime_inertia`; its inertia stays folded into the leg dynamics",
                     ));
                 } else {
