@@ -52,10 +52,18 @@ fn spec_file(variant: &str) -> &'static str {
 /// Appended to the PUMA 560's spec for the run-time-parameter variant (also read by
 /// `tests/tests/params.rs`).
 const PARAMS_SCENE: &str = include_str!("src/params_scene.toml");
+/// The same with every body's inertial parameters at run time (`runtime_inertia = "all"`).
+const PARAMS_SCENE_INERTIA: &str = include_str!("src/params_scene_inertia.toml");
 /// The same for the Gough–Stewart platform: a payload on a tool fixed to the platform.
 const PARAMS_SCENE_GS: &str = include_str!("src/params_scene_gs.toml");
 /// The same for a closed-loop mechanism (the spherical five-bar).
 const PARAMS_SCENE_CLOSED: &str = include_str!("src/params_scene_closed.toml");
+
+/// `scene` (one of the `PARAMS_SCENE*` texts) with every body's inertial parameters at run time
+/// as well (also in `tests/tests/params.rs`).
+fn with_runtime_inertia(scene: &str) -> String {
+    scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
+}
 
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
@@ -100,10 +108,18 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE}");
     let p = write(&out, "puma_params", &src);
     generate(&out, "puma_params", &p, |_| {});
+    let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
+    let src = format!("{src}\n{PARAMS_SCENE_INERTIA}");
+    let p = write(&out, "puma_inertia", &src);
+    generate(&out, "puma_inertia", &p, |_| {});
     let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
     generate(&out, "gs_params", &p, |_| {});
+    let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
+    let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_GS));
+    let p = write(&out, "gs_inertia", &src);
+    generate(&out, "gs_inertia", &p, |_| {});
     // A generic leg (Newton inverse kinematics): `tests/tests/parallel.rs`.
     let generic = Path::new("../codegen/tests/data/good_parallel/generic_leg.toml");
     println!("cargo:rerun-if-changed={}", generic.display());
@@ -114,6 +130,10 @@ fn main() {
     let src = format!("{src}\n{PARAMS_SCENE_CLOSED}");
     let p = write(&out, "closed_params", &src);
     generate(&out, "closed_params", &p, |_| {});
+    let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
+    let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_CLOSED));
+    let p = write(&out, "closed_inertia", &src);
+    generate(&out, "closed_inertia", &p, |_| {});
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

@@ -11,7 +11,7 @@ use runtime::closed::noc::{self, Plan};
 use runtime::parallel::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
-use crate::parallel::{Layout, drive_inputs, params_items, payload_inputs};
+use crate::parallel::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{flat, ids, in_fresh_graph, inputs};
 use crate::schedule::{OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
@@ -39,32 +39,48 @@ pub struct Kernels {
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
 pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
-    kernels_with(plan, &Layout::default(), None)
+    kernels_with(plan, &Layout::default(), None, &[])
 }
 
 /// [`kernels`] with run-time parameters in [`Layout`]'s layout: a payload on tree body
-/// `payload_body` (entries 0–9, that body's frame) and the drives of every tree joint, through
-/// [`noc::Extras`].
+/// `payload_body` (entries 0–9, that body's frame), the drives of every tree joint, and the
+/// run-time bodies on tree bodies `bodies` (`[scene] runtime_inertia`, ten entries each from
+/// [`Layout::body_base`]), through [`noc::Extras`].
 pub fn kernels_with(
     plan: &Plan,
     layout: &Layout,
     payload_body: Option<usize>,
+    bodies: &[usize],
 ) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body));
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body, bodies));
     r.map(|k| Kernels { graph, ..k })
 }
 
-fn build(plan: &Plan, layout: &Layout, payload_body: Option<usize>) -> Result<Kernels, Singular> {
+fn build(
+    plan: &Plan,
+    layout: &Layout,
+    payload_body: Option<usize>,
+    bodies: &[usize],
+) -> Result<Kernels, Singular> {
     let d = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, d);
     let ud = inputs(Arg::Ud, d);
     let tau = inputs(Arg::Tau, d);
     let c = noc::configuration(plan, &x, true)?;
+    let mut payloads: Vec<_> = payload_body
+        .filter(|_| layout.payload)
+        .map(|b| (b, payload_inputs()))
+        .into_iter()
+        .collect();
+    payloads.extend(
+        bodies
+            .iter()
+            .enumerate()
+            .map(|(k, &b)| (b, payload_inputs_at(layout.body_base(plan.nx(), k)))),
+    );
     let extras = noc::Extras {
-        payload: payload_body
-            .filter(|_| layout.payload)
-            .map(|b| (b, payload_inputs())),
+        payloads,
         drives: layout.drives().then(|| drive_inputs(plan.nx(), layout)),
     };
     let rates = noc::joint_rates_generic(plan, &c, &u);
@@ -122,7 +138,9 @@ pub fn generate_with(
     let plan = Plan::new(model)?;
     let layout = Layout::of(params);
     let payload = params.and_then(|p| p.payload);
-    let k = kernels_with(&plan, &layout, payload.map(|p| p.0)).map_err(|e| {
+    let bodies = params.map_or(&[][..], |p| &p.bodies[..]);
+    let body_links: Vec<usize> = bodies.iter().map(|b| b.body).collect();
+    let k = kernels_with(&plan, &layout, payload.map(|p| p.0), &body_links).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the loop geometry")
     })?;
     let g = &k.graph;
@@ -255,7 +273,11 @@ pub fn generate_with(
     if layout.any() {
         header.insert(
             3,
-            "Run-time parameters: the scene's payload and joint drives (`Params`, `[scene] parameters = \"runtime\"`).".into(),
+            if bodies.is_empty() {
+                "Run-time parameters: the scene's payload and joint drives (`Params`, `[scene] parameters = \"runtime\"`).".into()
+            } else {
+                "Run-time parameters: the scene's payload, joint drives and the inertial parameters of the bodies in `RUNTIME_BODY_NAMES` (`Params`, `[scene] parameters = \"runtime\"`).".into()
+            },
         );
     }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
@@ -285,6 +307,8 @@ pub fn generate_with(
             &drives,
             ("NX", "tree joint (`JOINT_NAMES` order)"),
             "a payload on a body and the joints' drives the scene models",
+            bodies,
+            &|b| format!("tree body `{}`", model.tree.bodies[b].name),
         )
     } else {
         quote!()

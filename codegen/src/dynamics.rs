@@ -113,22 +113,27 @@ pub struct Tree {
     gravity: Vec3,
     /// Per joint: friction and rotor inertia (added after the rigid-body sweeps).
     drives: Vec<Drive>,
-    /// Run-time parameters (`[scene] parameters = "runtime"`): the payload's link and the
-    /// Coulomb speed scale; the drive coefficients are then inputs too.
+    /// Run-time parameters (`[scene] parameters = "runtime"`): the links of the payload and of
+    /// the run-time bodies, and the Coulomb speed scale; the drive coefficients are then inputs
+    /// too.
     params: Option<ParamLayout>,
 }
 
 /// What [`Tree::with_runtime_params`] makes an input.
 #[derive(Clone, Debug)]
 struct ParamLayout {
-    payload: Option<usize>,
+    /// Rigid bodies with run-time inertial parameters: `(link, first index)` of the payload
+    /// (index 0) and of each run-time body ([`body_param_index`]). Each enters as a payload on
+    /// its link.
+    rigid: Vec<(usize, usize)>,
     coulomb_velocity: f64,
 }
 
 /// Index into the run-time parameter array (`Params::to_array`) of a `dof`-joint tree:
 /// `0` payload mass, `1..4` its mass centre, `4..10` its inertia `xx, xy, xz, yy, yz, zz` (body
 /// frame of the payload's body, about the mass centre), then per joint `damping`, `friction`,
-/// `armature` (`10 + kind·dof + joint`).
+/// `armature` (`10 + kind·dof + joint`), then ten entries per run-time body
+/// ([`body_param_index`], in the same order as the payload's).
 pub fn param_index(kind: ParamKind, joint: usize, dof: usize) -> usize {
     match kind {
         ParamKind::Damping => 10 + joint,
@@ -148,9 +153,21 @@ pub enum ParamKind {
     Armature,
 }
 
-/// Number of run-time parameters of a `dof`-joint tree.
+/// Number of run-time parameters of a `dof`-joint tree without run-time bodies.
 pub fn param_count(dof: usize) -> usize {
     10 + 3 * dof
+}
+
+/// Number of run-time parameters of a `dof`-joint tree with `bodies` run-time bodies
+/// (`[scene] runtime_inertia`).
+pub fn param_count_with(dof: usize, bodies: usize) -> usize {
+    param_count(dof) + 10 * bodies
+}
+
+/// First index of run-time body `k`'s ten parameters in a `dof`-joint tree: after the drives,
+/// mass, mass centre (3), inertia about it `xx, xy, xz, yy, yz, zz`, as the payload's.
+pub fn body_param_index(k: usize, dof: usize) -> usize {
+    param_count(dof) + 10 * k
 }
 
 /// A body in the canonical frames, before the origin choice: mass centre and inertia about it.
@@ -313,9 +330,26 @@ impl Tree {
     /// and every joint's drive coefficients become inputs (`Arg::P`, see [`param_index`]).
     pub fn with_runtime_params(mut self, payload: Option<usize>, coulomb_velocity: f64) -> Tree {
         self.params = Some(ParamLayout {
-            payload,
+            rigid: payload.map(|b| (b, 0)).into_iter().collect(),
             coulomb_velocity,
         });
+        self
+    }
+
+    /// Run-time inertial parameters of rigid bodies (`[scene] runtime_inertia`; call after
+    /// [`Tree::with_runtime_params`]): entry `k` rides on model body `bodies[k]` and reads its
+    /// ten parameters from [`body_param_index`]`(k, dof)`, exactly as a run-time payload there.
+    /// The bodies' constants must already be zero in the model.
+    pub fn with_runtime_bodies(mut self, bodies: &[usize]) -> Tree {
+        let n = self.dof();
+        if let Some(p) = &mut self.params {
+            p.rigid.extend(
+                bodies
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &b)| (b, body_param_index(k, n))),
+            );
+        }
         self
     }
 
@@ -940,7 +974,7 @@ impl<'a> Sym<'a> {
 }
 
 /// Nodes already needed (their cost is sunk), indexed by node id.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct Paid(Vec<bool>);
 
 impl Paid {
@@ -1064,6 +1098,12 @@ pub fn friction_effort(g: &mut Graph, d: &Drive, qd: ExprId) -> ExprId {
 
 /// `Tᵀ (M ṫ + W M t − w^G)`: inverse dynamics (or its parts), one effort per joint.
 pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId> {
+    inverse_dynamics_sunk(g, tree, terms, &[])
+}
+
+/// [`inverse_dynamics`] in a function that also needs the nodes of `sunk` (forward dynamics:
+/// the mass matrix), which the run-time bodies' choice of wrench form counts as paid.
+fn inverse_dynamics_sunk(g: &mut Graph, tree: &Tree, terms: Terms, sunk: &[ExprId]) -> Vec<ExprId> {
     let n = tree.dof();
     let mut s = Sym::new(g, tree);
     let zero = s.g.zero();
@@ -1239,10 +1279,11 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         moment.push(choice.0);
         extra_moment.push(choice.1);
     }
-    // A run-time payload on link b: its Newton–Euler wrench about the link origin (eq. 12),
-    // `f = m a + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × J ω + h × a`.
-    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
-        let (m, h, j) = payload_params(&mut s, b);
+    // A run-time payload or body on link b: its Newton–Euler wrench about the link origin
+    // (eq. 12), `f = m a + ω̇ × h + ω × (ω × h)`, `n = J ω̇ + ω × J ω + h × a`.
+    let rigid = tree.params.as_ref().map_or(&[][..], |p| &p.rigid[..]);
+    for &(b, at) in rigid {
+        let (m, h, j) = payload_params(&mut s, b, at);
         let (w, wd, a) = (omega[b], omegad[b], acc[b]);
         let ma = s.scale3(m, a);
         let u = s.u_matrix(w, wd);
@@ -1254,6 +1295,36 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
         let ha = s.cross(h, a);
         let nb = s.add3(jwd, gyro);
         let nb = s.add3(nb, ha);
+        let (f, nb) = if at == 0 {
+            (f, nb)
+        } else {
+            // A run-time body: the same wrench formed about its mass centre,
+            // `f = m (a + U c)`, `n = I_c ω̇ + ω × I_c ω + c × f`, needs no inertia about the
+            // origin; keep the cheaper form (the payload keeps the first).
+            let (m, c, ic) = centre_params(&mut s, b, at);
+            let uc = s.mat_vec(&u, c);
+            let ac = s.add3(a, uc);
+            let fc = s.scale3(m, ac);
+            let iwd = s.mat_vec(&ic, wd);
+            let iw = s.mat_vec(&ic, w);
+            let gyro = s.cross(w, iw);
+            let cf = s.cross(c, fc);
+            let nc = s.add3(iwd, gyro);
+            let nc = s.add3(nc, cf);
+            let mut known = paid.clone();
+            known.pay(s.g, sunk);
+            let cost = |s: &Sym<'_>, f: &V3, n: &V3| {
+                marginal_flops(s.g, &[f[0], f[1], f[2], n[0], n[1], n[2]], &known)
+            };
+            let chosen = if cost(&s, &fc, &nc) < cost(&s, &f, &nb) {
+                (fc, nc)
+            } else {
+                (f, nb)
+            };
+            let (f, n) = chosen;
+            paid.pay(s.g, &[f[0], f[1], f[2], n[0], n[1], n[2]]);
+            chosen
+        };
         force[b] = s.add3(force[b], f);
         moment[b] = s.add3(moment[b], nb);
     }
@@ -1312,11 +1383,34 @@ fn add_param_drive_efforts(g: &mut Graph, n: usize, vs: f64, terms: Terms, tau: 
     }
 }
 
-/// The run-time payload's inertial parameters in link `b`'s frame: mass, first moment `m c`
-/// and inertia about the link origin (`x_link = A x_body − d e_z`; parallel-axis theorem).
-fn payload_params(s: &mut Sym<'_>, b: usize) -> (ExprId, V3, M3) {
+/// The inertial parameters of a run-time payload or body (`Arg::P` entries `at..at + 10`) in
+/// link `b`'s frame: mass, first moment `m c` and inertia about the link origin
+/// (`x_link = A x_body − d e_z`; parallel-axis theorem).
+fn payload_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
+    let (m, c, ic) = centre_params(s, b, at);
+    let h = s.scale3(m, c);
+    // J = I_c + m (c·c 1 − c cᵀ) = I_c + (h·c) 1 − h cᵀ.
+    let hc = s.dot(h, c);
+    let mut j = ic;
+    for r in 0..3 {
+        for k in r..3 {
+            let hck = s.g.mul(h[r], c[k]);
+            let mut v = s.g.sub(ic[r][k], hck);
+            if r == k {
+                v = s.g.add(v, hc);
+            }
+            j[r][k] = v;
+            j[k][r] = v;
+        }
+    }
+    (m, h, j)
+}
+
+/// The inertial parameters of a run-time payload or body (`Arg::P` entries `at..at + 10`) in
+/// link `b`'s frame: mass, mass centre and inertia about it (`x_link = A x_body − d e_z`).
+fn centre_params(s: &mut Sym<'_>, b: usize, at: usize) -> (ExprId, V3, M3) {
     let (a, d) = s.tree.links[b].to_link;
-    let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, k);
+    let p = |s: &mut Sym<'_>, k: usize| s.g.input(Arg::P, at + k);
     let m = p(s, 0);
     let cb = [p(s, 1), p(s, 2), p(s, 3)];
     let ic_b = {
@@ -1346,22 +1440,7 @@ fn payload_params(s: &mut Sym<'_>, b: usize) -> (ExprId, V3, M3) {
             ic[k][r] = acc;
         }
     }
-    let h = s.scale3(m, c);
-    // J = I_c + m (c·c 1 − c cᵀ) = I_c + (h·c) 1 − h cᵀ.
-    let hc = s.dot(h, c);
-    let mut j = ic;
-    for r in 0..3 {
-        for k in r..3 {
-            let hck = s.g.mul(h[r], c[k]);
-            let mut v = s.g.sub(ic[r][k], hck);
-            if r == k {
-                v = s.g.add(v, hc);
-            }
-            j[r][k] = v;
-            j[k][r] = v;
-        }
-    }
-    (m, h, j)
+    (m, c, ic)
 }
 
 /// Composite inertia of a subtree about its root body's origin, in its frame.
@@ -1385,8 +1464,9 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
             j: s.cm(&l.j),
         })
         .collect();
-    if let Some(b) = tree.params.as_ref().and_then(|p| p.payload) {
-        let (m, h, j) = payload_params(&mut s, b);
+    let rigid = tree.params.as_ref().map_or(&[][..], |p| &p.rigid[..]);
+    for &(b, at) in rigid {
+        let (m, h, j) = payload_params(&mut s, b, at);
         let c = comp[b];
         let hs = s.add3(c.h, h);
         let mut js = c.j;
@@ -1508,13 +1588,14 @@ pub const PIVOT_TOLERANCE: f64 = 1e-12;
 pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
     let n = tree.dof();
     let m = mass_matrix(g, tree);
-    let bias = inverse_dynamics(
+    let bias = inverse_dynamics_sunk(
         g,
         tree,
         Terms {
             acceleration: false,
             ..Terms::ALL
         },
+        &m.concat(),
     );
     let rhs: Vec<ExprId> = (0..n)
         .map(|i| {

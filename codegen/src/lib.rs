@@ -203,6 +203,8 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
     let mut tree = Tree::new(model);
     if let Some(rp) = params {
         tree = tree.with_runtime_params(rp.payload.as_ref().map(|p| p.0), rp.coulomb_velocity);
+        let bodies: Vec<usize> = rp.bodies.iter().map(|b| b.body).collect();
+        tree = tree.with_runtime_bodies(&bodies);
     }
     let mut g = Graph::new();
     let mm = dynamics::mass_matrix(&mut g, &tree);
@@ -268,7 +270,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
     use proc_macro2::Literal;
     use quote::quote;
     let n = model.dof();
-    let np = Literal::usize_unsuffixed(dynamics::param_count(n));
+    let np = Literal::usize_unsuffixed(dynamics::param_count_with(n, rp.bodies.len()));
     let arr = |f: &dyn Fn(&runtime::model::Drive) -> f64| {
         let v: Vec<_> = model
             .joints
@@ -292,7 +294,13 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
             payload_params(&format!("body `{}`", model.bodies[*b].name), *m, c, i)
         }
     };
+    let (body_items, body_fields, body_default, body_fill) = body_params(
+        &rp.bodies,
+        &|b| format!("model body `{}`", model.bodies[b].name),
+        dynamics::body_param_index(0, n),
+    );
     quote! {
+        #body_items
         /// Number of run-time parameters in [`Params::to_array`].
         pub const NP: usize = #np;
         /// Run-time parameters (`[scene] parameters = "runtime"`): every function takes them, so
@@ -306,6 +314,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
             pub friction: [f64; DOF],
             /// Reflected rotor inertia per joint (kg·m² or kg).
             pub armature: [f64; DOF],
+            #body_fields
         }
         impl Params {
             /// The values of the spec (what a module with constants would fold in).
@@ -314,6 +323,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
                 damping: #damping,
                 friction: #friction,
                 armature: #armature,
+                #body_default
             };
             /// The flat layout the generated functions read.
             pub fn to_array(&self) -> [f64; NP] {
@@ -326,6 +336,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
                     a[#a0 + i] = self.armature[i];
                     i += 1;
                 }
+                #body_fill
                 a
             }
         }
@@ -388,6 +399,104 @@ pub(crate) fn payload_params(
             a[7] = self.payload_inertia[1][1];
             a[8] = self.payload_inertia[1][2];
             a[9] = self.payload_inertia[2][2];
+        },
+    )
+}
+
+/// The run-time bodies' items of a module (`[scene] runtime_inertia`; nothing without any):
+/// `NB` and `RUNTIME_BODY_NAMES` (outside `Params`), the fields `body_mass`, `body_com` and
+/// `body_inertia` of `Params`, their `DEFAULT` values and their part of `to_array` (ten entries
+/// per body from `base`, ordered as the payload's). `frame` names the owner of the frame of a
+/// model body ("model body `link6`", "the platform").
+pub(crate) fn body_params(
+    bodies: &[spec::RuntimeBody],
+    frame: &dyn Fn(usize) -> String,
+    base: usize,
+) -> (
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+) {
+    use proc_macro2::Literal;
+    use quote::quote;
+    if bodies.is_empty() {
+        return (quote!(), quote!(), quote!(), quote!());
+    }
+    let nb = Literal::usize_unsuffixed(bodies.len());
+    let base = Literal::usize_unsuffixed(base);
+    let names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut names_doc = vec![
+        " The bodies whose inertial parameters are run-time parameters (`[scene] runtime_inertia`), \
+         in the order of `Params::body_mass`, `body_com` and `body_inertia`. Each body's mass \
+         centre and inertia are in the frame of the model body it is part of (after fixed-joint \
+         merging):"
+            .to_string(),
+    ];
+    for (k, b) in bodies.iter().enumerate() {
+        names_doc.push(format!(" {k}. `{}`: {}.", b.name, frame(b.body)));
+    }
+    let mass: Vec<_> = bodies.iter().map(|b| emit::float_lit(b.mass)).collect();
+    let com: Vec<_> = bodies
+        .iter()
+        .map(|b| {
+            let c: Vec<_> = b.com.iter().map(|v| emit::float_lit(*v)).collect();
+            quote!([#(#c),*])
+        })
+        .collect();
+    let inertia: Vec<_> = bodies
+        .iter()
+        .map(|b| {
+            let rows: Vec<_> = b
+                .inertia
+                .iter()
+                .map(|r| {
+                    let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
+                    quote!([#(#r),*])
+                })
+                .collect();
+            quote!([#(#rows),*])
+        })
+        .collect();
+    (
+        quote! {
+            /// Number of bodies with run-time inertial parameters ([`RUNTIME_BODY_NAMES`]).
+            pub const NB: usize = #nb;
+            #(#[doc = #names_doc])*
+            pub const RUNTIME_BODY_NAMES: [&str; NB] = [#(#names),*];
+        },
+        quote! {
+            /// Mass of each body of [`RUNTIME_BODY_NAMES`] (kg).
+            pub body_mass: [f64; NB],
+            /// Mass centre of each body of [`RUNTIME_BODY_NAMES`] (m), in the frame of the
+            /// model body it is part of (listed there).
+            pub body_com: [[f64; 3]; NB],
+            /// Inertia of each body of [`RUNTIME_BODY_NAMES`] about its mass centre (kg·m²,
+            /// symmetric), in the axes of the model body it is part of.
+            pub body_inertia: [[[f64; 3]; 3]; NB],
+        },
+        quote! {
+            body_mass: [#(#mass),*],
+            body_com: [#(#com),*],
+            body_inertia: [#(#inertia),*],
+        },
+        quote! {
+            let mut k = 0;
+            while k < NB {
+                let b = #base + 10 * k;
+                let (c, j) = (&self.body_com[k], &self.body_inertia[k]);
+                a[b] = self.body_mass[k];
+                a[b + 1] = c[0];
+                a[b + 2] = c[1];
+                a[b + 3] = c[2];
+                a[b + 4] = j[0][0];
+                a[b + 5] = j[0][1];
+                a[b + 6] = j[0][2];
+                a[b + 7] = j[1][1];
+                a[b + 8] = j[1][2];
+                a[b + 9] = j[2][2];
+                k += 1;
+            }
         },
     )
 }

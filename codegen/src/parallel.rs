@@ -48,7 +48,9 @@ pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
 /// the generated `Params::to_array`: entries 0–9 the platform payload (mass, mass centre,
 /// inertia `xx, xy, xz, yy, yz, zz`, platform frame; reserved even without one), then, per leg
 /// joint `3·leg + k`, the viscous coefficients and the Coulomb levels (with `friction`), then
-/// the rotor inertias (with `rotor_inertia`).
+/// the rotor inertias (with `rotor_inertia`), then ten entries per run-time body
+/// (`[scene] runtime_inertia`, ordered as the payload's; [`Layout::body_base`]). Closed loops
+/// use the same layout with the tree joints and tree bodies.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Layout {
     /// The platform payload.
@@ -59,6 +61,8 @@ pub struct Layout {
     pub rotor_inertia: bool,
     /// `v_s` of the regularized Coulomb law.
     pub coulomb_velocity: f64,
+    /// Number of run-time bodies (`[scene] runtime_inertia`).
+    pub bodies: usize,
 }
 
 impl Layout {
@@ -71,13 +75,14 @@ impl Layout {
                 friction: p.leg_friction,
                 rotor_inertia: p.leg_rotor_inertia,
                 coulomb_velocity: p.coulomb_velocity,
+                bodies: p.bodies.len(),
             },
         }
     }
 
     /// Whether the module takes `Params`.
     pub fn any(&self) -> bool {
-        self.payload || self.drives()
+        self.payload || self.drives() || self.bodies > 0
     }
 
     /// Whether the leg joints' drives are run-time parameters.
@@ -100,6 +105,16 @@ impl Layout {
         let c = take(self.friction);
         let a = take(self.rotor_inertia);
         (v, c, a, at)
+    }
+
+    /// First index of run-time body `k`'s ten parameters, with `nlj` leg (or tree) joints.
+    pub fn body_base(&self, nlj: usize, k: usize) -> usize {
+        self.offsets(nlj).3 + 10 * k
+    }
+
+    /// Number of run-time parameters (`Params::to_array`), with `nlj` leg (or tree) joints.
+    pub fn count(&self, nlj: usize) -> usize {
+        self.body_base(nlj, self.bodies)
     }
 }
 
@@ -129,7 +144,13 @@ pub(crate) fn drive_inputs(
 
 /// The payload of the `Arg::P` inputs (entries 0–9).
 pub(crate) fn payload_inputs() -> noc::Payload<Sx> {
-    let p = inputs(Arg::P, 10);
+    payload_inputs_at(0)
+}
+
+/// A rigid body's parameters of the `Arg::P` inputs `at..at + 10`, ordered as the payload's.
+pub(crate) fn payload_inputs_at(at: usize) -> noc::Payload<Sx> {
+    let p = inputs(Arg::P, at + 10);
+    let p = &p[at..];
     noc::Payload {
         mass: p[0],
         com: [p[1], p[2], p[3]],
@@ -159,8 +180,12 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         .then(|| drive_inputs(3 * plan.legs.len(), layout));
     let mut f = noc::generalized_force_with(plan, &pl, &legs, &u, &ud, true, drives.as_ref());
     let mut i = noc::generalized_inertia_with(plan, &pl, &legs, drives.as_ref());
-    let payload = layout.payload.then(payload_inputs);
-    if let Some(p) = &payload {
+    // The payload, then the platform's own inertia when it is given at run time (each a
+    // payload on the platform).
+    let mut payloads: Vec<_> = layout.payload.then(payload_inputs).into_iter().collect();
+    let nlj = 3 * plan.legs.len();
+    payloads.extend((0..layout.bodies).map(|k| payload_inputs_at(layout.body_base(nlj, k))));
+    for p in &payloads {
         let fp = noc::payload_force(plan, &pl, p, &u, &ud, true);
         let ip = noc::payload_inertia(plan, &pl, p);
         for r in 0..n {
@@ -170,7 +195,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
             }
         }
     }
-    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, payload.as_ref(), drives.as_ref())?;
+    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, &payloads, drives.as_ref())?;
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
     Ok(Kernels {
         graph: Graph::new(),
@@ -434,10 +459,19 @@ pub fn generate_with(
         "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
     ];
     if layout.any() {
-        let what = match (layout.payload, layout.drives()) {
-            (true, true) => "the platform's payload and the leg joints' drives",
-            (true, false) => "the platform's payload",
-            _ => "the leg joints' drives",
+        let mut parts = Vec::new();
+        if layout.payload {
+            parts.push("the platform's payload");
+        }
+        if layout.bodies > 0 {
+            parts.push("the platform's own inertia (`RUNTIME_BODY_NAMES`)");
+        }
+        if layout.drives() {
+            parts.push("the leg joints' drives");
+        }
+        let what = match parts.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => parts.concat(),
         };
         header.insert(
             3,
@@ -491,6 +525,8 @@ pub fn generate_with(
             &drives,
             ("LEG_JOINTS", "leg joint (`LEG_JOINT_NAMES` order)"),
             "the payload on the platform and the leg joints' drives the scene models",
+            params.map_or(&[][..], |p| &p.bodies[..]),
+            &|_| "the platform".to_string(),
         );
         quote! {
             #leg_items
@@ -525,19 +561,25 @@ pub fn generate_with(
 /// The `NP` constant and the `Params` struct of a module with run-time parameters (parallel
 /// mechanisms and closed loops, in [`Layout`]'s layout): the payload's fields (on `payload.0`,
 /// its values in that frame), then one array per drive effect over `drives`, of length
-/// `per.0` (a constant of the module), each entry a `per.1`.
+/// `per.0` (a constant of the module), each entry a `per.1`, then the run-time bodies' fields
+/// (`bodies`, on the model body `frame` names; [`crate::body_params`]).
+// The pieces of one struct: kept apart, they would only be regrouped by every caller.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn params_items(
     layout: &Layout,
     payload: Option<(String, f64, runtime::model::Vec3, runtime::model::Mat3)>,
     drives: &[&runtime::model::Drive],
     per: (&str, &str),
     what: &str,
+    bodies: &[crate::spec::RuntimeBody],
+    frame: &dyn Fn(usize) -> String,
 ) -> TokenStream {
     let (mut fields, mut default, mut fill) = match &payload {
         Some((on, m, c, i)) => crate::payload_params(on, *m, c, i),
         None => (quote!(), quote!(), quote!()),
     };
-    let (v0, c0, a0, np) = layout.offsets(drives.len());
+    let (v0, c0, a0, _) = layout.offsets(drives.len());
+    let np = layout.count(drives.len());
     let len = proc_macro2::Ident::new(per.0, proc_macro2::Span::call_site());
     let mut drive_field =
         |at: Option<usize>,
@@ -580,11 +622,17 @@ pub(crate) fn params_items(
         "Reflected rotor inertia (kg·m² or kg)",
         &|d| d.armature,
     );
+    let (body_items, body_fields, body_default, body_fill) =
+        crate::body_params(bodies, frame, layout.body_base(drives.len(), 0));
+    fields.extend(body_fields);
+    default.extend(body_default);
+    fill.extend(body_fill);
     let np = Literal::usize_unsuffixed(np);
     let doc = format!(
         " Run-time parameters (`[scene] parameters = \"runtime\"`): {what}, so one binary serves several tools or drive calibrations. SI units. The functions of the masses take them last; the kinematics do not."
     );
     quote! {
+        #body_items
         /// Number of run-time parameters in [`Params::to_array`].
         pub const NP: usize = #np;
         #[doc = #doc]

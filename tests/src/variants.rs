@@ -31,6 +31,14 @@ pub mod gs_point_legs {
 pub mod puma_params {
     include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));
 }
+/// The PUMA 560 with every body's inertial parameters at run time
+/// (`src/params_scene_inertia.toml`).
+pub mod puma_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/puma_inertia/puma560.rs"
+    ));
+}
 /// The Gough–Stewart platform with a tool and a run-time payload (`src/params_scene_gs.toml`).
 pub mod gs_params {
     include!(concat!(
@@ -44,6 +52,21 @@ pub mod closed_params {
     include!(concat!(
         env!("OUT_DIR"),
         "/variants/closed_params/spherical_five_bar.rs"
+    ));
+}
+/// `gs_params` with the platform's own inertia at run time as well (`runtime_inertia = "all"`).
+pub mod gs_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/gs_inertia/gough_stewart.rs"
+    ));
+}
+/// `closed_params` with every body's inertial parameters at run time as well
+/// (`runtime_inertia = "all"`).
+pub mod closed_inertia {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/closed_inertia/spherical_five_bar.rs"
     ));
 }
 /// A Gough–Stewart platform with one generic leg (its prismatic axis off the U–S line), whose

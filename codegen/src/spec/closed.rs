@@ -112,6 +112,7 @@ pub(crate) fn lower_closed_attached(
     }
     let topo = topo?;
     let built = lower::build(spec, &topo, &axes, diags);
+    lower::check_runtime_bodies(spec, &built.attach, diags);
     if diags.has_errors() {
         return None;
     }

@@ -62,6 +62,33 @@ pub(crate) struct SceneSpec {
     pub runtime_params: bool,
     /// Span of the `parameters` value.
     pub runtime_params_span: Span,
+    /// `runtime_inertia = ["body", …]` or `"all"`: these bodies' inertial parameters become
+    /// run-time parameters (with `parameters = "runtime"` only); with the span of the value.
+    pub runtime_inertia: Option<(RuntimeInertia, Span)>,
+    /// The bodies `runtime_inertia` resolved to, with their inertial data as the spec gives it
+    /// (filled by `apply_scene`, which then zeroes those bodies' constants).
+    pub runtime_bodies: Vec<RuntimeBodySpec>,
+}
+
+/// The value of `[scene] runtime_inertia`.
+#[derive(Clone, Debug)]
+pub(crate) enum RuntimeInertia {
+    /// `"all"`: every body with mass or inertia that can take part (see `apply_scene`).
+    All,
+    /// The bodies named.
+    Bodies(Vec<Named>),
+}
+
+/// A body whose inertial parameters are run-time parameters: its index in `Spec::bodies`, the
+/// name as written (`None` when `"all"` picked it), and its mass (kg), mass centre (m) and
+/// inertia about the mass centre (kg·m²) in its own frame, as the spec gives them.
+#[derive(Clone, Debug)]
+pub(crate) struct RuntimeBodySpec {
+    pub body: usize,
+    pub named: Option<Named>,
+    pub mass: f64,
+    pub com: Vec3,
+    pub inertia: Mat3,
 }
 
 /// The default `v_s` of the regularized Coulomb law (rad/s or m/s): 99.5 % of the Coulomb
@@ -82,6 +109,8 @@ impl Default for SceneSpec {
             snap: None,
             runtime_params: false,
             runtime_params_span: None,
+            runtime_inertia: None,
+            runtime_bodies: Vec::new(),
         }
     }
 }

@@ -27,6 +27,7 @@ pub(super) fn lower_built(spec: &Spec, diags: &mut Diagnostics) -> Option<Built>
     }
     let topo = topo?;
     let built = build(spec, &topo, &axes, diags);
+    check_runtime_bodies(spec, &built.attach, diags);
     check_massless_subtrees(spec, &built, diags);
     if diags.has_errors() {
         None
@@ -46,6 +47,12 @@ fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) 
         .iter()
         .map(|b| b.mass != 0.0 || b.inertia.iter().flatten().any(|x| *x != 0.0))
         .collect();
+    // Bodies with run-time inertia have zero constants but a mass at run time.
+    for r in &spec.scene.runtime_bodies {
+        if let Some(t) = built.attach[r.body].and_then(|a| a.target) {
+            massive[t] = true;
+        }
+    }
     // Parents come before children: accumulate from the tips.
     for i in (0..m.joints.len()).rev() {
         if massive[i]
@@ -68,6 +75,28 @@ fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) 
             .with_span(j.span.clone())
             .with_hint("its row of the mass matrix is zero at every configuration, so forward_dynamics will always return Err(Singular); give a body beyond it a mass or an inertia, or make the joint fixed"),
         );
+    }
+}
+
+/// A body named in `[scene] runtime_inertia` must move: one fixed to the base (directly or
+/// through fixed joints) never enters the dynamics, so its parameters would do nothing.
+pub(super) fn check_runtime_bodies(
+    spec: &Spec,
+    attach: &[Option<Attach>],
+    diags: &mut Diagnostics,
+) {
+    for r in &spec.scene.runtime_bodies {
+        if let (Some(n), Some(Attach { target: None, .. })) = (&r.named, attach[r.body]) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "body {:?} is fixed to the base: its inertia never enters the dynamics",
+                    n.name
+                ))
+                .with_key(n.key.clone())
+                .with_span(n.span.clone())
+                .with_hint("name only bodies that a joint moves; `\"all\"` leaves out the bodies fixed to the base"),
+            );
+        }
     }
 }
 

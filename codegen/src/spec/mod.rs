@@ -185,6 +185,7 @@ fn load_any(
                 && s.platform.is_none()
                 && closed::is_closed(&s)
                 && s.scene.payload.is_none()
+                && s.scene.runtime_bodies.is_empty()
                 && !s.scene.friction
                 && !s.scene.rotor_inertia
             {
@@ -198,7 +199,9 @@ fn load_any(
             if s.scene.runtime_params && s.platform.is_some() {
                 // Parallel mechanisms: the run-time parameters are the platform's payload.
                 match &s.scene.payload {
-                    None if s.scene.friction || s.scene.rotor_inertia => {}
+                    None if s.scene.friction
+                        || s.scene.rotor_inertia
+                        || !s.scene.runtime_bodies.is_empty() => {}
                     None => d.push(
                         Diagnostic::error("run-time parameters of a parallel mechanism are its platform payload and the leg joints' drives, but the scene declares no payload and has neither `friction` nor `rotor_inertia` on")
                             .with_key("scene.parameters")
@@ -321,6 +324,7 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
     for n in &scene.massless {
         massless.extend(find(n, diags));
     }
+    let runtime = resolve_runtime_inertia(spec, &scene, &point, &massless, &find, diags);
     if let Some(p) = &scene.payload
         && let Some(i) = find(&p.body, diags)
     {
@@ -401,6 +405,14 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
         j.axes.clear();
         j.actuated = false;
     }
+    // Run-time inertia: the spec's values are kept apart as the defaults, the constants go.
+    for r in &runtime {
+        let b = &mut spec.bodies[r.body];
+        b.mass = 0.0;
+        b.com = [0.0; 3];
+        b.inertia = [[0.0; 3]; 3];
+    }
+    spec.scene.runtime_bodies = runtime;
     for i in point {
         spec.bodies[i].inertia = [[0.0; 3]; 3];
     }
@@ -408,6 +420,95 @@ fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
         spec.bodies[i].mass = 0.0;
         spec.bodies[i].inertia = [[0.0; 3]; 3];
     }
+}
+
+/// `[scene] runtime_inertia`: the bodies whose inertial parameters become run-time
+/// parameters, with the spec's values (see [`ir::RuntimeBodySpec`]). `"all"` takes every body
+/// with mass or inertia that is neither a point mass nor massless (in a parallel mechanism:
+/// the platform and the bodies fixed to it). Errors: the key without `parameters = "runtime"`,
+/// unknown names (with a suggestion), a body named twice or also in `point_mass` / `massless`,
+/// and a leg body of a parallel mechanism.
+fn resolve_runtime_inertia(
+    spec: &ir::Spec,
+    scene: &ir::SceneSpec,
+    point: &[usize],
+    massless: &[usize],
+    find: &dyn Fn(&ir::Named, &mut Diagnostics) -> Option<usize>,
+    diags: &mut Diagnostics,
+) -> Vec<ir::RuntimeBodySpec> {
+    let Some((which, span)) = &scene.runtime_inertia else {
+        return Vec::new();
+    };
+    if !scene.runtime_params {
+        diags.push(
+            Diagnostic::error("`runtime_inertia` makes bodies' inertial parameters run-time parameters, but the scene's parameters are constants")
+                .with_key("scene.runtime_inertia")
+                .with_span(span.clone())
+                .with_hint("add `parameters = \"runtime\"` to [scene] (the module then takes a `Params` struct), or remove `runtime_inertia`"),
+        );
+        return Vec::new();
+    }
+    let on_platform =
+        |name: &str| spec.platform.is_none() || parallel::pose_on_platform(spec, name).is_some();
+    let mut chosen: Vec<(usize, Option<ir::Named>)> = Vec::new();
+    match which {
+        ir::RuntimeInertia::All => {
+            for (i, b) in spec.bodies.iter().enumerate() {
+                let has_mass = b.mass != 0.0 || b.inertia.iter().flatten().any(|x| *x != 0.0);
+                if has_mass && !point.contains(&i) && !massless.contains(&i) && on_platform(&b.name)
+                {
+                    chosen.push((i, None));
+                }
+            }
+        }
+        ir::RuntimeInertia::Bodies(names) => {
+            for n in names {
+                let Some(i) = find(n, diags) else { continue };
+                let error = |msg: String, hint: &str| {
+                    Diagnostic::error(msg)
+                        .with_key(n.key.clone())
+                        .with_span(n.span.clone())
+                        .with_hint(hint)
+                };
+                if chosen.iter().any(|(k, _)| *k == i) {
+                    diags.push(error(
+                        format!("body {:?} is named twice in `runtime_inertia`", n.name),
+                        "name each body once",
+                    ));
+                } else if point.contains(&i) || massless.contains(&i) {
+                    let what = if point.contains(&i) {
+                        "point_mass"
+                    } else {
+                        "massless"
+                    };
+                    diags.push(error(
+                        format!("body {:?} is in both `runtime_inertia` and `{what}`", n.name),
+                        "a body's inertia is either given at run time or simplified as a constant: remove it from one of the two lists",
+                    ));
+                } else if !on_platform(&n.name) {
+                    diags.push(error(
+                        format!("body {:?} is not the platform or fixed to it: leg bodies' inertia is constant; only the platform's can be a run-time parameter", n.name),
+                        "name the platform body (or a body fixed to it), or drop this body from `runtime_inertia`; its inertia stays folded into the leg dynamics",
+                    ));
+                } else {
+                    chosen.push((i, Some(n.clone())));
+                }
+            }
+        }
+    }
+    chosen
+        .into_iter()
+        .map(|(i, named)| {
+            let b = &spec.bodies[i];
+            ir::RuntimeBodySpec {
+                body: i,
+                named,
+                mass: b.mass,
+                com: b.com,
+                inertia: b.inertia,
+            }
+        })
+        .collect()
 }
 
 fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostics) {
@@ -476,6 +577,52 @@ pub struct RuntimeParams {
     /// Parallel mechanisms and closed loops: the joints' rotor inertias are run-time parameters
     /// (the scene's `rotor_inertia` is on).
     pub leg_rotor_inertia: bool,
+    /// `[scene] runtime_inertia`: the bodies whose inertial parameters are run-time parameters,
+    /// in the order of the list (`"all"`: the spec's body order), bodies fixed to the base left
+    /// out. Their constants are zero in the model.
+    pub bodies: Vec<RuntimeBody>,
+}
+
+/// A body whose inertial parameters are run-time parameters (`[scene] runtime_inertia`): it
+/// enters the dynamics exactly as a run-time payload on the model body it is part of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeBody {
+    /// The spec body's name (the generated `RUNTIME_BODY_NAMES`).
+    pub name: String,
+    /// The model body it is rigidly part of (after fixed-joint merging; for a parallel
+    /// mechanism 0, the platform; for closed loops a body of the spanning tree).
+    pub body: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Mass centre in the model body's frame (m).
+    pub com: runtime::model::Vec3,
+    /// Inertia about the mass centre, model body's axes (kg·m²).
+    pub inertia: runtime::model::Mat3,
+}
+
+impl RuntimeBody {
+    /// The spec's values of `r` placed on model body `body` at `pose` (the spec body's frame in
+    /// the model body's frame).
+    fn placed(
+        spec: &ir::Spec,
+        r: &ir::RuntimeBodySpec,
+        body: usize,
+        pose: &runtime::model::Transform,
+    ) -> RuntimeBody {
+        let m = geom::MassProps {
+            mass: r.mass,
+            com: r.com,
+            inertia: r.inertia,
+        }
+        .transformed(pose);
+        RuntimeBody {
+            name: spec.bodies[r.body].name.clone(),
+            body,
+            mass: m.mass,
+            com: m.com,
+            inertia: m.inertia,
+        }
+    }
 }
 
 /// See [`RuntimeParams`].
@@ -506,22 +653,47 @@ pub fn scene_params(
     };
     let with_drives =
         |spec: &ir::Spec,
-         payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>| {
+         payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
+         bodies: Vec<RuntimeBody>| {
             let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
-            (payload.is_some() || friction || rotor).then_some(RuntimeParams {
-                payload,
-                coulomb_velocity: spec.scene.coulomb_velocity,
-                leg_friction: friction,
-                leg_rotor_inertia: rotor,
-            })
+            (payload.is_some() || friction || rotor || !bodies.is_empty()).then_some(
+                RuntimeParams {
+                    payload,
+                    coulomb_velocity: spec.scene.coulomb_velocity,
+                    leg_friction: friction,
+                    leg_rotor_inertia: rotor,
+                    bodies,
+                },
+            )
         };
+    // The run-time bodies placed by `attach` (closed loops, trees): on the model body each
+    // spec body is part of; those fixed to the base move with nothing and are left out.
+    let attached = |spec: &ir::Spec, attach: &[Option<lower::Attach>]| -> Vec<RuntimeBody> {
+        spec.scene
+            .runtime_bodies
+            .iter()
+            .filter_map(|r| {
+                let at = attach[r.body]?;
+                Some(RuntimeBody::placed(spec, r, at.target?, &at.pose))
+            })
+            .collect()
+    };
     if spec.platform.is_some() {
         prepare(&mut spec, overrides, &mut d);
         let payload = match spec.scene.payload.as_ref() {
             None => None,
             Some(p) => placed(&spec, 0, &parallel::pose_on_platform(&spec, &p.body.name)?),
         };
-        return with_drives(&spec, payload);
+        let bodies = spec
+            .scene
+            .runtime_bodies
+            .iter()
+            .filter_map(|r| {
+                let pose = parallel::pose_on_platform(&spec, &spec.bodies[r.body].name)?;
+                Some(RuntimeBody::placed(&spec, r, 0, &pose))
+            })
+            .collect();
+        return with_drives(&spec, payload, bodies);
     }
     if closed::is_closed(&spec) {
         prepare(&mut spec, overrides, &mut d);
@@ -532,7 +704,8 @@ pub fn scene_params(
             let at = attach[b]?;
             placed(&spec, at.target?, &at.pose)
         });
-        return with_drives(&spec, payload);
+        let bodies = attached(&spec, &attach);
+        return with_drives(&spec, payload, bodies);
     }
     prepare(&mut spec, overrides, &mut d);
     let built = lower::lower_built(&spec, &mut d)?;
@@ -553,6 +726,7 @@ pub fn scene_params(
         coulomb_velocity: spec.scene.coulomb_velocity,
         leg_friction: false,
         leg_rotor_inertia: false,
+        bodies: attached(&spec, &built.attach),
     })
 }
 

@@ -11,7 +11,7 @@ use toml::de::{DeTable, DeValue};
 use super::angle::{ANGLE_HINT, parse_angle};
 use super::ir::{
     AxisSpec, BodySpec, Coordinates, Dh, DriveSpec, JointSpec, Kind, Named, Payload, Placement,
-    PlatformSpec, SceneSpec, Spec,
+    PlatformSpec, RuntimeInertia, SceneSpec, Spec,
 };
 use super::{sanitize_name, suggest_hint};
 use crate::diag::{Diagnostic, Diagnostics};
@@ -31,6 +31,7 @@ const SCENE_KEYS: &[&str] = &[
     "coulomb_velocity",
     "snap",
     "parameters",
+    "runtime_inertia",
 ];
 const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
@@ -473,6 +474,25 @@ impl Reader<'_> {
                             .with_hint("\"constants\" (the default: folded into the code) or \"runtime\" (a generated `Params` struct with the payload and the joints' damping, friction and armature, passed to every function)"),
                     ),
                 }
+            }
+            if let Some(v) = get(t, "runtime_inertia") {
+                let span = Some(v.span());
+                let which = match v.get_ref() {
+                    DeValue::String(x) if x.as_ref() == "all" => Some(RuntimeInertia::All),
+                    DeValue::String(x) => {
+                        self.diags.push(
+                            Diagnostic::error(format!("unknown `runtime_inertia` value {:?}", x.as_ref()))
+                                .with_key("scene.runtime_inertia")
+                                .with_span(span.clone())
+                                .with_hint("write \"all\" (every body with mass) or a list of body names, e.g. [\"link5\", \"link6\"]"),
+                        );
+                        None
+                    }
+                    _ => self
+                        .names(v, "scene.runtime_inertia")
+                        .map(RuntimeInertia::Bodies),
+                };
+                scene.runtime_inertia = which.map(|w| (w, span));
             }
             if let Some(v) = get(t, "snap")
                 && let Some(x) = self.number(v, "scene.snap")

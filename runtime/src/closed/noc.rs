@@ -798,16 +798,17 @@ pub fn tree_efforts<R: Real>(
     m: &[BodyMotion<R>],
     gravity: bool,
 ) -> Vec<R> {
-    tree_efforts_with(plan, k, m, gravity, None)
+    tree_efforts_with(plan, k, m, gravity, &[])
 }
 
 /// Values of a closed-loop mechanism given at run time in place of the plan's constants (a
 /// generated module's `Params`, where they are symbolic inputs).
 #[derive(Clone, Debug)]
 pub struct Extras<R> {
-    /// A payload rigidly attached to tree body `.0` (its mass centre and inertia in that body's
-    /// frame).
-    pub payload: Option<(usize, Payload<R>)>,
+    /// Rigid bodies given at run time, each attached to tree body `.0` (its mass centre and
+    /// inertia in that body's frame): a payload, and the bodies whose inertial parameters are
+    /// run-time parameters (their constants zero in the plan).
+    pub payloads: Vec<(usize, Payload<R>)>,
     /// The drives of every tree joint (entry `j`: tree joint `j`), replacing the plan's.
     pub drives: Option<DriveInputs<R>>,
 }
@@ -816,20 +817,20 @@ impl<R> Extras<R> {
     /// No run-time values: the plan's constants.
     pub fn none() -> Extras<R> {
         Extras {
-            payload: None,
+            payloads: Vec::new(),
             drives: None,
         }
     }
 }
 
-/// [`tree_efforts`] with a [`Payload`] on tree body `payload.0` (Newton–Euler of the payload,
+/// [`tree_efforts`] with [`Payload`]s, each on tree body `.0` (Newton–Euler of the payload,
 /// eq. 12, added to that body's wrench).
 pub fn tree_efforts_with<R: Real>(
     plan: &Plan,
     k: &Kin<R>,
     m: &[BodyMotion<R>],
     gravity: bool,
-    payload: Option<&(usize, Payload<R>)>,
+    payloads: &[(usize, Payload<R>)],
 ) -> Vec<R> {
     let n = plan.nx();
     let g: V<R> = if gravity { cv(&plan.gravity) } else { zero3() };
@@ -848,9 +849,7 @@ pub fn tree_efforts_with<R: Real>(
             force[i] = add(force[i], f);
             moment[i] = add(moment[i], add(nc, cross(c, f)));
         }
-        if let Some((b, p)) = payload
-            && *b == i
-        {
+        for (_, p) in payloads.iter().filter(|(b, _)| *b == i) {
             let c = add(k.pos[i], mv(&k.rot[i], p.com));
             let a = m[i].accel_at(k.o[i], c);
             let f = scale(p.mass, sub(a, g));
@@ -916,7 +915,7 @@ pub fn generalized_force_with<R: Real>(
         xdd[j] = xdd_d[k];
     }
     let m = motions(plan, &c.kin, &xd, Some(&xdd));
-    let mut tau = tree_efforts_with(plan, &c.kin, &m, gravity, extras.payload.as_ref());
+    let mut tau = tree_efforts_with(plan, &c.kin, &m, gravity, &extras.payloads);
     // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
     // with the rest (the lecture's dissipative term δ).
     for (j, jp) in plan.joints.iter().enumerate() {
@@ -958,17 +957,23 @@ pub fn generalized_inertia_with<R: Real>(
     // centre velocities for it.
     let mut cols: Vec<Vec<(V<R>, V<R>)>> = Vec::with_capacity(d);
     let mut rates: Vec<Vec<R>> = Vec::with_capacity(d);
-    // The payload's angular velocity and mass-centre velocity per column.
-    let mut payload_cols: Vec<(V<R>, V<R>)> = Vec::new();
+    // Each payload's angular velocity and mass-centre velocity per column.
+    let mut payload_cols: Vec<Vec<(V<R>, V<R>)>> = Vec::new();
     for k in 0..d {
         let mut e = vec![R::c(0.0); d];
         e[k] = R::c(1.0);
         let xd = joint_rates_generic(plan, c, &e);
         let m = motions(plan, &c.kin, &xd, None);
-        if let Some((b, p)) = &extras.payload {
-            let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
-            payload_cols.push((m[*b].w, m[*b].vel_at(c.kin.o[*b], cw)));
-        }
+        payload_cols.push(
+            extras
+                .payloads
+                .iter()
+                .map(|(b, p)| {
+                    let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
+                    (m[*b].w, m[*b].vel_at(c.kin.o[*b], cw))
+                })
+                .collect(),
+        );
         rates.push(xd);
         cols.push(
             (0..n)
@@ -995,12 +1000,12 @@ pub fn generalized_inertia_with<R: Real>(
             }
         }
     }
-    if let Some((b, p)) = &extras.payload {
+    for (k, (b, p)) in extras.payloads.iter().enumerate() {
         let rot = &c.kin.rot[*b];
         for i in 0..d {
             for j in i..d {
-                let (wi, vi) = payload_cols[i];
-                let (wj, vj) = payload_cols[j];
+                let (wi, vi) = payload_cols[i][k];
+                let (wj, vj) = payload_cols[j][k];
                 let (wbi, wbj) = (mtv(rot, wi), mtv(rot, wj));
                 let v = p.mass * dot(vi, vj) + dot(wbi, mv(&p.inertia, wbj));
                 out[i][j] = out[i][j] + v;

@@ -1774,24 +1774,25 @@ pub fn forward_dynamics_generic<R: Real>(
     u: &[R],
     tau: &[R],
 ) -> Result<Vec<R>, Singular> {
-    forward_dynamics_with(plan, x, u, tau, None, None)
+    forward_dynamics_with(plan, x, u, tau, &[], None)
 }
 
-/// [`forward_dynamics_generic`] with a [`Payload`] on the platform and the leg joints' drives
-/// from `drives` (see [`generalized_force_with`]).
+/// [`forward_dynamics_generic`] with [`Payload`]s on the platform (a payload, and the
+/// platform's own inertia when it is given at run time) and the leg joints' drives from
+/// `drives` (see [`generalized_force_with`]).
 pub fn forward_dynamics_with<R: Real>(
     plan: &Plan,
     x: &[R],
     u: &[R],
     tau: &[R],
-    payload: Option<&Payload<R>>,
+    payloads: &[Payload<R>],
     drives: Option<&DriveInputs<R>>,
 ) -> Result<Vec<R>, Singular> {
     let (pl, legs) = kinematics(plan, x)?;
     let n = plan.dof();
     let zero = vec![R::c(0.0); n];
     let mut h = generalized_force_with(plan, &pl, &legs, u, &zero, true, drives);
-    if let Some(p) = payload {
+    for p in payloads {
         let hp = payload_force(plan, &pl, p, u, &zero, true);
         for i in 0..n {
             h[i] = h[i] + hp[i];
@@ -1808,7 +1809,7 @@ pub fn forward_dynamics_with<R: Real>(
         })
         .collect();
     let mut m = generalized_inertia_with(plan, &pl, &legs, drives);
-    if let Some(p) = payload {
+    for p in payloads {
         let mp = payload_inertia(plan, &pl, p);
         for i in 0..n {
             for j in 0..n {
