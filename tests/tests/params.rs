@@ -238,6 +238,99 @@ fn with_payload(spec: &str, body: &str, mass: f64, com: [f64; 3], i6: [f64; 6]) 
 /// the generator), and the drives set on the model's leg joints. `Params::DEFAULT` is the
 /// spec's payload on the turned tool (no drives); random payloads and drives set at run time
 /// are compared with the same payload written on the platform and the same drives.
+/// The check shared by the parallel `Params` tests: the compiled module `$g` with `p` against
+/// the runtime on `spec` (the same values as constants, `p`'s drives set on the leg joints),
+/// 50 random states, all four functions; the worst relative error.
+macro_rules! parallel_check {
+    ($g:ident) => {
+        |p: &$g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+            let mut model = parallel(spec);
+            // The drives of `p` as the model's constants, leg joint `3·leg + k`.
+            for (l, leg) in model.legs.iter_mut().enumerate() {
+                for (k, j) in leg.joints.iter_mut().enumerate().take(3) {
+                    let i = 3 * l + k;
+                    j.drive = Drive {
+                        viscous: p.damping[i],
+                        coulomb: p.friction[i],
+                        coulomb_velocity: 1e-4,
+                        armature: p.armature[i],
+                    };
+                }
+            }
+            let plan = runtime::parallel::Plan::new(&model).unwrap();
+            let home = model.home_x();
+            let mut worst: f64 = 0.0;
+            for _ in 0..50 {
+                let (x, u, ud) = tests::pkm::random_state(&plan, &home, r, 0.3, 0.1);
+                let xa: [f64; 7] = x.clone().try_into().unwrap();
+                let ua: [f64; $g::DOF] = u.clone().try_into().unwrap();
+                let uda: [f64; $g::DOF] = ud.clone().try_into().unwrap();
+                let tau = $g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+                let want = runtime::parallel::noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+                worst = worst.max(tests::pkm::rel(&tau, &want));
+                let m = $g::mass_matrix(&xa, p).unwrap();
+                let want = runtime::parallel::noc::mass_matrix(&plan, &x).unwrap();
+                worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+                let ma = $g::actuator_mass_matrix(&xa, p).unwrap();
+                let want = runtime::parallel::noc::actuator_mass_matrix(&plan, &x).unwrap();
+                worst = worst.max(tests::pkm::rel(&ma.concat(), &want.concat()));
+                let back = $g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+                worst = worst.max(tests::pkm::rel(&back, &ud));
+            }
+            worst
+        }
+    };
+}
+
+/// The check shared by the closed-loop `Params` tests: the compiled module `$g` with `p`
+/// against the runtime on `spec` (the same values as constants, `p`'s drives on every tree
+/// joint), 50 random states of the spherical five-bar; the worst relative error.
+macro_rules! closed_check {
+    ($g:ident) => {
+        |p: &$g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
+            let mut model = closed(spec);
+            for (j, joint) in model.tree.joints.iter_mut().enumerate() {
+                joint.drive = Drive {
+                    viscous: p.damping[j],
+                    coulomb: p.friction[j],
+                    coulomb_velocity: 1e-4,
+                    armature: p.armature[j],
+                };
+            }
+            let plan = runtime::closed::noc::Plan::new(&model).unwrap();
+            let mut worst: f64 = 0.0;
+            for _ in 0..50 {
+                let (x, u, ud) = tests::closed::random_state(
+                    &plan,
+                    r,
+                    tests::closed::reach("spherical_five_bar"),
+                );
+                let xa: [f64; $g::NX] = x.clone().try_into().unwrap();
+                let ua: [f64; $g::DOF] = u.clone().try_into().unwrap();
+                let uda: [f64; $g::DOF] = ud.clone().try_into().unwrap();
+                let tau = $g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
+                let want = runtime::closed::noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+                worst = worst.max(tests::pkm::rel(&tau, &want));
+                let m = $g::mass_matrix(&xa, p).unwrap();
+                let want = runtime::closed::noc::mass_matrix(&plan, &x).unwrap();
+                worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
+                let back = $g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
+                worst = worst.max(tests::pkm::rel(&back, &ud));
+            }
+            worst
+        }
+    };
+}
+
+/// A closed-loop spec's validated model.
+fn closed(spec: &str) -> runtime::closed::ClosedModel {
+    match load_mechanism("sfb.toml", spec) {
+        Ok((Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("not a closed-loop spec"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
 #[test]
 fn parallel_payload_at_run_time_matches_constants() {
     use runtime::parallel::Plan;
@@ -246,42 +339,7 @@ fn parallel_payload_at_run_time_matches_constants() {
     const N: usize = g::DOF;
     let src = format!("{GS}\n{GS_SCENE}");
     let constants = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
-    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
-        let mut model = parallel(spec);
-        // The drives of `p` as the model's constants, leg joint `3·leg + k`.
-        for (l, leg) in model.legs.iter_mut().enumerate() {
-            for (k, j) in leg.joints.iter_mut().enumerate().take(3) {
-                let i = 3 * l + k;
-                j.drive = Drive {
-                    viscous: p.damping[i],
-                    coulomb: p.friction[i],
-                    coulomb_velocity: 1e-4,
-                    armature: p.armature[i],
-                };
-            }
-        }
-        let plan = Plan::new(&model).unwrap();
-        let home = model.home_x();
-        let mut worst: f64 = 0.0;
-        for _ in 0..50 {
-            let (x, u, ud) = tests::pkm::random_state(&plan, &home, r, 0.3, 0.1);
-            let xa: [f64; 7] = x.clone().try_into().unwrap();
-            let ua: [f64; N] = u.clone().try_into().unwrap();
-            let uda: [f64; N] = ud.clone().try_into().unwrap();
-            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
-            let want = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
-            worst = worst.max(tests::pkm::rel(&tau, &want));
-            let m = g::mass_matrix(&xa, p).unwrap();
-            let want = noc::mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
-            let ma = g::actuator_mass_matrix(&xa, p).unwrap();
-            let want = noc::actuator_mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&ma.concat(), &want.concat()));
-            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
-            worst = worst.max(tests::pkm::rel(&back, &ud));
-        }
-        worst
-    };
+    let check = parallel_check!(g);
     let mut r = tests::rng(43);
     // The spec's payload, on the tool, by default.
     let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
@@ -386,40 +444,7 @@ fn closed_loop_payload_and_drives_at_run_time_match_constants() {
     const NX: usize = g::NX;
     let src = format!("{SFB}\n{CLOSED_SCENE}");
     let constants = src.replace("parameters = \"runtime\"", "parameters = \"constants\"");
-    let closed = |spec: &str| match load_mechanism("sfb.toml", spec) {
-        Ok((Mechanism::Closed(m), _)) => m,
-        Ok(_) => panic!("not a closed-loop spec"),
-        Err(d) => panic!("{d}"),
-    };
-    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
-        let mut model = closed(spec);
-        for (j, joint) in model.tree.joints.iter_mut().enumerate() {
-            joint.drive = Drive {
-                viscous: p.damping[j],
-                coulomb: p.friction[j],
-                coulomb_velocity: 1e-4,
-                armature: p.armature[j],
-            };
-        }
-        let plan = Plan::new(&model).unwrap();
-        let mut worst: f64 = 0.0;
-        for _ in 0..50 {
-            let (x, u, ud) =
-                tests::closed::random_state(&plan, r, tests::closed::reach("spherical_five_bar"));
-            let xa: [f64; NX] = x.clone().try_into().unwrap();
-            let ua: [f64; N] = u.clone().try_into().unwrap();
-            let uda: [f64; N] = ud.clone().try_into().unwrap();
-            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
-            let want = cnoc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
-            worst = worst.max(tests::pkm::rel(&tau, &want));
-            let m = g::mass_matrix(&xa, p).unwrap();
-            let want = cnoc::mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
-            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
-            worst = worst.max(tests::pkm::rel(&back, &ud));
-        }
-        worst
-    };
+    let check = closed_check!(g);
     let mut r = tests::rng(44);
     // The spec's payload by default (no drives).
     let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);
@@ -772,46 +797,12 @@ fn random_props(
 /// body's, in its tree body's frame as lowered) through `Params`.
 #[test]
 fn closed_loop_runtime_inertia_matches_constants() {
-    use runtime::closed::noc::{self as cnoc, Plan};
     use tests::variants::closed_inertia as g;
     const N: usize = g::DOF;
     const NX: usize = g::NX;
     let src = format!("{SFB}\n{}", with_runtime_inertia(CLOSED_SCENE));
     let constants = as_constants(&src, true);
-    let closed = |spec: &str| match load_mechanism("sfb.toml", spec) {
-        Ok((Mechanism::Closed(m), _)) => m,
-        Ok(_) => panic!("not a closed-loop spec"),
-        Err(d) => panic!("{d}"),
-    };
-    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
-        let mut model = closed(spec);
-        for (j, joint) in model.tree.joints.iter_mut().enumerate() {
-            joint.drive = Drive {
-                viscous: p.damping[j],
-                coulomb: p.friction[j],
-                coulomb_velocity: 1e-4,
-                armature: p.armature[j],
-            };
-        }
-        let plan = Plan::new(&model).unwrap();
-        let mut worst: f64 = 0.0;
-        for _ in 0..50 {
-            let (x, u, ud) =
-                tests::closed::random_state(&plan, r, tests::closed::reach("spherical_five_bar"));
-            let xa: [f64; NX] = x.clone().try_into().unwrap();
-            let ua: [f64; N] = u.clone().try_into().unwrap();
-            let uda: [f64; N] = ud.clone().try_into().unwrap();
-            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
-            let want = cnoc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
-            worst = worst.max(tests::pkm::rel(&tau, &want));
-            let m = g::mass_matrix(&xa, p).unwrap();
-            let want = cnoc::mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
-            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
-            worst = worst.max(tests::pkm::rel(&back, &ud));
-        }
-        worst
-    };
+    let check = closed_check!(g);
     assert_eq!(
         g::RUNTIME_BODY_NAMES,
         ["proximal_a", "distal_a", "proximal_b", "distal_b"]
@@ -859,47 +850,11 @@ fn closed_loop_runtime_inertia_matches_constants() {
 /// random platform parameters written into the spec as constants, against the runtime.
 #[test]
 fn parallel_platform_inertia_at_run_time_matches_constants() {
-    use runtime::parallel::Plan;
-    use runtime::parallel::noc;
     use tests::variants::gs_inertia as g;
     const N: usize = g::DOF;
     let src = format!("{GS}\n{}", with_runtime_inertia(GS_SCENE));
     let constants = as_constants(&src, true);
-    let check = |p: &g::Params, spec: &str, r: &mut rand::rngs::StdRng| -> f64 {
-        let mut model = parallel(spec);
-        for (l, leg) in model.legs.iter_mut().enumerate() {
-            for (k, j) in leg.joints.iter_mut().enumerate().take(3) {
-                let i = 3 * l + k;
-                j.drive = Drive {
-                    viscous: p.damping[i],
-                    coulomb: p.friction[i],
-                    coulomb_velocity: 1e-4,
-                    armature: p.armature[i],
-                };
-            }
-        }
-        let plan = Plan::new(&model).unwrap();
-        let home = model.home_x();
-        let mut worst: f64 = 0.0;
-        for _ in 0..50 {
-            let (x, u, ud) = tests::pkm::random_state(&plan, &home, r, 0.3, 0.1);
-            let xa: [f64; 7] = x.clone().try_into().unwrap();
-            let ua: [f64; N] = u.clone().try_into().unwrap();
-            let uda: [f64; N] = ud.clone().try_into().unwrap();
-            let tau = g::inverse_dynamics(&xa, &ua, &uda, p).unwrap();
-            let want = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
-            worst = worst.max(tests::pkm::rel(&tau, &want));
-            let m = g::mass_matrix(&xa, p).unwrap();
-            let want = noc::mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&m.concat(), &want.concat()));
-            let ma = g::actuator_mass_matrix(&xa, p).unwrap();
-            let want = noc::actuator_mass_matrix(&plan, &x).unwrap();
-            worst = worst.max(tests::pkm::rel(&ma.concat(), &want.concat()));
-            let back = g::forward_dynamics(&xa, &ua, &tau, p).unwrap();
-            worst = worst.max(tests::pkm::rel(&back, &ud));
-        }
-        worst
-    };
+    let check = parallel_check!(g);
     assert_eq!(g::RUNTIME_BODY_NAMES, ["platform"]);
     let mut r = tests::rng(47);
     let mut worst = check(&g::Params::DEFAULT, &constants, &mut r);

@@ -97,6 +97,23 @@ fn end_motion(motion: PlatformMotion, lk: &LegKin<f64>, u: &[f64], ud: &[f64]) -
 }
 
 /// Number of bodies `r` (leg bodies and the platform).
+/// Body `b`'s blocks: `M_b = diag(I_b, m_b 1₃)` (eq. 5) and its weight `m_b g` in `w^G`.
+fn put_body(
+    m: &mut DMatrix<f64>,
+    gravity: &mut DVector<f64>,
+    b: usize,
+    inertia: Matrix3<f64>,
+    mass: f64,
+    g: Vector3<f64>,
+) {
+    m.fixed_view_mut::<3, 3>(6 * b, 6 * b).copy_from(&inertia);
+    m.fixed_view_mut::<3, 3>(6 * b + 3, 6 * b + 3)
+        .copy_from(&(Matrix3::identity() * mass));
+    gravity
+        .fixed_rows_mut::<3>(6 * b + 3)
+        .copy_from(&(g * mass));
+}
+
 fn body_count(plan: &Plan) -> usize {
     plan.legs.iter().map(|lp| lp.joints.len()).sum::<usize>() + 1
 }
@@ -151,13 +168,8 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             td_u.fixed_rows_mut::<3>(6 * b).copy_from(&alpha);
             td_u.fixed_rows_mut::<3>(6 * b + 3).copy_from(&acc);
             let rot = frame * m3(&lk.rot[k]);
-            m.fixed_view_mut::<3, 3>(6 * b, 6 * b)
-                .copy_from(&(rot * m3(&inertia) * rot.transpose()));
-            m.fixed_view_mut::<3, 3>(6 * b + 3, 6 * b + 3)
-                .copy_from(&(Matrix3::identity() * mass));
-            gravity
-                .fixed_rows_mut::<3>(6 * b + 3)
-                .copy_from(&(g_world * mass));
+            let inertia = rot * m3(&inertia) * rot.transpose();
+            put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
             b += 1;
         }
     }
@@ -169,6 +181,7 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
         PlatformMotion::PlanarPoint { .. } => {
             t[(6 * b + 3, 0)] = 1.0;
             t[(6 * b + 4, 1)] = 1.0;
+            put_body(&mut m, &mut gravity, b, Matrix3::zeros(), mass, g_world);
         }
         PlatformMotion::Pose | PlatformMotion::Orientation { .. } => {
             let rot = m3(&pl.rot);
@@ -184,15 +197,10 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             let w = v3([u[0], u[1], u[2]]);
             td_u.fixed_rows_mut::<3>(6 * b + 3)
                 .copy_from(&w.cross(&w.cross(&rc)));
-            m.fixed_view_mut::<3, 3>(6 * b, 6 * b)
-                .copy_from(&(rot * m3(&inertia) * rot.transpose()));
+            let inertia = rot * m3(&inertia) * rot.transpose();
+            put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
         }
     }
-    m.fixed_view_mut::<3, 3>(6 * b + 3, 6 * b + 3)
-        .copy_from(&(Matrix3::identity() * mass));
-    gravity
-        .fixed_rows_mut::<3>(6 * b + 3)
-        .copy_from(&(g_world * mass));
     // W from the bodies' angular velocities ω = (T u)_ω.
     let twist = &t * DVector::from_column_slice(u);
     let mut w = DMatrix::zeros(6 * r, 6 * r);
