@@ -219,6 +219,14 @@ fn gough_stewart(points: &mut Vec<Point>) {
         noc::inverse_dynamics(&plan, x, u, ud).unwrap()
     };
     add("runtime (leg-wise, f64)", &rt);
+    let literal = |i: usize| {
+        let (x, u, ud) = &states[i];
+        runtime::parallel::literal::inverse_dynamics(&plan, x, u, ud)
+            .unwrap()
+            .as_slice()
+            .to_vec()
+    };
+    add("runtime (literal NOC, nalgebra)", &literal);
     let lag = |i: usize| {
         let (x, u, ud) = &states[i];
         let legs = noc::leg_joint_positions(&plan, x).unwrap();
