@@ -21,7 +21,10 @@
 //!   joint of which 2 are independent; the Bricard linkage has one redundant equation). At home,
 //!   [`Plan::new`] keeps `NX − DOF` rows of `Φ_x` that are independent over the dependent
 //!   columns (greedy Gram–Schmidt on unit-scaled rows) and checks that the others depend on
-//!   them: the mobility `NX − rank Φ_x` must equal `DOF`.
+//!   them: the mobility `NX − rank Φ_x` must equal `DOF`. The other rows whose dependent
+//!   columns do not vanish at home (an overconstrained loop's: Bricard's fifth equation) are
+//!   spare rows of `Φ_d`'s LU ([`noc::Plan::spare`]): its partial pivoting then chooses, at each
+//!   configuration, which `NX − DOF` equations to solve.
 //! * Velocities: `ẋ_d = −Φ_d⁻¹ Φ_i u`, i.e. `ẋ = S u`, `S = [1; −Φ_d⁻¹ Φ_i]` — the natural
 //!   orthogonal complement of the loop Jacobian (`Φ_x S = 0`).
 //! * Accelerations: `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`, the bias `Φ̇ ẋ` from the tree's body

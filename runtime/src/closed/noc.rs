@@ -7,7 +7,9 @@
 //! 2. The kept loop equations `Φ` and their Jacobian rows over the joints (a cut's point rows:
 //!    the columns `e_j × (P − o_j)` (R) or `e_j` (P) of the joints between the two bodies; its
 //!    axis rows: `(ω_b − ω_a)·(m × n)` with `n` the axis on one side and `m ⊥ n` on the other).
-//! 3. `Φ_d` (dependent columns) by LU with partial pivoting; `ẋ = S u`.
+//! 3. `Φ_d` (dependent columns) by LU with partial pivoting; `ẋ = S u`. An overconstrained
+//!    loop's redundant equations that do not vanish identically are spare rows of the LU
+//!    ([`Plan::spare`]): the pivoting chooses, per configuration, which equations to solve.
 //! 4. The body motions with `ẍ = 0` give the bias `Φ̇ ẋ`; `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`.
 //! 5. The tree's inverse dynamics, then `f = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`.
 
@@ -111,6 +113,12 @@ pub struct Plan {
     pub cuts: Vec<CutPlan>,
     /// The kept loop equations (`NX − DOF` of them).
     pub rows: Vec<Row>,
+    /// The redundant loop equations not identically zero at home (an overconstrained loop's,
+    /// such as Bricard's): spare rows of `Φ_d`'s LU, whose partial pivoting then chooses, at
+    /// each configuration, which `NX − DOF` of the kept and spare equations to solve (the set
+    /// chosen at home can become ill-conditioned away from it). Planar loops have none (their
+    /// redundant rows vanish identically).
+    pub spare: Vec<Row>,
     /// Every loop equation (the kept ones and the redundant ones), for the closure checks.
     pub all_rows: Vec<Row>,
     /// Independent joints (in order).
@@ -171,6 +179,7 @@ impl Plan {
             joints,
             cuts,
             rows: candidates.clone(),
+            spare: Vec::new(),
             all_rows: candidates.clone(),
             independent,
             dependent,
@@ -281,6 +290,16 @@ impl Plan {
         }
         kept.sort_unstable();
         plan.rows = kept.iter().map(|&i| candidates[i]).collect();
+        // Spare rows: the other equations whose dependent columns do not vanish at home.
+        plan.spare = (0..candidates.len())
+            .filter(|i| !kept.contains(i))
+            .filter(|&i| {
+                let d = dep(&jac[i]);
+                libm::sqrt(d.iter().map(|x| x * x).sum::<f64>())
+                    > RANK_TOLERANCE * row_scale(&plan, &candidates[i])
+            })
+            .map(|i| candidates[i])
+            .collect();
         // The full evaluation must succeed at home.
         let d = plan.independent.len();
         inverse_dynamics(&plan, &x0, &vec![0.0; d], &vec![0.0; d]).map_err(|e| {
@@ -298,6 +317,7 @@ impl Plan {
             joints: joint_plans(tree),
             cuts: Vec::new(),
             rows: Vec::new(),
+            spare: Vec::new(),
             all_rows: Vec::new(),
             independent: (0..tree.dof()).collect(),
             dependent: Vec::new(),
@@ -313,6 +333,10 @@ impl Plan {
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.independent.len()
+    }
+    /// The rows of `Φ_d`'s LU: the kept loop equations, then the spare ones.
+    pub fn system_rows(&self) -> impl Iterator<Item = &Row> {
+        self.rows.iter().chain(&self.spare)
     }
 }
 
@@ -588,7 +612,9 @@ fn row_bias<R: Real>(plan: &Plan, k: &Kin<R>, m: &[BodyMotion<R>], r: &Row) -> R
 }
 
 /// An LU factorization with partial pivoting (data-dependent row swaps recorded as the
-/// compared magnitudes), of a matrix with columns scaled to unit norm.
+/// compared magnitudes), of a matrix with columns scaled to unit norm and at least as many
+/// rows as columns: the pivoting chooses the `n` rows solved, the others (spare rows, after
+/// the swaps the last ones) are left out.
 #[derive(Clone, Debug)]
 pub struct Lu<R> {
     m: Vec<Vec<R>>,
@@ -596,25 +622,27 @@ pub struct Lu<R> {
     sc: Vec<R>,
 }
 
-/// Factorize the square `a`; a column of zero norm or a pivot `|p| ≤ CONSTRAINT_TOLERANCE`
-/// is `Singular { site: Constraint(i) }` (condition estimate `1/|p|`).
+/// Factorize `a` (`nr ≥ n` rows, `n` columns); a column of zero norm or a pivot
+/// `|p| ≤ CONSTRAINT_TOLERANCE` is `Singular { site: Constraint(i) }` (condition estimate
+/// `1/|p|`).
 pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
-    let n = a.len();
+    let nr = a.len();
+    let n = a.first().map_or(0, Vec::len);
     let mut sc = Vec::with_capacity(n);
     for j in 0..n {
         let mut s = R::c(0.0);
-        for i in 0..n {
+        for i in 0..nr {
             s = s + a[i][j] * a[i][j];
         }
         let s = R::check(s, R::c(0.0), R::c(1.0), Site::Constraint(j), false)?;
         sc.push(R::c(1.0) / s.sqrt());
     }
-    let mut m: Vec<Vec<R>> = (0..n)
+    let mut m: Vec<Vec<R>> = (0..nr)
         .map(|i| (0..n).map(|j| a[i][j] * sc[j]).collect())
         .collect();
     let mut swaps = Vec::new();
     for k in 0..n {
-        for i in k + 1..n {
+        for i in k + 1..nr {
             let (p, q) = (m[i][k], m[k][k]);
             swaps.push((k, i, p, q));
             for j in 0..n {
@@ -631,7 +659,7 @@ pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
             true,
         )?;
         let inv = R::c(1.0) / piv;
-        for i in k + 1..n {
+        for i in k + 1..nr {
             let f = m[i][k] * inv;
             m[i][k] = f;
             for j in k + 1..n {
@@ -643,9 +671,10 @@ pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
 }
 
 impl<R: Real> Lu<R> {
-    /// Solve `a x = b`.
+    /// Solve `a x = b` (`b` over every row of `a`; the rows the pivoting left out are not
+    /// used).
     pub fn solve(&self, b: &[R]) -> Vec<R> {
-        let n = b.len();
+        let n = self.sc.len();
         let mut x = b.to_vec();
         for &(k, i, p, q) in &self.swaps {
             let (xi, xk) = (x[i], x[k]);
@@ -663,13 +692,15 @@ impl<R: Real> Lu<R> {
             }
             x[i] = x[i] / self.m[i][i];
         }
+        x.truncate(n);
         for i in 0..n {
             x[i] = x[i] * self.sc[i];
         }
         x
     }
 
-    /// Solve `aᵀ y = b`.
+    /// Solve `aₛᵀ y = b`, `aₛ` the rows of `a` the pivoting chose (`y` over every row of `a`,
+    /// zero on the others).
     pub fn solve_t(&self, b: &[R]) -> Vec<R> {
         let n = b.len();
         let mut z: Vec<R> = (0..n).map(|i| b[i] * self.sc[i]).collect();
@@ -685,6 +716,7 @@ impl<R: Real> Lu<R> {
                 z[i] = z[i] - self.m[j][i] * z[j];
             }
         }
+        z.resize(self.m.len(), R::c(0.0));
         for &(k, i, p, q) in self.swaps.iter().rev() {
             let (zi, zk) = (z[i], z[k]);
             z[k] = R::select_abs_gt(p, q, zi, zk);
@@ -698,7 +730,7 @@ impl<R: Real> Lu<R> {
 pub struct Config<R> {
     /// Tree kinematics.
     pub kin: Kin<R>,
-    /// Jacobian rows of the kept equations (all joints).
+    /// Jacobian rows of the kept equations, then the spare ones (all joints).
     pub jac: Vec<Vec<R>>,
     /// LU of `Φ_d`.
     pub lu: Lu<R>,
@@ -742,8 +774,7 @@ pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Confi
         }
     }
     let jac: Vec<Vec<R>> = plan
-        .rows
-        .iter()
+        .system_rows()
         .map(|r| jacobian_row(plan, &kin, r))
         .collect();
     let phid: Vec<Vec<R>> = jac
@@ -895,8 +926,7 @@ pub fn generalized_force_with<R: Real>(
     let xd = joint_rates_generic(plan, c, u);
     let bias_m = motions(plan, &c.kin, &xd, None);
     let rhs: Vec<R> = plan
-        .rows
-        .iter()
+        .system_rows()
         .zip(&c.jac)
         .map(|(r, row)| {
             let b = row_bias(plan, &c.kin, &bias_m, r);
@@ -1062,15 +1092,15 @@ pub fn forward_dynamics_with<R: Real>(
     solve_spd(&m, &rhs)
 }
 
-/// One Newton step of the kept loop equations at `x` (the independent coordinates held): the
-/// full step `Δx` (zero on the independent coordinates), the largest scaled residual of the kept
-/// equations, `max_k |Φ_k| / scale_k`, and that of every loop equation and of the revolute
+/// One Newton step of the kept loop equations at `x` (the independent coordinates held; with
+/// spare rows, of those the LU's pivoting chose): the full step `Δx` (zero on the independent
+/// coordinates), the largest scaled residual of the kept and spare equations,
+/// `max_k |Φ_k| / scale_k`, and that of every loop equation and of the revolute
 /// axes' alignment `n_a·n_b − 1` (both signed: the entry of largest magnitude).
 pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R, R), Singular> {
     let c = configuration(plan, x, false)?;
     let phi: Vec<R> = plan
-        .rows
-        .iter()
+        .system_rows()
         .map(|r| row_value(plan, &c.kin, r))
         .collect();
     let rhs: Vec<R> = phi.iter().map(|&v| -v).collect();
@@ -1080,7 +1110,7 @@ pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R, R), Sing
         dx[j] = dd[k];
     }
     let mut kept = R::c(0.0);
-    for (r, &v) in plan.rows.iter().zip(&phi) {
+    for (r, &v) in plan.system_rows().zip(&phi) {
         let s = v * R::c(1.0 / row_scale(plan, r));
         kept = R::select_abs_gt(s, kept, s, kept);
     }
@@ -1202,18 +1232,18 @@ pub fn forward_dynamics(
 pub fn constraint_condition(plan: &Plan, x: &[f64]) -> f64 {
     let k = kinematics(plan, x);
     let phid: Vec<Vec<f64>> = plan
-        .rows
-        .iter()
+        .system_rows()
         .map(|r| {
             let row = jacobian_row(plan, &k, r);
             plan.dependent.iter().map(|&j| row[j]).collect()
         })
         .collect();
     // The same factorization without the threshold.
-    let n = phid.len();
+    let n = plan.dependent.len();
+    let nr = phid.len();
     let mut m = phid;
     for j in 0..n {
-        let s = libm::sqrt((0..n).map(|i| m[i][j] * m[i][j]).sum::<f64>());
+        let s = libm::sqrt((0..nr).map(|i| m[i][j] * m[i][j]).sum::<f64>());
         if !(s > 0.0) {
             return f64::INFINITY;
         }
@@ -1223,7 +1253,7 @@ pub fn constraint_condition(plan: &Plan, x: &[f64]) -> f64 {
     }
     let mut smallest = f64::INFINITY;
     for c in 0..n {
-        let p = (c..n)
+        let p = (c..nr)
             .max_by(|&a, &b| m[a][c].abs().total_cmp(&m[b][c].abs()))
             .unwrap_or(c);
         m.swap(c, p);
@@ -1232,7 +1262,7 @@ pub fn constraint_condition(plan: &Plan, x: &[f64]) -> f64 {
         if piv == 0.0 {
             return f64::INFINITY;
         }
-        for i in c + 1..n {
+        for i in c + 1..nr {
             let f = m[i][c] / piv;
             for j in c..n {
                 m[i][j] -= f * m[c][j];
