@@ -218,17 +218,20 @@ pub fn lu_many_ops(n: usize, k: usize) -> OpCount {
     c.add += n * n;
     c.sqrt += n;
     c.div += n;
+    // Elimination: the pivot's conditional swaps (one comparison per lower row), its two
+    // tests, its reciprocal, and the updates of the columns right of it and of the
+    // right-hand sides.
     for p in 0..n {
         let rows = n - p - 1;
         c.cmp += rows + 2;
         c.div += 1;
-        c.mul += rows * (1 + (n - p) + k);
-        c.add += rows * ((n - p) + k);
+        c.mul += rows * (1 + (n - p - 1) + k);
+        c.add += rows * ((n - p - 1) + k);
     }
-    // Back substitution for k right-hand sides, then the column scaling of the result.
-    c.mul += k * (n * (n - 1) / 2) + n * k;
+    // Back substitution for k right-hand sides (by the reciprocal pivots), then the column
+    // scaling of the result.
+    c.mul += k * (n * (n - 1) / 2) + 2 * n * k;
     c.add += k * (n * (n - 1) / 2);
-    c.div += n * k;
     c
 }
 
@@ -826,6 +829,12 @@ fn templates(
         /// Solve `a X = B` (or `aᵀ X = B`) for `K` right-hand sides (`b[i][k]`: equation `i`,
         /// right-hand side `k`) by one LU with partial pivoting after scaling the columns to
         /// unit norm; `Err(Site::Actuation)` when a pivot is not above the tolerance.
+        ///
+        /// Branch-free pivoting: at step `k` each lower row is swapped into row `k` by selects
+        /// when its entry in column `k` is larger in magnitude, so row `k` ends with the
+        /// largest (the same pivot as a search, the first one on ties) and the whole
+        /// elimination unrolls into straight-line code. The reciprocal pivots are kept for the
+        /// back substitution.
         #[allow(clippy::all)]
         fn lu_solve_many<const K: usize>(a: &[[f64; DOF]; DOF], b: &[[f64; K]; DOF], transpose: bool) -> Result<[[f64; K]; DOF], Singular> {
             let mut m = [[0.0; DOF]; DOF];
@@ -843,29 +852,32 @@ fn templates(
                 let s = #sqrt;
                 if s > 0.0 {
                     sc[j] = 1.0 / s;
-                    for i in 0..DOF {
-                        m[i][j] *= sc[j];
-                    }
+                }
+            }
+            for i in 0..DOF {
+                for j in 0..DOF {
+                    m[i][j] *= sc[j];
                 }
             }
             let mut x = *b;
+            let mut inv = [0.0; DOF];
             let mut pmax: f64 = 0.0;
             for k in 0..DOF {
-                let mut p = k;
-                let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
                 for i in k + 1..DOF {
-                    let v = if m[i][k] < 0.0 { -m[i][k] } else { m[i][k] };
-                    if v > best {
-                        best = v;
-                        p = i;
+                    let (p, q) = (m[i][k], m[k][k]);
+                    let swap = (if p < 0.0 { -p } else { p }) > (if q < 0.0 { -q } else { q });
+                    for j in k..DOF {
+                        let (u, v) = (m[k][j], m[i][j]);
+                        m[k][j] = if swap { v } else { u };
+                        m[i][j] = if swap { u } else { v };
+                    }
+                    for c in 0..K {
+                        let (u, v) = (x[k][c], x[i][c]);
+                        x[k][c] = if swap { v } else { u };
+                        x[i][c] = if swap { u } else { v };
                     }
                 }
-                // `p < DOF` always; the remainder says so in a form the optimizer keeps (range
-                // metadata), so it drops the bounds checks of the swaps (no panic path at
-                // opt-level "s").
-                let p = p % DOF;
-                m.swap(k, p);
-                x.swap(k, p);
+                let best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
                 if !(best > 0.0 && best < f64::INFINITY) {
                     return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: f64::INFINITY });
                 }
@@ -875,16 +887,15 @@ fn templates(
                 if !(best > #act_tol_lit * pmax) {
                     return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: pmax / best });
                 }
-                let inv = 1.0 / m[k][k];
+                let r = 1.0 / m[k][k];
+                inv[k] = r;
                 for i in k + 1..DOF {
-                    let f = m[i][k] * inv;
-                    if f != 0.0 {
-                        for j in k..DOF {
-                            m[i][j] -= f * m[k][j];
-                        }
-                        for c in 0..K {
-                            x[i][c] -= f * x[k][c];
-                        }
+                    let f = m[i][k] * r;
+                    for j in k + 1..DOF {
+                        m[i][j] -= f * m[k][j];
+                    }
+                    for c in 0..K {
+                        x[i][c] -= f * x[k][c];
                     }
                 }
             }
@@ -894,7 +905,7 @@ fn templates(
                     for j in i + 1..DOF {
                         s -= m[i][j] * x[j][c];
                     }
-                    x[i][c] = s / m[i][i];
+                    x[i][c] = s * inv[i];
                 }
             }
             for i in 0..DOF {
