@@ -38,6 +38,7 @@ pub mod diag;
 pub mod dynamics;
 pub mod emit;
 pub mod indices;
+mod lu;
 pub mod macro_support;
 pub mod parallel;
 pub mod scalar;

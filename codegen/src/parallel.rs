@@ -16,7 +16,7 @@ use crate::scalar::{Sx, flat, ids, in_fresh_graph, inputs};
 use crate::emit::{self, Function, Part, Shape};
 use crate::schedule::{OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
-use crate::{Config, Generated, MathBackend, VERSION};
+use crate::{Config, Generated, MathBackend, VERSION, lu};
 
 /// The DAG kernels of a parallel mechanism.
 pub struct Kernels {
@@ -209,28 +209,29 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     })
 }
 
-/// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: column scaling,
-/// partial pivoting, `k` right-hand sides (`lu_solve` is `k = 1`, `lu_inverse` is `k = n`).
+/// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: squared column
+/// norms, partial pivoting, `k` right-hand sides (`lu_solve` is `k = 1`, `lu_inverse` is
+/// `k = n`). The error paths (a square root and a division each) are not counted.
 pub fn lu_many_ops(n: usize, k: usize) -> OpCount {
     let mut c = OpCount::default();
-    // Column scaling: norms, reciprocals, products.
-    c.mul += 2 * n * n;
-    c.add += n * n;
-    c.sqrt += n;
-    c.div += n;
-    // Elimination: the pivot's conditional swaps (one comparison per lower row), its two
-    // tests, its reciprocal, and the updates of the columns right of it and of the
-    // right-hand sides.
+    // Squared column norms (for the scale-free pivot test).
+    c.mul += n * n;
+    c.add += n * (n - 1);
     for p in 0..n {
         let rows = n - p - 1;
+        // The pivot's conditional swaps (one comparison per lower row); its square and the
+        // two cross-multiplied products of the tolerance test, the tolerance's product, the
+        // test and the running maximum's comparison.
         c.cmp += rows + 2;
+        c.mul += 4;
+        // Its reciprocal, and the updates of the columns right of it and of the right-hand
+        // sides.
         c.div += 1;
         c.mul += rows * (1 + (n - p - 1) + k);
         c.add += rows * ((n - p - 1) + k);
     }
-    // Back substitution for k right-hand sides (by the reciprocal pivots), then the column
-    // scaling of the result.
-    c.mul += k * (n * (n - 1) / 2) + 2 * n * k;
+    // Back substitution for k right-hand sides (by the reciprocal pivots).
+    c.mul += k * (n * (n - 1) / 2) + n * k;
     c.add += k * (n * (n - 1) / 2);
     c
 }
@@ -459,7 +460,7 @@ pub fn generate_with(
             MathBackend::Std => "Math backend: std.".into(),
             MathBackend::Runtime(p) => format!("Math backend: `{p}::math` (nocdyn runtime)."),
         },
-        "Operation counts per call (the LU of `A` counted with its column scaling):".into(),
+        "Operation counts per call (the LU of `A` counted with its pivot tests; error paths not counted):".into(),
     ];
     if layout.any() {
         let mut parts = Vec::new();
@@ -678,7 +679,6 @@ fn templates(
     } else {
         (quote!(), quote!())
     };
-    let sqrt = emit::math_call(cfg, "sqrt", quote!(s));
     let sqrt_n = emit::math_call(cfg, "sqrt", quote!(n));
     let sqrt_a = emit::math_call(cfg, "sqrt", quote!(a2));
     let sin_cos = emit::math_call(cfg, "sin_cos", quote!(0.5 * a));
@@ -711,7 +711,39 @@ fn templates(
         sin_cos.clone(),
         sqrt_n.clone(),
     );
-    let act_tol_lit = Literal::f64_unsuffixed(act_tol);
+    // The squared tolerance, rounded to 13 significant digits so that `1e-8²` reads `1e-16`.
+    let act_tol2 = act_tol * act_tol;
+    let act_tol2 = format!("{act_tol2:.12e}").parse().unwrap_or(act_tol2);
+    let sqrt_call = |t: TokenStream| emit::math_call(cfg, "sqrt", t);
+    let lu = |name: &str, doc: &str, transpose: bool, rhs: lu::Rhs| {
+        lu::lu_solve_fn(&lu::LuSolve {
+            name,
+            doc,
+            n: plan.dof(),
+            transpose,
+            rhs,
+            tol2: act_tol2,
+            sqrt: &sqrt_call,
+        })
+    };
+    let lu_solve = lu(
+        "lu_solve",
+        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with its columns scaled to unit 2-norm must exceed the tolerance times the\n largest so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of the largest scaled\n pivot to this one as the condition estimate.",
+        false,
+        lu::Rhs::Vector,
+    );
+    let lu_solve_t = lu(
+        "lu_solve_t",
+        " Solve `aᵀ x = b` (as `lu_solve`, on the transpose).",
+        true,
+        lu::Rhs::Vector,
+    );
+    let lu_inverse = lu(
+        "lu_inverse",
+        " `a⁻¹`: one factorization (as `lu_solve`) for the `DOF` columns of the identity.",
+        false,
+        lu::Rhs::Identity,
+    );
     let fk_tol_lit = Literal::f64_unsuffixed(fk_tol);
     let fk_max_lit = Literal::usize_unsuffixed(fk_max);
     let leg_doc = format!(
@@ -728,8 +760,10 @@ fn templates(
         #[inline]
         pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF] #p_arg) -> Result<[f64; DOF], Singular> {
             let (a, f) = id_parts(x, u, ud #p_pass)?;
-            lu_solve(&a, &f, true)
+            lu_solve_t(&a, &f)
         }
+
+        #lu_solve_t
 
         }
     } else {
@@ -737,15 +771,7 @@ fn templates(
     };
     let amm_wrapper = if want("actuator_mass_matrix") {
         quote! {
-        /// `A⁻¹`: one factorization for the `DOF` columns of the identity.
-        #[allow(clippy::all)]
-        fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
-            let mut e = [[0.0; DOF]; DOF];
-            for i in 0..DOF {
-                e[i][i] = 1.0;
-            }
-            lu_solve_many(a, &e, false)
-        }
+        #lu_inverse
 
         /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
         #[allow(clippy::all)]
@@ -826,113 +852,7 @@ fn templates(
         /// Which actuators are revolute (angles are compared modulo 2π).
         const REVOLUTE: [bool; DOF] = [#(#revolute),*];
 
-        /// Solve `a X = B` (or `aᵀ X = B`) for `K` right-hand sides (`b[i][k]`: equation `i`,
-        /// right-hand side `k`) by one LU with partial pivoting after scaling the columns to
-        /// unit norm; `Err(Site::Actuation)` when a pivot is not above the tolerance.
-        ///
-        /// Branch-free pivoting: at step `k` each lower row is swapped into row `k` by selects
-        /// when its entry in column `k` is larger in magnitude, so row `k` ends with the
-        /// largest (the same pivot as a search, the first one on ties) and the whole
-        /// elimination unrolls into straight-line code. The reciprocal pivots are kept for the
-        /// back substitution.
-        #[allow(clippy::all)]
-        fn lu_solve_many<const K: usize>(a: &[[f64; DOF]; DOF], b: &[[f64; K]; DOF], transpose: bool) -> Result<[[f64; K]; DOF], Singular> {
-            let mut m = [[0.0; DOF]; DOF];
-            for i in 0..DOF {
-                for j in 0..DOF {
-                    m[i][j] = if transpose { a[j][i] } else { a[i][j] };
-                }
-            }
-            let mut sc = [1.0; DOF];
-            for j in 0..DOF {
-                let mut s = 0.0;
-                for i in 0..DOF {
-                    s += m[i][j] * m[i][j];
-                }
-                let s = #sqrt;
-                if s > 0.0 {
-                    sc[j] = 1.0 / s;
-                }
-            }
-            for i in 0..DOF {
-                for j in 0..DOF {
-                    m[i][j] *= sc[j];
-                }
-            }
-            let mut x = *b;
-            let mut inv = [0.0; DOF];
-            let mut pmax: f64 = 0.0;
-            for k in 0..DOF {
-                for i in k + 1..DOF {
-                    let (p, q) = (m[i][k], m[k][k]);
-                    let swap = (if p < 0.0 { -p } else { p }) > (if q < 0.0 { -q } else { q });
-                    for j in k..DOF {
-                        let (u, v) = (m[k][j], m[i][j]);
-                        m[k][j] = if swap { v } else { u };
-                        m[i][j] = if swap { u } else { v };
-                    }
-                    for c in 0..K {
-                        let (u, v) = (x[k][c], x[i][c]);
-                        x[k][c] = if swap { v } else { u };
-                        x[i][c] = if swap { u } else { v };
-                    }
-                }
-                let best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
-                if !(best > 0.0 && best < f64::INFINITY) {
-                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: f64::INFINITY });
-                }
-                if best > pmax {
-                    pmax = best;
-                }
-                if !(best > #act_tol_lit * pmax) {
-                    return Err(Singular { site: Site::Actuation(k), value: m[k][k], condition_estimate: pmax / best });
-                }
-                let r = 1.0 / m[k][k];
-                inv[k] = r;
-                for i in k + 1..DOF {
-                    let f = m[i][k] * r;
-                    for j in k + 1..DOF {
-                        m[i][j] -= f * m[k][j];
-                    }
-                    for c in 0..K {
-                        x[i][c] -= f * x[k][c];
-                    }
-                }
-            }
-            for c in 0..K {
-                for i in (0..DOF).rev() {
-                    let mut s = x[i][c];
-                    for j in i + 1..DOF {
-                        s -= m[i][j] * x[j][c];
-                    }
-                    x[i][c] = s * inv[i];
-                }
-            }
-            for i in 0..DOF {
-                for c in 0..K {
-                    x[i][c] *= sc[i];
-                    if !x[i][c].is_finite() {
-                        return Err(Singular { site: Site::Input, value: x[i][c], condition_estimate: f64::INFINITY });
-                    }
-                }
-            }
-            Ok(x)
-        }
-
-        /// `lu_solve_many` for one right-hand side.
-        #[allow(clippy::all)]
-        fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF], transpose: bool) -> Result<[f64; DOF], Singular> {
-            let mut bb = [[0.0; 1]; DOF];
-            for i in 0..DOF {
-                bb[i][0] = b[i];
-            }
-            let x = lu_solve_many(a, &bb, transpose)?;
-            let mut out = [0.0; DOF];
-            for i in 0..DOF {
-                out[i] = x[i][0];
-            }
-            Ok(out)
-        }
+        #lu_solve
 
         #id_wrapper
 
@@ -988,7 +908,7 @@ fn templates(
                 if cur.1 <= tol {
                     return Ok(x);
                 }
-                let Ok(du) = lu_solve(&cur.2, &cur.0, false) else {
+                let Ok(du) = lu_solve(&cur.2, &cur.0) else {
                     return Err(NoConvergence { iterations: it, residual: cur.1 });
                 };
                 let mut step = 1.0;

@@ -1,0 +1,220 @@
+//! Straight-line LU solves of a platform's actuation matrix `A` (`DOF × DOF`).
+//!
+//! The generated module solves with `A` in three places: `Aᵀ τ = f` in the inverse dynamics
+//! (the lecture's eq. 66 rearranged), `A Δx = Δq` in each forward-kinematics Newton step, and
+//! `A⁻¹` (all `DOF` columns of the identity) for `A⁻ᵀ I A⁻¹` (eq. 68). Each is emitted as one
+//! function of straight-line code: every index is a constant, every entry a local, so nothing
+//! is left to the optimizer's loop unrolling or unswitching (a loop over a row swap that depends
+//! on a comparison gets unswitched into an unpredictable branch).
+//!
+//! The factorization is Gaussian elimination with partial pivoting:
+//! - at step `k` each lower row `i` is swapped into row `k` by selects when `|m_ik| > |m_kk|`,
+//!   so row `k` ends with the largest entry of the column (the pivot a search would choose, the
+//!   first one on ties) without a data-dependent branch;
+//! - the tolerance test is that of the matrix with its columns scaled to unit 2-norm (scaling
+//!   the columns changes neither the pivots chosen nor, in exact arithmetic, the solution): the
+//!   scaled pivot `|p_k|/‖a_k‖` must exceed `tol` times the largest scaled pivot so far. It is
+//!   compared squared and cross-multiplied, `p_k² · d > tol² · n · ‖a_k‖²` with the largest so
+//!   far kept as the fraction `n / d`, so the test needs neither a square root nor a division;
+//!   those are spent only on the error path (the scaled pivot and the condition estimate
+//!   `max_j (|p_j|/‖a_j‖) / (|p_k|/‖a_k‖)` reported in `Singular`);
+//! - back substitution multiplies by the reciprocal pivots kept from the elimination.
+//!
+//! The operation count is [`crate::parallel::lu_many_ops`]; the error paths are not counted.
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+/// What the emitted function solves for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Rhs {
+    /// One right-hand side `b: &[f64; DOF]`, solution `[f64; DOF]`.
+    Vector,
+    /// The identity's `DOF` columns: the inverse, `[[f64; DOF]; DOF]`.
+    Identity,
+}
+
+/// One straight-line solve.
+pub(crate) struct LuSolve<'a> {
+    /// Name of the emitted function.
+    pub name: &'a str,
+    /// Doc comment of the emitted function.
+    pub doc: &'a str,
+    /// Matrix order (`DOF`).
+    pub n: usize,
+    /// Solve with `aᵀ` instead of `a`.
+    pub transpose: bool,
+    pub rhs: Rhs,
+    /// The squared pivot tolerance, `tol²`.
+    pub tol2: f64,
+    /// The square-root call of the chosen math backend, applied to the tokens given.
+    pub sqrt: &'a dyn Fn(TokenStream) -> TokenStream,
+}
+
+fn m(i: usize, j: usize) -> Ident {
+    format_ident!("m{}_{}", i, j)
+}
+
+fn x(i: usize, c: usize) -> Ident {
+    format_ident!("x{}_{}", i, c)
+}
+
+fn abs(v: &Ident) -> TokenStream {
+    quote!((if #v < 0.0 { -#v } else { #v }))
+}
+
+/// The emitted function.
+pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
+    let n = s.n;
+    let k_rhs = match s.rhs {
+        Rhs::Vector => 1,
+        Rhs::Identity => n,
+    };
+    let name = format_ident!("{}", s.name);
+    let doc = s.doc;
+    let tol2 = Literal::f64_unsuffixed(s.tol2);
+    let mut st: Vec<TokenStream> = Vec::new();
+    // The matrix and the right-hand sides as locals.
+    for i in 0..n {
+        for j in 0..n {
+            let (r, c) = if s.transpose { (j, i) } else { (i, j) };
+            let (mi, r, c) = (
+                m(i, j),
+                Literal::usize_unsuffixed(r),
+                Literal::usize_unsuffixed(c),
+            );
+            st.push(quote!(let #mi = a[#r][#c];));
+        }
+    }
+    for i in 0..n {
+        for c in 0..k_rhs {
+            let xi = x(i, c);
+            st.push(match s.rhs {
+                Rhs::Vector => {
+                    let i = Literal::usize_unsuffixed(i);
+                    quote!(let #xi = b[#i];)
+                }
+                Rhs::Identity if i == c => quote!(let #xi = 1.0;),
+                Rhs::Identity => quote!(let #xi = 0.0;),
+            });
+        }
+    }
+    // Squared column norms ‖a_j‖².
+    for j in 0..n {
+        let nj = format_ident!("n{}", j);
+        let terms = (0..n).map(|i| {
+            let e = m(i, j);
+            quote!(#e * #e)
+        });
+        st.push(quote!(let #nj = #(#terms)+*;));
+    }
+    st.push(quote!(let pn: f64 = 0.0;));
+    st.push(quote!(let pd: f64 = 1.0;));
+    for k in 0..n {
+        let kk = m(k, k);
+        // Conditional swaps: row k ends with the largest |entry| of column k.
+        for i in k + 1..n {
+            let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
+            st.push(quote!(let s = #a_ik > #a_kk;));
+            for j in k..n {
+                let (u, v) = (m(k, j), m(i, j));
+                st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
+            }
+            for c in 0..k_rhs {
+                let (u, v) = (x(k, c), x(i, c));
+                st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
+            }
+        }
+        let kl = Literal::usize_unsuffixed(k);
+        let nk = format_ident!("n{}", k);
+        let sqrt_n = (s.sqrt)(quote!(s));
+        st.push(quote! {
+            let best = if #kk < 0.0 { -#kk } else { #kk };
+            if !(best > 0.0 && best < f64::INFINITY) {
+                return Err(Singular { site: Site::Actuation(#kl), value: #kk, condition_estimate: f64::INFINITY });
+            }
+            let b2 = #kk * #kk;
+            let lhs = b2 * pd;
+            let rhs = pn * #nk;
+            if !(lhs > #tol2 * rhs) {
+                let s = #nk;
+                let n = #sqrt_n;
+                let s = rhs / lhs;
+                let c = #sqrt_n;
+                return Err(Singular {
+                    site: Site::Actuation(#kl),
+                    value: if n > 0.0 { #kk / n } else { #kk },
+                    condition_estimate: if c >= 0.0 { c } else { f64::INFINITY },
+                });
+            }
+        });
+        if k + 1 < n {
+            st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #nk) } else { (pn, pd) };));
+        }
+        let rk = format_ident!("r{}", k);
+        st.push(quote!(let #rk = 1.0 / #kk;));
+        // Elimination below the pivot.
+        for i in k + 1..n {
+            let ik = m(i, k);
+            st.push(quote!(let f = #ik * #rk;));
+            for j in k + 1..n {
+                let (ij, kj) = (m(i, j), m(k, j));
+                st.push(quote!(let #ij = #ij - f * #kj;));
+            }
+            for c in 0..k_rhs {
+                let (ic, kc) = (x(i, c), x(k, c));
+                st.push(quote!(let #ic = #ic - f * #kc;));
+            }
+        }
+    }
+    // Back substitution by the reciprocal pivots.
+    for c in 0..k_rhs {
+        for i in (0..n).rev() {
+            let (ic, ri) = (x(i, c), format_ident!("r{}", i));
+            let terms = (i + 1..n).map(|j| {
+                let (ij, jc) = (m(i, j), x(j, c));
+                quote!(- #ij * #jc)
+            });
+            st.push(quote!(let #ic = (#ic #(#terms)*) * #ri;));
+        }
+    }
+    match s.rhs {
+        Rhs::Vector => {
+            let out = (0..n).map(|i| x(i, 0));
+            quote! {
+                #[doc = #doc]
+                #[allow(clippy::all, unused_variables)]
+                fn #name(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+                    #(#st)*
+                    let out = [#(#out),*];
+                    for v in out.iter() {
+                        if !v.is_finite() {
+                            return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
+                        }
+                    }
+                    Ok(out)
+                }
+            }
+        }
+        Rhs::Identity => {
+            let rows = (0..n).map(|i| {
+                let row = (0..n).map(|c| x(i, c));
+                quote!([#(#row),*])
+            });
+            quote! {
+                #[doc = #doc]
+                #[allow(clippy::all, unused_variables)]
+                fn #name(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+                    #(#st)*
+                    let out = [#(#rows),*];
+                    for v in out.iter().flatten() {
+                        if !v.is_finite() {
+                            return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
+                        }
+                    }
+                    Ok(out)
+                }
+            }
+        }
+    }
+}
