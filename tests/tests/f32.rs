@@ -227,10 +227,10 @@ macro_rules! closed {
                 if cond <= 100.0 {
                     worst_conditioned = worst_conditioned.max(here);
                 }
-                // How far beyond the problem's own condition the f32 code loses: the tree
-                // efforts `τ_T` of an open tree can be much larger than the projected
-                // `f = Sᵀτ_T`, and their rounding survives the projection (a diagnostic for
-                // the figures; the bound asserted is the one below).
+                // How far beyond the problem's own condition (in the inputs) the f32 code
+                // loses: the f32 assembly and the f32 geometry constants open the loops by
+                // about `cond(Φ_d) · 2⁻²⁴`, a perturbation the condition above leaves out
+                // (a diagnostic for the figures; the bound asserted is the one below).
                 let ratio = rel(&to64(&tau32), &tau) / (cond * f32::EPSILON as f64 / 2.0);
                 worst_ratio = worst_ratio.max(ratio);
             }
@@ -238,9 +238,8 @@ macro_rules! closed {
             assert!(skipped < 100, "{name}: {skipped}");
             assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
             // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
-            // equations) and project the open tree's efforts (`f = Sᵀτ_T`, where `τ_T` can be
-            // far larger than `f`), which costs about a digit more: 1e-3 (measured worst:
-            // Bricard's overconstrained loop, 1.1e-4).
+            // equations, whose error the loop's condition amplifies), which costs about a digit
+            // more: 1e-3 (measured worst: the N-four-bar's assembly, 5.5e-5).
             assert!(worst < 10.0 * F32_TOLERANCE, "{name}: {worst:e}");
         }
     )*};

@@ -29,8 +29,13 @@
 //!   orthogonal complement of the loop Jacobian (`Φ_x S = 0`).
 //! * Accelerations: `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`, the bias `Φ̇ ẋ` from the tree's body
 //!   accelerations with `ẍ = 0`.
-//! * Dynamics: the tree's joint efforts `τ_T` for `(x, ẋ, ẍ)` (recursive Newton–Euler), then
-//!   `f = Sᵀ τ_T = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`; the inertia `Sᵀ M_T S` from the bodies' twists in `u`.
+//! * Dynamics: each body's Newton–Euler wrench for `(x, ẋ, ẍ)` at its mass centre, projected by
+//!   its twist per unit speed (column `k` of `S` through the velocity recursion): `f_k =
+//!   Σ_b ω_b⁽ᵏ⁾·n_b + v_b⁽ᵏ⁾·f_b`, the lecture's `f = Tᵀ w` (eq. 53). This equals `Sᵀ τ_T` with
+//!   `τ_T` the open tree's joint efforts, but those hold whole subtrees on long lever arms and
+//!   cancel in the projection (by up to 1,600 times the result on the bundled loops), so
+//!   their rounding survived it; the bodies' powers cancel far less. The inertia `Sᵀ M_T S`
+//!   from the same twists.
 //! * `Φ_d` is factorized by LU with partial pivoting after scaling its columns to unit norm
 //!   (pivot choices are data-dependent selections, so the generated code pivots too); a pivot
 //!   `≤ CONSTRAINT_TOLERANCE` is `Singular { site: Constraint(i) }`.

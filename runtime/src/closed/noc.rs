@@ -820,18 +820,6 @@ pub fn joint_rates_generic<R: Real>(plan: &Plan, c: &Config<R>, u: &[R]) -> Vec<
     xd
 }
 
-/// The tree's joint efforts for the body motions `m` (recursive Newton–Euler, backward
-/// sweep): each body's `w = M ṫ + W M t − w^G` (eq. 12) summed over subtrees; `τ_j = e_j · n`
-/// (R, the moment about the joint point) or `e_j · f` (P).
-pub fn tree_efforts<R: Real>(
-    plan: &Plan,
-    k: &Kin<R>,
-    m: &[BodyMotion<R>],
-    gravity: bool,
-) -> Vec<R> {
-    tree_efforts_with(plan, k, m, gravity, &[])
-}
-
 /// Values of a closed-loop mechanism given at run time in place of the plan's constants (a
 /// generated module's `Params`, where they are symbolic inputs).
 #[derive(Clone, Debug)]
@@ -854,56 +842,9 @@ impl<R> Extras<R> {
     }
 }
 
-/// [`tree_efforts`] with [`Payload`]s, each on tree body `.0` (Newton–Euler of the payload,
-/// eq. 12, added to that body's wrench).
-pub fn tree_efforts_with<R: Real>(
-    plan: &Plan,
-    k: &Kin<R>,
-    m: &[BodyMotion<R>],
-    gravity: bool,
-    payloads: &[(usize, Payload<R>)],
-) -> Vec<R> {
-    let n = plan.nx();
-    let g: V<R> = if gravity { cv(&plan.gravity) } else { zero3() };
-    // Subtree force and moment about the base origin.
-    let mut force: Vec<V<R>> = vec![zero3(); n];
-    let mut moment: Vec<V<R>> = vec![zero3(); n];
-    let mut tau = vec![R::c(0.0); n];
-    for i in (0..n).rev() {
-        let (mass, com, inertia) = plan.joints[i].body;
-        let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
-        if !massless {
-            let c = add(k.pos[i], mv(&k.rot[i], cv(&com)));
-            let a = m[i].accel_at(k.o[i], c);
-            let f = scale(R::c(mass), sub(a, g));
-            let nc = euler(&k.rot[i], &inertia, m[i].w, m[i].alpha);
-            force[i] = add(force[i], f);
-            moment[i] = add(moment[i], add(nc, cross(c, f)));
-        }
-        for (_, p) in payloads.iter().filter(|(b, _)| *b == i) {
-            let c = add(k.pos[i], mv(&k.rot[i], p.com));
-            let a = m[i].accel_at(k.o[i], c);
-            let f = scale(p.mass, sub(a, g));
-            let rot = &k.rot[i];
-            let (wb, ab) = (mtv(rot, m[i].w), mtv(rot, m[i].alpha));
-            let nb = add(mv(&p.inertia, ab), cross(wb, mv(&p.inertia, wb)));
-            force[i] = add(force[i], f);
-            moment[i] = add(moment[i], add(mv(rot, nb), cross(c, f)));
-        }
-        tau[i] = match plan.joints[i].kind {
-            JointKind::Revolute => dot(k.e[i], sub(moment[i], cross(k.o[i], force[i]))),
-            JointKind::Prismatic => dot(k.e[i], force[i]),
-        };
-        if let Some(p) = plan.joints[i].parent {
-            force[p] = add(force[p], force[i]);
-            moment[p] = add(moment[p], moment[i]);
-        }
-    }
-    tau
-}
-
 /// The generalized force `f = I u̇ + C u − γ` (`γ` only with `gravity`) of the independent
-/// coordinates: `f = Sᵀ τ_T = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`.
+/// coordinates: `f = Tᵀ w`, each body's wrench projected by its twist per unit speed (equal to
+/// `Sᵀ τ_T` with the open tree's joint efforts `τ_T`, with less cancellation).
 pub fn generalized_force<R: Real>(
     plan: &Plan,
     c: &Config<R>,
@@ -923,7 +864,16 @@ pub fn generalized_force_with<R: Real>(
     gravity: bool,
     extras: &Extras<R>,
 ) -> Vec<R> {
-    let xd = joint_rates_generic(plan, c, u);
+    // The columns of `S` and the bodies' twists per unit speed (for the projection below);
+    // `ẋ = S u` from the columns, the independent rates exactly `u`.
+    let t = unit_twists(plan, c, extras);
+    let mut xd = vec![R::c(0.0); plan.nx()];
+    for (k, &j) in plan.independent.iter().enumerate() {
+        xd[j] = u[k];
+    }
+    for &j in &plan.dependent {
+        xd[j] = (1..u.len()).fold(t.rates[0][j] * u[0], |s, k| s + t.rates[k][j] * u[k]);
+    }
     let bias_m = motions(plan, &c.kin, &xd, None);
     let rhs: Vec<R> = plan
         .system_rows()
@@ -945,27 +895,97 @@ pub fn generalized_force_with<R: Real>(
         xdd[j] = xdd_d[k];
     }
     let m = motions(plan, &c.kin, &xd, Some(&xdd));
-    let mut tau = tree_efforts_with(plan, &c.kin, &m, gravity, &extras.payloads);
-    // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
-    // with the rest (the lecture's dissipative term δ).
-    for (j, jp) in plan.joints.iter().enumerate() {
-        tau[j] = tau[j]
-            + match &extras.drives {
-                Some(d) => d.effort(j, xd[j], xdd[j]),
-                None => drive_effort(&jp.drive, xd[j], xdd[j]),
-            };
+    // Virtual power body by body (the lecture's eq. 53, `f = Tᵀ w` with `T`'s block rows the
+    // bodies' twists per unit speed): f_k = Σ_b ω_b⁽ᵏ⁾·n_b + v_b⁽ᵏ⁾·f_b, each body's wrench
+    // `w_b = M ṫ + W M t − w^G` (eq. 12) at its mass centre. Not `Sᵀ τ_T`: the open tree's
+    // joint efforts hold whole subtrees on long lever arms and cancel in the projection (by up
+    // to 1,600 times the result on the bundled loops), and their rounding survives; the
+    // bodies' powers cancel far less (≤ 8 times, Bricard's 170).
+    let d = plan.dof();
+    let g: V<R> = if gravity { cv(&plan.gravity) } else { zero3() };
+    let mut f = vec![R::c(0.0); d];
+    for b in 0..plan.nx() {
+        let (mass, com, inertia) = plan.joints[b].body;
+        if mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0) {
+            continue;
+        }
+        let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
+        let fb = scale(R::c(mass), sub(m[b].accel_at(c.kin.o[b], cw), g));
+        let nb = euler(&c.kin.rot[b], &inertia, m[b].w, m[b].alpha);
+        for (k, fk) in f.iter_mut().enumerate() {
+            let (w, v) = t.bodies[k][b];
+            *fk = *fk + (dot(w, nb) + dot(v, fb));
+        }
     }
-    let td: Vec<R> = plan.dependent.iter().map(|&j| tau[j]).collect();
-    let y = c.lu.solve_t(&td);
-    plan.independent
-        .iter()
-        .map(|&j| {
-            c.jac
+    for (i, (b, p)) in extras.payloads.iter().enumerate() {
+        let rot = &c.kin.rot[*b];
+        let cw = add(c.kin.pos[*b], mv(rot, p.com));
+        let fb = scale(p.mass, sub(m[*b].accel_at(c.kin.o[*b], cw), g));
+        let (wb, ab) = (mtv(rot, m[*b].w), mtv(rot, m[*b].alpha));
+        let nb = mv(rot, add(mv(&p.inertia, ab), cross(wb, mv(&p.inertia, wb))));
+        for (k, fk) in f.iter_mut().enumerate() {
+            let (w, v) = t.payloads[k][i];
+            *fk = *fk + (dot(w, nb) + dot(v, fb));
+        }
+    }
+    // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
+    // (the lecture's dissipative term δ).
+    for (j, jp) in plan.joints.iter().enumerate() {
+        let e = match &extras.drives {
+            Some(dr) => dr.effort(j, xd[j], xdd[j]),
+            None if jp.drive.is_none() => continue,
+            None => drive_effort(&jp.drive, xd[j], xdd[j]),
+        };
+        for (k, fk) in f.iter_mut().enumerate() {
+            *fk = *fk + t.rates[k][j] * e;
+        }
+    }
+    f
+}
+
+/// Per unit independent speed `u = e_k`: the joint rates (column `k` of `S`), each body's
+/// angular velocity and mass-centre velocity, each payload's likewise.
+struct UnitTwists<R> {
+    rates: Vec<Vec<R>>,
+    bodies: Vec<Vec<(V<R>, V<R>)>>,
+    payloads: Vec<Vec<(V<R>, V<R>)>>,
+}
+
+fn unit_twists<R: Real>(plan: &Plan, c: &Config<R>, extras: &Extras<R>) -> UnitTwists<R> {
+    let d = plan.dof();
+    let n = plan.nx();
+    let mut t = UnitTwists {
+        rates: Vec::with_capacity(d),
+        bodies: Vec::with_capacity(d),
+        payloads: Vec::with_capacity(d),
+    };
+    for k in 0..d {
+        let mut e = vec![R::c(0.0); d];
+        e[k] = R::c(1.0);
+        let xd = joint_rates_generic(plan, c, &e);
+        let m = motions(plan, &c.kin, &xd, None);
+        t.payloads.push(
+            extras
+                .payloads
                 .iter()
-                .zip(&y)
-                .fold(tau[j], |s, (row, &yk)| s - row[j] * yk)
-        })
-        .collect()
+                .map(|(b, p)| {
+                    let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
+                    (m[*b].w, m[*b].vel_at(c.kin.o[*b], cw))
+                })
+                .collect(),
+        );
+        t.rates.push(xd);
+        t.bodies.push(
+            (0..n)
+                .map(|b| {
+                    let (_, com, _) = plan.joints[b].body;
+                    let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
+                    (m[b].w, m[b].vel_at(c.kin.o[b], cw))
+                })
+                .collect(),
+        );
+    }
+    t
 }
 
 /// The generalized inertia `I = Sᵀ M_T S` of the independent coordinates, from each body's
@@ -983,38 +1003,11 @@ pub fn generalized_inertia_with<R: Real>(
 ) -> Vec<Vec<R>> {
     let d = plan.dof();
     let n = plan.nx();
-    // Column k of S: the joint rates for u = e_k; the bodies' angular velocities and mass
-    // centre velocities for it.
-    let mut cols: Vec<Vec<(V<R>, V<R>)>> = Vec::with_capacity(d);
-    let mut rates: Vec<Vec<R>> = Vec::with_capacity(d);
-    // Each payload's angular velocity and mass-centre velocity per column.
-    let mut payload_cols: Vec<Vec<(V<R>, V<R>)>> = Vec::new();
-    for k in 0..d {
-        let mut e = vec![R::c(0.0); d];
-        e[k] = R::c(1.0);
-        let xd = joint_rates_generic(plan, c, &e);
-        let m = motions(plan, &c.kin, &xd, None);
-        payload_cols.push(
-            extras
-                .payloads
-                .iter()
-                .map(|(b, p)| {
-                    let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
-                    (m[*b].w, m[*b].vel_at(c.kin.o[*b], cw))
-                })
-                .collect(),
-        );
-        rates.push(xd);
-        cols.push(
-            (0..n)
-                .map(|b| {
-                    let (_, com, _) = plan.joints[b].body;
-                    let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
-                    (m[b].w, m[b].vel_at(c.kin.o[b], cw))
-                })
-                .collect(),
-        );
-    }
+    let UnitTwists {
+        rates,
+        bodies: cols,
+        payloads: payload_cols,
+    } = unit_twists(plan, c, extras);
     let mut out = vec![vec![R::c(0.0); d]; d];
     for b in 0..n {
         let (mass, _, inertia) = plan.joints[b].body;
