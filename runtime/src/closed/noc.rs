@@ -527,7 +527,14 @@ impl<R: Real> BodyMotion<R> {
     }
     /// Acceleration of the material point at `x`.
     fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
-        let r = sub(x, o);
+        self.accel_rel(sub(x, o))
+    }
+    /// Velocity of the material point at `o + r`.
+    fn vel_rel(&self, r: V<R>) -> V<R> {
+        add(self.v, cross(self.w, r))
+    }
+    /// Acceleration of the material point at `o + r`.
+    fn accel_rel(&self, r: V<R>) -> V<R> {
         add(
             add(self.a, cross(self.alpha, r)),
             cross(self.w, cross(self.w, r)),
@@ -909,8 +916,8 @@ pub fn generalized_force_with<R: Real>(
         if mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0) {
             continue;
         }
-        let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
-        let fb = scale(R::c(mass), sub(m[b].accel_at(c.kin.o[b], cw), g));
+        let r = offset(&c.kin, b, cv(&com));
+        let fb = scale(R::c(mass), sub(m[b].accel_rel(r), g));
         let nb = euler(&c.kin.rot[b], &inertia, m[b].w, m[b].alpha);
         for (k, fk) in f.iter_mut().enumerate() {
             let (w, v) = t.bodies[k][b];
@@ -919,8 +926,8 @@ pub fn generalized_force_with<R: Real>(
     }
     for (i, (b, p)) in extras.payloads.iter().enumerate() {
         let rot = &c.kin.rot[*b];
-        let cw = add(c.kin.pos[*b], mv(rot, p.com));
-        let fb = scale(p.mass, sub(m[*b].accel_at(c.kin.o[*b], cw), g));
+        let r = offset(&c.kin, *b, p.com);
+        let fb = scale(p.mass, sub(m[*b].accel_rel(r), g));
         let (wb, ab) = (mtv(rot, m[*b].w), mtv(rot, m[*b].alpha));
         let nb = mv(rot, add(mv(&p.inertia, ab), cross(wb, mv(&p.inertia, wb))));
         for (k, fk) in f.iter_mut().enumerate() {
@@ -941,6 +948,14 @@ pub fn generalized_force_with<R: Real>(
         }
     }
     f
+}
+
+/// The point `p` of body `b` (body-frame coordinates) relative to the body's joint point,
+/// `(pos − o) + R p` (base frame): formed from the difference of the two absolute points, not
+/// from the absolute position of `p`, so far from the base origin nothing large cancels (and
+/// `pos − o` folds to zero where they coincide).
+fn offset<R: Real>(k: &Kin<R>, b: usize, p: V<R>) -> V<R> {
+    add(sub(k.pos[b], k.o[b]), mv(&k.rot[b], p))
 }
 
 /// Per unit independent speed `u = e_k`: the joint rates (column `k` of `S`), each body's
@@ -968,10 +983,7 @@ fn unit_twists<R: Real>(plan: &Plan, c: &Config<R>, extras: &Extras<R>) -> UnitT
             extras
                 .payloads
                 .iter()
-                .map(|(b, p)| {
-                    let cw = add(c.kin.pos[*b], mv(&c.kin.rot[*b], p.com));
-                    (m[*b].w, m[*b].vel_at(c.kin.o[*b], cw))
-                })
+                .map(|(b, p)| (m[*b].w, m[*b].vel_rel(offset(&c.kin, *b, p.com))))
                 .collect(),
         );
         t.rates.push(xd);
@@ -979,8 +991,7 @@ fn unit_twists<R: Real>(plan: &Plan, c: &Config<R>, extras: &Extras<R>) -> UnitT
             (0..n)
                 .map(|b| {
                     let (_, com, _) = plan.joints[b].body;
-                    let cw = add(c.kin.pos[b], mv(&c.kin.rot[b], cv(&com)));
-                    (m[b].w, m[b].vel_at(c.kin.o[b], cw))
+                    (m[b].w, m[b].vel_rel(offset(&c.kin, b, cv(&com))))
                 })
                 .collect(),
         );
