@@ -292,10 +292,11 @@ pub fn generate_with(
         .iter()
         .map(|&j| Literal::usize_unsuffixed(j))
         .collect();
-    let revolute: Vec<bool> = plan
-        .independent
-        .iter()
-        .map(|&j| model.tree.joints[j].kind == runtime::model::JointKind::Revolute)
+    let wrap: Vec<bool> = (0..plan.nx())
+        .map(|j| {
+            !plan.independent.contains(&j)
+                && model.tree.joints[j].kind == runtime::model::JointKind::Revolute
+        })
         .collect();
     let items = templates();
     let params = if layout.any() {
@@ -325,8 +326,8 @@ pub fn generate_with(
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#act_names),*];
         /// Index in `x` of each independent coordinate.
         pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
-        /// Which independent coordinates are angles.
-        const REVOLUTE: [bool; DOF] = [#(#revolute),*];
+        /// The dependent revolute joints: assembly keeps each within ±π of its guess.
+        const WRAP: [bool; NX] = [#(#wrap),*];
         #params
         #items
         #(#fns)*
@@ -419,10 +420,27 @@ fn templates() -> TokenStream {
         /// equation is within `1e-12` (times the mechanism's size for a point equation) and
         /// every loop equation (the redundant ones too) and revolute-axis alignment within
         /// `1e-9` (else a spurious branch: `Err`), then one more full step (kept unless it
-        /// raises the residual).
+        /// raises the residual). Each dependent angle stays within ±π of its guess (the same
+        /// configuration, fewest turns: pass the last configuration to follow a motion).
         #[allow(clippy::all)]
         pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            let _ = REVOLUTE;
+            // A dependent angle moved to within ±π of its guess (the same configuration): a
+            // long Newton step can land turns away, where f32 (and f64) keep fewer digits.
+            let wrap = |x: &mut [f64; NX]| {
+                let t = 2.0 * core::f64::consts::PI;
+                for i in 0..NX {
+                    let d = x[i] - guess[i];
+                    let ad = if d < 0.0 { -d } else { d };
+                    if WRAP[i] && ad > core::f64::consts::PI && ad < 1e9 {
+                        let k = d / t + 0.5;
+                        let mut n = k as i64 as f64;
+                        if n > k {
+                            n -= 1.0;
+                        }
+                        x[i] = guess[i] + (d - n * t);
+                    }
+                }
+            };
             let mut x = *guess;
             for k in 0..DOF {
                 x[INDEPENDENT[k]] = q[k];
@@ -456,6 +474,7 @@ fn templates() -> TokenStream {
                     for i in 0..NX {
                         xn[i] += step * dx[i];
                     }
+                    wrap(&mut xn);
                     if let Ok((dn, rn, fulln)) = newton_step(&xn) {
                         if abs(rn) < abs(r) {
                             x = xn;

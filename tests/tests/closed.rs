@@ -207,6 +207,21 @@ macro_rules! generated_matches_runtime {
                 let fd = g::forward_dynamics(&xa, &ua, &ours).unwrap();
                 worst = worst.max(fd_error(&fd, &ud, &ours, &mr));
                 let xi = g::inverse_kinematics(&xa).unwrap();
+                // Assembly from home (the runtime's in `random_state`, then the generated
+                // one's) keeps every dependent angle within ±π of the guess: the same
+                // configuration with the fewest turns (Newton's long steps used to land
+                // hundreds of radians away, where f32 keeps four digits fewer).
+                let within = |v: &[f64]| {
+                    plan.dependent.iter().all(|&j| {
+                        m.tree.joints[j].kind != runtime::model::JointKind::Revolute
+                            || v[j].abs() <= std::f64::consts::PI + 1e-12
+                    })
+                };
+                assert!(within(&x), "{name}: runtime assembly {x:?}");
+                if let Ok(h) = g::forward_kinematics(&xi, &[0.0; g::NX]) {
+                    assert!(within(&h), "{name}: generated assembly {h:?}");
+                    assert!(g::inverse_dynamics(&h, &ua, &uda).is_ok(), "{name}: {h:?}");
+                }
                 let guess: [f64; g::NX] = core::array::from_fn(|i| x[i] + rng.random_range(-0.05..0.05));
                 // Newton from a perturbed guess: the same outcome as the runtime's (near a
                 // singular configuration both may fail; then both must).

@@ -1287,6 +1287,8 @@ pub fn closure_residual(plan: &Plan, x: &[f64]) -> f64 {
 /// does not reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when
 /// every kept loop equation is within [`FK_TOLERANCE`] (point equations times the size); then
 /// one more full step (kept unless it raises the residual) takes the coordinates to rounding.
+/// Each dependent angle stays within ±π of its guess (the same configuration with the fewest
+/// turns: a long Newton step can land turns away, where fewer digits are left).
 pub fn forward_kinematics(
     plan: &Plan,
     xi: &[f64],
@@ -1322,7 +1324,8 @@ pub fn forward_kinematics(
         let mut step = 1.0;
         let mut moved = false;
         for _ in 0..20 {
-            let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + step * b).collect();
+            let mut xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + step * b).collect();
+            wrap_near(plan, &mut xn, guess);
             if let Ok((dn, rn, fulln)) = newton_step(plan, &xn)
                 && rn.abs() < r.abs()
             {
@@ -1340,6 +1343,25 @@ pub fn forward_kinematics(
         }
     }
     Err(fail(FK_MAX_ITERATIONS, r.abs()))
+}
+
+/// The dependent revolute coordinates of `x` moved by whole turns to within ±π of `guess`'s.
+fn wrap_near(plan: &Plan, x: &mut [f64], guess: &[f64]) {
+    let t = 2.0 * core::f64::consts::PI;
+    for &j in &plan.dependent {
+        let d = x[j] - guess[j];
+        if plan.joints[j].kind == JointKind::Revolute
+            && d.abs() > core::f64::consts::PI
+            && d.abs() < 1e9
+        {
+            let k = d / t + 0.5;
+            let mut n = k as i64 as f64;
+            if n > k {
+                n -= 1.0;
+            }
+            x[j] = guess[j] + (d - n * t);
+        }
+    }
 }
 
 /// Potential energy of gravity at `x`, `−Σ m_b gᵀ c_b` (J, zero at the base origin).
