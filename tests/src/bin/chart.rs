@@ -8,7 +8,7 @@
 //! ∞-norm over the states). Writes `PREFIX.csv`, `PREFIX.md` and `PREFIX.svg` (log–log).
 //!
 //! ```text
-//! cargo run --release -p tests --bin chart [-- PREFIX]      (default: docs/figures/chart)
+//! cargo run --profile bench -p tests --bin chart [-- PREFIX]   (default: docs/figures/chart)
 //! ```
 
 use std::fmt::Write as _;
