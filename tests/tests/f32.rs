@@ -2,7 +2,9 @@
 //! `f32` feature) against the same mechanism's `f64` module (itself checked against the
 //! independent routes), on random regular states. The error is relative in the ∞-norm of the
 //! `f64` result; away from singularities it must stay within 1e-4 (the figure printed is the
-//! worst over the states, the charter's "f32 worst relative error").
+//! worst over the states, the charter's "f32 worst relative error"). Closed loops are also
+//! measured assembled by the `f64` module and evaluated in `f32` (within 1e-5 where the
+//! problem is well conditioned), and against the `f32`-rounded mechanism evaluated exactly.
 
 use rand::Rng;
 use tests::pkm::rel;
@@ -114,6 +116,95 @@ fn parallel_mechanisms_in_single_precision() {
     );
 }
 
+/// `f64` arithmetic on the model's constants rounded to `f32`: every constant the closed-loop
+/// evaluator takes (geometry, inertia, gravity: [`runtime::parallel::Real::c`]) is rounded to
+/// single precision, every operation is done in double. What it computes is the exact
+/// dynamics of the mechanism an `f32` module describes, to `f64` rounding: the error no `f32`
+/// arithmetic, however careful, can remove.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+struct F32Constants(f64);
+
+macro_rules! f32c_op {
+    ($tr:ident, $m:ident, $op:tt) => {
+        impl core::ops::$tr for F32Constants {
+            type Output = F32Constants;
+            fn $m(self, o: F32Constants) -> F32Constants {
+                F32Constants(self.0 $op o.0)
+            }
+        }
+    };
+}
+f32c_op!(Add, add, +);
+f32c_op!(Sub, sub, -);
+f32c_op!(Mul, mul, *);
+f32c_op!(Div, div, /);
+
+impl core::ops::Neg for F32Constants {
+    type Output = F32Constants;
+    fn neg(self) -> F32Constants {
+        F32Constants(-self.0)
+    }
+}
+
+impl runtime::parallel::Real for F32Constants {
+    fn c(v: f64) -> Self {
+        F32Constants(v as f32 as f64)
+    }
+    fn sqrt(self) -> Self {
+        F32Constants(self.0.sqrt())
+    }
+    fn atan2(self, x: Self) -> Self {
+        F32Constants(self.0.atan2(x.0))
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.0.sin_cos();
+        (F32Constants(s), F32Constants(c))
+    }
+    fn select_abs_gt(a: Self, b: Self, x: Self, y: Self) -> Self {
+        if a.0.abs() > b.0.abs() { x } else { y }
+    }
+    fn check(
+        value: Self,
+        threshold: Self,
+        scale: Self,
+        site: runtime::parallel::Site,
+        two_sided: bool,
+    ) -> Result<Self, runtime::parallel::Singular> {
+        f64::check(value.0, threshold.0, scale.0, site, two_sided).map(F32Constants)
+    }
+}
+
+/// The inverse dynamics of the `f32` module's mechanism (constants rounded to `f32`), in `f64`
+/// arithmetic: assembled from the independent coordinates `xi` by Newton's method from `guess`
+/// (the exact model's assembly), then evaluated.
+fn f32_model_inverse_dynamics(
+    plan: &runtime::closed::noc::Plan,
+    xi: &[f64],
+    guess: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Option<Vec<f64>> {
+    use runtime::closed::noc as cnoc;
+    let lift = |v: &[f64]| -> Vec<F32Constants> { v.iter().map(|&t| F32Constants(t)).collect() };
+    let mut x = lift(guess);
+    for (k, &j) in plan.independent.iter().enumerate() {
+        x[j] = F32Constants(xi[k]);
+    }
+    for _ in 0..20 {
+        let (dx, _, _) = cnoc::newton_step(plan, &x).ok()?;
+        let step = dx.iter().fold(0.0f64, |m, d| m.max(d.0.abs()));
+        for (a, d) in x.iter_mut().zip(&dx) {
+            *a = *a + *d;
+        }
+        if step < 1e-15 {
+            break;
+        }
+    }
+    let c = cnoc::configuration(plan, &x, false).ok()?;
+    let f = cnoc::generalized_force(plan, &c, &lift(u), &lift(ud), true);
+    Some(f.iter().map(|t| t.0).collect())
+}
+
 macro_rules! closed {
     ($($m:ident),*) => {$(
         {
@@ -136,6 +227,8 @@ macro_rules! closed {
             let (mut worst_cond, mut worst_conditioned, mut worst_ratio): (f64, f64, f64) = (0.0, 0.0, 0.0);
             let mut prng = tests::rng(29);
             let mut worst_end: f64 = 0.0;
+            let (mut worst_model, mut worst_excess, mut model_failures): (f64, f64, usize) = (0.0, 0.0, 0);
+            let (mut worst_mixed, mut worst_mixed_conditioned, mut worst_scaled): (f64, f64, f64) = (0.0, 0.0, 0.0);
             for _ in 0..200 {
                 let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, tests::closed::reach(name));
                 // Away from singularities: the loop equations' condition estimate below 100
@@ -164,6 +257,7 @@ macro_rules! closed {
                     continue;
                 };
                 let xi: [f64; N] = core::array::from_fn(|k| xi32[k] as f64);
+                let mixed_here: f64;
                 let xr = d::forward_kinematics(&xi, &x.clone().try_into().unwrap()).unwrap();
                 let assembly = rel(&to64(&x32), &xr);
                 worst_assembly = worst_assembly.max(assembly);
@@ -193,7 +287,23 @@ macro_rules! closed {
                     let m = d::mass_matrix(&xr).unwrap();
                     let m32 = s::mass_matrix(&xa).unwrap();
                     worst_function = worst_function.max(rel(&to64(&m32.concat()), &m.concat()));
+                    // The mixed route: assembled in f64 (the f64 module's `forward_kinematics`),
+                    // the functions in f32 at that assembly rounded.
+                    mixed_here = rel(&to64(&t32), &t).max(rel(&to64(&m32.concat()), &m.concat()));
+                    // The effort's scale: its terms `|I u̇| + |C u| + |γ|`, entrywise.
+                    let z = [0.0; N];
+                    let g = d::inverse_dynamics(&xr, &z, &z).unwrap();
+                    let cu = d::inverse_dynamics(&xr, &ua64, &z).unwrap();
+                    let scale = (0..N)
+                        .map(|i| {
+                            let iu: f64 = (0..N).map(|j| m[i][j] * uda64[j]).sum();
+                            iu.abs() + (cu[i] - g[i]).abs() + g[i].abs()
+                        })
+                        .fold(0.0f64, f64::max);
+                    let e = (0..N).map(|i| (t32[i] as f64 - t[i]).abs()).fold(0.0f64, f64::max);
+                    worst_scaled = worst_scaled.max(e / scale);
                 }
+                worst_mixed = worst_mixed.max(mixed_here);
                 let (u32_, ud32) = (to32::<N>(&u), to32::<N>(&ud));
                 let ur: [f64; N] = core::array::from_fn(|i| u32_[i] as f64);
                 let udr: [f64; N] = core::array::from_fn(|i| ud32[i] as f64);
@@ -202,6 +312,15 @@ macro_rules! closed {
                 let m = d::mass_matrix(&xr).unwrap();
                 let m32 = s::mass_matrix(&x32).unwrap();
                 let here = rel(&to64(&tau32), &tau).max(rel(&to64(&m32.concat()), &m.concat()));
+                // The same efforts for the mechanism the f32 module describes (its constants
+                // rounded), in f64 arithmetic: the part of the error the f32 model makes.
+                if let Some(t) = f32_model_inverse_dynamics(&plan, &xi, &xr, &ur, &udr) {
+                    let e = rel(&t, &tau);
+                    worst_model = worst_model.max(e);
+                    worst_excess = worst_excess.max(rel(&to64(&tau32), &tau) - e);
+                } else {
+                    model_failures += 1;
+                }
                 worst = worst.max(here);
                 worst_end = worst_end.max(here);
                 // The problem's own condition (f64, no f32 involved): the largest relative
@@ -226,6 +345,7 @@ macro_rules! closed {
                 worst_cond = worst_cond.max(cond);
                 if cond <= 100.0 {
                     worst_conditioned = worst_conditioned.max(here);
+                    worst_mixed_conditioned = worst_mixed_conditioned.max(mixed_here);
                 }
                 // How far beyond the problem's own condition (in the inputs) the f32 code
                 // loses: the f32 assembly and the f32 geometry constants open the loops by
@@ -235,12 +355,19 @@ macro_rules! closed {
                 worst_ratio = worst_ratio.max(ratio);
             }
             println!("{name}: f32 vs f64, worst relative error {worst:.1e}: assembly {worst_assembly:.1e}, functions at the f64 assembly rounded to f32 {worst_function:.1e}, of which f32 arithmetic (inverse dynamics against f64 at the same rounded input) {worst_arith:.1e}; worst error in units of rounding against double-double: f32 {loss32:.0}, f64 {loss64:.0} ({skipped} of 200 states skipped as near-singular; f32 assembly failed {fk_failures} times); end to end (f32 assembly, then the functions) {worst_end:.1e}; problem condition up to {worst_cond:.0}, worst error where it is ≤ 100: {worst_conditioned:.1e}; inverse-dynamics error at most {worst_ratio:.1} × cond × 2⁻²⁴");
+            println!("{name}: the f32 model's constants alone (f64 arithmetic): {worst_model:.1e}; f32 inverse dynamics beyond that: {worst_excess:.1e} ({model_failures} failures); f64 assembly then f32 functions {worst_mixed:.1e} (problem condition ≤ 100: {worst_mixed_conditioned:.1e}; f32 inverse dynamics error relative to the effort's terms {worst_scaled:.1e})");
             assert!(skipped < 100, "{name}: {skipped}");
             assert!(fk_failures <= 4, "{name}: f32 assembly failed {fk_failures} of 200 times");
             // Closed loops assemble in f32 too (Newton to the f32 rounding floor of the loop
             // equations, whose error the loop's condition amplifies), which costs about a digit
             // more: 1e-3 (measured worst: the N-four-bar's assembly, 5.5e-5).
             assert!(worst < 10.0 * F32_TOLERANCE, "{name}: {worst:e}");
+            // Assembled in f64 and evaluated in f32, the charter's target holds wherever the
+            // problem itself is well conditioned (condition of the efforts in the inputs ≤ 100:
+            // beyond that even exact f32 inputs lose `cond · 2⁻²⁴`), and relative to the
+            // effort's terms everywhere.
+            assert!(worst_mixed_conditioned <= 1e-5, "{name}: {worst_mixed_conditioned:e}");
+            assert!(worst_scaled <= 1e-5, "{name}: {worst_scaled:e}");
         }
     )*};
 }
