@@ -108,7 +108,8 @@ pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> 
 }
 
 /// The public functions of a closed-loop module that `[scene] functions` can leave out
-/// (`inverse_kinematics` and `forward_kinematics` are always emitted).
+/// (`inverse_kinematics`, `actuator_rates` and `forward_kinematics` are always emitted;
+/// `actuator_mass_matrix` with `mass_matrix`).
 pub const SELECTABLE: [&str; 4] = [
     "joint_rates",
     "inverse_dynamics",
@@ -314,6 +315,25 @@ pub fn generate_with(
     } else {
         quote!()
     };
+    // The names every actuator-space module has (parallel mechanisms): here the actuated
+    // joints are the independent coordinates, so `A = 1`.
+    let actuator_mass_matrix = if wanted("mass_matrix") {
+        let (p_arg, p_call) = if layout.any() {
+            (quote!(, p: &Params), quote!(, p))
+        } else {
+            (quote!(), quote!())
+        };
+        quote! {
+            /// The mass matrix in actuator space, `A⁻ᵀ I A⁻¹` (the lecture's eq. 68): the
+            /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
+            #[allow(clippy::all)]
+            pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
+                mass_matrix(x #p_call)
+            }
+        }
+    } else {
+        quote!()
+    };
     let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of position coordinates `x`: every joint of the spanning tree.
@@ -326,11 +346,15 @@ pub fn generate_with(
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#act_names),*];
         /// Index in `x` of each independent coordinate.
         pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
+        /// The spec's home configuration (every tree joint at zero, where the spec's geometry
+        /// closes the loops in its declared branch): a guess for `forward_kinematics` near home.
+        pub const HOME: [f64; NX] = [0.0; NX];
         /// The dependent revolute joints: assembly keeps each within ±π of its guess.
         const WRAP: [bool; NX] = [#(#wrap),*];
         #params
         #items
         #(#fns)*
+        #actuator_mass_matrix
         #indices
     };
     let code = emit::render(&header, tokens);
@@ -411,6 +435,21 @@ fn templates() -> TokenStream {
                 q[k] = v;
             }
             Ok(q)
+        }
+
+        /// The actuated joints' rates `q̇ = A u`: the actuated joints are the independent
+        /// coordinates (`A = 1`), so `u` itself. `Err(Site::Input)` for a non-finite independent
+        /// coordinate or speed;
+        /// whether `x` closes the loops is not needed here (`joint_rates` checks it).
+        #[allow(clippy::all)]
+        pub fn actuator_rates(x: &[f64; NX], u: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+            inverse_kinematics(x)?;
+            for k in 0..DOF {
+                if !u[k].is_finite() {
+                    return Err(Singular { site: Site::Input, value: u[k], condition_estimate: f64::INFINITY });
+                }
+            }
+            Ok(*u)
         }
 
         /// Forward kinematics (assembly): the joint positions that close the loops with the

@@ -539,6 +539,11 @@ pub fn generate_with(
     };
     let nx_lit = Literal::usize_unsuffixed(nx);
     let n_lit = Literal::usize_unsuffixed(n);
+    let home: Vec<Literal> = model
+        .home_x()
+        .iter()
+        .map(|&v| Literal::f64_unsuffixed(v))
+        .collect();
     let indices = crate::indices::template(cfg);
     let tokens = quote! {
         /// Number of position coordinates `x`.
@@ -547,6 +552,10 @@ pub fn generate_with(
         pub const DOF: usize = #n_lit;
         /// The actuated joints, in the order of `q` and `tau`.
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#names),*];
+        /// The spec's home configuration `x` (its legs in their declared branches): a guess for
+        /// `forward_kinematics` near home.
+        #[allow(clippy::excessive_precision)]
+        pub const HOME: [f64; NX] = [#(#home),*];
         #params_items
         #items
         #(#fns)*

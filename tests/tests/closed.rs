@@ -252,6 +252,18 @@ macro_rules! generated_matches_runtime {
             assert_eq!(e.site, g::Site::Input, "{}", stringify!($m));
             let e = g::forward_dynamics(&open, &ua, &[f64::INFINITY; g::DOF]).unwrap_err();
             assert!(matches!(e.site, g::Site::Input | g::Site::Closure(_)), "{}: {e:?}", stringify!($m));
+            // The actuator-space names of the parallel modules: the actuated joints are the
+            // independent coordinates, so `A = 1`.
+            let xa: [f64; g::NX] = x.clone().try_into().unwrap();
+            assert_eq!(g::actuator_rates(&xa, &ua).unwrap(), ua, "{}", stringify!($m));
+            assert_eq!(g::actuator_mass_matrix(&xa).unwrap(), g::mass_matrix(&xa).unwrap());
+            let e = g::actuator_rates(&xa, &[f64::NAN; g::DOF]).unwrap_err();
+            assert_eq!(e.site, g::Site::Input, "{}", stringify!($m));
+            // `HOME` closes the loops (the functions accept it) and assembly from it returns it.
+            assert!(g::mass_matrix(&g::HOME).is_ok(), "{}", stringify!($m));
+            let q = g::inverse_kinematics(&g::HOME).unwrap();
+            let back = g::forward_kinematics(&q, &g::HOME).unwrap();
+            assert!(max_abs_diff(&back, &g::HOME) <= 1e-12, "{}: {back:?}", stringify!($m));
         }
     )*};
 }

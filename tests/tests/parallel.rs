@@ -94,6 +94,11 @@ macro_rules! generated_vs_runtime {
                 stringify!($name),
                 worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6]
             );
+            // `HOME` is the spec's home pose: reachable, and forward kinematics from it
+            // returns it.
+            let q = g::inverse_kinematics(&g::HOME).unwrap();
+            let back = g::forward_kinematics(&q, &g::HOME).unwrap();
+            assert!(rel(&back, &g::HOME) <= 1e-12, "{}: {back:?}", stringify!($name));
             for (k, w) in worst.iter().enumerate() {
                 let tol = if k == 6 { 1e-9 } else { 1e-11 };
                 assert!(*w <= tol, "{}: check {k}: {w:e}", stringify!($name));
