@@ -123,7 +123,7 @@ pub struct Plan {
     pub all_rows: Vec<Row>,
     /// Independent joints (in order).
     pub independent: Vec<usize>,
-    /// Dependent joints (increasing).
+    /// Dependent joints, in the order of the columns of `Φ_d` (banded: see `band_order`).
     pub dependent: Vec<usize>,
     /// `anc[b][j]`: joint `j` moves body `b`.
     pub anc: Vec<Vec<bool>>,
@@ -300,6 +300,7 @@ impl Plan {
             })
             .map(|i| candidates[i])
             .collect();
+        band_order(&mut plan);
         // The full evaluation must succeed at home.
         let d = plan.independent.len();
         inverse_dynamics(&plan, &x0, &vec![0.0; d], &vec![0.0; d]).map_err(|e| {
@@ -354,6 +355,129 @@ fn joint_plans(tree: &crate::model::Model) -> Vec<JointPlan> {
             drive: j.drive,
         })
         .collect()
+}
+
+/// Order the dependent coordinates (the columns of `Φ_d`) and the loop equations (its rows)
+/// for a narrow band: a chain of loops (the N-four-bar, a ladder) written in any order then
+/// factorizes in `O(n)` instead of `O(n³)`, since the generated LU's pivot selects only mix
+/// rows that share a column. Columns by reverse Cuthill–McKee over "appear in the same
+/// equation" (structurally: the joints that move either body of the equation's cut), rows by
+/// their first and last column; the spec's order stays where this does not make the LU
+/// cheaper (counted on the structural pattern) and for fewer than eight dependent coordinates.
+fn band_order(plan: &mut Plan) {
+    // Below this many dependent coordinates the dense LU costs a few dozen selects at most:
+    // the spec's order stays (and with it the rounding of the bundled small loops).
+    const BAND_MIN: usize = 8;
+    let nd = plan.dependent.len();
+    let col_of = |j: usize| plan.dependent.iter().position(|&d| d == j);
+    let pattern = |r: &Row| -> Vec<usize> {
+        let c = &plan.cuts[row_cut(r)];
+        let moves = |b: Option<usize>, j: usize| b.is_some_and(|b| plan.anc[b][j]);
+        (0..plan.joints.len())
+            .filter(|&j| moves(c.parent, j) || moves(c.child, j))
+            .filter_map(col_of)
+            .collect()
+    };
+    let rows: Vec<Vec<usize>> = plan.rows.iter().chain(&plan.spare).map(pattern).collect();
+    let mut adj = vec![Vec::<usize>::new(); nd];
+    for r in &rows {
+        for &a in r {
+            for &b in r {
+                if a != b && !adj[a].contains(&b) {
+                    adj[a].push(b);
+                }
+            }
+        }
+    }
+    let mut order: Vec<usize> = Vec::with_capacity(nd);
+    let mut seen = vec![false; nd];
+    while order.len() < nd {
+        let start = (0..nd)
+            .filter(|&c| !seen[c])
+            .min_by_key(|&c| (adj[c].len(), c))
+            .unwrap_or(0);
+        seen[start] = true;
+        let mut head = order.len();
+        order.push(start);
+        while head < order.len() {
+            let mut next: Vec<usize> = adj[order[head]]
+                .iter()
+                .copied()
+                .filter(|&c| !seen[c])
+                .collect();
+            next.sort_by_key(|&c| (adj[c].len(), c));
+            for c in next {
+                seen[c] = true;
+                order.push(c);
+            }
+            head += 1;
+        }
+    }
+    order.reverse();
+    // The cost of the LU (as the generator sees it) in a column order: the entries that the
+    // swap selects and the eliminations touch, on the structural pattern. Rows in the order
+    // they get below.
+    let lu_cost = |pos: &[usize]| -> usize {
+        let mut m: Vec<Vec<bool>> = rows
+            .iter()
+            .map(|r| {
+                let mut row = vec![false; nd];
+                for &c in r {
+                    row[pos[c]] = true;
+                }
+                row
+            })
+            .collect();
+        m.sort_by_key(|r| (r.iter().position(|&v| v), r.iter().rposition(|&v| v)));
+        let mut cost = 0;
+        for k in 0..nd.min(m.len()) {
+            for i in k + 1..m.len() {
+                if m[i][k] {
+                    for j in k..nd {
+                        let v = m[i][j] || m[k][j];
+                        cost += usize::from(v);
+                        m[i][j] = v;
+                        m[k][j] = v;
+                    }
+                }
+            }
+            for i in k + 1..m.len() {
+                if m[i][k] {
+                    for j in k + 1..nd {
+                        cost += usize::from(m[k][j]);
+                        m[i][j] |= m[k][j];
+                    }
+                }
+            }
+        }
+        cost
+    };
+    let mut pos = vec![0; nd];
+    for (p, &c) in order.iter().enumerate() {
+        pos[c] = p;
+    }
+    let identity: Vec<usize> = (0..nd).collect();
+    if nd < BAND_MIN || lu_cost(&pos) >= lu_cost(&identity) {
+        pos = identity;
+    }
+    let mut dependent = plan.dependent.clone();
+    for (c, &p) in pos.iter().enumerate() {
+        dependent[p] = plan.dependent[c];
+    }
+    let key = |r: &Row| {
+        let cols = pattern(r);
+        (
+            cols.iter().map(|&c| pos[c]).min().unwrap_or(usize::MAX),
+            cols.iter().map(|&c| pos[c]).max().unwrap_or(0),
+        )
+    };
+    let mut kept = plan.rows.clone();
+    kept.sort_by_key(|r| key(r));
+    let mut spare = plan.spare.clone();
+    spare.sort_by_key(|r| key(r));
+    plan.rows = kept;
+    plan.spare = spare;
+    plan.dependent = dependent;
 }
 
 fn row_cut(r: &Row) -> usize {
@@ -458,7 +582,7 @@ fn side(plan: &Plan, parent: Option<usize>, child: Option<usize>, j: usize) -> i
 }
 
 /// The Jacobian row of a loop equation over all joints.
-fn jacobian_row<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> Vec<R> {
+pub fn jacobian_row<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> Vec<R> {
     let n = plan.nx();
     let mut out = vec![R::c(0.0); n];
     match *r {
@@ -649,10 +773,15 @@ pub fn lu_factor<R: Real>(a: &[Vec<R>]) -> Result<Lu<R>, Singular> {
         .collect();
     let mut swaps = Vec::new();
     for k in 0..n {
+        // Rows swapped in the active columns only, the multipliers left where they were
+        // computed (LINPACK's `dgefa`; the solves replay the swaps step by step). Swapping
+        // whole rows (LAPACK's convention) is the same arithmetic, but as selects it carries
+        // every earlier multiplier down each candidate row, and a banded `Φ_d` (a chain of
+        // loops) becomes a dense `L` in the generated code.
         for i in k + 1..nr {
             let (p, q) = (m[i][k], m[k][k]);
             swaps.push((k, i, p, q));
-            for j in 0..n {
+            for j in k..n {
                 let (x, y) = (m[i][j], m[k][j]);
                 m[k][j] = R::select_abs_gt(p, q, x, y);
                 m[i][j] = R::select_abs_gt(p, q, y, x);
@@ -682,15 +811,18 @@ impl<R: Real> Lu<R> {
     /// used).
     pub fn solve(&self, b: &[R]) -> Vec<R> {
         let n = self.sc.len();
+        let nr = self.m.len();
         let mut x = b.to_vec();
-        for &(k, i, p, q) in &self.swaps {
-            let (xi, xk) = (x[i], x[k]);
-            x[k] = R::select_abs_gt(p, q, xi, xk);
-            x[i] = R::select_abs_gt(p, q, xk, xi);
-        }
-        for i in 0..n {
-            for j in 0..i {
-                x[i] = x[i] - self.m[i][j] * x[j];
+        // `L⁻¹P`: each step's swaps, then its column of multipliers (`dgesl`).
+        let mut swaps = self.swaps.iter().peekable();
+        for k in 0..n {
+            while let Some(&(_, i, p, q)) = swaps.next_if(|s| s.0 == k) {
+                let (xi, xk) = (x[i], x[k]);
+                x[k] = R::select_abs_gt(p, q, xi, xk);
+                x[i] = R::select_abs_gt(p, q, xk, xi);
+            }
+            for i in k + 1..nr {
+                x[i] = x[i] - self.m[i][k] * x[k];
             }
         }
         for i in (0..n).rev() {
@@ -711,23 +843,27 @@ impl<R: Real> Lu<R> {
     pub fn solve_t(&self, b: &[R]) -> Vec<R> {
         let n = b.len();
         let mut z: Vec<R> = (0..n).map(|i| b[i] * self.sc[i]).collect();
-        // Uᵀ z' = D b (forward), Lᵀ w = z' (backward), y = Pᵀ w.
+        // Uᵀ z' = D b (forward).
         for i in 0..n {
             for j in 0..i {
                 z[i] = z[i] - self.m[j][i] * z[j];
             }
             z[i] = z[i] / self.m[i][i];
         }
-        for i in (0..n).rev() {
-            for j in i + 1..n {
-                z[i] = z[i] - self.m[j][i] * z[j];
+        // `(L⁻¹P)ᵀ`: step by step backwards, its column of multipliers, then its swaps in
+        // reverse (the spare rows start at zero).
+        let nr = self.m.len();
+        z.resize(nr, R::c(0.0));
+        let mut swaps = self.swaps.iter().rev().peekable();
+        for k in (0..n).rev() {
+            for i in k + 1..nr {
+                z[k] = z[k] - self.m[i][k] * z[i];
             }
-        }
-        z.resize(self.m.len(), R::c(0.0));
-        for &(k, i, p, q) in self.swaps.iter().rev() {
-            let (zi, zk) = (z[i], z[k]);
-            z[k] = R::select_abs_gt(p, q, zi, zk);
-            z[i] = R::select_abs_gt(p, q, zk, zi);
+            while let Some(&(_, i, p, q)) = swaps.next_if(|s| s.0 == k) {
+                let (zi, zk) = (z[i], z[k]);
+                z[k] = R::select_abs_gt(p, q, zi, zk);
+                z[i] = R::select_abs_gt(p, q, zk, zi);
+            }
         }
         z
     }
