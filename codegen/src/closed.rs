@@ -299,6 +299,16 @@ pub fn generate_with(
                 && model.tree.joints[j].kind == runtime::model::JointKind::Revolute
         })
         .collect();
+    let step: Vec<Literal> = plan
+        .independent
+        .iter()
+        .map(|&j| {
+            Literal::f64_unsuffixed(match model.tree.joints[j].kind {
+                runtime::model::JointKind::Revolute => noc::FK_STEP,
+                runtime::model::JointKind::Prismatic => noc::FK_STEP * plan.size,
+            })
+        })
+        .collect();
     let items = templates();
     let params = if layout.any() {
         let drives: Vec<&runtime::model::Drive> =
@@ -349,6 +359,9 @@ pub fn generate_with(
         /// The spec's home configuration (every tree joint at zero, where the spec's geometry
         /// closes the loops in its declared branch): a guess for `forward_kinematics` near home.
         pub const HOME: [f64; NX] = [0.0; NX];
+        /// The largest move of each independent coordinate per stage of `forward_kinematics`
+        /// (rad, or m: a fraction of the mechanism's size).
+        const STEP: [f64; DOF] = [#(#step),*];
         /// The dependent revolute joints: assembly keeps each within ±π of its guess.
         const WRAP: [bool; NX] = [#(#wrap),*];
         #params
@@ -382,6 +395,8 @@ fn templates() -> TokenStream {
         tol(1e-10)
     });
     let fk_max = Literal::usize_unsuffixed(noc::FK_MAX_ITERATIONS);
+    let max_stages = Literal::usize_unsuffixed(noc::FK_MAX_STAGES);
+    let max_stages_f = Literal::f64_unsuffixed(noc::FK_MAX_STAGES as f64);
     let full_tol = Literal::f64_unsuffixed(tol(noc::FULL_TOLERANCE));
     let closure_doc = format!(
         " Kept loop equation `k` exceeds `{clo_tol:e}` (times the mechanism's size for a point equation): `x` does not close the loops. `value` is `tol² − Φ_k²`."
@@ -453,16 +468,64 @@ fn templates() -> TokenStream {
         }
 
         /// Forward kinematics (assembly): the joint positions that close the loops with the
-        /// independent coordinates `q` (angles compared as given), by Newton's method on the
-        /// dependent coordinates from `guess` (its branch), the step halved while it does not
-        /// reduce the residual; at most 50 iterations, converged when every kept loop
-        /// equation is within `1e-12` (times the mechanism's size for a point equation) and
-        /// every loop equation (the redundant ones too) and revolute-axis alignment within
-        /// `1e-9` (else a spurious branch: `Err`), then one more full step (kept unless it
-        /// raises the residual). Each dependent angle stays within ±π of its guess (the same
-        /// configuration, fewest turns: pass the last configuration to follow a motion).
+        /// independent coordinates `q` (angles compared as given), on the branch of `guess`
+        /// (pass the last configuration to follow a motion, or `HOME`). The independent
+        /// coordinates move from `guess`'s to `q` in equal stages of at most `STEP` each (at
+        /// most 64 stages), each assembled by Newton's method from the last: a far target
+        /// stays on the guess's assembly mode. If a stage fails (the straight path crosses a
+        /// singularity), one Newton solve from `guess` decides. Each solve: the step halved
+        /// while it does not reduce the residual; at most 50 iterations, converged when every
+        /// kept loop equation is within `1e-12` (times the mechanism's size for a point
+        /// equation) and every loop equation (the redundant ones too) and revolute-axis
+        /// alignment within `1e-9` (else a spurious branch: `Err`), then one more full step
+        /// (kept unless it raises the residual); each dependent angle stays within ±π of its
+        /// guess.
         #[allow(clippy::all)]
         pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
+            let mut need: f64 = 1.0;
+            for k in 0..DOF {
+                let d = q[k] - guess[INDEPENDENT[k]];
+                let a = (if d < 0.0 { -d } else { d }) / STEP[k];
+                if !(a <= need) {
+                    need = a;
+                }
+            }
+            if need > 1.0 {
+                let stages = if need < #max_stages_f {
+                    let n = need as usize;
+                    if (n as f64) < need { n + 1 } else { n }
+                } else {
+                    #max_stages
+                };
+                let mut x = *guess;
+                let mut followed = true;
+                for s in 1..=stages {
+                    let t = s as f64 / stages as f64;
+                    let mut qs = *q;
+                    if s < stages {
+                        for k in 0..DOF {
+                            let g = guess[INDEPENDENT[k]];
+                            qs[k] = g + t * (q[k] - g);
+                        }
+                    }
+                    match newton_assembly(&qs, &x) {
+                        Ok(xn) => x = xn,
+                        Err(_) => {
+                            followed = false;
+                            break;
+                        }
+                    }
+                }
+                if followed {
+                    return Ok(x);
+                }
+            }
+            newton_assembly(q, guess)
+        }
+
+        /// One Newton solve of `forward_kinematics` from `guess`.
+        #[allow(clippy::all)]
+        fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
             // A dependent angle moved to within ±π of its guess (the same configuration): a
             // long Newton step can land turns away, where f32 (and f64) keep fewer digits.
             let wrap = |x: &mut [f64; NX]| {

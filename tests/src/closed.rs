@@ -37,7 +37,9 @@ pub fn random_state(plan: &Plan, rng: &mut StdRng, reach: f64) -> (Vec<f64>, Vec
         let xi: Vec<f64> = (0..n)
             .map(|_| reach * rng.random_range(-1.0..1.0))
             .collect();
-        let Ok(x) = noc::forward_kinematics(plan, &xi, &home) else {
+        // One Newton solve from home (no path following): the states land on every branch
+        // Newton reaches, a wider sample than home's own.
+        let Ok(x) = noc::newton_assembly(plan, &xi, &home) else {
             continue;
         };
         if noc::inverse_dynamics(plan, &x, &vec![0.0; n], &vec![0.0; n]).is_err() {

@@ -207,10 +207,12 @@ macro_rules! generated_matches_runtime {
                 let fd = g::forward_dynamics(&xa, &ua, &ours).unwrap();
                 worst = worst.max(fd_error(&fd, &ud, &ours, &mr));
                 let xi = g::inverse_kinematics(&xa).unwrap();
-                // Assembly from home (the runtime's in `random_state`, then the generated
-                // one's) keeps every dependent angle within ±π of the guess: the same
-                // configuration with the fewest turns (Newton's long steps used to land
-                // hundreds of radians away, where f32 keeps four digits fewer).
+                // One Newton solve from home (the runtime's in `random_state`) keeps every
+                // dependent angle within ±π of the guess: the same configuration with the
+                // fewest turns (Newton's long steps used to land hundreds of radians away,
+                // where f32 keeps four digits fewer). Assembly from home follows the path
+                // in stages, each such a solve: the generated code's ends where the runtime's
+                // does (the same branch).
                 let within = |v: &[f64]| {
                     plan.dependent.iter().all(|&j| {
                         m.tree.joints[j].kind != runtime::model::JointKind::Revolute
@@ -218,9 +220,13 @@ macro_rules! generated_matches_runtime {
                     })
                 };
                 assert!(within(&x), "{name}: runtime assembly {x:?}");
-                if let Ok(h) = g::forward_kinematics(&xi, &[0.0; g::NX]) {
-                    assert!(within(&h), "{name}: generated assembly {h:?}");
-                    assert!(g::inverse_dynamics(&h, &ua, &uda).is_ok(), "{name}: {h:?}");
+                match (g::forward_kinematics(&xi, &g::HOME), noc::forward_kinematics(&plan, &xi, &g::HOME)) {
+                    (Ok(h), Ok(r)) => {
+                        assert!(max_abs_diff(&h, &r) <= 1e-9, "{name}: {h:?} vs {r:?}");
+                        assert!(g::inverse_dynamics(&h, &ua, &uda).is_ok(), "{name}: {h:?}");
+                    }
+                    (Err(_), Err(_)) => {}
+                    (a, b) => panic!("{name}: generated {a:?} but runtime {b:?}"),
                 }
                 let guess: [f64; g::NX] = core::array::from_fn(|i| x[i] + rng.random_range(-0.05..0.05));
                 // Newton from a perturbed guess: the same outcome as the runtime's (near a
@@ -495,5 +501,39 @@ fn n_four_bar_at_the_benchmark_size() {
         );
         let mm = noc::mass_matrix(&plan, &x).unwrap();
         assert!((mm[0][0] - a).abs() <= 1e-11 * a, "{}", mm[0][0]);
+    }
+    // Assembly from home to a far crank angle follows the path and stays on the
+    // parallelogram branch (one Newton solve from home folds some couplers beyond 0.76 rad).
+    for theta in [0.3, 0.6, 2.6, 2.9] {
+        let x = noc::forward_kinematics(
+            &plan,
+            &[theta - std::f64::consts::FRAC_PI_2],
+            &vec![0.0; plan.nx()],
+        )
+        .unwrap();
+        let tau = noc::inverse_dynamics(&plan, &x, &[0.0], &[0.0]).unwrap();
+        let want = b * 9.81 * f64::cos(theta);
+        assert!(
+            (tau[0] - want).abs() <= 1e-10 * want.abs(),
+            "θ = {theta}: {} vs {want}",
+            tau[0]
+        );
+    }
+}
+
+/// The generated assembly from `HOME` to a far crank angle stays on the N-four-bar's
+/// parallelogram branch, as its closed form shows.
+#[test]
+fn generated_assembly_follows_the_branch_of_its_guess() {
+    use mechanisms::n_four_bar as g;
+    for theta in [0.3f64, 0.5, 2.7, 2.9] {
+        let x = g::forward_kinematics(&[theta - std::f64::consts::FRAC_PI_2], &g::HOME).unwrap();
+        let tau = g::inverse_dynamics(&x, &[0.0], &[0.0]).unwrap();
+        let want = n_four_bar_closed_form(theta, 0.0);
+        assert!(
+            (tau[0] - want).abs() <= 1e-10 * want.abs(),
+            "θ = {theta}: {} vs {want}",
+            tau[0]
+        );
     }
 }

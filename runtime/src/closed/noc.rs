@@ -38,6 +38,11 @@ pub const CONSTRAINT_TOLERANCE: f64 = 1e-4;
 pub const CLOSURE_TOLERANCE: f64 = 1e-9;
 /// Newton (forward kinematics): at most this many iterations.
 pub const FK_MAX_ITERATIONS: usize = 50;
+/// Forward kinematics follows the path from the guess's independent coordinates to the
+/// target in stages of at most this (rad; times the mechanism's size for a prismatic joint).
+pub const FK_STEP: f64 = 0.25;
+/// At most this many stages (longer stages beyond `FK_MAX_STAGES × FK_STEP`).
+pub const FK_MAX_STAGES: usize = 64;
 /// Newton converges when every kept loop equation is within `1e-12` (point equations times
 /// the mechanism's size).
 pub const FK_TOLERANCE: f64 = 1e-12;
@@ -1418,18 +1423,74 @@ pub fn closure_residual(plan: &Plan, x: &[f64]) -> f64 {
     newton_step(plan, x).map_or(f64::INFINITY, |(_, _, r)| r.abs())
 }
 
+/// The number of continuation stages from `guess` to the independent coordinates `xi`: no
+/// independent coordinate moves more than [`FK_STEP`] (rad, or times the size for a
+/// prismatic joint) per stage, at most [`FK_MAX_STAGES`]; 1 for non-finite input.
+pub fn continuation_stages(plan: &Plan, xi: &[f64], guess: &[f64]) -> usize {
+    let mut need: f64 = 1.0;
+    for (k, &j) in plan.independent.iter().enumerate() {
+        let step = match plan.joints[j].kind {
+            JointKind::Revolute => FK_STEP,
+            JointKind::Prismatic => FK_STEP * plan.size,
+        };
+        need = need.max(libm::ceil(libm::fabs(xi[k] - guess[j]) / step));
+    }
+    if need.is_finite() {
+        (need as usize).min(FK_MAX_STAGES)
+    } else {
+        1
+    }
+}
+
 /// Forward kinematics (assembly): the closed configuration whose independent coordinates are
-/// `xi`, by Newton's method on the dependent coordinates from `guess` (the step halved while it
-/// does not reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when
-/// every kept loop equation is within [`FK_TOLERANCE`] (point equations times the size); then
-/// one more full step (kept unless it raises the residual) takes the coordinates to rounding.
-/// Each dependent angle stays within ±π of its guess (the same configuration with the fewest
-/// turns: a long Newton step can land turns away, where fewer digits are left).
+/// `xi`, on the branch of `guess`. The independent coordinates move from `guess`'s to `xi` in
+/// [`continuation_stages`] equal stages, each assembled by [`newton_assembly`] from the last
+/// (path following: a far target stays on the guess's assembly mode instead of wherever one
+/// Newton solve from far away lands). If a stage fails (the straight path crosses a
+/// singularity), one Newton solve from `guess` decides, as with a single stage.
 pub fn forward_kinematics(
     plan: &Plan,
     xi: &[f64],
     guess: &[f64],
 ) -> Result<Vec<f64>, NoConvergence> {
+    let stages = continuation_stages(plan, xi, guess);
+    if stages > 1 {
+        let mut x = guess.to_vec();
+        let mut followed = true;
+        for s in 1..=stages {
+            let t = s as f64 / stages as f64;
+            let q: Vec<f64> = if s == stages {
+                xi.to_vec()
+            } else {
+                plan.independent
+                    .iter()
+                    .zip(xi)
+                    .map(|(&j, &v)| guess[j] + t * (v - guess[j]))
+                    .collect()
+            };
+            match newton_assembly(plan, &q, &x) {
+                Ok(xn) => x = xn,
+                Err(_) => {
+                    followed = false;
+                    break;
+                }
+            }
+        }
+        if followed {
+            return Ok(x);
+        }
+    }
+    newton_assembly(plan, xi, guess)
+}
+
+/// One Newton solve (the stage of [`forward_kinematics`]): the closed configuration with
+/// independent coordinates `xi` nearest `guess` in Newton's sense (the step halved while it
+/// does not reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when
+/// every kept loop equation is within [`FK_TOLERANCE`] (point equations times the size); then
+/// one more full step (kept unless it raises the residual) takes the coordinates to rounding.
+/// Each dependent angle stays within ±π of its guess (the same configuration with the fewest
+/// turns: a long Newton step can land turns away, where fewer digits are left).
+pub fn newton_assembly(plan: &Plan, xi: &[f64], guess: &[f64]) -> Result<Vec<f64>, NoConvergence> {
     let mut x = guess.to_vec();
     for (k, &j) in plan.independent.iter().enumerate() {
         x[j] = xi[k];
