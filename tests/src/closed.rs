@@ -7,13 +7,14 @@ use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
 /// The bundled closed-loop specs (module names).
-pub const CLOSED: [&str; 6] = [
+pub const CLOSED: [&str; 7] = [
     "four_bar",
     "five_bar_joints",
     "spherical_five_bar",
     "bricard",
     "n_four_bar",
     "tripod_3prs",
+    "andrews_squeezer",
 ];
 
 /// The validated model of a bundled closed-loop spec.

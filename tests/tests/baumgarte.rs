@@ -23,6 +23,11 @@ fn table(
     let mut out = Vec::new();
     for name in tests::closed::CLOSED {
         let model = tests::closed::model(name);
+        // Released from rest: without gravity (Andrews' squeezer, driven by a spring and a
+        // torque nocdyn does not model) nothing moves.
+        if model.tree.gravity == [0.0; 3] {
+            continue;
+        }
         let plan = runtime::closed::Plan::new(&model).unwrap();
         let x0 = vec![0.0; plan.nx()];
         let stab = baumgarte::simulate(&plan, &model.tree, &x0, DT, steps, ALPHA, ALPHA);

@@ -380,6 +380,7 @@ fn closed_loops_in_single_precision() {
         spherical_five_bar,
         bricard,
         n_four_bar,
-        tripod_3prs
+        tripod_3prs,
+        andrews_squeezer
     );
 }

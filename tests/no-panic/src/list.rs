@@ -13,7 +13,8 @@
 /// `inverse_kinematics`, `actuator_rates`, `inverse_dynamics`, `mass_matrix`,
 /// `actuator_mass_matrix`, `forward_dynamics`, `forward_kinematics`) and `closed_macro!(…)` with
 /// every closed-loop module in joint coordinates (`NX`, `DOF`, `inverse_kinematics`,
-/// `forward_kinematics`, `joint_rates`, `inverse_dynamics`, `mass_matrix`, `forward_dynamics`).
+/// `forward_kinematics`, `joint_rates`, `actuator_rates`, `inverse_dynamics`, `mass_matrix`,
+/// `actuator_mass_matrix`, `forward_dynamics`).
 #[allow(unused_macros)]
 macro_rules! for_each_mechanism {
     ($tree:ident, $parallel:ident, $closed:ident) => {
@@ -33,6 +34,14 @@ macro_rules! for_each_mechanism {
             agile_eye,
             planar_five_bar
         );
-        $closed!(four_bar, five_bar_joints, spherical_five_bar, bricard, n_four_bar, tripod_3prs);
+        $closed!(
+            four_bar,
+            five_bar_joints,
+            spherical_five_bar,
+            bricard,
+            n_four_bar,
+            tripod_3prs,
+            andrews_squeezer
+        );
     };
 }

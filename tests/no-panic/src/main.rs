@@ -207,6 +207,16 @@ macro_rules! closed {
                 }
                 #[cfg_attr(feature = "prove", no_panic::no_panic)]
                 #[inline(never)]
+                pub fn actuator_rates(x: &[F; NX], u: &[F; N]) -> Result<[F; N], g::Singular> {
+                    g::actuator_rates(x, u)
+                }
+                #[cfg_attr(feature = "prove", no_panic::no_panic)]
+                #[inline(never)]
+                pub fn actuator_mass_matrix(x: &[F; NX]) -> Result<[[F; N]; N], g::Singular> {
+                    g::actuator_mass_matrix(x)
+                }
+                #[cfg_attr(feature = "prove", no_panic::no_panic)]
+                #[inline(never)]
                 pub fn inverse_dynamics(
                     x: &[F; NX],
                     u: &[F; N],
@@ -247,6 +257,8 @@ macro_rules! closed {
                         }
                     };
                     s += pick(joint_rates(&x, &u).map(|v| v[0]));
+                    s += pick(actuator_rates(&x, &u).map(|v| v[0]));
+                    s += pick(actuator_mass_matrix(&x).map(|m| m[0][0]));
                     s += pick(inverse_dynamics(&x, &u, &ud).map(|v| v[0]));
                     s += pick(mass_matrix(&x).map(|m| m[0][0]));
                     s += pick(forward_dynamics(&x, &u, &ud).map(|v| v[0]));
