@@ -337,6 +337,7 @@ pub fn generate_with(
             /// The mass matrix in actuator space, `A⁻ᵀ I A⁻¹` (the lecture's eq. 68): the
             /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
             #[allow(clippy::all)]
+            #[inline(always)]
             pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
                 mass_matrix(x #p_call)
             }
