@@ -309,7 +309,18 @@ pub fn generate_with(
             })
         })
         .collect();
-    let items = templates();
+    let items = templates(!plan.springs.is_empty());
+    let spring_names = if plan.springs.is_empty() {
+        quote!()
+    } else {
+        let names: Vec<&str> = plan.springs.iter().map(|s| s.name.as_str()).collect();
+        let ns = Literal::usize_unsuffixed(names.len());
+        quote! {
+            /// The spring-dampers (`[[spring]]`), in the order of `Site::Spring`: applied
+            /// forces, in every function's efforts with gravity.
+            pub const SPRING_NAMES: [&str; #ns] = [#(#names),*];
+        }
+    };
     let params = if layout.any() {
         let drives: Vec<&runtime::model::Drive> =
             model.tree.joints.iter().map(|j| &j.drive).collect();
@@ -357,6 +368,7 @@ pub fn generate_with(
         pub const ACTUATOR_NAMES: [&str; DOF] = [#(#act_names),*];
         /// Index in `x` of each independent coordinate.
         pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
+        #spring_names
         /// The spec's home configuration (every tree joint at zero, where the spec's geometry
         /// closes the loops in its declared branch): a guess for `forward_kinematics` near home.
         pub const HOME: [f64; NX] = [0.0; NX];
@@ -381,7 +393,7 @@ pub fn generate_with(
     })
 }
 
-fn templates() -> TokenStream {
+fn templates(springs: bool) -> TokenStream {
     let tol = crate::scalar::tolerance;
     let con_tol = tol(noc::CONSTRAINT_TOLERANCE);
     let clo_tol = tol(noc::CLOSURE_TOLERANCE);
@@ -405,6 +417,18 @@ fn templates() -> TokenStream {
     let constraint_doc = format!(
         " Pivot `i` of the LU of `Φ_d` (columns scaled to unit norm, partial pivoting) is `|p| ≤ {con_tol:e}`: the independent coordinates (nearly) fail to determine the others."
     );
+    let spring_variant = if springs {
+        let doc = format!(
+            " Spring `k` (`SPRING_NAMES` order) is shorter than `{:e}` times the mechanism's size: its force has no direction.",
+            noc::SPRING_TOLERANCE
+        );
+        quote! {
+            #[doc = #doc]
+            Spring(usize),
+        }
+    } else {
+        quote!()
+    };
     quote! {
         /// Where an evaluation failed.
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -415,6 +439,7 @@ fn templates() -> TokenStream {
             Closure(usize),
             #[doc = #constraint_doc]
             Constraint(usize),
+            #spring_variant
             /// An input is NaN or infinite, or so large that a result overflows.
             Input,
         }

@@ -409,6 +409,10 @@ fn site_tokens(site: runtime::parallel::Site) -> TokenStream {
             let i = Literal::usize_unsuffixed(i);
             quote!(site: Site::Constraint(#i))
         }
+        S::Spring(i) => {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(site: Site::Spring(#i))
+        }
         S::Platform => quote!(site: Site::Platform),
         S::Input => quote!(site: Site::Input),
     }

@@ -178,6 +178,28 @@ pub struct CSystem {
     pub gravity: Vec3,
     /// Closure data for [`closure_residual`] (empty for hand-built systems).
     pub closure: Vec<Coincidence>,
+    /// Spring-dampers between material points.
+    pub springs: Vec<CSpring>,
+}
+
+/// A linear spring-damper between the material points currently at `point_a` (of body `a`;
+/// `None`: the ground) and `point_b`: tension `k (L − L₀) + c L̇`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CSpring {
+    /// First body.
+    pub a: Option<usize>,
+    /// First point (base frame, m).
+    pub point_a: Vec3,
+    /// Second body.
+    pub b: Option<usize>,
+    /// Second point (base frame, m).
+    pub point_b: Vec3,
+    /// Stiffness (N/m).
+    pub stiffness: f64,
+    /// Rest length (m).
+    pub rest_length: f64,
+    /// Damping (N·s/m).
+    pub damping: f64,
 }
 
 impl CSystem {
@@ -188,6 +210,7 @@ impl CSystem {
             joints,
             gravity,
             closure: Vec::new(),
+            springs: Vec::new(),
         }
     }
 }
@@ -791,6 +814,30 @@ pub fn inverse_dynamics(
             h[6 * b + 3 + c] = f[c];
         }
     }
+    // Springs: the force on each end, `∓T n` (`n` from a to b), moved to the mass centre.
+    for s in &sys.springs {
+        let vel = |body: Option<usize>, p: &Vec3| {
+            body.map_or([0.0; 3], |b| {
+                let r = sub(*p, sys.bodies[b].com);
+                add(lin(&twists[b]), cross(ang(&twists[b]), r))
+            })
+        };
+        let d = sub(s.point_b, s.point_a);
+        let l = dot(d, d).sqrt();
+        let n = scale(1.0 / l, d);
+        let ldot = dot(n, sub(vel(s.b, &s.point_b), vel(s.a, &s.point_a)));
+        let t = s.stiffness * (l - s.rest_length) + s.damping * ldot;
+        for (body, p, sign) in [(s.a, &s.point_a, 1.0), (s.b, &s.point_b, -1.0)] {
+            if let Some(b) = body {
+                let force = scale(sign * t, n);
+                let mom = cross(sub(*p, sys.bodies[b].com), force);
+                for c in 0..3 {
+                    h[6 * b + c] -= mom[c];
+                    h[6 * b + 3 + c] -= force[c];
+                }
+            }
+        }
+    }
     let na = actuators.len();
     let mut a = DMatrix::<f64>::zeros(n, n_joint_rows + na);
     for (col, row) in rows[..n_joint_rows].iter().chain(&actuators).enumerate() {
@@ -1091,6 +1138,7 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
         joints,
         gravity: model.gravity,
         closure,
+        springs: Vec::new(),
     }
 }
 
@@ -1151,6 +1199,25 @@ pub fn from_closed(model: &runtime::closed::ClosedModel, x: &[f64]) -> CSystem {
             point: fb.translation,
             kind,
             actuated: false,
+        });
+    }
+    for s in &model.springs {
+        let at = |b: Option<usize>, p: &Vec3| {
+            pose_of(b)
+                .compose(&Transform {
+                    translation: *p,
+                    ..Transform::IDENTITY
+                })
+                .translation
+        };
+        sys.springs.push(CSpring {
+            a: s.body_a,
+            point_a: at(s.body_a, &s.point_a),
+            b: s.body_b,
+            point_b: at(s.body_b, &s.point_b),
+            stiffness: s.stiffness,
+            rest_length: s.rest_length,
+            damping: s.damping,
         });
     }
     sys

@@ -55,6 +55,12 @@ fn energy_is_conserved_without_actuation() {
     }
     for name in tests::closed::CLOSED {
         let model = tests::closed::model(name);
+        // Released under gravity at 1 kHz: Andrews' squeezer has no gravity, and its spring
+        // turns the crank at ~1000 rad/s, a time scale of microseconds that a 1 ms step cannot
+        // follow (its own test integrates at 2.5 µs against the published solution).
+        if model.tree.gravity == [0.0; 3] {
+            continue;
+        }
         let plan = runtime::closed::Plan::new(&model).unwrap();
         let mech = runtime::simulate::Mechanism::Closed(&plan);
         let x0 = vec![0.0; plan.nx()];

@@ -26,6 +26,24 @@ pub(crate) struct Spec {
     pub platform: Option<PlatformSpec>,
     /// The `[scene]` table: what the application needs (TOML only).
     pub scene: SceneSpec,
+    /// `[[spring]]` force elements (TOML only; closed loops in joint coordinates).
+    pub springs: Vec<SpringSpec>,
+}
+
+/// A `[[spring]]` entry: a linear spring-damper between a point of `body_a` and one of
+/// `body_b` (body frames; `"base"` allowed).
+#[derive(Clone, Debug)]
+pub(crate) struct SpringSpec {
+    pub name: String,
+    pub key: String,
+    pub span: Span,
+    pub body_a: Named,
+    pub point_a: Vec3,
+    pub body_b: Named,
+    pub point_b: Vec3,
+    pub stiffness: f64,
+    pub rest_length: f64,
+    pub damping: f64,
 }
 
 /// A name written in the `[scene]` table, with where.

@@ -232,6 +232,20 @@ fn load_any(
             .map(|p| p.span.clone().unwrap_or(0..0));
         let functions = spec.as_ref().and_then(|s| s.scene.functions.clone());
         let mechanism = spec.and_then(|s| {
+            if let Some(sp) = s.springs.first()
+                && (s.platform.is_some() || !closed::is_closed(&s))
+            {
+                d.push(
+                    Diagnostic::error(format!(
+                        "spring \"{}\": force elements are supported in closed-loop mechanisms in joint coordinates only",
+                        sp.name
+                    ))
+                    .with_key(sp.key.clone())
+                    .with_span(sp.span.clone())
+                    .with_hint("trees and parallel platforms take no [[spring]] yet: add the spring's effort to the actuator efforts you pass in, or write the mechanism in joint coordinates"),
+                );
+                return None;
+            }
             if s.platform.is_some() {
                 parallel::lower_parallel(&s, &mut d).map(Mechanism::Parallel)
             } else if closed::is_closed(&s) {

@@ -1037,3 +1037,67 @@ mod parallel_specs {
         }
     }
 }
+
+mod springs {
+    use crate::spec::{Mechanism, load_mechanism};
+
+    const SQUEEZER: &str = include_str!("../../../mechanisms/specs/andrews_squeezer.toml");
+    const FOUR_BAR: &str = include_str!("../../../mechanisms/specs/four_bar.toml");
+    const PUMA: &str = include_str!("../../../mechanisms/specs/puma560.toml");
+
+    fn errors(src: &str) -> String {
+        match load_mechanism("s.toml", src) {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e.render(),
+        }
+    }
+
+    fn with_spring(base: &str, body_b: &str, extra: &str) -> String {
+        format!(
+            "{base}\n[[spring]]\nname = \"s1\"\nbody_a = \"base\"\npoint_a = [0.1, 0.2, 0.0]\nbody_b = \"{body_b}\"\nstiffness = 100.0\nrest_length = 0.1\n{extra}"
+        )
+    }
+
+    #[test]
+    fn the_squeezer_spring_is_read_into_the_model() {
+        let Ok((Mechanism::Closed(m), _)) = load_mechanism("andrews_squeezer.toml", SQUEEZER)
+        else {
+            panic!("the squeezer did not load");
+        };
+        assert_eq!(m.springs.len(), 1);
+        let s = &m.springs[0];
+        assert_eq!(
+            (s.body_a, s.stiffness, s.rest_length, s.damping),
+            (None, 4530.0, 0.07785, 0.0)
+        );
+        assert_eq!(s.point_a, [0.014, 0.072, 0.0]);
+        assert_eq!(m.tree.bodies[s.body_b.unwrap()].name, "K3");
+    }
+
+    #[test]
+    fn bad_springs_are_reported_at_their_keys() {
+        let e = errors(&with_spring(FOUR_BAR, "rokcer", ""));
+        assert!(
+            e.contains("spring \"s1\" names body \"rokcer\"")
+                && e.contains("did you mean \"rocker\""),
+            "{e}"
+        );
+        let e = errors(&with_spring(FOUR_BAR, "rocker", "damping = -1.0\n"));
+        assert!(
+            e.contains("damping must be finite and not negative") && e.contains("s.toml:"),
+            "{e}"
+        );
+        let e = errors(&with_spring(FOUR_BAR, "rocker", "colour = 3\n"));
+        assert!(e.contains("colour"), "{e}");
+        let e = errors(&with_spring(PUMA, "link1", ""));
+        assert!(
+            e.contains("force elements are supported in closed-loop mechanisms"),
+            "{e}"
+        );
+        // Both points at the base origin and on the crank's joint point: zero length at home.
+        let e = errors(&format!(
+            "{FOUR_BAR}\n[[spring]]\nname = \"s1\"\nbody_a = \"base\"\nbody_b = \"crank\"\nstiffness = 1.0\nrest_length = 0.0\n"
+        ));
+        assert!(e.contains("zero length at home"), "{e}");
+    }
+}

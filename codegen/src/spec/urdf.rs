@@ -734,5 +734,6 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         joints_incomplete: false,
         platform: None,
         scene: Default::default(),
+        springs: Vec::new(),
     })
 }

@@ -86,6 +86,29 @@ pub struct Cut {
     pub kind: CutKind,
 }
 
+/// A linear spring-damper between two points (an applied force element): tension
+/// `T = stiffness · (L − rest_length) + damping · L̇` along the line of the points, `L` their
+/// distance; it pulls the points together when `T > 0`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spring {
+    /// Name (from the spec).
+    pub name: String,
+    /// Tree body of the first point (`None`: the base).
+    pub body_a: Option<usize>,
+    /// The first point in `body_a`'s frame (m).
+    pub point_a: Vec3,
+    /// Tree body of the second point (`None`: the base).
+    pub body_b: Option<usize>,
+    /// The second point in `body_b`'s frame (m).
+    pub point_b: Vec3,
+    /// Stiffness (N/m), `>= 0`.
+    pub stiffness: f64,
+    /// Rest length (m), `>= 0`.
+    pub rest_length: f64,
+    /// Damping (N·s/m), `>= 0`.
+    pub damping: f64,
+}
+
 /// A validated closed-loop mechanism in joint coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClosedModel {
@@ -97,6 +120,8 @@ pub struct ClosedModel {
     pub cuts: Vec<Cut>,
     /// Indices of the independent (actuated) tree joints, in order.
     pub independent: Vec<usize>,
+    /// Spring-dampers (applied forces, with gravity in the generalized force).
+    pub springs: Vec<Spring>,
 }
 
 /// Length tolerance of the closure check at home, relative to the mechanism's size.

@@ -49,6 +49,9 @@ pub const FK_TOLERANCE: f64 = 1e-12;
 /// Newton's result must also satisfy every loop equation (the redundant ones) and keep the
 /// revolute axes aligned within this (scaled); else it is a spurious branch of the kept ones.
 pub const FULL_TOLERANCE: f64 = 1e-9;
+/// A spring shorter than this times the mechanism's size has no direction:
+/// `Singular { site: Spring(k) }`.
+pub const SPRING_TOLERANCE: f64 = 1e-9;
 /// Rank tolerance of the home analysis (relative to unit-scaled rows).
 pub const RANK_TOLERANCE: f64 = 1e-9;
 
@@ -134,6 +137,8 @@ pub struct Plan {
     pub anc: Vec<Vec<bool>>,
     /// The mechanism's size (m).
     pub size: f64,
+    /// Spring-dampers.
+    pub springs: Vec<super::Spring>,
 }
 
 impl Plan {
@@ -190,6 +195,7 @@ impl Plan {
             dependent,
             anc: ancestry(tree),
             size: model.size(),
+            springs: model.springs.clone(),
         };
         // The Jacobian of every candidate at home, rows scaled to unit norm.
         let x0 = vec![0.0; n];
@@ -329,6 +335,7 @@ impl Plan {
             dependent: Vec::new(),
             anc: ancestry(tree),
             size: 1.0,
+            springs: Vec::new(),
         }
     }
 
@@ -886,6 +893,8 @@ pub struct Config<R> {
     /// generator must keep them alive (schedule them as extra roots), or the tests vanish as
     /// dead code.
     pub checks: Vec<R>,
+    /// Each spring's length `L` and unit direction `n` (from its first point to its second).
+    pub springs: Vec<(R, V<R>)>,
 }
 
 /// Kinematics, the loop Jacobian and the LU of `Φ_d` at `x`; with `check`, the kept loop
@@ -930,11 +939,31 @@ pub fn configuration<R: Real>(plan: &Plan, x: &[R], check: bool) -> Result<Confi
         .map(|row| plan.dependent.iter().map(|&j| row[j]).collect())
         .collect();
     let lu = lu_factor(&phid)?;
+    // Springs: a length above `SPRING_TOLERANCE` times the size, else no direction.
+    let mut springs = Vec::with_capacity(plan.springs.len());
+    for (i, s) in plan.springs.iter().enumerate() {
+        let d = sub(
+            point_of(&kin, s.body_b, &s.point_b),
+            point_of(&kin, s.body_a, &s.point_a),
+        );
+        let tol = R::tolerance(SPRING_TOLERANCE) * plan.size;
+        let l2 = R::check(
+            dot(d, d),
+            R::c(tol * tol),
+            R::c(plan.size * plan.size),
+            Site::Spring(i),
+            false,
+        )?;
+        let l = l2.sqrt();
+        let inv = R::c(1.0) / l;
+        springs.push((l, scale(inv, d)));
+    }
     Ok(Config {
         kin,
         jac,
         lu,
         checks,
+        springs,
     })
 }
 
@@ -1074,6 +1103,33 @@ pub fn generalized_force_with<R: Real>(
         for (k, fk) in f.iter_mut().enumerate() {
             let (w, v) = t.payloads[k][i];
             *fk = *fk + (dot(w, nb) + dot(v, fb));
+        }
+    }
+    // Springs (applied forces, counted with gravity): the tension `T = k (L − L₀) + c L̇`
+    // does the virtual power `−T L̇`, so each effort gains `T ∂L/∂u_k`, with
+    // `∂L/∂u_k = n · (v_b⁽ᵏ⁾ − v_a⁽ᵏ⁾)` at the two points.
+    if gravity {
+        for (s, &(l, n)) in plan.springs.iter().zip(&c.springs) {
+            let dl: Vec<R> = (0..d)
+                .map(|k| {
+                    let at = |body: Option<usize>, p: &Vec3| -> V<R> {
+                        let Some(b) = body else { return zero3() };
+                        let (w, v) = t.bodies[k][b];
+                        let com = plan.joints[b].body.1;
+                        let r = mv(
+                            &c.kin.rot[b],
+                            cv(&[p[0] - com[0], p[1] - com[1], p[2] - com[2]]),
+                        );
+                        add(v, cross(w, r))
+                    };
+                    dot(n, sub(at(s.body_b, &s.point_b), at(s.body_a, &s.point_a)))
+                })
+                .collect();
+            let ldot = (1..d).fold(dl[0] * u[0], |acc, k| acc + dl[k] * u[k]);
+            let tension = R::c(s.stiffness) * (l - R::c(s.rest_length)) + R::c(s.damping) * ldot;
+            for (fk, g) in f.iter_mut().zip(&dl) {
+                *fk = *fk + tension * *g;
+            }
         }
     }
     // The drives of every tree joint, actuated or passive: `I_a ẍ + δ(ẋ)`, mapped by `Sᵀ`
@@ -1561,7 +1617,8 @@ fn wrap_near(plan: &Plan, x: &mut [f64], guess: &[f64]) {
     }
 }
 
-/// Potential energy of gravity at `x`, `−Σ m_b gᵀ c_b` (J, zero at the base origin).
+/// Potential energy at `x`: gravity's `−Σ m_b gᵀ c_b` (J, zero at the base origin) plus the springs'
+/// `½ k (L − L₀)²`.
 pub fn potential_energy(plan: &Plan, x: &[f64]) -> f64 {
     let k = kinematics(plan, x);
     let mut v = 0.0;
@@ -1569,6 +1626,15 @@ pub fn potential_energy(plan: &Plan, x: &[f64]) -> f64 {
         let (mass, com, _) = j.body;
         let c = add(k.pos[b], mv(&k.rot[b], cv(&com)));
         v -= mass * dot(cv(&plan.gravity), c);
+    }
+    // The springs' elastic energy, `½ k (L − L₀)²`.
+    for s in &plan.springs {
+        let d = sub(
+            point_of(&k, s.body_b, &s.point_b),
+            point_of(&k, s.body_a, &s.point_a),
+        );
+        let stretch = libm::sqrt(dot(d, d)) - s.rest_length;
+        v += 0.5 * s.stiffness * stretch * stretch;
     }
     v
 }

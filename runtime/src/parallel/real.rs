@@ -33,11 +33,14 @@ pub enum Site {
     /// block `Φ_d` (a configuration where the independent coordinates do not determine the
     /// others: a change of mobility or a bifurcation).
     Constraint(usize),
+    /// Spring `k` has (nearly) zero length: the direction of its force is undefined.
+    Spring(usize),
 }
 
 impl Site {
     /// A compact code (for generated code and the DAG): `MassMatrix(i)` = i, `Leg(k)` = 256 + k,
-    /// `Reach(k)` = 512 + k, `Actuation(i)` = 768 + i, `Platform` = 1024, `Input` = 1025.
+    /// `Reach(k)` = 512 + k, `Actuation(i)` = 768 + i, `Platform` = 1024, `Input` = 1025,
+    /// `Closure(k)` = 1280 + k, `Constraint(i)` = 1536 + i, `Spring(k)` = 1792 + k.
     pub fn code(self) -> u16 {
         match self {
             Site::MassMatrix(i) => i as u16,
@@ -48,6 +51,7 @@ impl Site {
             Site::Input => 1025,
             Site::Closure(k) => 1280 + k as u16,
             Site::Constraint(i) => 1536 + i as u16,
+            Site::Spring(k) => 1792 + k as u16,
         }
     }
 
@@ -61,6 +65,7 @@ impl Site {
             1024 => Site::Platform,
             1280..1536 => Site::Closure(c as usize - 1280),
             1536..1792 => Site::Constraint(c as usize - 1536),
+            1792..2048 => Site::Spring(c as usize - 1792),
             _ => Site::Input,
         }
     }
@@ -89,6 +94,7 @@ impl fmt::Display for Site {
                 f,
                 "pivot {i} of the constraint Jacobian's dependent block (the independent coordinates do not determine the others)"
             ),
+            Site::Spring(k) => write!(f, "spring {k} (zero length: no direction)"),
         }
     }
 }
