@@ -761,3 +761,43 @@ fn andrews_squeezer_reproduces_the_published_solution() {
     );
     assert!(ep < 1e-9 && ev < 1e-9, "{ours:?}");
 }
+
+/// A damped spring (the four-bar with a spring-damper from a ground point to the coupler):
+/// the NOC efforts against Newton–Euler with Lagrange multipliers, which applies the spring's
+/// force `∓(k (L − L₀) + c L̇) n` at the two material points on its own, at moving states (so the
+/// damping term is exercised).
+#[test]
+fn damped_spring_matches_the_lagrange_route() {
+    let src = format!(
+        "{}\n[[spring]]\nname = \"s\"\nbody_a = \"base\"\npoint_a = [0.3, -0.2, 0.0]\nbody_b = \"coupler\"\npoint_b = [0.35, 0.05, 0.0]\nstiffness = 250.0\nrest_length = 0.3\ndamping = 7.5\n",
+        std::fs::read_to_string(tests::pkm::spec_path("four_bar")).unwrap()
+    );
+    let Ok((codegen::spec::Mechanism::Closed(m), _)) =
+        codegen::spec::load_mechanism("s.toml", &src)
+    else {
+        panic!("the spec did not load");
+    };
+    let plan = Plan::new(&m).unwrap();
+    // The same without the damping: the damping term must matter at these states.
+    let mut undamped = m.clone();
+    undamped.springs[0].damping = 0.0;
+    let plan0 = Plan::new(&undamped).unwrap();
+    let mut rng = tests::rng(31);
+    let (mut worst, mut damping_share): (f64, f64) = (0.0, 0.0);
+    for _ in 0..100 {
+        let (x, u, ud) = random_state(&plan, &mut rng, 3.0);
+        let ours = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
+        let theirs = lagrange_efforts(&m, &x, &u, &ud);
+        worst = worst.max(rel(&ours, &theirs));
+        let without = noc::inverse_dynamics(&plan0, &x, &u, &ud).unwrap();
+        damping_share = damping_share.max(rel(&ours, &without));
+    }
+    println!(
+        "four-bar with a damped spring: NOC vs Lagrange multipliers {worst:.1e} (the damping moves the efforts by up to {damping_share:.1e})"
+    );
+    assert!(
+        damping_share > 1e-2,
+        "the damping hardly matters here: {damping_share}"
+    );
+    assert!(worst < 1e-10, "{worst:e}");
+}
