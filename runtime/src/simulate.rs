@@ -72,14 +72,26 @@ impl Report {
 impl Mechanism<'_> {
     /// Speed rates `u̇` with no actuation.
     pub fn acceleration(&self, x: &[f64], u: &[f64]) -> Result<Vec<f64>, String> {
+        self.acceleration_driven(x, u, &vec![0.0; u.len()])
+    }
+
+    /// Speed rates `u̇` under the actuator efforts `tau` (N or N·m).
+    pub fn acceleration_driven(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        tau: &[f64],
+    ) -> Result<Vec<f64>, String> {
         match self {
-            Mechanism::Tree(m) => crate::noc::forward_dynamics(m, x, u, &vec![0.0; u.len()])
+            Mechanism::Tree(m) => crate::noc::forward_dynamics(m, x, u, tau)
                 .map(|v| v.iter().copied().collect())
                 .map_err(|e| format!("{e:?}")),
-            Mechanism::Parallel(p) => parallel::noc::forward_dynamics(p, x, u, &vec![0.0; u.len()])
-                .map_err(|e| format!("{e}")),
-            Mechanism::Closed(p) => closed::noc::forward_dynamics(p, x, u, &vec![0.0; u.len()])
-                .map_err(|e| format!("{e}")),
+            Mechanism::Parallel(p) => {
+                parallel::noc::forward_dynamics(p, x, u, tau).map_err(|e| format!("{e}"))
+            }
+            Mechanism::Closed(p) => {
+                closed::noc::forward_dynamics(p, x, u, tau).map_err(|e| format!("{e}"))
+            }
         }
     }
 
@@ -142,6 +154,39 @@ pub fn simulate(
     steps: usize,
     method: Method,
 ) -> Result<Report, String> {
+    simulate_driven(mech, x0, u0, &vec![0.0; u0.len()], dt, steps, method).map(|d| d.report)
+}
+
+/// The end of a driven run: its report and the last state reached.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Driven {
+    /// The run's figures. Under efforts the energy changes by their work, so `max_drift` is
+    /// then the energy exchanged, not an error.
+    pub report: Report,
+    /// Positions at the end (at `report.time`; where the run stopped, the last good step).
+    pub x: Vec<f64>,
+    /// Speeds at the end.
+    pub u: Vec<f64>,
+}
+
+/// [`simulate`] under constant actuator efforts `tau` (N or N·m, one per speed), returning the
+/// last state too: e.g. a benchmark driven by a motor torque.
+pub fn simulate_driven(
+    mech: Mechanism<'_>,
+    x0: &[f64],
+    u0: &[f64],
+    tau: &[f64],
+    dt: f64,
+    steps: usize,
+    method: Method,
+) -> Result<Driven, String> {
+    if tau.len() != u0.len() {
+        return Err(alloc::format!(
+            "{} efforts for {} speeds",
+            tau.len(),
+            u0.len()
+        ));
+    }
     let (t0, v0) = mech.energy(x0, u0)?;
     let mut r = Report {
         time: 0.0,
@@ -160,23 +205,23 @@ pub fn simulate(
         let step = || -> Result<(Vec<f64>, Vec<f64>), String> {
             match method {
                 Method::SymplecticEuler => {
-                    let a = mech.acceleration(&x, &u)?;
+                    let a = mech.acceleration_driven(&x, &u, tau)?;
                     let un = axpy(&u, dt, &a);
                     let xn = mech.advance(&x, &scale(dt, &un))?;
                     Ok((xn, un))
                 }
                 Method::Rk4 => {
-                    let a1 = mech.acceleration(&x, &u)?;
+                    let a1 = mech.acceleration_driven(&x, &u, tau)?;
                     let u1 = u.clone();
                     let x2 = mech.advance(&x, &scale(0.5 * dt, &u1))?;
                     let u2 = axpy(&u, 0.5 * dt, &a1);
-                    let a2 = mech.acceleration(&x2, &u2)?;
+                    let a2 = mech.acceleration_driven(&x2, &u2, tau)?;
                     let x3 = mech.advance(&x, &scale(0.5 * dt, &u2))?;
                     let u3 = axpy(&u, 0.5 * dt, &a2);
-                    let a3 = mech.acceleration(&x3, &u3)?;
+                    let a3 = mech.acceleration_driven(&x3, &u3, tau)?;
                     let x4 = mech.advance(&x, &scale(dt, &u3))?;
                     let u4 = axpy(&u, dt, &a3);
-                    let a4 = mech.acceleration(&x4, &u4)?;
+                    let a4 = mech.acceleration_driven(&x4, &u4, tau)?;
                     let dx: Vec<f64> = (0..u.len())
                         .map(|i| dt / 6.0 * (u1[i] + 2.0 * u2[i] + 2.0 * u3[i] + u4[i]))
                         .collect();
@@ -191,7 +236,7 @@ pub fn simulate(
             Ok(s) => s,
             Err(e) => {
                 r.stopped = Some(e);
-                return Ok(r);
+                return Ok(Driven { report: r, x, u });
             }
         };
         x = xn;
@@ -204,10 +249,10 @@ pub fn simulate(
             }
             Err(e) => {
                 r.stopped = Some(e);
-                return Ok(r);
+                return Ok(Driven { report: r, x, u });
             }
         }
         r.max_closure = r.max_closure.max(mech.closure(&x));
     }
-    Ok(r)
+    Ok(Driven { report: r, x, u })
 }
