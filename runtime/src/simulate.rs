@@ -181,11 +181,7 @@ pub fn simulate_driven(
     method: Method,
 ) -> Result<Driven, String> {
     if tau.len() != u0.len() {
-        return Err(alloc::format!(
-            "{} efforts for {} speeds",
-            tau.len(),
-            u0.len()
-        ));
+        return Err(format!("{} efforts for {} speeds", tau.len(), u0.len()));
     }
     let (t0, v0) = mech.energy(x0, u0)?;
     let mut r = Report {

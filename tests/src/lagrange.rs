@@ -1202,14 +1202,7 @@ pub fn from_closed(model: &runtime::closed::ClosedModel, x: &[f64]) -> CSystem {
         });
     }
     for s in &model.springs {
-        let at = |b: Option<usize>, p: &Vec3| {
-            pose_of(b)
-                .compose(&Transform {
-                    translation: *p,
-                    ..Transform::IDENTITY
-                })
-                .translation
-        };
+        let at = |b: Option<usize>, p: &Vec3| pose_of(b).apply(p);
         sys.springs.push(CSpring {
             a: s.body_a,
             point_a: at(s.body_a, &s.point_a),

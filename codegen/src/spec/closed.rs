@@ -128,19 +128,20 @@ pub(crate) fn lower_closed_attached(
             independent.push(k);
         }
     }
+    // A spec body's model body and its pose in that body's frame (`None` for the base).
+    let body_of = |name: &str| -> Option<(Option<usize>, Transform)> {
+        if name == super::ir::BASE {
+            return Some((None, Transform::IDENTITY));
+        }
+        let b = spec.bodies.iter().position(|b| b.name == name)?;
+        let a = attach[b]?;
+        Some((a.target, a.pose))
+    };
     let mut cuts = Vec::new();
     for (ji, j) in spec.joints.iter().enumerate() {
         if !skip.joint[ji] {
             continue;
         }
-        let body_of = |name: &str| -> Option<(Option<usize>, Transform)> {
-            if name == super::ir::BASE {
-                return Some((None, Transform::IDENTITY));
-            }
-            let b = spec.bodies.iter().position(|b| b.name == name)?;
-            let a = attach[b]?;
-            Some((a.target, a.pose))
-        };
         let (Some((pa, pose_a)), Some((cb, pose_b))) = (body_of(&j.parent), body_of(&j.child))
         else {
             continue; // reported by the topology check
@@ -166,54 +167,33 @@ pub(crate) fn lower_closed_attached(
     // Springs: each point in the frame of the model body its spec body became part of.
     let mut springs = Vec::new();
     for sp in &spec.springs {
-        let mut ends = Vec::with_capacity(2);
-        for (body, point) in [(&sp.body_a, &sp.point_a), (&sp.body_b, &sp.point_b)] {
-            if body.name == super::ir::BASE {
-                ends.push(Some((None, *point)));
-                continue;
-            }
-            let place = spec
-                .bodies
-                .iter()
-                .position(|b| b.name == body.name)
-                .and_then(|b| attach[b]);
-            match place {
-                Some(a) => {
-                    let p = compose(
-                        &a.pose,
-                        &Transform {
-                            translation: *point,
-                            ..Transform::IDENTITY
-                        },
-                    );
-                    ends.push(Some((a.target, p.translation)));
-                }
-                None => {
-                    let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
-                    let mut d = Diagnostic::error(format!(
+        let mut end = |body: &super::ir::Named, point: &runtime::model::Vec3| {
+            let place = body_of(&body.name);
+            if place.is_none() {
+                let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
+                diags.push(
+                    Diagnostic::error(format!(
                         "spring \"{}\" names body {:?}, which the mechanism does not have",
                         sp.name, body.name
                     ))
                     .with_key(body.key.clone())
-                    .with_span(body.span.clone());
-                    d = d.with_hint(
+                    .with_span(body.span.clone())
+                    .with_hint(
                         super::suggest_hint(&body.name, &names)
                             .unwrap_or_else(|| "name a [[body]] of this spec, or \"base\"".into()),
-                    );
-                    diags.push(d);
-                    ends.push(None);
-                }
+                    ),
+                );
             }
-        }
-        if let (Some(Some((body_a, point_a))), Some(Some((body_b, point_b)))) =
-            (ends.first(), ends.get(1))
-        {
+            place.map(|(target, pose)| (target, pose.apply(point)))
+        };
+        let (a, b) = (end(&sp.body_a, &sp.point_a), end(&sp.body_b, &sp.point_b));
+        if let (Some((body_a, point_a)), Some((body_b, point_b))) = (a, b) {
             springs.push(runtime::closed::Spring {
                 name: sp.name.clone(),
-                body_a: *body_a,
-                point_a: *point_a,
-                body_b: *body_b,
-                point_b: *point_b,
+                body_a,
+                point_a,
+                body_b,
+                point_b,
                 stiffness: sp.stiffness,
                 rest_length: sp.rest_length,
                 damping: sp.damping,
@@ -230,23 +210,23 @@ pub(crate) fn lower_closed_attached(
         independent,
         springs,
     };
-    if let Err(e) = Plan::new(&closed) {
-        // A spring of zero length at home: point at the spring.
-        if let Some(sp) = spec
-            .springs
-            .iter()
-            .enumerate()
-            .find(|(k, _)| e.contains(&format!("spring {k} ")))
-            .map(|(_, sp)| sp)
-        {
+    // A spring of zero length at home has no direction there (the functions' `Spring` guard).
+    let size = closed.size();
+    for (k, sp) in spec.springs.iter().enumerate() {
+        let l = closed.spring_length_at_home(k);
+        if l <= runtime::closed::noc::SPRING_TOLERANCE * size {
             diags.push(
-                Diagnostic::error(format!("spring \"{}\" has zero length at home ({e})", sp.name))
+                Diagnostic::error(format!("spring \"{}\" has zero length at home ({l:e} m)", sp.name))
                     .with_key(sp.key.clone())
                     .with_span(sp.span.clone())
                     .with_hint("its two points coincide with every joint at zero, so its force has no direction there: check point_a and point_b"),
             );
-            return None;
         }
+    }
+    if diags.has_errors() {
+        return None;
+    }
+    if let Err(e) = Plan::new(&closed) {
         // Point at the first loop-closing joint (the loops are where the analysis failed).
         let at = spec.joints.iter().find(|j| j.child_origin.is_some());
         let mut d = Diagnostic::error(e).with_hint("the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)");

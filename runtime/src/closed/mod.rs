@@ -154,6 +154,16 @@ impl ClosedModel {
         s
     }
 
+    /// The length (m) of spring `k` at home (every tree joint at zero).
+    pub fn spring_length_at_home(&self, k: usize) -> f64 {
+        let poses = home_poses(&self.tree);
+        let s = &self.springs[k];
+        let at = |b: Option<usize>, p: &Vec3| b.map_or(Transform::IDENTITY, |b| poses[b]).apply(p);
+        let (a, b) = (at(s.body_a, &s.point_a), at(s.body_b, &s.point_b));
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    }
+
     /// Structural checks: independent joints valid and distinct, at least one cut, and every
     /// loop closed at home (origins together, revolute axes aligned).
     pub fn validate(&self) -> Result<(), String> {

@@ -594,7 +594,7 @@ fn side(plan: &Plan, parent: Option<usize>, child: Option<usize>, j: usize) -> i
 }
 
 /// The Jacobian row of a loop equation over all joints.
-pub fn jacobian_row<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> Vec<R> {
+fn jacobian_row<R: Real>(plan: &Plan, k: &Kin<R>, r: &Row) -> Vec<R> {
     let n = plan.nx();
     let mut out = vec![R::c(0.0); n];
     match *r {
@@ -1482,7 +1482,7 @@ pub fn closure_residual(plan: &Plan, x: &[f64]) -> f64 {
 /// The number of continuation stages from `guess` to the independent coordinates `xi`: no
 /// independent coordinate moves more than [`FK_STEP`] (rad, or times the size for a
 /// prismatic joint) per stage, at most [`FK_MAX_STAGES`]; 1 for non-finite input.
-pub fn continuation_stages(plan: &Plan, xi: &[f64], guess: &[f64]) -> usize {
+fn continuation_stages(plan: &Plan, xi: &[f64], guess: &[f64]) -> usize {
     let mut need: f64 = 1.0;
     for (k, &j) in plan.independent.iter().enumerate() {
         let step = match plan.joints[j].kind {
@@ -1500,7 +1500,7 @@ pub fn continuation_stages(plan: &Plan, xi: &[f64], guess: &[f64]) -> usize {
 
 /// Forward kinematics (assembly): the closed configuration whose independent coordinates are
 /// `xi`, on the branch of `guess`. The independent coordinates move from `guess`'s to `xi` in
-/// [`continuation_stages`] equal stages, each assembled by [`newton_assembly`] from the last
+/// equal stages (`continuation_stages`), each assembled by [`newton_assembly`] from the last
 /// (path following: a far target stays on the guess's assembly mode instead of wherever one
 /// Newton solve from far away lands). If a stage fails (the straight path crosses a
 /// singularity), one Newton solve from `guess` decides, as with a single stage.
@@ -1607,12 +1607,7 @@ fn wrap_near(plan: &Plan, x: &mut [f64], guess: &[f64]) {
             && d.abs() > core::f64::consts::PI
             && d.abs() < 1e9
         {
-            let k = d / t + 0.5;
-            let mut n = k as i64 as f64;
-            if n > k {
-                n -= 1.0;
-            }
-            x[j] = guess[j] + (d - n * t);
+            x[j] = guess[j] + (d - libm::floor(d / t + 0.5) * t);
         }
     }
 }
