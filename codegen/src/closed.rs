@@ -12,29 +12,29 @@ use runtime::parallel::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::parallel::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
-use crate::scalar::{flat, ids, in_fresh_graph, inputs};
-use crate::schedule::{OpCount, schedule};
+use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
+use crate::schedule::{Kernel, OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
 
-/// The DAG kernels of a closed-loop mechanism.
+/// The DAG kernels of a closed-loop mechanism: each function's outputs with the guards its
+/// evaluation asked for (the closure tests of `x` among them: nothing reads their values, and
+/// they are scheduled all the same).
 pub struct Kernels {
     /// The shared DAG.
     pub graph: Graph,
     /// All joint rates `ẋ = S u`.
-    pub joint_rates: Vec<ExprId>,
+    pub joint_rates: Kernel,
     /// Generalized forces of the independent coordinates.
-    pub inverse_dynamics: Vec<ExprId>,
+    pub inverse_dynamics: Kernel,
     /// `I`, row-major.
-    pub mass_matrix: Vec<ExprId>,
+    pub mass_matrix: Kernel,
     /// `u̇`.
-    pub forward_dynamics: Vec<ExprId>,
+    pub forward_dynamics: Kernel,
     /// Newton step (`NX`), the signed largest scaled residual of the kept loop equations, then
-    /// that of every loop equation and axis alignment.
-    pub newton_step: Vec<ExprId>,
-    /// The closure tests of the inputs: scheduled (as extra roots) in every function that
-    /// takes a closed `x`, though no output uses them.
-    pub checks: Vec<ExprId>,
+    /// that of every loop equation and axis alignment (on open configurations by design: no
+    /// closure tests).
+    pub newton_step: Kernel,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -67,7 +67,6 @@ fn build(
     let u = inputs(Arg::U, d);
     let ud = inputs(Arg::Ud, d);
     let tau = inputs(Arg::Tau, d);
-    let c = noc::configuration(plan, &x, true)?;
     let mut payloads: Vec<_> = payload_body
         .filter(|_| layout.payload)
         .map(|b| (b, payload_inputs()))
@@ -83,22 +82,34 @@ fn build(
         payloads,
         drives: layout.drives().then(|| drive_inputs(plan.nx(), layout)),
     };
-    let rates = noc::joint_rates_generic(plan, &c, &u);
-    let f = noc::generalized_force_with(plan, &c, &u, &ud, true, &extras);
-    let m = noc::generalized_inertia_with(plan, &c, &extras);
-    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, &extras)?;
-    let (step, kept, full) = noc::newton_step(plan, &x)?;
-    let mut newton = ids(&step);
-    newton.push(kept.0);
-    newton.push(full.0);
+    // Each function as the `f64` API evaluates it, from `x` (the shared configuration is built
+    // once; the DAG shares it, and each kernel keeps the guards it asked for).
+    let kernel = |f: &dyn Fn() -> Result<Vec<ExprId>, Singular>| {
+        let (outputs, guards) = guarded(f);
+        outputs.map(|o| Kernel::new(o, guards))
+    };
+    let configured = |f: &dyn Fn(&noc::Config<Sx>) -> Vec<ExprId>| {
+        kernel(&|| noc::configuration(plan, &x, true).map(|c| f(&c)))
+    };
     Ok(Kernels {
         graph: Graph::new(),
-        joint_rates: ids(&rates),
-        inverse_dynamics: ids(&f),
-        mass_matrix: flat(&m),
-        forward_dynamics: ids(&fd),
-        newton_step: newton,
-        checks: ids(&c.checks),
+        joint_rates: configured(&|c| ids(&noc::joint_rates_generic(plan, c, &u)))?,
+        inverse_dynamics: configured(&|c| {
+            ids(&noc::generalized_force_with(
+                plan, c, &u, &ud, true, &extras,
+            ))
+        })?,
+        mass_matrix: configured(&|c| flat(&noc::generalized_inertia_with(plan, c, &extras)))?,
+        forward_dynamics: kernel(&|| {
+            noc::forward_dynamics_with(plan, &x, &u, &tau, &extras).map(|fd| ids(&fd))
+        })?,
+        newton_step: kernel(&|| {
+            let (step, kept, full) = noc::newton_step(plan, &x)?;
+            let mut newton = ids(&step);
+            newton.push(kept.0);
+            newton.push(full.0);
+            Ok(newton)
+        })?,
     })
 }
 
@@ -158,20 +169,14 @@ pub fn generate_with(
     let make = |name: &'static str,
                 doc: Vec<String>,
                 args: Vec<Arg>,
-                outputs: Vec<ExprId>,
+                kernel: &Kernel,
                 shape: Shape,
                 public: bool| Function {
         name,
         doc,
         args,
-        // The closure tests first (they are cheap and guard everything else), except in
-        // Newton's step, which runs on open configurations by design.
-        schedule: if name == "newton_step" {
-            schedule(g, &outputs)
-        } else {
-            schedule(g, &[k.checks.clone(), outputs.clone()].concat())
-        },
-        outputs,
+        schedule: schedule(g, kernel),
+        outputs: kernel.outputs.clone(),
         shape,
         dof: n,
         public,
@@ -185,7 +190,7 @@ pub fn generate_with(
                 "All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`). {coords}. `Err` when `x` does not close the loops (`Site::Closure`) or the independent coordinates do not determine the others (`Site::Constraint`)."
             )],
             vec![Arg::X, Arg::U],
-            k.joint_rates.clone(),
+            &k.joint_rates,
             fallible(&[Part::Coords(nx)]),
             true,
         ),
@@ -195,7 +200,7 @@ pub fn generate_with(
                 "Generalized forces of the independent coordinates, `f = Sᵀ τ_tree = I u̇ + C u − γ` (N or N·m, gravity included): the efforts of the actuated joints that produce the motion `(x, u, ud)`. {coords}."
             )],
             with_p(vec![Arg::X, Arg::U, Arg::Ud]),
-            k.inverse_dynamics.clone(),
+            &k.inverse_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
@@ -203,7 +208,7 @@ pub fn generate_with(
             "mass_matrix",
             vec!["Generalized inertia `I = Sᵀ M S` of the independent coordinates (symmetric positive definite away from singularities).".into()],
             with_p(vec![Arg::X]),
-            k.mass_matrix.clone(),
+            &k.mass_matrix,
             fallible(&[Part::Matrix]),
             true,
         ),
@@ -211,7 +216,7 @@ pub fn generate_with(
             "forward_dynamics",
             vec!["Rates `u̇` of the independent speeds with `I u̇ = τ − (C u − γ)` for the actuator efforts `tau`; `Err` where the method fails or a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
             with_p(vec![Arg::X, Arg::U, Arg::Tau]),
-            k.forward_dynamics.clone(),
+            &k.forward_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
@@ -219,7 +224,7 @@ pub fn generate_with(
             "newton_step",
             vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates, the signed largest scaled residual of the kept loop equations, and that of every loop equation and revolute-axis alignment.".into()],
             vec![Arg::X],
-            k.newton_step.clone(),
+            &k.newton_step,
             fallible(&[Part::Coords(nx), Part::Scalar, Part::Scalar]),
             false,
         ),

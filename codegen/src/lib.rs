@@ -49,7 +49,7 @@ pub mod sym;
 use dynamics::{Terms, Tree};
 use emit::{Function, Shape};
 use runtime::model::Model;
-use schedule::{OpCount, schedule};
+use schedule::{Kernel, OpCount, schedule};
 use sym::{Arg, Graph};
 
 /// Where generated code takes `sin_cos` and `sqrt` from.
@@ -189,6 +189,9 @@ pub struct Symbolic {
     pub inverse_dynamics: Vec<sym::ExprId>,
     /// `I⁻¹ (τ − C q̇ + γ)` with checked pivots.
     pub forward_dynamics: Vec<sym::ExprId>,
+    /// The pivot guards of `forward_dynamics`, in the order of its factorization (the other
+    /// functions test nothing).
+    pub forward_dynamics_guards: Vec<sym::ExprId>,
     /// Joint friction `δ(q̇)`, when some joint's drive has friction (`[scene] friction`).
     pub friction: Option<Vec<sym::ExprId>>,
 }
@@ -227,7 +230,12 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         },
     );
     let inverse_dynamics = dynamics::inverse_dynamics(&mut g, &tree, Terms::ALL);
+    debug_assert!(
+        g.take_guards().is_empty(),
+        "a tree function other than FD tests"
+    );
     let forward_dynamics = dynamics::forward_dynamics(&mut g, &tree);
+    let forward_dynamics_guards = g.take_guards();
     let friction = model
         .joints
         .iter()
@@ -250,6 +258,7 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         gravity,
         inverse_dynamics,
         forward_dynamics,
+        forward_dynamics_guards,
         friction,
     }
 }
@@ -517,9 +526,11 @@ pub fn generate_with(
         gravity: grav,
         inverse_dynamics: id,
         forward_dynamics: fd,
+        forward_dynamics_guards: fd_guards,
         friction,
     } = symbolic_with(model, params);
-    type Spec = (&'static str, Vec<String>, Vec<Arg>, Vec<sym::ExprId>, Shape);
+    type Spec = (&'static str, Vec<String>, Vec<Arg>, Kernel, Shape);
+    let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
     let mut specs: Vec<Spec> = vec![
         (
             "mass_matrix",
@@ -529,7 +540,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Q],
-            mm_out,
+            k(mm_out),
             Shape::Matrix,
         ),
         (
@@ -540,7 +551,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Q, Arg::Qd],
-            cor,
+            k(cor),
             Shape::Vector,
         ),
         (
@@ -551,7 +562,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Q],
-            grav,
+            k(grav),
             Shape::Vector,
         ),
         (
@@ -563,7 +574,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Q, Arg::Qd, Arg::Qdd],
-            id,
+            k(id),
             Shape::Vector,
         ),
         (
@@ -575,7 +586,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Q, Arg::Qd, Arg::Tau],
-            fd,
+            Kernel::new(fd, fd_guards),
             Shape::FallibleVector,
         ),
     ];
@@ -589,7 +600,7 @@ pub fn generate_with(
                     .into(),
             ],
             vec![Arg::Qd],
-            friction,
+            k(friction),
             Shape::Vector,
         ));
     }
@@ -601,8 +612,9 @@ pub fn generate_with(
     let functions: Vec<Function<'_>> = specs
         .into_iter()
         .filter(|s| only.is_none_or(|o| o.iter().any(|f| f == s.0)))
-        .map(|(name, doc, args, outputs, shape)| {
-            let schedule = schedule(&g, &outputs);
+        .map(|(name, doc, args, kernel, shape)| {
+            let schedule = schedule(&g, &kernel);
+            let outputs = kernel.outputs;
             Function {
                 name,
                 doc,

@@ -11,31 +11,32 @@ use runtime::model::JointKind;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular};
 
-use crate::scalar::{Sx, flat, ids, in_fresh_graph, inputs};
+use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
-use crate::schedule::{OpCount, schedule};
+use crate::schedule::{Kernel, OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, lu};
 
-/// The DAG kernels of a parallel mechanism.
+/// The DAG kernels of a parallel mechanism: each function's outputs with the guards its
+/// evaluation asked for.
 pub struct Kernels {
     /// The shared DAG.
     pub graph: Graph,
     /// Actuated joint positions `q(x)`.
-    pub inverse_kinematics: Vec<ExprId>,
+    pub inverse_kinematics: Kernel,
     /// `A u`.
-    pub actuator_rates: Vec<ExprId>,
+    pub actuator_rates: Kernel,
     /// `A` (row-major) then `f = I u̇ + C u − γ`.
-    pub id_parts: Vec<ExprId>,
+    pub id_parts: Kernel,
     /// `I`, row-major.
-    pub mass_matrix: Vec<ExprId>,
+    pub mass_matrix: Kernel,
     /// `A` then `I`.
-    pub inertia_parts: Vec<ExprId>,
+    pub inertia_parts: Kernel,
     /// `u̇`.
-    pub forward_dynamics: Vec<ExprId>,
+    pub forward_dynamics: Kernel,
     /// `q(x)` then `A`.
-    pub fk_parts: Vec<ExprId>,
+    pub fk_parts: Kernel,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -164,8 +165,13 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let u = inputs(Arg::U, n);
     let ud = inputs(Arg::Ud, n);
     let tau = inputs(Arg::Tau, n);
-    let (pl, legs) = noc::kinematics(plan, &x)?;
-    let q = noc::actuated_positions(plan, &legs);
+    // Inverse kinematics needs the legs' positions; every other function starts from their
+    // kinematics, Jacobians included, and its tests.
+    let (pos, pos_guards) = guarded(|| noc::positions(plan, &x));
+    let q = noc::actuated_positions(plan, &pos?.1);
+    let (kin, kin_guards) = guarded(|| noc::kinematics(plan, &x));
+    let (pl, legs) = kin?;
+    let with_kin = |outputs: Vec<ExprId>| Kernel::new(outputs, kin_guards.clone());
     let a = noc::actuation_matrix(plan, &legs);
     let rates: Vec<Sx> = a
         .iter()
@@ -195,17 +201,20 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
             }
         }
     }
-    let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, &payloads, drives.as_ref())?;
+    // Forward dynamics from `x`, as the `f64` API evaluates it (the kinematics again, shared
+    // in the DAG, and the `LDLᵀ` of `I`).
+    let (fd, fd_guards) =
+        guarded(|| noc::forward_dynamics_with(plan, &x, &u, &tau, &payloads, drives.as_ref()));
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
     Ok(Kernels {
         graph: Graph::new(),
-        inverse_kinematics: ids(&q),
-        actuator_rates: ids(&rates),
-        id_parts: cat(flat(&a), ids(&f)),
-        mass_matrix: flat(&i),
-        inertia_parts: cat(flat(&a), flat(&i)),
-        forward_dynamics: ids(&fd),
-        fk_parts: cat(ids(&q), flat(&a)),
+        inverse_kinematics: Kernel::new(ids(&q), pos_guards),
+        actuator_rates: with_kin(ids(&rates)),
+        id_parts: with_kin(cat(flat(&a), ids(&f))),
+        mass_matrix: with_kin(flat(&i)),
+        inertia_parts: with_kin(cat(flat(&a), flat(&i))),
+        forward_dynamics: Kernel::new(ids(&fd?), fd_guards),
+        fk_parts: with_kin(cat(ids(&q), flat(&a))),
     })
 }
 
@@ -332,14 +341,14 @@ pub fn generate_with(
     let make = |name: &'static str,
                 doc: Vec<String>,
                 args: Vec<Arg>,
-                outputs: Vec<ExprId>,
+                kernel: &Kernel,
                 shape: Shape,
                 public: bool| Function {
         name,
         doc,
         args,
-        schedule: schedule(g, &outputs),
-        outputs,
+        schedule: schedule(g, kernel),
+        outputs: kernel.outputs.clone(),
         shape,
         dof: n,
         public,
@@ -352,7 +361,7 @@ pub fn generate_with(
                 "Actuated joint positions `q(x)` (rad or m, in `ACTUATOR_NAMES` order) by closed-form leg inverse kinematics. {coords}. `Err` when a leg cannot reach the platform (`Site::Reach`) or is singular (`Site::Leg`)."
             )],
             vec![Arg::X],
-            k.inverse_kinematics.clone(),
+            &k.inverse_kinematics,
             fallible(&[Part::Vector]),
             true,
         ),
@@ -360,7 +369,7 @@ pub fn generate_with(
             "actuator_rates",
             vec!["Actuator rates `q̇ = A u` (rad/s or m/s); `Err` at a leg singularity.".into()],
             vec![Arg::X, Arg::U],
-            k.actuator_rates.clone(),
+            &k.actuator_rates,
             fallible(&[Part::Vector]),
             true,
         ),
@@ -368,7 +377,7 @@ pub fn generate_with(
             "id_parts",
             vec!["Kernel of `inverse_dynamics`: the actuation matrix `A` and the generalized force `f = I u̇ + C u − γ`.".into()],
             with_p(vec![Arg::X, Arg::U, Arg::Ud]),
-            k.id_parts.clone(),
+            &k.id_parts,
             fallible(&[Part::Matrix, Part::Vector]),
             false,
         ),
@@ -376,7 +385,7 @@ pub fn generate_with(
             "mass_matrix",
             vec!["Generalized inertia `I = TᵀMT` of the speeds `u` (symmetric positive definite away from singularities; kg·m², kg·m, kg).".into()],
             with_p(vec![Arg::X]),
-            k.mass_matrix.clone(),
+            &k.mass_matrix,
             fallible(&[Part::Matrix]),
             true,
         ),
@@ -384,7 +393,7 @@ pub fn generate_with(
             "inertia_parts",
             vec!["Kernel of `actuator_mass_matrix`: `A` and `I`.".into()],
             with_p(vec![Arg::X]),
-            k.inertia_parts.clone(),
+            &k.inertia_parts,
             fallible(&[Part::Matrix, Part::Matrix]),
             false,
         ),
@@ -392,7 +401,7 @@ pub fn generate_with(
             "forward_dynamics",
             vec!["Speed rates `u̇` with `I u̇ = Aᵀ τ − (C u − γ)` for the actuator efforts `tau` (N or N·m); `Err` at a leg singularity or when a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
             with_p(vec![Arg::X, Arg::U, Arg::Tau]),
-            k.forward_dynamics.clone(),
+            &k.forward_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
@@ -400,7 +409,7 @@ pub fn generate_with(
             "fk_parts",
             vec!["Kernel of `forward_kinematics`: `q(x)` and `A(x)`.".into()],
             vec![Arg::X],
-            k.fk_parts.clone(),
+            &k.fk_parts,
             fallible(&[Part::Vector, Part::Matrix]),
             false,
         ),

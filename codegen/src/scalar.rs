@@ -40,6 +40,21 @@ pub(crate) fn tolerance(t: f64) -> f64 {
     }
 }
 
+/// Run `f` and return its result with every guard it asked for (each once, in the order first
+/// asked): the guard roots of the function `f` evaluates. A capture inside another hands its
+/// guards on to the outer one.
+pub(crate) fn guarded<T>(f: impl FnOnce() -> T) -> (T, Vec<ExprId>) {
+    let outer = with(|g| g.take_guards());
+    let r = f();
+    let inner = with(|g| {
+        let inner = g.take_guards();
+        g.log_guards(&outer);
+        g.log_guards(&inner);
+        inner
+    });
+    (r, inner)
+}
+
 pub(crate) fn with<T>(f: impl FnOnce(&mut Graph) -> T) -> T {
     GRAPH.with(|c| f(&mut c.borrow_mut()))
 }

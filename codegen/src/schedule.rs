@@ -104,8 +104,35 @@ impl Schedule {
     }
 }
 
-/// Schedule the nodes that `roots` need.
-pub fn schedule(g: &Graph, roots: &[ExprId]) -> Schedule {
+/// One function's DAG: its outputs and every guard its evaluation asked for
+/// ([`Graph::take_guards`], [`crate::scalar::guarded`]).
+#[derive(Clone, Debug, Default)]
+pub struct Kernel {
+    /// The values the function returns, in order.
+    pub outputs: Vec<ExprId>,
+    /// The tests the function performs, in the order the evaluator asked for them.
+    pub guards: Vec<ExprId>,
+}
+
+impl Kernel {
+    /// `outputs` with the `guards` they were computed under.
+    pub fn new(outputs: Vec<ExprId>, guards: Vec<ExprId>) -> Kernel {
+        Kernel { outputs, guards }
+    }
+}
+
+/// Schedule the nodes that a function's guards and outputs need: the guards first, in the
+/// order the evaluator asked for them (so the first failing test is the one the `f64`
+/// evaluator reports), then the outputs. Every guard is a root: a test never vanishes as dead
+/// code because no output reads the value it passes on.
+pub fn schedule(g: &Graph, k: &Kernel) -> Schedule {
+    debug_assert!(
+        k.guards
+            .iter()
+            .all(|&id| matches!(g.node(id), Node::Guard { .. })),
+        "a guard root that is not a guard"
+    );
+    let roots: Vec<ExprId> = k.guards.iter().chain(&k.outputs).copied().collect();
     let mut s = Schedule::default();
     let mut done: HashMap<ExprId, ()> = HashMap::new();
     let mut next = 0usize;

@@ -105,6 +105,10 @@ pub const TWO_SIDED: u16 = 0x8000;
 #[derive(Default, Clone)]
 pub struct Graph {
     nodes: IndexSet<Node, FxBuildHasher>,
+    /// Every guard asked for since the last [`Graph::take_guards`], in the order asked (a guard
+    /// is a test the evaluator performs: the function that asked for it must schedule it
+    /// whether or not any output uses its value).
+    guards: Vec<ExprId>,
 }
 
 impl Graph {
@@ -361,14 +365,33 @@ impl Graph {
         }
     }
 
-    /// A checked pivot (see [`Node::Guard`]).
+    /// A checked pivot (see [`Node::Guard`]), logged for [`Graph::take_guards`].
     pub fn guard(&mut self, value: ExprId, tol: ExprId, scale: ExprId, index: usize) -> ExprId {
-        self.intern(Node::Guard {
+        let id = self.intern(Node::Guard {
             value,
             tol,
             scale,
             index: index as u16,
-        })
+        });
+        self.guards.push(id);
+        id
+    }
+
+    /// The guards asked for since the last call, each once, in the order first asked; the log
+    /// is left empty. A function's schedule takes them as roots ([`crate::schedule::schedule`]),
+    /// so a test the evaluator performs reaches the output even when nothing reads the value
+    /// it passes on (the last pivot of a square LU feeds no row below it).
+    pub fn take_guards(&mut self) -> Vec<ExprId> {
+        let mut seen = std::collections::HashSet::new();
+        std::mem::take(&mut self.guards)
+            .into_iter()
+            .filter(|&id| seen.insert(id))
+            .collect()
+    }
+
+    /// Append `guards` to the log (to hand a nested capture's guards on to the enclosing one).
+    pub fn log_guards(&mut self, guards: &[ExprId]) {
+        self.guards.extend_from_slice(guards);
     }
 
     /// Operands of a node, in order.

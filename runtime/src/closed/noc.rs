@@ -889,9 +889,8 @@ pub struct Config<R> {
     pub jac: Vec<Vec<R>>,
     /// LU of `Φ_d`.
     pub lu: Lu<R>,
-    /// The checked values of the closure tests (with `check`). Nothing else uses them, so a
-    /// generator must keep them alive (schedule them as extra roots), or the tests vanish as
-    /// dead code.
+    /// The checked values of the closure tests (with `check`). Nothing else uses them: a
+    /// generator keeps every test it was asked for as a root of the function's DAG.
     pub checks: Vec<R>,
     /// Each spring's length `L` and unit direction `n` (from its first point to its second).
     pub springs: Vec<(R, V<R>)>,

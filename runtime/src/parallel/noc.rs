@@ -540,6 +540,7 @@ fn two_axes<R: Real>(
     q: V<R>,
     sigma: f64,
     leg: usize,
+    check: bool,
 ) -> Result<[(R, R); 2], Singular> {
     let w = dot3(e1, e2);
     let k = cross3(e1, e2);
@@ -561,14 +562,20 @@ fn two_axes<R: Real>(
     };
     // γ² < 0: the target is out of reach; γ² ≈ 0 (within 1e-12 of |p|²): the boundary of the
     // leg's workspace, where its Jacobian is singular.
-    let g2 = R::check(
-        g2,
-        R::c(-R::tolerance(1e-12)) * pp,
-        pp,
-        Site::Reach(leg),
-        false,
-    )?;
-    let g2 = R::check(g2, R::c(0.0), pp, Site::Leg(leg), false)?;
+    // Unchecked (`!check`) where the caller's own tests cover these cases and nothing it
+    // returns uses the angles.
+    let g2 = if check {
+        let g2 = R::check(
+            g2,
+            R::c(-R::tolerance(1e-12)) * pp,
+            pp,
+            Site::Reach(leg),
+            false,
+        )?;
+        R::check(g2, R::c(0.0), pp, Site::Leg(leg), false)?
+    } else {
+        g2
+    };
     let gamma = R::c(sigma) * g2.sqrt();
     let c = add(
         add(scale(alpha, cv(e1)), scale(beta, cv(e2))),
@@ -584,7 +591,11 @@ fn two_axes<R: Real>(
     let cq = sub(c, scale(e1q, cv(e1)));
     let qq = sub(q, scale(e1q, cv(e1)));
     let n1 = dot(cq, cq);
-    let n1 = R::check(n1, R::c(0.0), pp, Site::Leg(leg), false)?;
+    let n1 = if check {
+        R::check(n1, R::c(0.0), pp, Site::Leg(leg), false)?
+    } else {
+        n1
+    };
     let s1 = dot(cross(cv(e1), cq), qq) / n1;
     let c1 = dot(cq, qq) / n1;
     Ok([(s1, c1), (s2, c2)])
@@ -678,11 +689,15 @@ pub struct UpsKin<R> {
     pub s: V<R>,
 }
 
-/// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`.
+/// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`. Each test is
+/// made where its value is used: the Jacobian's (`Site::Leg`) only with `jacobian` (positions
+/// alone do not need it), and a closed-form UPS leg's by its own leg vector (reach: `ρ > 0`;
+/// the U's singularity: `|e₀ × s| > 0`), since nothing it returns uses its U angles or `J⁻¹`.
 pub fn leg_kinematics<R: Real>(
     plan: &Plan,
     k: usize,
     pl: &Platform<R>,
+    jacobian: bool,
 ) -> Result<LegKin<R>, Singular> {
     let lp = &plan.legs[k];
     let fr: M<R> = cm(&lp.frame.rotation);
@@ -741,7 +756,16 @@ pub fn leg_kinematics<R: Real>(
             let dir = mtv(&fr, s);
             let p = sub3(&lp.end_home, &lp.u_centre);
             let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
-            let [a, b] = two_axes(&lp.axes[0], &lp.axes[1], cv(&p), dir, lp.sigma_u, k)?;
+            let closed = lp.ups.is_some();
+            let [a, b] = two_axes(
+                &lp.axes[0],
+                &lp.axes[1],
+                cv(&p),
+                dir,
+                lp.sigma_u,
+                k,
+                !closed,
+            )?;
             q.push(JointPos::R(a.0, a.1));
             q.push(JointPos::R(b.0, b.1));
             q.push(JointPos::P(d));
@@ -762,7 +786,7 @@ pub fn leg_kinematics<R: Real>(
             let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
             let qv = sub(target, u);
             let p = sub3(&lp.end_home, &lp.u_centre);
-            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k)?;
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
             q.push(JointPos::P(s));
             q.push(JointPos::R(a.0, a.1));
             q.push(JointPos::R(b.0, b.1));
@@ -775,7 +799,7 @@ pub fn leg_kinematics<R: Real>(
             // The rod direction in the crank's home frame.
             let qv = mtv(&r0, sub(target, u));
             let p = sub3(&lp.end_home, &lp.u_centre);
-            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k)?;
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
             q.push(JointPos::R(s0, c0));
             q.push(JointPos::R(a.0, a.1));
             q.push(JointPos::R(b.0, b.1));
@@ -800,6 +824,7 @@ pub fn leg_kinematics<R: Real>(
                 target,
                 lp.sigma_u,
                 k,
+                true,
             )?;
             q.push(JointPos::R(a.0, a.1));
             q.push(JointPos::R(b.0, b.1));
@@ -859,13 +884,17 @@ pub fn leg_kinematics<R: Real>(
     let r2 = cross(cols[0], cols[1]);
     let det = dot(cols[0], r0);
     let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
-    let det = R::check(
-        det,
-        R::c(R::tolerance(LEG_TOLERANCE)) * hn,
-        hn,
-        Site::Leg(k),
-        true,
-    )?;
+    let det = if jacobian && lp.ups.is_none() {
+        R::check(
+            det,
+            R::c(R::tolerance(LEG_TOLERANCE)) * hn,
+            hn,
+            Site::Leg(k),
+            true,
+        )?
+    } else {
+        det
+    };
     let id = R::c(1.0) / det;
     Ok(LegKin {
         q,
@@ -979,15 +1008,29 @@ fn generic_ik<R: Real>(lp: &LegPlan, target: V<R>, k: usize) -> Result<Vec<Joint
     Ok(q)
 }
 
-/// The legs' kinematics at `x`.
+/// The legs' kinematics at `x`, their Jacobians tested.
 pub fn kinematics<R: Real>(
     plan: &Plan,
     x: &[R],
 ) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    kinematics_of(plan, x, true)
+}
+
+/// The legs' joint positions at `x`: [`kinematics`] without the Jacobians' tests (their
+/// `J⁻¹` is not to be used).
+pub fn positions<R: Real>(plan: &Plan, x: &[R]) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    kinematics_of(plan, x, false)
+}
+
+fn kinematics_of<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    jacobian: bool,
+) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
     let pl = platform(plan, x)?;
     let mut legs = Vec::with_capacity(plan.legs.len());
     for k in 0..plan.legs.len() {
-        legs.push(leg_kinematics(plan, k, &pl)?);
+        legs.push(leg_kinematics(plan, k, &pl, jacobian)?);
     }
     Ok((pl, legs))
 }
@@ -1956,7 +1999,7 @@ fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {
 /// Actuated joint positions (rad or m) for the platform coordinates `x`.
 pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
     check_finite(&[x])?;
-    let (_, legs) = kinematics(plan, x)?;
+    let (_, legs) = positions(plan, x)?;
     finite(actuated_positions(plan, &legs))
 }
 
