@@ -105,7 +105,7 @@ impl Schedule {
 }
 
 /// One function's DAG: its outputs and every guard its evaluation asked for
-/// ([`Graph::take_guards`], [`crate::scalar::guarded`]).
+/// ([`Graph::take_guards`]; the symbolic scalar captures them per function).
 #[derive(Clone, Debug, Default)]
 pub struct Kernel {
     /// The values the function returns, in order.
