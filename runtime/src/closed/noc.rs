@@ -983,12 +983,14 @@ fn project_out(v: &[f64], basis: &[Vec<f64>]) -> Vec<f64> {
 
 /// The numerical rank of `rows` at threshold `tol`: Gram–Schmidt with pivoting on the largest
 /// residual (QR with column pivoting of the transpose, Businger & Golub 1965), counting the
-/// steps whose pivot residual exceeds `tol` (Golub & Van Loan, "numerical rank").
+/// steps whose pivot residual exceeds `tol` (Golub & Van Loan, "numerical rank"), at most one
+/// per column.
 fn numerical_rank(rows: &[Vec<f64>], tol: f64) -> usize {
     let mut resid: Vec<Vec<f64>> = rows.to_vec();
     let mut done = vec![false; rows.len()];
+    let width = rows.first().map_or(0, Vec::len);
     let mut rank = 0;
-    loop {
+    while rank < width {
         let best = (0..resid.len())
             .filter(|&i| !done[i])
             .map(|i| (i, norm(&resid[i])))
@@ -1008,6 +1010,7 @@ fn numerical_rank(rows: &[Vec<f64>], tol: f64) -> usize {
             }
         }
     }
+    rank
 }
 
 /// All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`).
