@@ -39,7 +39,7 @@ const SUPPORTED_POSE: &[&[JointKind]] = &[
     ],
 ];
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
-const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"";
+const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point)";
 
 /// Validates a spec with a `[platform]` table and builds the parallel model. Errors and
 /// warnings go to `diags`; `None` when there was any error.
@@ -170,6 +170,30 @@ fn lower_checked(
                 );
             }
         }
+    }
+    if motion == Some(Coordinates::Planar)
+        && let Some([(first, p), (j, q)]) = apart(spec, ps)
+    {
+        let v = |p: [f64; 3]| {
+            format!(
+                "[{}, {}, {}]",
+                geom::num(p[0]),
+                geom::num(p[1]),
+                geom::num(p[2])
+            )
+        };
+        diags.push(
+            Diagnostic::error(format!(
+                "joints \"{}\" and \"{}\" meet the planar platform \"{pname}\" at different points ({} and {} in its frame)",
+                first.name,
+                j.name,
+                v(p),
+                v(q)
+            ))
+            .with_key(format!("{}.child_origin", j.key))
+            .with_span(j.child_origin_span.clone().or(j.span.clone()))
+            .with_hint("with coordinates = \"planar\" the platform is the point where the legs meet (a five-bar's tool point; its rotation is not modelled): give every joint into it the same child_origin. A linkage closed at different points of a link is a closed loop in joint coordinates: leave out [platform] and keep child_origin on the loop-closing joints"),
+        );
     }
     if !closing.iter().any(|c| *c) {
         diags.push(
@@ -617,8 +641,9 @@ fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
         })
         .sum();
     // A planar point platform's spin about the plane normal is idle (the point has no
-    // orientation), so it does not count.
-    let idle = i64::from(coords == Coordinates::Planar);
+    // orientation), so it does not count; a "platform" that the legs meet at different points
+    // is a link whose spin they determine.
+    let idle = i64::from(coords == Coordinates::Planar && apart(spec, ps).is_none());
     let m = lambda * (n - j - 1) + f - idle;
     let coords_word = match coords {
         Coordinates::Pose => "pose",
@@ -656,6 +681,25 @@ fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnostics) {
             )),
         );
     }
+}
+
+/// Two joints into the platform that meet it at different points (their `child_origin`, the
+/// platform frame's origin when missing; beyond the geometric tolerance), with the points.
+type Apart<'a> = [(&'a JointSpec, [f64; 3]); 2];
+
+/// `None` when every joint into the platform meets it at the same point.
+fn apart<'a>(spec: &'a Spec, ps: &PlatformSpec) -> Option<Apart<'a>> {
+    let at = |j: &'a JointSpec| (j, j.child_origin.unwrap_or(Transform::IDENTITY).translation);
+    let mut into = spec
+        .joints
+        .iter()
+        .filter(|j| Some(j.child.as_str()) == ps.body.as_deref())
+        .map(at);
+    let (first, p) = into.next()?;
+    into.find(|(_, q)| {
+        geom::norm(&[q[0] - p[0], q[1] - p[1], q[2] - p[2]]) > GEOMETRY_TOLERANCE * scale(ps)
+    })
+    .map(|other| [(first, p), other])
 }
 
 /// `actuated` only on revolute and prismatic joints.

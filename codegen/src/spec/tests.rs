@@ -1036,6 +1036,44 @@ mod parallel_specs {
             );
         }
     }
+
+    const FIVE_BAR: &str = include_str!("../../../mechanisms/specs/planar_five_bar.toml");
+
+    /// A correct five-bar written with a link as the `planar` platform (the legs meet it at two
+    /// points): its mobility is 2, not 1 (the idle spin of a point platform is not subtracted
+    /// for a link); what is reported is the form, at the second joint's `child_origin`.
+    #[test]
+    fn planar_platform_met_at_two_points_is_not_a_mobility_error() {
+        let src = include_str!("../../tests/data/bad_parallel/planar_link_platform.toml");
+        let e = errors("planar_link_platform.toml", src);
+        assert!(!e.contains("mobility"), "{e}");
+        assert!(
+            e.contains("joints \"p_left\" and \"b_right\" meet the planar platform \"distal_right\" at different points"),
+            "{e}"
+        );
+        // A point platform keeps its count: the bundled five-bar loads.
+        load_parallel("planar_five_bar.toml", FIVE_BAR);
+    }
+
+    /// The hint of an unsupported leg lists the planar five-bar's leg.
+    #[test]
+    fn unsupported_planar_leg_hint_lists_the_planar_leg() {
+        let src = FIVE_BAR.replacen(
+            "name = \"b_left\"\nkind = \"revolute\"",
+            "name = \"b_left\"\nkind = \"prismatic\"",
+            1,
+        );
+        assert_ne!(src, FIVE_BAR);
+        let e = errors("five_bar.toml", &src);
+        assert!(
+            e.contains("leg \"p_left\" is R-P-R, which is not a supported leg type"),
+            "{e}"
+        );
+        assert!(
+            e.contains("for coordinates = \"planar\" R-R-R with every axis along z"),
+            "{e}"
+        );
+    }
 }
 
 mod springs {

@@ -21,7 +21,10 @@
 //!   joint of which 2 are independent; the Bricard linkage has one redundant equation). At home,
 //!   [`Plan::new`] keeps `NX − DOF` rows of `Φ_x` that are independent over the dependent
 //!   columns (greedy Gram–Schmidt on unit-scaled rows) and checks that the others depend on
-//!   them: the mobility `NX − rank Φ_x` must equal `DOF`. The other rows whose dependent
+//!   them: the mobility `NX − rank Φ_x` must equal `DOF`. Every rank decision is relative:
+//!   `Φ_x` made dimensionless (point rows over the size, prismatic columns times it), a
+//!   residual at or below [`noc::RANK_TOLERANCE`] `· ‖Φ_x‖_F` is zero (a loop turned in space
+//!   has rounding noise where an axis-aligned one has exact zeros). The other rows whose dependent
 //!   columns do not vanish at home (an overconstrained loop's: Bricard's fifth equation) are
 //!   spare rows of `Φ_d`'s LU ([`noc::Plan::spare`]): its partial pivoting then chooses, at each
 //!   configuration, which `NX − DOF` equations to solve.

@@ -52,8 +52,13 @@ pub const FULL_TOLERANCE: f64 = 1e-9;
 /// A spring shorter than this times the mechanism's size has no direction:
 /// `Singular { site: Spring(k) }`.
 pub const SPRING_TOLERANCE: f64 = 1e-9;
-/// Rank tolerance of the home analysis (relative to unit-scaled rows).
-pub const RANK_TOLERANCE: f64 = 1e-9;
+/// Rank tolerance of the home analysis, relative to `‖J‖_F` of the dimensionless loop
+/// Jacobian (point rows over the size, prismatic columns times it): a residual at or below it
+/// is zero. The loops close at home only to within [`super::HOME_TOLERANCE`], which leaves
+/// residuals near that in redundant rows (1.9e-10 measured on the Bricard linkage opened by
+/// 0.9e-9 rad), so ten times it; rounding leaves about `ε‖J‖` (1e-16), genuine rows 1e-1 on
+/// the bundled loops.
+pub const RANK_TOLERANCE: f64 = 1e-8;
 
 /// One kept loop equation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -197,40 +202,25 @@ impl Plan {
             size: model.size(),
             springs: model.springs.clone(),
         };
-        // The Jacobian of every candidate at home, rows scaled to unit norm.
+        // The Jacobian of every candidate at home, made dimensionless: point rows divided by
+        // the size, prismatic columns multiplied by it (a slide of one size weighs as a turn of
+        // one radian). Rounding leaves entries that are zero in exact arithmetic at about
+        // `ε‖J‖` (a loop turned in space): the rank decisions below take a residual as zero up
+        // to `tol = RANK_TOLERANCE · ‖J‖_F`, never up to exactly zero.
         let x0 = vec![0.0; n];
         let kin = kinematics(&plan, &x0);
         let jac: Vec<Vec<f64>> = candidates
             .iter()
-            .map(|r| jacobian_row(&plan, &kin, r))
+            .map(|r| {
+                let s = row_scale(&plan, r);
+                let row = jacobian_row(&plan, &kin, r);
+                (0..n).map(|j| row[j] * col_scale(&plan, j) / s).collect()
+            })
             .collect();
+        let tol = RANK_TOLERANCE * norm(&jac.concat());
         let nd = plan.dependent.len();
-        let unit = |v: &[f64]| -> Vec<f64> {
-            let s = libm::sqrt(v.iter().map(|x| x * x).sum::<f64>());
-            if s > 0.0 {
-                v.iter().map(|x| x / s).collect()
-            } else {
-                v.to_vec()
-            }
-        };
         // Mobility at home: NX − rank of the loop equations (all columns).
-        let rank = {
-            let mut basis: Vec<Vec<f64>> = Vec::new();
-            for row in &jac {
-                let mut r = unit(row);
-                for b in &basis {
-                    let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
-                    for (x, y) in r.iter_mut().zip(b) {
-                        *x -= d * y;
-                    }
-                }
-                let s = libm::sqrt(r.iter().map(|x| x * x).sum::<f64>());
-                if s > 1e-6 {
-                    basis.push(r.iter().map(|x| x / s).collect());
-                }
-            }
-            basis.len()
-        };
+        let rank = numerical_rank(&jac, tol);
         if n - rank != plan.independent.len() {
             return Err(alloc::format!(
                 "the mechanism has {} degree(s) of freedom at home ({n} joint coordinates, {rank} independent loop equations) but {} joint(s) are actuated; mark one actuated joint per degree of freedom",
@@ -238,26 +228,40 @@ impl Plan {
                 plan.independent.len()
             ));
         }
-        // Greedy Gram–Schmidt over the dependent columns.
+        // Greedy Gram–Schmidt over the dependent columns on unit rows (the best conditioned
+        // next row first); a row counts only while its residual, at the row's own size,
+        // exceeds `tol`.
         let dep = |row: &[f64]| -> Vec<f64> { plan.dependent.iter().map(|&j| row[j]).collect() };
-        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let dep_norm: Vec<f64> = jac.iter().map(|r| norm(&dep(r))).collect();
+        let mut resid: Vec<Vec<f64>> = jac
+            .iter()
+            .zip(&dep_norm)
+            .map(|(r, &s)| {
+                let d = dep(r);
+                if s > tol {
+                    d.iter().map(|x| x / s).collect()
+                } else {
+                    vec![0.0; nd]
+                }
+            })
+            .collect();
         let mut kept: Vec<usize> = Vec::new();
-        let mut resid: Vec<Vec<f64>> = jac.iter().map(|r| unit(&dep(r))).collect();
         for _ in 0..nd {
             let mut best = (0usize, -1.0);
             for (i, r) in resid.iter().enumerate() {
                 let s = r.iter().map(|x| x * x).sum::<f64>();
-                if !kept.contains(&i) && s > best.1 + 1e-12 {
+                if !kept.contains(&i) && s > best.1 + 1e-12 && libm::sqrt(s) * dep_norm[i] > tol {
                     best = (i, s);
                 }
             }
-            if !(best.1 > RANK_TOLERANCE * RANK_TOLERANCE) {
+            if best.1 < 0.0 {
                 return Err(alloc::format!(
                     "the actuated joints do not determine the others at home: the loop equations have rank {} over the {nd} other joint coordinates (mark a different set of joints as actuated)",
                     kept.len()
                 ));
             }
-            let b = unit(&resid[best.0]);
+            let s = libm::sqrt(best.1);
+            let b: Vec<f64> = resid[best.0].iter().map(|x| x / s).collect();
             kept.push(best.0);
             for r in resid.iter_mut() {
                 let d: f64 = r.iter().zip(&b).map(|(x, y)| x * y).sum();
@@ -265,33 +269,16 @@ impl Plan {
                     *x -= d * y;
                 }
             }
-            basis.push(b);
         }
         // Mobility: every candidate row (all columns) must depend on the kept ones.
         let mut full: Vec<Vec<f64>> = Vec::new();
         for &k in &kept {
-            let mut r = unit(&jac[k]);
-            for b in &full {
-                let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
-                for (x, y) in r.iter_mut().zip(b) {
-                    *x -= d * y;
-                }
-            }
-            full.push(unit(&r));
+            let r = project_out(&jac[k], &full);
+            let s = norm(&r);
+            full.push(r.iter().map(|x| x / s).collect());
         }
         for (i, row) in jac.iter().enumerate() {
-            if kept.contains(&i) {
-                continue;
-            }
-            let mut r = unit(row);
-            for b in &full {
-                let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
-                for (x, y) in r.iter_mut().zip(b) {
-                    *x -= d * y;
-                }
-            }
-            let s = libm::sqrt(r.iter().map(|x| x * x).sum::<f64>());
-            if s > 1e-6 {
+            if !kept.contains(&i) && norm(&project_out(row, &full)) > tol {
                 return Err(alloc::format!(
                     "the loop equations have more independent rows than the {nd} dependent coordinates: the mechanism has fewer degrees of freedom than the {} marked actuated (loop equation {i} of cut {} is independent of the rest)",
                     plan.independent.len(),
@@ -303,12 +290,7 @@ impl Plan {
         plan.rows = kept.iter().map(|&i| candidates[i]).collect();
         // Spare rows: the other equations whose dependent columns do not vanish at home.
         plan.spare = (0..candidates.len())
-            .filter(|i| !kept.contains(i))
-            .filter(|&i| {
-                let d = dep(&jac[i]);
-                libm::sqrt(d.iter().map(|x| x * x).sum::<f64>())
-                    > RANK_TOLERANCE * row_scale(&plan, &candidates[i])
-            })
+            .filter(|i| !kept.contains(i) && dep_norm[*i] > tol)
             .map(|i| candidates[i])
             .collect();
         band_order(&mut plan);
@@ -971,6 +953,63 @@ fn row_scale(plan: &Plan, r: &Row) -> f64 {
         Row::Point { .. } => plan.size,
         Row::Axis { .. } => 1.0,
     }
+}
+
+/// The weight of joint `j`'s column in the home analysis: 1 for a revolute (rad), the size for
+/// a prismatic joint (m), so that every column is per unit of dimensionless motion.
+fn col_scale(plan: &Plan, j: usize) -> f64 {
+    match plan.joints[j].kind {
+        JointKind::Revolute => 1.0,
+        JointKind::Prismatic => plan.size,
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    libm::sqrt(v.iter().map(|x| x * x).sum::<f64>())
+}
+
+/// `v` minus its components along the orthonormal `basis`.
+fn project_out(v: &[f64], basis: &[Vec<f64>]) -> Vec<f64> {
+    let mut r = v.to_vec();
+    for b in basis {
+        let d: f64 = r.iter().zip(b).map(|(x, y)| x * y).sum();
+        for (x, y) in r.iter_mut().zip(b) {
+            *x -= d * y;
+        }
+    }
+    r
+}
+
+/// The numerical rank of `rows` at threshold `tol`: Gram–Schmidt with pivoting on the largest
+/// residual (QR with column pivoting of the transpose, Businger & Golub 1965), counting the
+/// steps whose pivot residual exceeds `tol` (Golub & Van Loan, "numerical rank"), at most one
+/// per column.
+fn numerical_rank(rows: &[Vec<f64>], tol: f64) -> usize {
+    let mut resid: Vec<Vec<f64>> = rows.to_vec();
+    let mut done = vec![false; rows.len()];
+    let width = rows.first().map_or(0, Vec::len);
+    let mut rank = 0;
+    while rank < width {
+        let best = (0..resid.len())
+            .filter(|&i| !done[i])
+            .map(|i| (i, norm(&resid[i])))
+            .fold(None, |b: Option<(usize, f64)>, c| match b {
+                Some(b) if b.1 >= c.1 => Some(b),
+                _ => Some(c),
+            });
+        let Some((i, s)) = best.filter(|b| b.1 > tol) else {
+            return rank;
+        };
+        done[i] = true;
+        rank += 1;
+        let b = [resid[i].iter().map(|x| x / s).collect::<Vec<f64>>()];
+        for (k, r) in resid.iter_mut().enumerate() {
+            if !done[k] {
+                *r = project_out(r, &b);
+            }
+        }
+    }
+    rank
 }
 
 /// All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`).
