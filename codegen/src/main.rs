@@ -49,7 +49,7 @@ struct Cli {
     /// Validate the spec only; generate nothing.
     #[arg(long)]
     check: bool,
-    /// Print the operation-count table instead of the code.
+    /// Also print the operation-count table, to standard error.
     #[arg(long)]
     stats: bool,
     /// Where sin/cos and sqrt come from.
@@ -176,13 +176,11 @@ fn main() -> ExitCode {
     if !out.warnings.is_empty() {
         eprint!("{}", out.warnings.render());
     }
-    let text = if cli.stats {
-        let mut t = out.stats_table().join("\n");
-        t.push('\n');
-        t
-    } else {
-        out.code
-    };
+    // The table goes to stderr: the module always goes where it would without `--stats`.
+    if cli.stats {
+        eprintln!("{}", out.stats_table().join("\n"));
+    }
+    let text = out.code;
     match &cli.output {
         Some(path) => {
             if let Err(e) = codegen::build_script::write_if_changed(path, &text) {

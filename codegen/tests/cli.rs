@@ -98,10 +98,13 @@ fn check_validates_without_generating() {
 }
 
 #[test]
-fn stats_prints_the_table() {
+fn stats_prints_the_table_to_stderr_beside_the_module() {
     let o = run(&["--stats", GOOD]);
     assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
-    let t = stdout(&o);
+    // The module still goes to stdout; the table goes to stderr.
+    let code = run(&[GOOD]);
+    assert!(o.stdout == code.stdout, "--stats changed the module");
+    let t = stderr(&o);
     let lines: Vec<&str> = t.lines().collect();
     assert!(
         lines[0].starts_with("| function | flops | flops/joint |"),
@@ -124,10 +127,25 @@ fn stats_prints_the_table() {
     );
     assert!(!t.contains("pub fn"), "--stats printed code");
     // The same table is in the generated header.
-    let code = run(&[GOOD]);
     for l in &lines {
         assert!(stdout(&code).contains(&format!("// {l}\n")), "{l}");
     }
+}
+
+/// `--stats -o FILE` writes the module into FILE, never the table.
+#[test]
+fn stats_never_replaces_the_module() {
+    let dir = scratch("stats_output");
+    let out = dir.join("planar_2r.rs");
+    let o = run(&["--stats", GOOD, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    assert!(o.stdout.is_empty(), "with -o nothing goes to stdout");
+    assert_eq!(std::fs::read(&out).unwrap(), run(&[GOOD]).stdout);
+    assert!(
+        stderr(&o).starts_with("| function | flops |"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
@@ -299,6 +317,6 @@ fn output_is_identical_across_processes() {
         assert!(a.stdout == b.stdout, "{spec}: two runs differ");
         let sa = run(&["--stats", spec]);
         let sb = run(&["--stats", spec]);
-        assert!(sa.stdout == sb.stdout, "{spec}: --stats differs");
+        assert!(sa.stderr == sb.stderr, "{spec}: --stats differs");
     }
 }
