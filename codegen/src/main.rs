@@ -70,8 +70,21 @@ struct Cli {
     rotor_inertia: bool,
     /// Take angles within TOL (rad) of a multiple of π/2, rotation entries within TOL of 0/±1
     /// and offsets within TOL (m) of 0 as exact, listing each change (as `[scene] snap`).
-    #[arg(long, value_name = "TOL")]
+    #[arg(long, value_name = "TOL", value_parser = snap_tolerance, allow_negative_numbers = true)]
     snap: Option<f64>,
+}
+
+/// `--snap`: the bounds of `[scene] snap`.
+fn snap_tolerance(s: &str) -> Result<f64, String> {
+    let tol: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if codegen::spec::is_snap_tolerance(tol) {
+        Ok(tol)
+    } else {
+        Err(format!(
+            "the tolerance must be in (0, {}] (as `[scene] snap`)",
+            codegen::spec::MAX_SNAP
+        ))
+    }
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]

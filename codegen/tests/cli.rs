@@ -320,3 +320,18 @@ fn output_is_identical_across_processes() {
         assert!(sa.stderr == sb.stderr, "{spec}: --stats differs");
     }
 }
+
+/// `--snap` takes the bounds of `[scene] snap`: a tolerance in (0, 0.01]. Out of them it is an
+/// invalid argument (exit 2, nothing generated), not a model change.
+#[test]
+fn snap_out_of_range_exits_2() {
+    for tol in ["0.5", "nan", "0", "-1", "inf", "0.011"] {
+        let o = run(&[PUMA, "--snap", tol]);
+        assert_eq!(o.status.code(), Some(2), "--snap {tol}: {}", stderr(&o));
+        assert!(o.stdout.is_empty(), "--snap {tol} generated code");
+        let err = stderr(&o);
+        assert!(err.contains("--snap") && err.contains("(0, 0.01]"), "{err}");
+    }
+    let o = run(&[PUMA, "--snap", "0.01", "--check"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}

@@ -54,6 +54,18 @@ pub(crate) fn in_range(x: f64) -> bool {
     x.abs() <= MAX_MAGNITUDE
 }
 
+/// The largest snapping tolerance (`[scene] snap`, `--snap`, [`SceneOverrides::snap`]): 0.01
+/// (rad, m, or a rotation entry).
+pub const MAX_SNAP: f64 = 1e-2;
+
+/// `true` when `tol` is a snapping tolerance: in (0, [`MAX_SNAP`]] (NaN is not).
+pub fn is_snap_tolerance(tol: f64) -> bool {
+    tol > 0.0 && tol <= MAX_SNAP
+}
+
+/// The hint of a snapping tolerance out of range.
+pub(crate) const SNAP_HINT: &str = "angles within this many rad of a multiple of π/2, rotation entries within it of 0 or ±1 and offsets within it (m) of 0 are taken as exact; e.g. 1e-6";
+
 /// The hint of a number out of [`in_range`].
 pub(crate) const RANGE_HINT: &str = "every number must lie within ±1e9 in SI units (m, kg, kg·m², rad, m/s²); check the units or the exponent";
 
@@ -305,8 +317,18 @@ fn no_drive(j: &ir::JointSpec, role: &str, hint: &str, diags: &mut Diagnostics) 
 fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {
     spec.scene.friction |= overrides.friction;
     spec.scene.rotor_inertia |= overrides.rotor_inertia;
-    if overrides.snap.is_some() {
-        spec.scene.snap = overrides.snap;
+    if let Some(tol) = overrides.snap {
+        if is_snap_tolerance(tol) {
+            spec.scene.snap = Some(tol);
+        } else {
+            // Set outside the file (`--snap`, `Builder::snap`): no place in it to point at.
+            diags.push(
+                Diagnostic::error(format!(
+                    "the snap tolerance {tol} is not in (0, {MAX_SNAP}]"
+                ))
+                .with_hint(SNAP_HINT),
+            );
+        }
     }
     snap::snap(spec, diags);
     apply_scene(spec, diags);

@@ -507,14 +507,14 @@ impl Reader<'_> {
             if let Some(v) = get(t, "snap")
                 && let Some(x) = self.number(v, "scene.snap")
             {
-                if x > 0.0 && x <= 1e-2 {
+                if super::is_snap_tolerance(x) {
                     scene.snap = Some(x);
                 } else {
                     self.diags.push(
                         Diagnostic::error("`snap` must be a tolerance in (0, 0.01]")
                             .with_key("scene.snap")
                             .with_span(Some(v.span()))
-                            .with_hint("angles within this many rad of a multiple of π/2, rotation entries within it of 0 or ±1 and offsets within it (m) of 0 are taken as exact; e.g. 1e-6"),
+                            .with_hint(super::SNAP_HINT),
                     );
                 }
             }

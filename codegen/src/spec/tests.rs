@@ -1101,3 +1101,31 @@ mod springs {
         assert!(e.contains("zero length at home"), "{e}");
     }
 }
+
+/// A snap tolerance from outside the spec (`Config::scene`, `Builder::snap`) takes the bounds of
+/// `[scene] snap`: 0.5 would zero the PUMA's a2 = 0.4318 m.
+#[test]
+fn snap_override_out_of_range_is_an_error() {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../mechanisms/specs/puma560.toml"
+    ))
+    .unwrap();
+    for tol in [0.5, f64::NAN, 0.0, -1.0, f64::INFINITY] {
+        let o = super::SceneOverrides {
+            snap: Some(tol),
+            ..Default::default()
+        };
+        let e = super::load_mechanism_with("puma560.toml", &src, &o).unwrap_err();
+        let r = e.render();
+        assert!(
+            r.contains("snap tolerance") && r.contains("(0, 0.01]"),
+            "{r}"
+        );
+    }
+    let o = super::SceneOverrides {
+        snap: Some(1e-2),
+        ..Default::default()
+    };
+    assert!(super::load_mechanism_with("puma560.toml", &src, &o).is_ok());
+}
