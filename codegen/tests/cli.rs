@@ -335,3 +335,54 @@ fn snap_out_of_range_exits_2() {
     let o = run(&[PUMA, "--snap", "0.01", "--check"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+/// Runs the CLI under `sh` with `limits` (`ulimit` options, e.g. `-v 2000000`) applied first.
+fn run_limited(limits: &str, args: &[&str]) -> Output {
+    Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg(format!("ulimit {limits} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_codegen"))
+        .args(args)
+        .output()
+        .expect("sh runs")
+}
+
+/// A 20,000-character body name and a joint whose parent differs by one letter: a located
+/// error at the name, no suggestion, and no quadratic memory on the way (the edit distance
+/// of the two names took 8·n² = 3.2 GB; here the process gets 1 GB of address space).
+#[test]
+fn a_very_long_name_is_refused_at_its_key() {
+    let dir = scratch("long_name");
+    let long = "a".repeat(20_000);
+    let near = format!("{}b", &long[1..]);
+    let spec = dir.join("long.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "[mechanism]\nname = \"x\"\n\n[[body]]\nname = \"{long}\"\nmass = 1.0\n\n\
+             [[joint]]\nname = \"j\"\nkind = \"R\"\nparent = \"{near}\"\nchild = \"{long}\"\n"
+        ),
+    )
+    .unwrap();
+    let urdf = dir.join("long.urdf");
+    std::fs::write(
+        &urdf,
+        format!(
+            "<robot name=\"r\">\n  <link name=\"base\"/>\n  <link name=\"{long}\"/>\n  \
+             <joint name=\"j\" type=\"revolute\">\n    <parent link=\"base\"/>\n    \
+             <child link=\"{near}\"/>\n  </joint>\n</robot>\n"
+        ),
+    )
+    .unwrap();
+    for (f, at) in [(&spec, ":5:8"), (&urdf, ":3:15")] {
+        let o = run_limited("-v 1000000", &["--check", path_str(f)]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{}: {err:.2000}", f.display());
+        assert!(
+            err.contains("too long") && err.contains(&format!("{}{at}", path_str(f))),
+            "{err:.2000}"
+        );
+        assert!(!err.contains("did you mean"), "{err:.2000}");
+    }
+}

@@ -44,6 +44,21 @@ pub const MAX_ENTRIES: usize = 1024;
 /// URDFs take 2.5 s and 4.2 s in release), so larger specs are refused up front.
 pub const MAX_DOF: usize = 128;
 
+/// The longest name (of a mechanism, body, joint or spring; URDF: robot, link or joint), in
+/// characters. Names become Rust identifiers and strings in the generated code.
+pub const MAX_NAME_LEN: usize = 128;
+
+/// The error of a name longer than [`MAX_NAME_LEN`], or `None`.
+pub(crate) fn name_too_long(name: &str) -> Option<Diagnostic> {
+    let n = name.chars().count();
+    (n > MAX_NAME_LEN).then(|| {
+        Diagnostic::error(format!(
+            "name too long: {n} characters (the limit is {MAX_NAME_LEN})"
+        ))
+        .with_hint("names become Rust identifiers in the generated code; shorten it")
+    })
+}
+
 /// The largest magnitude of any number in a spec (SI units). Larger values would overflow in
 /// the generator's constant folding; nothing physical comes close.
 pub const MAX_MAGNITUDE: f64 = 1e9;
@@ -903,41 +918,69 @@ pub(crate) fn suggest_hint(word: &str, candidates: &[&str]) -> Option<String> {
     closest(word, candidates).map(|c| format!("did you mean \"{c}\"?"))
 }
 
-/// The candidate with the smallest edit distance (transpositions count 1) to `word`, if that
-/// distance is at most a third of the word's length (at least 1); ties go to the first.
-pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
-    let limit = (word.chars().count() / 3).max(1);
-    candidates
-        .iter()
-        .map(|c| (edit_distance(&word.to_lowercase(), &c.to_lowercase()), *c))
-        .filter(|(d, _)| *d <= limit)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
-}
+/// The edit-distance cells one [`closest`] call may fill (about a millisecond): with many long
+/// candidates the first ones are compared, not all.
+const SUGGEST_BUDGET: usize = 1 << 18;
 
-/// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let (n, m) = (a.len(), b.len());
-    let mut d = vec![vec![0usize; m + 1]; n + 1];
-    for (i, row) in d.iter_mut().enumerate() {
-        row[0] = i;
+/// The candidate with the smallest edit distance (transpositions count 1) to `word`, if that
+/// distance is at most a third of the word's length (at least 1); ties go to the first. Words
+/// and candidates longer than [`MAX_NAME_LEN`] characters take no part.
+pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let word: Vec<char> = word.to_lowercase().chars().collect();
+    if word.len() > MAX_NAME_LEN {
+        return None;
     }
-    for (j, e) in d[0].iter_mut().enumerate() {
-        *e = j;
-    }
-    for i in 1..=n {
-        for j in 1..=m {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut v = (d[i - 1][j] + 1)
-                .min(d[i][j - 1] + 1)
-                .min(d[i - 1][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                v = v.min(d[i - 2][j - 2] + 1);
-            }
-            d[i][j] = v;
+    let mut best: Option<(usize, &str)> = None;
+    let mut budget = SUGGEST_BUDGET;
+    for c in candidates {
+        // Only a strictly closer candidate replaces the best so far.
+        let bound = match best {
+            None => (word.len() / 3).max(1),
+            Some((0, _)) => break,
+            Some((d, _)) => d - 1,
+        };
+        if c.len() > 4 * MAX_NAME_LEN {
+            continue;
+        }
+        let cand: Vec<char> = c.to_lowercase().chars().collect();
+        if cand.len() > MAX_NAME_LEN || cand.len().abs_diff(word.len()) > bound {
+            continue;
+        }
+        let cost = (word.len() + 1) * (cand.len() + 1);
+        if cost > budget {
+            break;
+        }
+        budget -= cost;
+        if let Some(d) = edit_distance_within(&word, &cand, bound) {
+            best = Some((d, c));
         }
     }
-    d[n][m]
+    best.map(|(_, c)| c)
+}
+
+/// The optimal-string-alignment distance (Levenshtein plus adjacent transpositions) of `a` and
+/// `b` when it is at most `bound`. Three rows, and an early exit once a whole row is past the
+/// bound (the distance never falls below a row's minimum).
+fn edit_distance_within(a: &[char], b: &[char], bound: usize) -> Option<usize> {
+    let m = b.len();
+    let mut before: Vec<usize> = vec![0; m + 1];
+    let mut prev: Vec<usize> = (0..=m).collect();
+    let mut cur: Vec<usize> = vec![0; m + 1];
+    for i in 1..=a.len() {
+        cur[0] = i;
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(before[j - 2] + 1);
+            }
+            cur[j] = v;
+        }
+        if cur.iter().all(|&v| v > bound) {
+            return None;
+        }
+        std::mem::swap(&mut before, &mut prev);
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    Some(prev[m]).filter(|&d| d <= bound)
 }

@@ -363,7 +363,9 @@ impl Reader<'_> {
             .next()
             .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
             && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !valid {
+        if let Some(d) = super::name_too_long(&n) {
+            self.diags.push(d.with_key(key).with_span(v.span()));
+        } else if !valid {
             self.err(format!("invalid name {n:?}"), &key, v.span()).hint = Some(
                 "names consist of ASCII letters, digits and `_`, and do not start with a digit"
                     .into(),
@@ -396,7 +398,10 @@ impl Reader<'_> {
                         Some(nv) => {
                             if let Some(n) = self.string(nv, "mechanism.name") {
                                 anchor = Some(nv.span());
-                                if !super::is_module_name(&n) {
+                                if let Some(d) = super::name_too_long(&n) {
+                                    self.diags
+                                        .push(d.with_key("mechanism.name").with_span(nv.span()));
+                                } else if !super::is_module_name(&n) {
                                     self.err(
                                         format!("invalid mechanism name {n:?}"),
                                         "mechanism.name",

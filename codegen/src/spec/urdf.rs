@@ -341,6 +341,14 @@ fn check_number(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
 fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, Vec<usize>) {
     let links: Vec<usize> = doc.children(doc.robot, "link").collect();
     let joints: Vec<usize> = doc.children(doc.robot, "joint").collect();
+    for &t in [doc.robot].iter().chain(&links).chain(&joints) {
+        if let Some(a) = doc.tags[t].attr("name")
+            && let Some(d) = super::name_too_long(a.value)
+        {
+            let what = doc.tags[t].name;
+            diags.push(d.with_key(format!("{what}.name")).with_span(a.span.clone()));
+        }
+    }
     for &l in &links {
         let t = &doc.tags[l];
         let lk = format!("link \"{}\"", t.attr("name").map_or("", |a| a.value));
