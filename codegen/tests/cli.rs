@@ -386,3 +386,148 @@ fn a_very_long_name_is_refused_at_its_key() {
         assert!(!err.contains("did you mean"), "{err:.2000}");
     }
 }
+
+/// Writes `text` to `dir/name` and returns the path.
+fn spec_file(dir: &Path, name: &str, text: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Asserts exit 2, nothing on stdout, and `what` in stderr at `file:at`.
+fn assert_located(o: &Output, file: &Path, at: &str, what: &str) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "{}: {err:.3000}", file.display());
+    assert!(o.stdout.is_empty(), "{}: generated code", file.display());
+    assert!(
+        err.contains(what) && err.contains(&format!("{}{at}", path_str(file))),
+        "{}: expected {what:?} at {at}:\n{err:.3000}",
+        file.display()
+    );
+}
+
+/// A good two-link robot (one revolute joint); `{}` is replaced by extra markup.
+const ROBOT: &str = r#"<robot name="r">
+  <link name="base"/>
+  <link name="l1">
+    <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+  </link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+</robot>
+"#;
+
+/// Deeply nested XML is refused by the tag scanner, before the recursive URDF reader sees it
+/// (13,000 levels overflowed its stack: SIGABRT, also with `--check`).
+#[test]
+fn deeply_nested_xml_is_refused() {
+    let dir = scratch("deep_xml");
+    let deep = format!(
+        "<robot name=\"r\">\n{}{}</robot>\n",
+        "<a>".repeat(13_000),
+        "</a>".repeat(13_000)
+    );
+    let f = spec_file(&dir, "deep.urdf", deep);
+    for args in [vec!["--check"], vec![]] {
+        let mut a = args.clone();
+        a.push(path_str(&f));
+        let o = run(&a);
+        // The 64th nested <a>, after `<robot name="r">\n` and 63 of them.
+        assert_located(
+            &o,
+            &f,
+            &format!(":2:{}", 63 * 3 + 1),
+            "nested deeper than 64",
+        );
+    }
+    // 60 levels inside an ignored element are fine.
+    let ok = ROBOT.replace(
+        "<link name=\"base\"/>",
+        &format!(
+            "<link name=\"base\"><visual>{}{}</visual></link>",
+            "<a>".repeat(60),
+            "</a>".repeat(60)
+        ),
+    );
+    let f = spec_file(&dir, "ok.urdf", ok);
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+/// XML that is not well formed is refused, located: text outside the root element, a second
+/// root element.
+#[test]
+fn malformed_xml_is_refused() {
+    let dir = scratch("malformed_xml");
+    let f = spec_file(&dir, "good.urdf", ROBOT);
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // A declaration, comments and a BOM are fine.
+    let f = spec_file(
+        &dir,
+        "decl.urdf",
+        format!("\u{feff}<?xml version=\"1.0\"?>\n<!-- c -->\n{ROBOT}<!-- end -->\n"),
+    );
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for (name, text, at, what) in [
+        (
+            "before.urdf",
+            format!("hello\n{ROBOT}"),
+            ":1:1",
+            "outside the root",
+        ),
+        (
+            "after.urdf",
+            format!("{ROBOT}  tail\n"),
+            ":8:3",
+            "outside the root",
+        ),
+        (
+            "second.urdf",
+            format!("{ROBOT}<robot name=\"s\"/>\n"),
+            ":8:1",
+            "second root element",
+        ),
+        (
+            "inner.urdf",
+            format!("<?xml version=\"1.0\"?>x{ROBOT}"),
+            ":1:22",
+            "outside the root",
+        ),
+    ] {
+        let f = spec_file(&dir, name, text);
+        assert_located(&run(&["--check", path_str(&f)]), &f, at, what);
+        assert_located(&run(&[path_str(&f)]), &f, at, what);
+    }
+}
+
+/// Element lookups stay linear in the file: 1,000 links beside a million ignored elements
+/// (each link's lookups scanned every tag: about a minute).
+#[test]
+fn a_wide_urdf_is_read_in_linear_time() {
+    let dir = scratch("wide_urdf");
+    let mut s = String::from("<robot name=\"r\"><link name=\"base\"/>\n");
+    for i in 0..1000 {
+        s += &format!(
+            "<link name=\"l{i}\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n"
+        );
+    }
+    for i in 0..1000 {
+        let parent = if i == 0 {
+            "base".into()
+        } else {
+            format!("l{}", i - 1)
+        };
+        s += &format!(
+            "<joint name=\"j{i}\" type=\"fixed\"><parent link=\"{parent}\"/><child link=\"l{i}\"/></joint>\n"
+        );
+    }
+    s += &format!("<gazebo>{}</gazebo></robot>\n", "<a/>".repeat(1_000_000));
+    let f = spec_file(&dir, "wide.urdf", s);
+    let t = std::time::Instant::now();
+    let o = run(&["--check", path_str(&f)]);
+    let took = t.elapsed();
+    // All joints are fixed: read, then refused for having no movable joint.
+    assert_located(&o, &f, ":1:", "no movable joints");
+    assert!(took.as_secs_f64() < 5.0, "took {took:?}");
+}
