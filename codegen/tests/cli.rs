@@ -531,3 +531,34 @@ fn a_wide_urdf_is_read_in_linear_time() {
     assert_located(&o, &f, ":1:", "no movable joints");
     assert!(took.as_secs_f64() < 5.0, "took {took:?}");
 }
+
+/// A key of 90 dotted parts (`a.a.….a = 1`), or a table header as deep, exceeds the TOML
+/// reader's recursion limit: a located error at the key, not a bare message.
+#[test]
+fn a_deeply_dotted_key_is_located() {
+    let dir = scratch("dotted");
+    let key = vec!["a"; 90].join(".");
+    let head = "[mechanism]\nname = \"x\"\n";
+    for (name, text, at) in [
+        ("dotted.toml", format!("{head}{key} = 1\n"), ":3:1"),
+        ("header.toml", format!("{head}\n[{key}]\nb = 1\n"), ":4:2"),
+        (
+            "spaced.toml",
+            format!("{head}x = 1\n  {}\n", vec!["'q'"; 90].join(" . ") + " = 2"),
+            ":4:3",
+        ),
+        (
+            "inline.toml",
+            format!("{head}t = {{ {key} = 1 }}\n"),
+            ":3:7",
+        ),
+    ] {
+        let f = spec_file(&dir, name, text);
+        assert_located(
+            &run(&["--check", path_str(&f)]),
+            &f,
+            at,
+            "TOML syntax error",
+        );
+    }
+}
