@@ -153,8 +153,9 @@ impl Builder {
         let mut written = Vec::new();
         for p in &self.specs {
             println!("cargo:rerun-if-changed={}", p.display());
-            let src = std::fs::read_to_string(p).map_err(|e| Error::Io(p.clone(), e))?;
+            let bytes = std::fs::read(p).map_err(|e| Error::Io(p.clone(), e))?;
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("spec");
+            let src = crate::spec::source_text(name, bytes).map_err(Error::Spec)?;
             let g = compile(name, &src, &self.config).map_err(Error::Spec)?;
             let path = out.join(format!("{}.rs", module_name(p, &self.specs)));
             write_if_changed(&path, &g.code)?;

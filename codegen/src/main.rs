@@ -6,8 +6,9 @@
 //! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
 //! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
 //! ```
-//! Exit codes: 0 success, 2 invalid spec or arguments (diagnostics on stderr, nothing written),
-//! 1 I/O error. A spec file literally named `map` or `isotropy` must be written `./map`.
+//! Exit codes: 0 success, 2 invalid spec (also one that is not UTF-8) or arguments (diagnostics
+//! on stderr, nothing written), 1 I/O error. A spec file literally named `map` or `isotropy`
+//! must be written `./map`.
 
 mod cli;
 
@@ -119,14 +120,10 @@ fn main() -> ExitCode {
         eprintln!("error: a spec file is required");
         return ExitCode::from(2);
     };
-    let source = match std::fs::read_to_string(spec) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: cannot read {}: {e}", spec.display());
-            return ExitCode::from(1);
-        }
+    let (name, source) = match cli::read_spec(spec) {
+        Ok(r) => r,
+        Err(code) => return code,
     };
-    let name = spec.to_string_lossy().into_owned();
     if cli.check {
         return match codegen::spec::load_mechanism(&name, &source) {
             Ok((mechanism, warnings)) => {

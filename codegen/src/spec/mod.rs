@@ -301,6 +301,36 @@ fn load_any(
     }
 }
 
+/// The text of a spec file read as bytes. A file that is not UTF-8 (UTF-16, Latin-1, cut
+/// inside a character) is an invalid spec: the error points at the first invalid byte.
+pub fn source_text(file_name: &str, bytes: Vec<u8>) -> Result<String, Diagnostics> {
+    let e = match String::from_utf8(bytes) {
+        Ok(s) => return Ok(s),
+        Err(e) => e,
+    };
+    let at = e.utf8_error().valid_up_to();
+    let bytes = e.as_bytes();
+    let hint = if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        "the file looks like UTF-16 (it starts with a byte-order mark): save it as UTF-8"
+    } else if e.utf8_error().error_len().is_none() {
+        "the file ends inside a character: is it cut short?"
+    } else {
+        "save the file as UTF-8 (this byte looks like another encoding, such as Latin-1)"
+    };
+    // Shown with the invalid bytes replaced by U+FFFD: the text before them is unchanged.
+    let shown = String::from_utf8_lossy(bytes);
+    let mut d = Diagnostics::new(file_name, &shown);
+    d.push(
+        Diagnostic::error(format!(
+            "the spec is not UTF-8 text: invalid byte 0x{:02X}",
+            bytes[at]
+        ))
+        .with_span(at..at + '\u{fffd}'.len_utf8())
+        .with_hint(hint),
+    );
+    Err(d)
+}
+
 /// The public functions a tree module has (`[scene] functions` picks among them).
 pub const TREE_FUNCTIONS: [&str; 6] = [
     "mass_matrix",
