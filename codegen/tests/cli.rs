@@ -562,3 +562,56 @@ fn a_deeply_dotted_key_is_located() {
         );
     }
 }
+
+/// The names in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `-o` replaces the file atomically: a write that fails midway (here the file-size limit, as
+/// a full disk would) leaves the previous module intact and no temporary file behind. Writing
+/// in place truncated the module to a fragment.
+#[test]
+fn a_failed_write_leaves_the_old_module_intact() {
+    let dir = scratch("failed_write");
+    let out = dir.join("module.rs");
+    let o = run(&[GOOD, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let old = std::fs::read(&out).unwrap();
+    // At most 2 blocks (1 or 2 KiB) per file; SIGXFSZ ignored, so the write fails with EFBIG.
+    let o = Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 2 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_codegen"))
+        .args([PUMA, "-o", path_str(&out)])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("error"), "{}", stderr(&o));
+    assert!(
+        std::fs::read(&out).unwrap() == old,
+        "the old module was changed"
+    );
+    assert_eq!(listing(&dir), ["module.rs"]);
+
+    // An output path that is a directory: exit 1, the directory as it was, nothing left over.
+    let sub = dir.join("sub.rs");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::write(sub.join("keep"), "x").unwrap();
+    let o = run(&[GOOD, "-o", path_str(&sub)]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(listing(&sub), ["keep"]);
+    assert_eq!(listing(&dir), ["module.rs", "sub.rs"]);
+
+    // A successful replace leaves only the module.
+    let o = run(&[PUMA, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&out).unwrap(), run(&[PUMA]).stdout);
+    assert_eq!(listing(&dir), ["module.rs", "sub.rs"]);
+}
