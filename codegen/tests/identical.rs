@@ -211,3 +211,45 @@ fn invalid_utf8_is_an_invalid_spec_everywhere() {
         );
     }
 }
+
+/// XML nested 13,000 deep (the URDF reader overflowed its stack: the process aborted, and the
+/// macro took rustc down) is an invalid spec in all three adapters, located at the first
+/// element too deep.
+#[cfg(feature = "urdf")]
+#[test]
+fn deep_xml_is_an_invalid_spec_everywhere() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("identical/deep_xml");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let path = dir.join("deep.urdf");
+    std::fs::write(
+        &path,
+        format!(
+            "<robot name=\"r\">\n{}{}</robot>\n",
+            "<a>".repeat(13_000),
+            "</a>".repeat(13_000)
+        ),
+    )
+    .unwrap();
+    let p = path.to_str().unwrap();
+    let at = ":2:190";
+    let out = Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .arg(p)
+        .output()
+        .expect("the codegen binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err:.2000}");
+    assert!(err.contains(&format!("{p}{at}")), "{err:.2000}");
+    match Builder::new().spec(&path).out_dir(&dir).compile() {
+        Err(codegen::build_script::Error::Spec(d)) => {
+            let r = d.render();
+            assert!(r.contains(&format!("deep.urdf{at}")), "{r:.2000}");
+        }
+        other => panic!("Builder gave {other:?}"),
+    }
+    let e = macro_support::expand(manifest_dir(), p, &Config::default()).unwrap_err();
+    assert!(
+        e.contains("nested deeper") && e.contains(&format!("{p}{at}")),
+        "{e:.2000}"
+    );
+}
