@@ -12,15 +12,16 @@
 //!   deleted ranges, truncation, numbers replaced by extreme values, duplicated or dropped lines;
 //! - for URDF specifically, attribute values replaced by random numbers and words.
 //!
-//! The binary is driven too, as a user runs it (`the_binary_never_crashes_hangs_or_goes_unlocated`):
-//! those specs, plus deep XML and TOML nesting, very long names, bad encodings (UTF-16,
-//! Latin-1, a cut character) and random bytes, with random flags (some invalid) and `-o`
-//! targets (fresh, existing, a directory, in a missing directory), under a 2 GB address-space
-//! limit. It reports the inputs tried, panics, crashes by signal, timeouts (a run is killed
-//! after `NOCDYN_FUZZ_TIMEOUT` seconds, default 5), unlocated errors (exit 2 without
-//! `file:line:col`) and other broken promises (exit codes, `-o` files, temporary files left,
-//! the `--stats` table); all but the first must be 0. The first failing inputs are kept in
-//! `target/tmp/fuzz_cli`.
+//! The binary is driven too, as a user runs it
+//! (`binary::the_binary_never_crashes_hangs_or_goes_unlocated`): those specs, plus deep XML
+//! and TOML nesting, very long names, bad encodings (UTF-16, Latin-1, a cut character),
+//! thousands of errors on one line and random bytes, with random flags (some invalid) and
+//! `-o` targets (fresh, existing, a directory, in a missing directory), under a 2 GB
+//! address-space limit. It reports the inputs tried, panics, crashes by signal, timeouts (a
+//! run is killed after `NOCDYN_FUZZ_TIMEOUT` seconds, default 5), unlocated errors (exit 2
+//! without `file:line:col`) and other broken promises (exit codes, `-o` files, temporary files
+//! left, the `--stats` table); all but the first must be 0. The first failing inputs are kept
+//! in `target/tmp/fuzz_cli`.
 //!
 //! Budget: `NOCDYN_FUZZ_CASES` cases per generator (default 2,000), `NOCDYN_FUZZ_CLI_CASES`
 //! binary runs (default 1,500, about 20 s); `NOCDYN_FUZZ_SEED` (a number) changes the RNG
@@ -843,6 +844,21 @@ mod binary {
                     }
                 };
                 ("bad encoding", name, bytes)
+            }
+            6 if rng.chance(40) => {
+                // Many errors, on one line or one per line.
+                let n = *rng.pick(&[1_000, 20_000, 50_000]);
+                let head = chain("m", "b1", "j1", "base");
+                let text = if rng.chance(50) {
+                    format!(
+                        "{head}[scene]\npoint_mass = [{}]\n",
+                        vec!["\"bx\""; n].join(",")
+                    )
+                } else {
+                    let keys: String = (0..n).map(|k| format!("k{k} = 1\n")).collect();
+                    head.replacen("[mechanism]\n", &format!("[mechanism]\n{keys}"), 1)
+                };
+                ("many errors", "many.toml".into(), text.into_bytes())
             }
             6 => {
                 let n = rng.below(4096);
