@@ -154,7 +154,7 @@ impl Builder {
         let mut written = Vec::new();
         for p in &self.specs {
             println!("cargo:rerun-if-changed={}", p.display());
-            let bytes = std::fs::read(p).map_err(|e| Error::Io(p.clone(), e))?;
+            let bytes = read_spec(p).map_err(|e| Error::Io(p.clone(), e))?;
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("spec");
             let src = crate::spec::source_text(name, bytes).map_err(Error::Spec)?;
             let g = compile(name, &src, &self.config).map_err(Error::Spec)?;
@@ -181,6 +181,19 @@ fn module_name(p: &Path, all: &[PathBuf]) -> String {
     } else {
         stem
     }
+}
+
+/// The bytes of a spec file, at most one more than
+/// [`MAX_SOURCE_BYTES`](crate::spec::MAX_SOURCE_BYTES) (which
+/// [`spec::source_text`](crate::spec::source_text) refuses): an endless or huge file is not
+/// read whole. The CLI, [`Builder`] and the `mechanism!` macro read specs so.
+pub fn read_spec(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(crate::spec::MAX_SOURCE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
 }
 
 /// Write `content` to `path` unless it already holds exactly that (keeps mtimes, avoids rebuilds).

@@ -34,7 +34,8 @@ pub fn resolve(manifest_dir: &Path, spec: &str) -> PathBuf {
 /// the compiler adds). Warnings are dropped, as [`build_script`](crate::build_script) drops them.
 pub fn expand(manifest_dir: &Path, spec: &str, cfg: &Config) -> Result<String, String> {
     let path = resolve(manifest_dir, spec);
-    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {spec}: {e}"))?;
+    let bytes =
+        crate::build_script::read_spec(&path).map_err(|e| format!("cannot read {spec}: {e}"))?;
     let source = crate::spec::source_text(spec, bytes).map_err(|d| d.render())?;
     compile(spec, &source, cfg)
         .map(|generated| generated.code)

@@ -615,3 +615,19 @@ fn a_failed_write_leaves_the_old_module_intact() {
     assert_eq!(std::fs::read(&out).unwrap(), run(&[PUMA]).stdout);
     assert_eq!(listing(&dir), ["module.rs", "sub.rs"]);
 }
+
+/// A file larger than the spec limit is refused without being read whole: `/dev/zero` (or a
+/// huge file) is an invalid spec, not a process that reads until memory runs out.
+#[test]
+fn an_endless_file_is_refused() {
+    if !Path::new("/dev/zero").exists() {
+        return;
+    }
+    let o = run_limited("-v 1000000", &["--check", "/dev/zero"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("too large") && stderr(&o).contains("/dev/zero:1:1"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -146,7 +146,7 @@ pub enum Target {
 /// A spec file's name (as given) and text. On failure the error is printed and the exit code
 /// returned: 1 when the file cannot be read, 2 when it is not UTF-8 (an invalid spec).
 pub fn read_spec(spec: &std::path::Path) -> Result<(String, String), ExitCode> {
-    let bytes = std::fs::read(spec).map_err(|e| {
+    let bytes = codegen::build_script::read_spec(spec).map_err(|e| {
         eprintln!("error: cannot read {}: {e}", spec.display());
         ExitCode::from(1)
     })?;

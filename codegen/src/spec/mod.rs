@@ -189,14 +189,7 @@ fn load_any(
 ) {
     let mut diags = Diagnostics::new(file_name, source);
     if source.len() > MAX_SOURCE_BYTES {
-        diags.push(
-            Diagnostic::error(format!(
-                "the spec is too large: {} bytes (the limit is {MAX_SOURCE_BYTES})",
-                source.len()
-            ))
-            .with_span(0..0)
-            .with_hint(format!("nocdyn generates mechanisms of at most {MAX_DOF} degrees of freedom and {MAX_ENTRIES} bodies or joints; is this the right file?")),
-        );
+        diags.push(too_large(source.len(), true));
         return (None, diags, None);
     }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
@@ -304,6 +297,12 @@ fn load_any(
 /// The text of a spec file read as bytes. A file that is not UTF-8 (UTF-16, Latin-1, cut
 /// inside a character) is an invalid spec: the error points at the first invalid byte.
 pub fn source_text(file_name: &str, bytes: Vec<u8>) -> Result<String, Diagnostics> {
+    if bytes.len() > MAX_SOURCE_BYTES {
+        // Checked first: the bytes may end inside a character.
+        let mut d = Diagnostics::new(file_name, "");
+        d.push(too_large(bytes.len(), false));
+        return Err(d);
+    }
     let e = match String::from_utf8(bytes) {
         Ok(s) => return Ok(s),
         Err(e) => e,
@@ -329,6 +328,19 @@ pub fn source_text(file_name: &str, bytes: Vec<u8>) -> Result<String, Diagnostic
         .with_hint(hint),
     );
     Err(d)
+}
+
+/// The error of a spec over [`MAX_SOURCE_BYTES`]: `len` bytes, or at least that many when the
+/// file was not read to its end (`whole` false).
+fn too_large(len: usize, whole: bool) -> Diagnostic {
+    let size = if whole {
+        format!("{len} bytes")
+    } else {
+        format!("more than {MAX_SOURCE_BYTES} bytes")
+    };
+    Diagnostic::error(format!("the spec is too large: {size} (the limit is {MAX_SOURCE_BYTES})"))
+        .with_span(0..0)
+        .with_hint(format!("nocdyn generates mechanisms of at most {MAX_DOF} degrees of freedom and {MAX_ENTRIES} bodies or joints; is this the right file?"))
 }
 
 /// The public functions a tree module has (`[scene] functions` picks among them).
