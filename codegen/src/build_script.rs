@@ -129,7 +129,8 @@ impl Builder {
     }
 
     /// Take near-exact angles and offsets as exact within `tol` in every spec, as
-    /// `[scene] snap = tol` does (each change is a warning).
+    /// `[scene] snap = tol` does (each change is a warning). `tol` out of (0, 0.01] makes
+    /// [`Builder::compile`] fail.
     pub fn snap(&mut self, tol: f64) -> &mut Self {
         self.config.scene.snap = Some(tol);
         self

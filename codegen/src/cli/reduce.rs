@@ -401,8 +401,9 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
     };
     match &args.output {
         Some(p) => {
-            if let Err(e) = std::fs::write(p, out) {
-                eprintln!("error: {}: {e}", p.display());
+            // Replaced atomically, as the generator's `-o`.
+            if let Err(e) = codegen::build_script::write_if_changed(p, &out) {
+                eprintln!("error: {e}");
                 return ExitCode::from(1);
             }
         }

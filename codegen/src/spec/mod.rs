@@ -163,7 +163,7 @@ pub struct SceneOverrides {
     /// Apply the joints' reflected rotor inertia (`armature`).
     pub rotor_inertia: bool,
     /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
-    /// replaces the spec's value).
+    /// replaces the spec's value). Out of (0, [`MAX_SNAP`]] it is an error.
     pub snap: Option<f64>,
 }
 
