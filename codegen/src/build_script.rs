@@ -13,7 +13,8 @@
 //!
 //! Each spec `dir/<stem>.toml` (or `.urdf`) becomes `$OUT_DIR/<stem>.rs`; a URDF whose stem is
 //! also a TOML spec's becomes `<stem>_urdf.rs`. Files are written only when their content
-//! changed, and `cargo:rerun-if-changed` is printed for every spec.
+//! changed, and replaced atomically ([`write_if_changed`]); `cargo:rerun-if-changed` is printed
+//! for every spec.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -128,7 +129,8 @@ impl Builder {
     }
 
     /// Take near-exact angles and offsets as exact within `tol` in every spec, as
-    /// `[scene] snap = tol` does (each change is a warning).
+    /// `[scene] snap = tol` does (each change is a warning). `tol` out of (0, 0.01] makes
+    /// [`Builder::compile`] fail.
     pub fn snap(&mut self, tol: f64) -> &mut Self {
         self.config.scene.snap = Some(tol);
         self
@@ -153,8 +155,9 @@ impl Builder {
         let mut written = Vec::new();
         for p in &self.specs {
             println!("cargo:rerun-if-changed={}", p.display());
-            let src = std::fs::read_to_string(p).map_err(|e| Error::Io(p.clone(), e))?;
+            let bytes = read_spec(p).map_err(|e| Error::Io(p.clone(), e))?;
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("spec");
+            let src = crate::spec::source_text(name, bytes).map_err(Error::Spec)?;
             let g = compile(name, &src, &self.config).map_err(Error::Spec)?;
             let path = out.join(format!("{}.rs", module_name(p, &self.specs)));
             write_if_changed(&path, &g.code)?;
@@ -181,13 +184,109 @@ fn module_name(p: &Path, all: &[PathBuf]) -> String {
     }
 }
 
+/// The bytes of a spec file, at most one more than
+/// [`MAX_SOURCE_BYTES`](crate::spec::MAX_SOURCE_BYTES) (which
+/// [`spec::source_text`](crate::spec::source_text) refuses): an endless or huge file is not
+/// read whole. The CLI, [`Builder`] and the `mechanism!` macro read specs so.
+pub fn read_spec(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(crate::spec::MAX_SOURCE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
 /// Write `content` to `path` unless it already holds exactly that (keeps mtimes, avoids rebuilds).
+///
+/// The file is replaced atomically: `content` goes to a temporary file in the same directory,
+/// which is then renamed over `path` (a symbolic link is followed). A reader, a crash or a full
+/// disk never leaves a partial module; on failure the old file stays as it was and the
+/// temporary file is removed. An existing file's permissions are kept.
 pub fn write_if_changed(path: &Path, content: &str) -> Result<(), Error> {
-    if std::fs::read_to_string(path)
-        .map(|old| old == content)
-        .unwrap_or(false)
-    {
+    use std::io::Write;
+    if std::fs::read(path).is_ok_and(|old| old == content.as_bytes()) {
         return Ok(());
     }
-    std::fs::write(path, content).map_err(|e| Error::Io(path.to_path_buf(), e))
+    let err = |e: std::io::Error| Error::Io(path.to_path_buf(), e);
+    let target = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let prefix = match target.file_name() {
+        Some(n) => format!(".{}.", n.to_string_lossy()),
+        None => ".nocdyn.".into(),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // As a newly created file would be (the umask applies); tempfile's default is 0o600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
+    if let Ok(meta) = std::fs::metadata(&target)
+        && meta.is_file()
+    {
+        tmp.as_file()
+            .set_permissions(meta.permissions())
+            .map_err(err)?;
+    }
+    tmp.write_all(content.as_bytes()).map_err(err)?;
+    tmp.as_file().sync_all().map_err(err)?;
+    // On failure the error holds the temporary file, which is removed when dropped.
+    tmp.persist(&target).map_err(|e| err(e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh, empty directory under the system's temporary directory.
+    fn scratch(test: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("nocdyn-build-script-{test}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn replaces_atomically_and_leaves_nothing_behind() {
+        let dir = scratch("replace");
+        let out = dir.join("m.rs");
+        write_if_changed(&out, "one").unwrap();
+        write_if_changed(&out, "two").unwrap();
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "two");
+        assert_eq!(listing(&dir), ["m.rs"]);
+        // A directory in the way: an error, the directory untouched, no temporary file.
+        let sub = dir.join("d.rs");
+        std::fs::create_dir(&sub).unwrap();
+        assert!(matches!(write_if_changed(&sub, "x"), Err(Error::Io(..))));
+        assert!(sub.is_dir());
+        assert_eq!(listing(&dir), ["d.rs", "m.rs"]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn keeps_the_permissions_of_the_file_it_replaces() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = scratch("permissions");
+        let out = dir.join("m.rs");
+        std::fs::write(&out, "old").unwrap();
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_if_changed(&out, "new").unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o640);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

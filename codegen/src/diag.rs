@@ -9,8 +9,14 @@ use std::fmt;
 use std::ops::Range;
 
 use codespan_reporting::diagnostic as cs;
-use codespan_reporting::files::SimpleFile;
+use codespan_reporting::files::{self, Files, SimpleFile};
 use codespan_reporting::term;
+
+/// The most diagnostics [`Diagnostics::render`] shows; the rest are counted in a last line.
+pub const MAX_RENDERED: usize = 100;
+
+/// Source lines longer than this (bytes) are shown cut to a window around the span.
+const LONG_LINE: usize = 240;
 
 /// How bad a [`Diagnostic`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -172,6 +178,9 @@ impl Diagnostics {
     /// Colour-free rendering through `codespan-reporting`: for every diagnostic, its severity and
     /// message, `file:line:column`, the source line with carets under the span labelled with the
     /// key, and the hint. Deterministic (no colours, no absolute paths beyond the given name).
+    ///
+    /// At most [`MAX_RENDERED`] diagnostics are shown, and a long source line only around the
+    /// span: the text stays proportional to the input however many errors one line has.
     pub fn render(&self) -> String {
         let file = SimpleFile::new(self.file_name.as_str(), self.source.as_str());
         let config = term::Config {
@@ -179,13 +188,17 @@ impl Diagnostics {
             ..term::Config::default()
         };
         let mut out = String::new();
-        for d in &self.list {
+        for d in self.list.iter().take(MAX_RENDERED) {
             let span = d.span.clone().map(|s| clamp_span(&self.source, s));
+            let excerpt = span
+                .as_ref()
+                .and_then(|s| Excerpt::of(&self.file_name, &self.source, s));
             let mut notes = Vec::new();
             let mut labels = Vec::new();
             match (&span, &d.key) {
                 (Some(s), key) => {
-                    let mut label = cs::Label::primary((), s.clone());
+                    let range = excerpt.as_ref().map_or(s.clone(), |e| e.range.clone());
+                    let mut label = cs::Label::primary((), range);
                     if let Some(k) = key {
                         label = label.with_message(k);
                     }
@@ -205,7 +218,11 @@ impl Diagnostics {
                 .with_message(&d.message)
                 .with_labels(labels)
                 .with_notes(notes.clone());
-            match term::emit_into_string(&config, &file, &diag) {
+            let rendered = match &excerpt {
+                Some(e) => term::emit_into_string(&config, e, &diag),
+                None => term::emit_into_string(&config, &file, &diag),
+            };
+            match rendered {
                 Ok(s) => out.push_str(&s),
                 Err(_) => {
                     // Cannot happen with a clamped span; fall back to a plain line.
@@ -221,7 +238,98 @@ impl Diagnostics {
                 }
             }
         }
+        if let Some(rest) = self.list.get(MAX_RENDERED..) {
+            let errors = rest.iter().filter(|d| d.is_error()).count();
+            out.push_str(&format!(
+                "... and {} more ({errors} errors, {} warnings) not shown\n",
+                rest.len(),
+                rest.len() - errors
+            ));
+        }
         out
+    }
+}
+
+/// A long source line cut to a window around a span, keeping the file's line and column
+/// numbers (codespan-reporting shows whole lines, once per diagnostic).
+struct Excerpt<'a> {
+    name: &'a str,
+    /// The window, part of one line.
+    text: &'a str,
+    /// The span in `text`.
+    range: Range<usize>,
+    /// 0-based line of the window.
+    line: usize,
+    /// Characters of the line before the window.
+    column: usize,
+}
+
+impl<'a> Excerpt<'a> {
+    /// `None` when the line of `span.start` is short enough to show whole.
+    fn of(name: &'a str, source: &'a str, span: &Range<usize>) -> Option<Self> {
+        let start = source[..span.start].rfind('\n').map_or(0, |i| i + 1);
+        let end = source[span.start..]
+            .find('\n')
+            .map_or(source.len(), |i| span.start + i);
+        if end - start <= LONG_LINE {
+            return None;
+        }
+        let fix = |mut i: usize| {
+            while !source.is_char_boundary(i) {
+                i -= 1;
+            }
+            i
+        };
+        let from = fix(span.start.saturating_sub(LONG_LINE / 4).max(start));
+        let shown = fix(span
+            .end
+            .clamp(span.start, span.start + LONG_LINE / 2)
+            .min(end));
+        let to = fix((shown + LONG_LINE / 4).min(end));
+        Some(Excerpt {
+            name,
+            text: &source[from..to],
+            range: span.start - from..shown - from,
+            line: source[..start].matches('\n').count(),
+            column: source[start..from].chars().count(),
+        })
+    }
+}
+
+impl<'a> Files<'a> for Excerpt<'a> {
+    type FileId = ();
+    type Name = &'a str;
+    type Source = &'a str;
+
+    fn name(&'a self, (): ()) -> Result<&'a str, files::Error> {
+        Ok(self.name)
+    }
+
+    fn source(&'a self, (): ()) -> Result<&'a str, files::Error> {
+        Ok(self.text)
+    }
+
+    fn line_index(&'a self, (): (), _: usize) -> Result<usize, files::Error> {
+        Ok(0)
+    }
+
+    fn line_number(&'a self, (): (), _: usize) -> Result<usize, files::Error> {
+        Ok(self.line + 1)
+    }
+
+    fn column_number(&'a self, (): (), _: usize, byte: usize) -> Result<usize, files::Error> {
+        let before = self.text.get(..byte).unwrap_or(self.text);
+        Ok(self.column + before.chars().count() + 1)
+    }
+
+    fn line_range(&'a self, (): (), line: usize) -> Result<Range<usize>, files::Error> {
+        match line {
+            0 => Ok(0..self.text.len()),
+            _ => Err(files::Error::LineTooLarge {
+                given: line,
+                max: 0,
+            }),
+        }
     }
 }
 
@@ -280,6 +388,38 @@ mod tests {
         assert!(r.contains("warning: no span here"), "{r}");
         assert!(r.contains("in arm.toml: body[0]"), "{r}");
         assert_eq!(r, d.to_string());
+    }
+
+    /// 2,000 errors on one 10 kB line: each shows a window of the line with the file's line
+    /// and column, and only the first `MAX_RENDERED` are shown (every error printed the whole
+    /// line: 20 MB of text, quadratic in the line's length).
+    #[test]
+    fn many_errors_on_a_long_line_render_in_proportion() {
+        let n = 2000;
+        let src = format!("v = [{}]\n", vec!["\"é\""; n].join(","));
+        let mut d = Diagnostics::new("x.toml", &src);
+        for (k, (at, _)) in src.match_indices("\"é\"").enumerate() {
+            d.push(
+                Diagnostic::error(format!("bad {k}"))
+                    .with_key(format!("v[{k}]"))
+                    .with_span(at..at + 4),
+            );
+        }
+        let r = d.render();
+        assert!(r.len() < 100_000, "{} bytes", r.len());
+        // The 100th entry: 5 characters before the list, 4 per entry (`"é",`).
+        let col = 6 + 4 * 99;
+        assert!(
+            r.contains(&format!("error: bad 99\n  --> x.toml:1:{col}\n")),
+            "{r:.3000}"
+        );
+        assert!(r.contains("^^^ v[99]"), "{r:.3000}");
+        assert!(!r.contains("bad 100\n"), "{r:.3000}");
+        assert!(
+            r.ends_with("... and 1900 more (1900 errors, 0 warnings) not shown\n"),
+            "{}",
+            &r[r.len() - 200..]
+        );
     }
 
     #[test]

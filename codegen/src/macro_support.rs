@@ -27,13 +27,16 @@ pub fn resolve(manifest_dir: &Path, spec: &str) -> PathBuf {
 ///
 /// # Errors
 ///
-/// The message a `compile_error!` shows: for an invalid spec, its rendered diagnostics
-/// ([`Diagnostics::render`](crate::diag::Diagnostics::render), the CLI's stderr); for an unreadable
+/// The message a `compile_error!` shows: for an invalid spec (also one that is not UTF-8), its
+/// rendered diagnostics ([`Diagnostics::render`](crate::diag::Diagnostics::render), the CLI's
+/// stderr); for an unreadable
 /// file, `cannot read <spec>: <reason>` (the CLI's message without its `error: ` prefix, which
 /// the compiler adds). Warnings are dropped, as [`build_script`](crate::build_script) drops them.
 pub fn expand(manifest_dir: &Path, spec: &str, cfg: &Config) -> Result<String, String> {
     let path = resolve(manifest_dir, spec);
-    let source = std::fs::read_to_string(&path).map_err(|e| format!("cannot read {spec}: {e}"))?;
+    let bytes =
+        crate::build_script::read_spec(&path).map_err(|e| format!("cannot read {spec}: {e}"))?;
+    let source = crate::spec::source_text(spec, bytes).map_err(|d| d.render())?;
     compile(spec, &source, cfg)
         .map(|generated| generated.code)
         .map_err(|diagnostics| diagnostics.render())

@@ -6,8 +6,9 @@
 //! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
 //! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
 //! ```
-//! Exit codes: 0 success, 2 invalid spec or arguments (diagnostics on stderr, nothing written),
-//! 1 I/O error. A spec file literally named `map` or `isotropy` must be written `./map`.
+//! Exit codes: 0 success, 2 invalid spec (also one that is not UTF-8) or arguments (diagnostics
+//! on stderr, nothing written), 1 I/O error. A spec file literally named `map` or `isotropy`
+//! must be written `./map`.
 
 mod cli;
 
@@ -49,7 +50,7 @@ struct Cli {
     /// Validate the spec only; generate nothing.
     #[arg(long)]
     check: bool,
-    /// Print the operation-count table instead of the code.
+    /// Also print the operation-count table, to standard error.
     #[arg(long)]
     stats: bool,
     /// Where sin/cos and sqrt come from.
@@ -70,8 +71,21 @@ struct Cli {
     rotor_inertia: bool,
     /// Take angles within TOL (rad) of a multiple of π/2, rotation entries within TOL of 0/±1
     /// and offsets within TOL (m) of 0 as exact, listing each change (as `[scene] snap`).
-    #[arg(long, value_name = "TOL")]
+    #[arg(long, value_name = "TOL", value_parser = snap_tolerance, allow_negative_numbers = true)]
     snap: Option<f64>,
+}
+
+/// `--snap`: the bounds of `[scene] snap`.
+fn snap_tolerance(s: &str) -> Result<f64, String> {
+    let tol: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if codegen::spec::is_snap_tolerance(tol) {
+        Ok(tol)
+    } else {
+        Err(format!(
+            "the tolerance must be in (0, {}] (as `[scene] snap`)",
+            codegen::spec::MAX_SNAP
+        ))
+    }
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -106,14 +120,10 @@ fn main() -> ExitCode {
         eprintln!("error: a spec file is required");
         return ExitCode::from(2);
     };
-    let source = match std::fs::read_to_string(spec) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: cannot read {}: {e}", spec.display());
-            return ExitCode::from(1);
-        }
+    let (name, source) = match cli::read_spec(spec) {
+        Ok(r) => r,
+        Err(code) => return code,
     };
-    let name = spec.to_string_lossy().into_owned();
     if cli.check {
         return match codegen::spec::load_mechanism(&name, &source) {
             Ok((mechanism, warnings)) => {
@@ -176,13 +186,11 @@ fn main() -> ExitCode {
     if !out.warnings.is_empty() {
         eprint!("{}", out.warnings.render());
     }
-    let text = if cli.stats {
-        let mut t = out.stats_table().join("\n");
-        t.push('\n');
-        t
-    } else {
-        out.code
-    };
+    // The table goes to stderr: the module always goes where it would without `--stats`.
+    if cli.stats {
+        eprintln!("{}", out.stats_table().join("\n"));
+    }
+    let text = out.code;
     match &cli.output {
         Some(path) => {
             if let Err(e) = codegen::build_script::write_if_changed(path, &text) {

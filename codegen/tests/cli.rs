@@ -98,10 +98,13 @@ fn check_validates_without_generating() {
 }
 
 #[test]
-fn stats_prints_the_table() {
+fn stats_prints_the_table_to_stderr_beside_the_module() {
     let o = run(&["--stats", GOOD]);
     assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
-    let t = stdout(&o);
+    // The module still goes to stdout; the table goes to stderr.
+    let code = run(&[GOOD]);
+    assert!(o.stdout == code.stdout, "--stats changed the module");
+    let t = stderr(&o);
     let lines: Vec<&str> = t.lines().collect();
     assert!(
         lines[0].starts_with("| function | flops | flops/joint |"),
@@ -124,10 +127,25 @@ fn stats_prints_the_table() {
     );
     assert!(!t.contains("pub fn"), "--stats printed code");
     // The same table is in the generated header.
-    let code = run(&[GOOD]);
     for l in &lines {
         assert!(stdout(&code).contains(&format!("// {l}\n")), "{l}");
     }
+}
+
+/// `--stats -o FILE` writes the module into FILE, never the table.
+#[test]
+fn stats_never_replaces_the_module() {
+    let dir = scratch("stats_output");
+    let out = dir.join("planar_2r.rs");
+    let o = run(&["--stats", GOOD, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    assert!(o.stdout.is_empty(), "with -o nothing goes to stdout");
+    assert_eq!(std::fs::read(&out).unwrap(), run(&[GOOD]).stdout);
+    assert!(
+        stderr(&o).starts_with("| function | flops |"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
@@ -299,6 +317,317 @@ fn output_is_identical_across_processes() {
         assert!(a.stdout == b.stdout, "{spec}: two runs differ");
         let sa = run(&["--stats", spec]);
         let sb = run(&["--stats", spec]);
-        assert!(sa.stdout == sb.stdout, "{spec}: --stats differs");
+        assert!(sa.stderr == sb.stderr, "{spec}: --stats differs");
     }
+}
+
+/// `--snap` takes the bounds of `[scene] snap`: a tolerance in (0, 0.01]. Out of them it is an
+/// invalid argument (exit 2, nothing generated), not a model change.
+#[test]
+fn snap_out_of_range_exits_2() {
+    for tol in ["0.5", "nan", "0", "-1", "inf", "0.011"] {
+        let o = run(&[PUMA, "--snap", tol]);
+        assert_eq!(o.status.code(), Some(2), "--snap {tol}: {}", stderr(&o));
+        assert!(o.stdout.is_empty(), "--snap {tol} generated code");
+        let err = stderr(&o);
+        assert!(err.contains("--snap") && err.contains("(0, 0.01]"), "{err}");
+    }
+    let o = run(&[PUMA, "--snap", "0.01", "--check"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+/// Runs the CLI under `sh` with `limits` (`ulimit` options, e.g. `-v 2000000`) applied first.
+fn run_limited(limits: &str, args: &[&str]) -> Output {
+    Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg(format!("ulimit {limits} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_codegen"))
+        .args(args)
+        .output()
+        .expect("sh runs")
+}
+
+/// A 20,000-character body name and a joint whose parent differs by one letter: a located
+/// error at the name, no suggestion, and no quadratic memory on the way (the edit distance
+/// of the two names took 8·n² = 3.2 GB; here the process gets 1 GB of address space).
+#[test]
+fn a_very_long_name_is_refused_at_its_key() {
+    let dir = scratch("long_name");
+    let long = "a".repeat(20_000);
+    let near = format!("{}b", &long[1..]);
+    let spec = dir.join("long.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "[mechanism]\nname = \"x\"\n\n[[body]]\nname = \"{long}\"\nmass = 1.0\n\n\
+             [[joint]]\nname = \"j\"\nkind = \"R\"\nparent = \"{near}\"\nchild = \"{long}\"\n"
+        ),
+    )
+    .unwrap();
+    let urdf = dir.join("long.urdf");
+    std::fs::write(
+        &urdf,
+        format!(
+            "<robot name=\"r\">\n  <link name=\"base\"/>\n  <link name=\"{long}\"/>\n  \
+             <joint name=\"j\" type=\"revolute\">\n    <parent link=\"base\"/>\n    \
+             <child link=\"{near}\"/>\n  </joint>\n</robot>\n"
+        ),
+    )
+    .unwrap();
+    for (f, at) in [(&spec, ":5:8"), (&urdf, ":3:15")] {
+        let o = run_limited("-v 1000000", &["--check", path_str(f)]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{}: {err:.2000}", f.display());
+        assert!(
+            err.contains("too long") && err.contains(&format!("{}{at}", path_str(f))),
+            "{err:.2000}"
+        );
+        assert!(!err.contains("did you mean"), "{err:.2000}");
+    }
+}
+
+/// Writes `text` to `dir/name` and returns the path.
+fn spec_file(dir: &Path, name: &str, text: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Asserts exit 2, nothing on stdout, and `what` in stderr at `file:at`.
+fn assert_located(o: &Output, file: &Path, at: &str, what: &str) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "{}: {err:.3000}", file.display());
+    assert!(o.stdout.is_empty(), "{}: generated code", file.display());
+    assert!(
+        err.contains(what) && err.contains(&format!("{}{at}", path_str(file))),
+        "{}: expected {what:?} at {at}:\n{err:.3000}",
+        file.display()
+    );
+}
+
+/// A good two-link robot (one revolute joint); `{}` is replaced by extra markup.
+const ROBOT: &str = r#"<robot name="r">
+  <link name="base"/>
+  <link name="l1">
+    <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+  </link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+</robot>
+"#;
+
+/// Deeply nested XML is refused by the tag scanner, before the recursive URDF reader sees it
+/// (13,000 levels overflowed its stack: SIGABRT, also with `--check`).
+#[test]
+fn deeply_nested_xml_is_refused() {
+    let dir = scratch("deep_xml");
+    let deep = format!(
+        "<robot name=\"r\">\n{}{}</robot>\n",
+        "<a>".repeat(13_000),
+        "</a>".repeat(13_000)
+    );
+    let f = spec_file(&dir, "deep.urdf", deep);
+    for args in [vec!["--check"], vec![]] {
+        let mut a = args.clone();
+        a.push(path_str(&f));
+        let o = run(&a);
+        // The 64th nested <a>, after `<robot name="r">\n` and 63 of them.
+        assert_located(
+            &o,
+            &f,
+            &format!(":2:{}", 63 * 3 + 1),
+            "nested deeper than 64",
+        );
+    }
+    // 60 levels inside an ignored element are fine.
+    let ok = ROBOT.replace(
+        "<link name=\"base\"/>",
+        &format!(
+            "<link name=\"base\"><visual>{}{}</visual></link>",
+            "<a>".repeat(60),
+            "</a>".repeat(60)
+        ),
+    );
+    let f = spec_file(&dir, "ok.urdf", ok);
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+/// XML that is not well formed is refused, located: text outside the root element, a second
+/// root element.
+#[test]
+fn malformed_xml_is_refused() {
+    let dir = scratch("malformed_xml");
+    let f = spec_file(&dir, "good.urdf", ROBOT);
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // A declaration, comments and a BOM are fine.
+    let f = spec_file(
+        &dir,
+        "decl.urdf",
+        format!("\u{feff}<?xml version=\"1.0\"?>\n<!-- c -->\n{ROBOT}<!-- end -->\n"),
+    );
+    let o = run(&["--check", path_str(&f)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for (name, text, at, what) in [
+        (
+            "before.urdf",
+            format!("hello\n{ROBOT}"),
+            ":1:1",
+            "outside the root",
+        ),
+        (
+            "after.urdf",
+            format!("{ROBOT}  tail\n"),
+            ":8:3",
+            "outside the root",
+        ),
+        (
+            "second.urdf",
+            format!("{ROBOT}<robot name=\"s\"/>\n"),
+            ":8:1",
+            "second root element",
+        ),
+        (
+            "inner.urdf",
+            format!("<?xml version=\"1.0\"?>x{ROBOT}"),
+            ":1:22",
+            "outside the root",
+        ),
+    ] {
+        let f = spec_file(&dir, name, text);
+        assert_located(&run(&["--check", path_str(&f)]), &f, at, what);
+        assert_located(&run(&[path_str(&f)]), &f, at, what);
+    }
+}
+
+/// Element lookups stay linear in the file: 1,000 links beside a million ignored elements
+/// (each link's lookups scanned every tag: about a minute).
+#[test]
+fn a_wide_urdf_is_read_in_linear_time() {
+    let dir = scratch("wide_urdf");
+    let mut s = String::from("<robot name=\"r\"><link name=\"base\"/>\n");
+    for i in 0..1000 {
+        s += &format!(
+            "<link name=\"l{i}\"><inertial><mass value=\"1\"/><inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n"
+        );
+    }
+    for i in 0..1000 {
+        let parent = if i == 0 {
+            "base".into()
+        } else {
+            format!("l{}", i - 1)
+        };
+        s += &format!(
+            "<joint name=\"j{i}\" type=\"fixed\"><parent link=\"{parent}\"/><child link=\"l{i}\"/></joint>\n"
+        );
+    }
+    s += &format!("<gazebo>{}</gazebo></robot>\n", "<a/>".repeat(1_000_000));
+    let f = spec_file(&dir, "wide.urdf", s);
+    let t = std::time::Instant::now();
+    let o = run(&["--check", path_str(&f)]);
+    let took = t.elapsed();
+    // All joints are fixed: read, then refused for having no movable joint.
+    assert_located(&o, &f, ":1:", "no movable joints");
+    assert!(took.as_secs_f64() < 5.0, "took {took:?}");
+}
+
+/// A key of 90 dotted parts (`a.a.….a = 1`), or a table header as deep, exceeds the TOML
+/// reader's recursion limit: a located error at the key, not a bare message.
+#[test]
+fn a_deeply_dotted_key_is_located() {
+    let dir = scratch("dotted");
+    let key = vec!["a"; 90].join(".");
+    let head = "[mechanism]\nname = \"x\"\n";
+    for (name, text, at) in [
+        ("dotted.toml", format!("{head}{key} = 1\n"), ":3:1"),
+        ("header.toml", format!("{head}\n[{key}]\nb = 1\n"), ":4:2"),
+        (
+            "spaced.toml",
+            format!("{head}x = 1\n  {}\n", vec!["'q'"; 90].join(" . ") + " = 2"),
+            ":4:3",
+        ),
+        (
+            "inline.toml",
+            format!("{head}t = {{ {key} = 1 }}\n"),
+            ":3:7",
+        ),
+    ] {
+        let f = spec_file(&dir, name, text);
+        assert_located(
+            &run(&["--check", path_str(&f)]),
+            &f,
+            at,
+            "TOML syntax error",
+        );
+    }
+}
+
+/// The names in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    v.sort();
+    v
+}
+
+/// `-o` replaces the file atomically: a write that fails midway (here the file-size limit, as
+/// a full disk would) leaves the previous module intact and no temporary file behind. Writing
+/// in place truncated the module to a fragment.
+#[test]
+fn a_failed_write_leaves_the_old_module_intact() {
+    let dir = scratch("failed_write");
+    let out = dir.join("module.rs");
+    let o = run(&[GOOD, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let old = std::fs::read(&out).unwrap();
+    // At most 2 blocks (1 or 2 KiB) per file; SIGXFSZ ignored, so the write fails with EFBIG.
+    let o = Command::new("sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 2 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_codegen"))
+        .args([PUMA, "-o", path_str(&out)])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("error"), "{}", stderr(&o));
+    assert!(
+        std::fs::read(&out).unwrap() == old,
+        "the old module was changed"
+    );
+    assert_eq!(listing(&dir), ["module.rs"]);
+
+    // An output path that is a directory: exit 1, the directory as it was, nothing left over.
+    let sub = dir.join("sub.rs");
+    std::fs::create_dir(&sub).unwrap();
+    std::fs::write(sub.join("keep"), "x").unwrap();
+    let o = run(&[GOOD, "-o", path_str(&sub)]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(listing(&sub), ["keep"]);
+    assert_eq!(listing(&dir), ["module.rs", "sub.rs"]);
+
+    // A successful replace leaves only the module.
+    let o = run(&[PUMA, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&out).unwrap(), run(&[PUMA]).stdout);
+    assert_eq!(listing(&dir), ["module.rs", "sub.rs"]);
+}
+
+/// A file larger than the spec limit is refused without being read whole: `/dev/zero` (or a
+/// huge file) is an invalid spec, not a process that reads until memory runs out.
+#[test]
+fn an_endless_file_is_refused() {
+    if !Path::new("/dev/zero").exists() {
+        return;
+    }
+    let o = run_limited("-v 1000000", &["--check", "/dev/zero"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("too large") && stderr(&o).contains("/dev/zero:1:1"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -12,8 +12,22 @@
 //!   deleted ranges, truncation, numbers replaced by extreme values, duplicated or dropped lines;
 //! - for URDF specifically, attribute values replaced by random numbers and words.
 //!
-//! Budget: `NOCDYN_FUZZ_CASES` cases per generator (default 2,000); `NOCDYN_FUZZ_SEED` (a
-//! number) changes the RNG seed. The number of inputs tried is printed (`--nocapture`).
+//! The binary is driven too, as a user runs it
+//! (`binary::the_binary_never_crashes_hangs_or_goes_unlocated`): those specs, plus deep XML
+//! and TOML nesting, very long names, bad encodings (UTF-16, Latin-1, a cut character),
+//! thousands of errors on one line and random bytes, with random flags (some invalid) and
+//! `-o` targets (fresh, existing, a directory, in a missing directory), under a 2 GB
+//! address-space limit. It reports the inputs tried, panics, crashes by signal, timeouts (a
+//! run is killed after `NOCDYN_FUZZ_TIMEOUT` seconds, default 5), unlocated errors (exit 2
+//! without `file:line:col`) and other broken promises (exit codes, `-o` files, temporary files
+//! left, the `--stats` table); all but the first must be 0. The first failing inputs are kept
+//! in `target/tmp/fuzz_cli`.
+//!
+//! Budget: `NOCDYN_FUZZ_CASES` cases per generator (default 2,000), `NOCDYN_FUZZ_CLI_CASES`
+//! binary runs (default 1,500, about 20 s); `NOCDYN_FUZZ_SEED` (a number) changes the RNG
+//! seed; `NOCDYN_FUZZ_BIN` drives another binary (e.g. `target/release/codegen`). The
+//! numbers are printed (`--nocapture`). A longer run:
+//! `NOCDYN_FUZZ_CLI_CASES=20000 cargo test -p codegen --test fuzz binary -- --nocapture`.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
@@ -637,4 +651,574 @@ fn mutated_urdf_attributes_never_panic() {
     })
     .unwrap_or_else(|e| panic!("{e}"));
     report("mutated URDF attributes", tried.into_inner());
+}
+
+/// The binary, as a user runs it (Unix: `sh`, `ulimit`, signals).
+#[cfg(unix)]
+mod binary {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    use proptest::strategy::ValueTree;
+
+    use super::*;
+
+    /// Binary runs (default 1,500; `NOCDYN_FUZZ_CLI_CASES` for a longer run).
+    fn cli_cases() -> usize {
+        std::env::var("NOCDYN_FUZZ_CLI_CASES")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1500)
+    }
+
+    /// A run is killed after this long (`NOCDYN_FUZZ_TIMEOUT`, seconds; default 5).
+    fn cli_timeout() -> Duration {
+        Duration::from_secs_f64(
+            std::env::var("NOCDYN_FUZZ_TIMEOUT")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(5.0),
+        )
+    }
+
+    /// The binary driven: the one cargo built for the tests, or `NOCDYN_FUZZ_BIN` (e.g. a release
+    /// build).
+    fn binary() -> String {
+        std::env::var("NOCDYN_FUZZ_BIN")
+            .unwrap_or_else(|_| env!("CARGO_BIN_EXE_codegen").to_owned())
+    }
+
+    /// SplitMix64: the few random choices of the binary runs.
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^ (z >> 31)
+        }
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n.max(1) as u64) as usize
+        }
+        fn pick<'a, T>(&mut self, xs: &'a [T]) -> &'a T {
+            &xs[self.below(xs.len())]
+        }
+        fn chance(&mut self, percent: usize) -> bool {
+            self.below(100) < percent
+        }
+    }
+
+    /// Where `-o` points, and what was there before the run.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    enum Out {
+        /// No `-o`: the module goes to stdout.
+        Stdout,
+        /// A file that does not exist yet.
+        Fresh,
+        /// A file holding an older module.
+        Existing,
+        /// A directory (the write must fail: exit 1).
+        Directory,
+        /// A file in a directory that does not exist (exit 1).
+        NoDir,
+    }
+
+    /// One binary run: the spec file's name and bytes, the flags, where the output goes, and
+    /// whether the flags are invalid by construction (then exit 2 with clap's message).
+    #[derive(Debug)]
+    struct Case {
+        what: &'static str,
+        file: String,
+        bytes: Vec<u8>,
+        flags: Vec<String>,
+        out: Out,
+        bad_args: bool,
+    }
+
+    /// A valid spec of a body-and-joint chain, with `name`s for the chain's parts.
+    fn chain(mech: &str, body: &str, joint: &str, parent_ref: &str) -> String {
+        format!(
+            "[mechanism]\nname = \"{mech}\"\n\n[[body]]\nname = \"{body}\"\nmass = 1.0\n\n\
+         [[joint]]\nname = \"{joint}\"\nkind = \"R\"\nparent = \"{parent_ref}\"\nchild = \"{body}\"\n"
+        )
+    }
+
+    /// A URDF robot with one revolute joint; `extra` goes inside the first link.
+    fn robot(link: &str, child_ref: &str, extra: &str) -> String {
+        format!(
+            "<robot name=\"r\">\n<link name=\"base\">{extra}</link>\n<link name=\"{link}\"><inertial><mass value=\"1\"/>\
+         <inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>\n\
+         <joint name=\"j\" type=\"revolute\"><parent link=\"base\"/><child link=\"{child_ref}\"/></joint>\n</robot>\n"
+        )
+    }
+
+    /// The inputs that took the process down or used it up before: deep nesting, long names, bad
+    /// encodings, plus random bytes. (file name, bytes).
+    fn hostile(rng: &mut Rng, specs: &[(String, String)]) -> (&'static str, String, Vec<u8>) {
+        let (name, good) = rng.pick(specs).clone();
+        match rng.below(9) {
+            0 => {
+                let depth = *rng.pick(&[10, 62, 63, 64, 65, 200, 5_000, 20_000]);
+                let closed = rng.chance(50);
+                let inner = format!(
+                    "{}{}",
+                    "<a>".repeat(depth),
+                    if closed {
+                        "</a>".repeat(depth)
+                    } else {
+                        String::new()
+                    }
+                );
+                let text = if rng.chance(50) {
+                    robot("l1", "l1", &format!("<visual>{inner}</visual>"))
+                } else {
+                    format!("<robot name=\"r\">{inner}</robot>\n")
+                };
+                ("deep XML", "deep.urdf".into(), text.into_bytes())
+            }
+            1 => {
+                let depth = *rng.pick(&[10, 79, 80, 81, 90, 300, 3_000]);
+                let key = vec!["a"; depth].join(if rng.chance(30) { " . " } else { "." });
+                let head = chain("m", "b1", "j1", "base");
+                let text = match rng.below(4) {
+                    0 => format!("{head}{key} = 1\n"),
+                    1 => format!("{head}[{key}]\nx = 1\n"),
+                    2 => format!("{head}v = {}1{}\n", "[".repeat(depth), "]".repeat(depth)),
+                    _ => format!("{head}v = {}1{}\n", "{a=".repeat(depth), "}".repeat(depth)),
+                };
+                ("deep TOML", "deep.toml".into(), text.into_bytes())
+            }
+            2 | 3 => {
+                let n = *rng.pick(&[64, 127, 128, 129, 1_000, 20_000]);
+                let long = "a".repeat(n);
+                let near = format!("{}b", &long[1..]);
+                let text = match rng.below(5) {
+                    0 => chain("m", &long, "j1", "base"),
+                    1 => chain("m", "b1", &long, "base"),
+                    2 => chain(&long, "b1", "j1", "base"),
+                    3 => chain("m", &long, "j1", &near).replace(
+                        &format!("child = \"{long}\""),
+                        &format!("child = \"{near}\""),
+                    ),
+                    _ => {
+                        return (
+                            "long name",
+                            "long.urdf".into(),
+                            robot(&long, &near, "").into_bytes(),
+                        );
+                    }
+                };
+                ("long name", "long.toml".into(), text.into_bytes())
+            }
+            4 | 5 => {
+                let bytes: Vec<u8> = match rng.below(6) {
+                    0 => [0xff, 0xfe]
+                        .into_iter()
+                        .chain(good.encode_utf16().flat_map(u16::to_le_bytes))
+                        .collect(),
+                    1 => [0xfe, 0xff]
+                        .into_iter()
+                        .chain(good.encode_utf16().flat_map(u16::to_be_bytes))
+                        .collect(),
+                    2 => {
+                        // One Latin-1 byte somewhere.
+                        let mut b = good.clone().into_bytes();
+                        let at = rng.below(b.len() + 1);
+                        b.insert(at, *rng.pick(&[0xe9u8, 0xfc, 0xb0, 0x80, 0xff]));
+                        b
+                    }
+                    3 => {
+                        // Cut inside a character.
+                        let mut b = format!("{good}# \u{e9}\u{1F600}").into_bytes();
+                        b.truncate(b.len() - 1 - rng.below(3));
+                        b
+                    }
+                    4 => format!("\u{feff}{good}").into_bytes(),
+                    _ => {
+                        let mut b = good.clone().into_bytes();
+                        let at = rng.below(b.len() + 1);
+                        b.insert(at, 0);
+                        b
+                    }
+                };
+                ("bad encoding", name, bytes)
+            }
+            6 if rng.chance(40) => {
+                // Many errors, on one line or one per line.
+                let n = *rng.pick(&[1_000, 20_000, 50_000]);
+                let head = chain("m", "b1", "j1", "base");
+                let text = if rng.chance(50) {
+                    format!(
+                        "{head}[scene]\npoint_mass = [{}]\n",
+                        vec!["\"bx\""; n].join(",")
+                    )
+                } else {
+                    let keys: String = (0..n).map(|k| format!("k{k} = 1\n")).collect();
+                    head.replacen("[mechanism]\n", &format!("[mechanism]\n{keys}"), 1)
+                };
+                ("many errors", "many.toml".into(), text.into_bytes())
+            }
+            6 => {
+                let n = rng.below(4096);
+                let bytes = (0..n).map(|_| rng.next() as u8).collect();
+                let file = if rng.chance(50) {
+                    "noise.toml"
+                } else {
+                    "noise.urdf"
+                };
+                ("random bytes", file.into(), bytes)
+            }
+            _ => {
+                let file = if rng.chance(50) {
+                    "empty.toml"
+                } else {
+                    "empty.urdf"
+                };
+                ("empty", file.into(), Vec::new())
+            }
+        }
+    }
+
+    /// Random flags: valid ones, and now and then an invalid one (`bad` is set).
+    fn flags(rng: &mut Rng, bad: &mut bool) -> Vec<String> {
+        let mut f: Vec<String> = Vec::new();
+        let mut push = |s: &str| f.push(s.to_owned());
+        for flag in ["--check", "--stats", "--friction", "--rotor-inertia"] {
+            if rng.chance(if flag == "--check" { 25 } else { 15 }) {
+                push(flag);
+            }
+        }
+        if rng.chance(20) {
+            let (tol, ok) = *rng.pick(&[
+                ("1e-6", true),
+                ("0.01", true),
+                ("1e-300", true),
+                ("0.5", false),
+                ("nan", false),
+                ("0", false),
+                ("-1", false),
+                ("inf", false),
+                ("x", false),
+            ]);
+            push("--snap");
+            push(tol);
+            *bad |= !ok;
+        }
+        if rng.chance(15) {
+            let (m, ok) = *rng.pick(&[
+                ("libm", true),
+                ("std", true),
+                ("runtime", true),
+                ("fast", false),
+            ]);
+            push("--math");
+            push(m);
+            *bad |= !ok;
+        }
+        if rng.chance(15) {
+            let (m, ok) = *rng.pick(&[("f32", true), ("f64", true), ("f16", false)]);
+            push("--float");
+            push(m);
+            *bad |= !ok;
+        }
+        if rng.chance(3) {
+            push("--bogus");
+            *bad = true;
+        }
+        f
+    }
+
+    fn case(rng: &mut Rng, specs: &[(String, String)], toml: &mut TestRunner) -> Case {
+        let (what, file, bytes) = match rng.below(10) {
+            0..=3 => {
+                let (name, src) = rng.pick(specs);
+                let mut s = src.clone();
+                let urdf = name.ends_with(".urdf");
+                for _ in 0..rng.below(5) {
+                    let e = edit().new_tree(toml).expect("an edit").current();
+                    apply(&mut s, &e, urdf);
+                }
+                ("mutated spec", name.clone(), s.into_bytes())
+            }
+            4..=5 => {
+                let s = toml_spec().new_tree(toml).expect("a spec").current();
+                ("random TOML", "fuzz.toml".to_owned(), s.into_bytes())
+            }
+            _ => hostile(rng, specs),
+        };
+        let mut bad_args = false;
+        let flags = flags(rng, &mut bad_args);
+        let out = *rng.pick(&[
+            Out::Stdout,
+            Out::Stdout,
+            Out::Fresh,
+            Out::Existing,
+            Out::Existing,
+            Out::Directory,
+            Out::NoDir,
+        ]);
+        Case {
+            what,
+            file,
+            bytes,
+            flags,
+            out,
+            bad_args,
+        }
+    }
+
+    /// What the runs found.
+    #[derive(Default)]
+    struct Tally {
+        tried: usize,
+        exits: [usize; 3],
+        panics: usize,
+        signals: usize,
+        timeouts: usize,
+        unlocated: usize,
+        /// Other broken promises: an unexpected exit code, a missing or changed output, temporary
+        /// files left behind.
+        wrong: usize,
+        failures: Vec<String>,
+    }
+
+    impl Tally {
+        fn fail(&mut self, kind: &str, c: &Case, dir: &Path, detail: &str) {
+            if self.failures.len() < 8 {
+                // Kept for reproduction: the spec file stays in its directory under this name.
+                let keep = dir.join(format!("failure-{}-{}", self.failures.len(), c.file));
+                let _ = std::fs::write(&keep, &c.bytes);
+                self.failures.push(format!(
+                    "{kind} ({}, {}, flags {:?}, out {:?}; input kept in {}):\n{detail:.2000}",
+                    c.what,
+                    c.file,
+                    c.flags,
+                    c.out,
+                    keep.display()
+                ));
+            }
+        }
+    }
+
+    /// `true` when `err` has `file:LINE:COL`.
+    fn located(err: &str, file: &str) -> bool {
+        let pat = format!("{file}:");
+        err.match_indices(&pat).any(|(i, _)| {
+            let rest = &err[i + pat.len()..];
+            let line = rest.bytes().take_while(u8::is_ascii_digit).count();
+            let col = rest[line..]
+                .strip_prefix(':')
+                .map_or(0, |r| r.bytes().take_while(u8::is_ascii_digit).count());
+            line > 0 && col > 0
+        })
+    }
+
+    /// Runs one case in `dir` (emptied first) under a 2 GB address-space limit, and checks it.
+    fn run_case(c: &Case, dir: &Path, tally: &mut Tally) {
+        use std::os::unix::process::ExitStatusExt;
+        let _ = std::fs::remove_dir_all(dir);
+        let outs = dir.join("out");
+        std::fs::create_dir_all(&outs).unwrap();
+        let spec = dir.join(&c.file);
+        std::fs::write(&spec, &c.bytes).unwrap();
+        const OLD: &str = "// an older module\n";
+        let target = match c.out {
+            Out::Stdout => None,
+            Out::Fresh => Some(outs.join("module.rs")),
+            Out::Existing => {
+                let p = outs.join("module.rs");
+                std::fs::write(&p, OLD).unwrap();
+                Some(p)
+            }
+            Out::Directory => {
+                let p = outs.join("module.rs");
+                std::fs::create_dir(&p).unwrap();
+                Some(p)
+            }
+            Out::NoDir => Some(outs.join("missing").join("module.rs")),
+        };
+        let before = listing(&outs);
+        let mut args: Vec<String> = vec![c.file.clone()];
+        args.extend(c.flags.iter().cloned());
+        if let Some(t) = &target {
+            args.push("-o".into());
+            args.push(t.to_str().unwrap().into());
+        }
+        let stdout = std::fs::File::create(dir.join("stdout")).unwrap();
+        let stderr = std::fs::File::create(dir.join("stderr")).unwrap();
+        let mut child = Command::new("sh")
+            .current_dir(dir)
+            .arg("-c")
+            .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
+            .arg(binary())
+            .args(&args)
+            .stdin(Stdio::null())
+            .stdout(stdout)
+            .stderr(stderr)
+            .spawn()
+            .expect("sh runs");
+        tally.tried += 1;
+        let start = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break Some(s);
+            }
+            if start.elapsed() > cli_timeout() {
+                let _ = child.kill();
+                let _ = child.wait();
+                break None;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        let out = std::fs::read(dir.join("stdout")).unwrap();
+        let err = String::from_utf8_lossy(&std::fs::read(dir.join("stderr")).unwrap()).into_owned();
+        let Some(status) = status else {
+            tally.timeouts += 1;
+            return tally.fail("timeout", c, dir, &err);
+        };
+        let code = match status.code() {
+            Some(code) => code,
+            None => {
+                tally.signals += 1;
+                let detail = format!("signal {:?}\n{err}", status.signal());
+                return tally.fail("crash", c, dir, &detail);
+            }
+        };
+        if code == 101 || err.contains("panicked") || err.contains("internal error") {
+            tally.panics += 1;
+            return tally.fail("panic", c, dir, &err);
+        }
+        if let Some(k) = tally.exits.get_mut(code as usize) {
+            *k += 1;
+        }
+        let check = c.flags.iter().any(|f| f == "--check");
+        let unwritable = matches!(c.out, Out::Directory | Out::NoDir);
+        let expected: &[i32] = if c.bad_args {
+            &[2]
+        } else if unwritable && !check {
+            &[1, 2]
+        } else {
+            &[0, 2]
+        };
+        if !expected.contains(&code) {
+            tally.wrong += 1;
+            return tally.fail(&format!("exit {code}"), c, dir, &err);
+        }
+        if code == 2 && !c.bad_args && !located(&err, &c.file) {
+            tally.unlocated += 1;
+            return tally.fail("unlocated error", c, dir, &err);
+        }
+        // The output: the module where it belongs on success, the old file untouched otherwise,
+        // and never a temporary file left behind.
+        let written = target.as_ref().and_then(|t| std::fs::read(t).ok());
+        let problem = if code == 0 && !check {
+            let module = if target.is_some() {
+                written.unwrap_or_default()
+            } else {
+                out
+            };
+            let stats = !c.flags.iter().any(|f| f == "--stats") || err.contains("| function |");
+            (!(String::from_utf8_lossy(&module).contains("pub fn") && stats))
+                .then_some("no module (or no --stats table)")
+        } else if c.out == Out::Existing && written.as_deref() != Some(OLD.as_bytes()) {
+            Some("the old module was changed")
+        } else if c.out == Out::Fresh && written.is_some() {
+            Some("a module was written")
+        } else {
+            None
+        };
+        let after = listing(&outs);
+        let stray = after
+            .iter()
+            .any(|n| !before.contains(n) && n != "module.rs");
+        if let Some(p) = problem.or(stray.then_some("temporary files left behind")) {
+            tally.wrong += 1;
+            tally.fail(p, c, dir, &err);
+        }
+    }
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .map(|r| {
+                r.map(|e| e.unwrap().file_name().into_string().unwrap())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    }
+
+    /// The binary as a user runs it: random, mutated and hostile specs (deep nesting, long names,
+    /// bad encodings, random bytes) with random flags and `-o` targets, two runs at a time. No
+    /// panic, no crash by signal, no timeout, no exit 2 without a `file:line:col`, and the exit
+    /// codes, `-o` files and `--stats` table as documented.
+    #[test]
+    fn the_binary_never_crashes_hangs_or_goes_unlocated() {
+        let specs = bundled();
+        let n = cli_cases();
+        let seed: u64 = std::env::var("NOCDYN_FUZZ_SEED")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(7);
+        let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz_cli");
+        let _ = std::fs::remove_dir_all(&root);
+        let start = Instant::now();
+        let tallies: Vec<Tally> = std::thread::scope(|s| {
+            let workers: Vec<_> = (0..2u64)
+                .map(|w| {
+                    let specs = &specs;
+                    let dir = root.join(format!("w{w}"));
+                    s.spawn(move || {
+                        let mut rng = Rng(seed ^ (w << 32) ^ 0x5eed);
+                        let mut toml = runner(10 + w as u8);
+                        let mut tally = Tally::default();
+                        for _ in (w as usize..n).step_by(2) {
+                            let c = case(&mut rng, specs, &mut toml);
+                            run_case(&c, &dir.join("case"), &mut tally);
+                        }
+                        tally
+                    })
+                })
+                .collect();
+            workers.into_iter().map(|w| w.join().unwrap()).collect()
+        });
+        let mut t = Tally::default();
+        for x in tallies {
+            t.tried += x.tried;
+            for k in 0..3 {
+                t.exits[k] += x.exits[k];
+            }
+            t.panics += x.panics;
+            t.signals += x.signals;
+            t.timeouts += x.timeouts;
+            t.unlocated += x.unlocated;
+            t.wrong += x.wrong;
+            t.failures.extend(x.failures);
+        }
+        println!(
+            "fuzz the binary: {} inputs tried in {:.1} s (exit 0: {}, 1: {}, 2: {}); {} panics, {} crashes by signal, {} timeouts (> {:?}), {} unlocated errors, {} other failures",
+            t.tried,
+            start.elapsed().as_secs_f64(),
+            t.exits[0],
+            t.exits[1],
+            t.exits[2],
+            t.panics,
+            t.signals,
+            t.timeouts,
+            cli_timeout(),
+            t.unlocated,
+            t.wrong
+        );
+        for f in &t.failures {
+            println!("{f}\n");
+        }
+        assert_eq!(t.tried, n);
+        assert_eq!(
+            (t.panics, t.signals, t.timeouts, t.unlocated, t.wrong),
+            (0, 0, 0, 0, 0),
+            "(panics, crashes by signal, timeouts, unlocated errors, other failures); see above"
+        );
+    }
 }

@@ -148,3 +148,108 @@ fn cli_builder_and_macro_agree_on_every_math_backend() {
         );
     }
 }
+
+/// A spec that is not UTF-8 (UTF-16 with its byte-order mark, Latin-1, a file cut inside a
+/// character) is an invalid spec in all three adapters, located at the first invalid byte: the
+/// CLI exits 2 (not 1, an I/O error), `Builder` returns `Error::Spec`, the macro's message
+/// has the location.
+#[test]
+fn invalid_utf8_is_an_invalid_spec_everywhere() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("identical/utf8");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let good = std::fs::read_to_string(manifest_dir().join(SPECS).join("planar_2r.toml")).unwrap();
+    let utf16: Vec<u8> = [0xff, 0xfe]
+        .into_iter()
+        .chain(good.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    let latin1: Vec<u8> = "# caf\u{e9}\n"
+        .chars()
+        .map(|c| c as u8)
+        .chain(good.bytes())
+        .collect();
+    let mut cut = format!("{good}# \u{e9}").into_bytes();
+    cut.pop();
+    let last_line = good.lines().count() + 1;
+    for (name, bytes, at) in [
+        ("utf16.toml", utf16, ":1:1".to_owned()),
+        ("latin1.toml", latin1, ":1:6".to_owned()),
+        ("cut.toml", cut, format!(":{last_line}:3")),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let p = path.to_str().unwrap();
+
+        let out = Command::new(env!("CARGO_BIN_EXE_codegen"))
+            .arg(p)
+            .output()
+            .expect("the codegen binary runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(
+            err.contains("not UTF-8") && err.contains(&format!("{p}{at}")),
+            "{name}: {err}"
+        );
+
+        let sub = dir.join(name.replace(".toml", ""));
+        std::fs::create_dir_all(&sub).unwrap();
+        match Builder::new().spec(&path).out_dir(&sub).compile() {
+            Err(codegen::build_script::Error::Spec(d)) => {
+                let r = d.render();
+                assert!(
+                    r.contains("not UTF-8") && r.contains(&format!("{name}{at}")),
+                    "{r}"
+                );
+            }
+            other => panic!("{name}: Builder gave {other:?}"),
+        }
+
+        let e = macro_support::expand(manifest_dir(), p, &Config::default()).unwrap_err();
+        assert!(
+            e.contains("not UTF-8") && e.contains(&format!("{p}{at}")),
+            "{name}: {e}"
+        );
+    }
+}
+
+/// XML nested 13,000 deep (the URDF reader overflowed its stack: the process aborted, and the
+/// macro took rustc down) is an invalid spec in all three adapters, located at the first
+/// element too deep.
+#[cfg(feature = "urdf")]
+#[test]
+fn deep_xml_is_an_invalid_spec_everywhere() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("identical/deep_xml");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let path = dir.join("deep.urdf");
+    std::fs::write(
+        &path,
+        format!(
+            "<robot name=\"r\">\n{}{}</robot>\n",
+            "<a>".repeat(13_000),
+            "</a>".repeat(13_000)
+        ),
+    )
+    .unwrap();
+    let p = path.to_str().unwrap();
+    let at = ":2:190";
+    let out = Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .arg(p)
+        .output()
+        .expect("the codegen binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err:.2000}");
+    assert!(err.contains(&format!("{p}{at}")), "{err:.2000}");
+    match Builder::new().spec(&path).out_dir(&dir).compile() {
+        Err(codegen::build_script::Error::Spec(d)) => {
+            let r = d.render();
+            assert!(r.contains(&format!("deep.urdf{at}")), "{r:.2000}");
+        }
+        other => panic!("Builder gave {other:?}"),
+    }
+    let e = macro_support::expand(manifest_dir(), p, &Config::default()).unwrap_err();
+    assert!(
+        e.contains("nested deeper") && e.contains(&format!("{p}{at}")),
+        "{e:.2000}"
+    );
+}

@@ -143,14 +143,25 @@ pub enum Target {
     },
 }
 
+/// A spec file's name (as given) and text. On failure the error is printed and the exit code
+/// returned: 1 when the file cannot be read, 2 when it is not UTF-8 (an invalid spec).
+pub fn read_spec(spec: &std::path::Path) -> Result<(String, String), ExitCode> {
+    let bytes = codegen::build_script::read_spec(spec).map_err(|e| {
+        eprintln!("error: cannot read {}: {e}", spec.display());
+        ExitCode::from(1)
+    })?;
+    let name = spec.to_string_lossy().into_owned();
+    let source = codegen::spec::source_text(&name, bytes).map_err(|d| {
+        eprint!("{}", d.render());
+        ExitCode::from(2)
+    })?;
+    Ok((name, source))
+}
+
 impl Target {
     /// Load a spec for the tools. Errors and warnings are printed; the exit code is returned.
     pub fn load(spec: &std::path::Path, space: SpaceArg) -> Result<Target, ExitCode> {
-        let source = std::fs::read_to_string(spec).map_err(|e| {
-            eprintln!("error: cannot read {}: {e}", spec.display());
-            ExitCode::from(1)
-        })?;
-        let name = spec.to_string_lossy().into_owned();
+        let (name, source) = read_spec(spec)?;
         let (target, warnings) = Target::compile(&name, &source, space).map_err(|e| {
             eprint!("{e}");
             ExitCode::from(2)

@@ -240,14 +240,10 @@ fn errors(m: &Mechanism, states: &[State], reference: &[Vec<f64>]) -> Option<(f6
 
 /// Run `reduce`.
 pub fn run(args: &ReduceArgs) -> ExitCode {
-    let source = match std::fs::read_to_string(&args.spec) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: cannot read {}: {e}", args.spec.display());
-            return ExitCode::from(1);
-        }
+    let (name, source) = match super::read_spec(&args.spec) {
+        Ok(r) => r,
+        Err(code) => return code,
     };
-    let name = args.spec.to_string_lossy().into_owned();
     if source
         .lines()
         .any(|l| l.trim_start().starts_with("[scene]"))
@@ -405,8 +401,9 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
     };
     match &args.output {
         Some(p) => {
-            if let Err(e) = std::fs::write(p, out) {
-                eprintln!("error: {}: {e}", p.display());
+            // Replaced atomically, as the generator's `-o`.
+            if let Err(e) = codegen::build_script::write_if_changed(p, &out) {
+                eprintln!("error: {e}");
                 return ExitCode::from(1);
             }
         }

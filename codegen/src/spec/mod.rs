@@ -44,6 +44,21 @@ pub const MAX_ENTRIES: usize = 1024;
 /// URDFs take 2.5 s and 4.2 s in release), so larger specs are refused up front.
 pub const MAX_DOF: usize = 128;
 
+/// The longest name (of a mechanism, body, joint or spring; URDF: robot, link or joint), in
+/// characters. Names become Rust identifiers and strings in the generated code.
+pub const MAX_NAME_LEN: usize = 128;
+
+/// The error of a name longer than [`MAX_NAME_LEN`], or `None`.
+pub(crate) fn name_too_long(name: &str) -> Option<Diagnostic> {
+    let n = name.chars().count();
+    (n > MAX_NAME_LEN).then(|| {
+        Diagnostic::error(format!(
+            "name too long: {n} characters (the limit is {MAX_NAME_LEN})"
+        ))
+        .with_hint("names become Rust identifiers in the generated code; shorten it")
+    })
+}
+
 /// The largest magnitude of any number in a spec (SI units). Larger values would overflow in
 /// the generator's constant folding; nothing physical comes close.
 pub const MAX_MAGNITUDE: f64 = 1e9;
@@ -53,6 +68,18 @@ pub const MAX_MAGNITUDE: f64 = 1e9;
 pub(crate) fn in_range(x: f64) -> bool {
     x.abs() <= MAX_MAGNITUDE
 }
+
+/// The largest snapping tolerance (`[scene] snap`, `--snap`, [`SceneOverrides::snap`]): 0.01
+/// (rad, m, or a rotation entry).
+pub const MAX_SNAP: f64 = 1e-2;
+
+/// `true` when `tol` is a snapping tolerance: in (0, [`MAX_SNAP`]] (NaN is not).
+pub fn is_snap_tolerance(tol: f64) -> bool {
+    tol > 0.0 && tol <= MAX_SNAP
+}
+
+/// The hint of a snapping tolerance out of range.
+pub(crate) const SNAP_HINT: &str = "angles within this many rad of a multiple of π/2, rotation entries within it of 0 or ±1 and offsets within it (m) of 0 are taken as exact; e.g. 1e-6";
 
 /// The hint of a number out of [`in_range`].
 pub(crate) const RANGE_HINT: &str = "every number must lie within ±1e9 in SI units (m, kg, kg·m², rad, m/s²); check the units or the exponent";
@@ -136,7 +163,7 @@ pub struct SceneOverrides {
     /// Apply the joints' reflected rotor inertia (`armature`).
     pub rotor_inertia: bool,
     /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
-    /// replaces the spec's value).
+    /// replaces the spec's value). Out of (0, [`MAX_SNAP`]] it is an error.
     pub snap: Option<f64>,
 }
 
@@ -162,14 +189,7 @@ fn load_any(
 ) {
     let mut diags = Diagnostics::new(file_name, source);
     if source.len() > MAX_SOURCE_BYTES {
-        diags.push(
-            Diagnostic::error(format!(
-                "the spec is too large: {} bytes (the limit is {MAX_SOURCE_BYTES})",
-                source.len()
-            ))
-            .with_span(0..0)
-            .with_hint(format!("nocdyn generates mechanisms of at most {MAX_DOF} degrees of freedom and {MAX_ENTRIES} bodies or joints; is this the right file?")),
-        );
+        diags.push(too_large(source.len(), true));
         return (None, diags, None);
     }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
@@ -274,6 +294,55 @@ fn load_any(
     }
 }
 
+/// The text of a spec file read as bytes. A file that is not UTF-8 (UTF-16, Latin-1, cut
+/// inside a character) is an invalid spec: the error points at the first invalid byte.
+pub fn source_text(file_name: &str, bytes: Vec<u8>) -> Result<String, Diagnostics> {
+    if bytes.len() > MAX_SOURCE_BYTES {
+        // Checked first: the bytes may end inside a character.
+        let mut d = Diagnostics::new(file_name, "");
+        d.push(too_large(bytes.len(), false));
+        return Err(d);
+    }
+    let e = match String::from_utf8(bytes) {
+        Ok(s) => return Ok(s),
+        Err(e) => e,
+    };
+    let at = e.utf8_error().valid_up_to();
+    let bytes = e.as_bytes();
+    let hint = if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        "the file looks like UTF-16 (it starts with a byte-order mark): save it as UTF-8"
+    } else if e.utf8_error().error_len().is_none() {
+        "the file ends inside a character: is it cut short?"
+    } else {
+        "save the file as UTF-8 (this byte looks like another encoding, such as Latin-1)"
+    };
+    // Shown with the invalid bytes replaced by U+FFFD: the text before them is unchanged.
+    let shown = String::from_utf8_lossy(bytes);
+    let mut d = Diagnostics::new(file_name, &shown);
+    d.push(
+        Diagnostic::error(format!(
+            "the spec is not UTF-8 text: invalid byte 0x{:02X}",
+            bytes[at]
+        ))
+        .with_span(at..at + '\u{fffd}'.len_utf8())
+        .with_hint(hint),
+    );
+    Err(d)
+}
+
+/// The error of a spec over [`MAX_SOURCE_BYTES`]: `len` bytes, or at least that many when the
+/// file was not read to its end (`whole` false).
+fn too_large(len: usize, whole: bool) -> Diagnostic {
+    let size = if whole {
+        format!("{len} bytes")
+    } else {
+        format!("more than {MAX_SOURCE_BYTES} bytes")
+    };
+    Diagnostic::error(format!("the spec is too large: {size} (the limit is {MAX_SOURCE_BYTES})"))
+        .with_span(0..0)
+        .with_hint(format!("nocdyn generates mechanisms of at most {MAX_DOF} degrees of freedom and {MAX_ENTRIES} bodies or joints; is this the right file?"))
+}
+
 /// The public functions a tree module has (`[scene] functions` picks among them).
 pub const TREE_FUNCTIONS: [&str; 6] = [
     "mass_matrix",
@@ -305,8 +374,18 @@ fn no_drive(j: &ir::JointSpec, role: &str, hint: &str, diags: &mut Diagnostics) 
 fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {
     spec.scene.friction |= overrides.friction;
     spec.scene.rotor_inertia |= overrides.rotor_inertia;
-    if overrides.snap.is_some() {
-        spec.scene.snap = overrides.snap;
+    if let Some(tol) = overrides.snap {
+        if is_snap_tolerance(tol) {
+            spec.scene.snap = Some(tol);
+        } else {
+            // Set outside the file (`--snap`, `Builder::snap`): no place in it to point at.
+            diags.push(
+                Diagnostic::error(format!(
+                    "the snap tolerance {tol} is not in (0, {MAX_SNAP}]"
+                ))
+                .with_hint(SNAP_HINT),
+            );
+        }
     }
     snap::snap(spec, diags);
     apply_scene(spec, diags);
@@ -881,41 +960,69 @@ pub(crate) fn suggest_hint(word: &str, candidates: &[&str]) -> Option<String> {
     closest(word, candidates).map(|c| format!("did you mean \"{c}\"?"))
 }
 
-/// The candidate with the smallest edit distance (transpositions count 1) to `word`, if that
-/// distance is at most a third of the word's length (at least 1); ties go to the first.
-pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
-    let limit = (word.chars().count() / 3).max(1);
-    candidates
-        .iter()
-        .map(|c| (edit_distance(&word.to_lowercase(), &c.to_lowercase()), *c))
-        .filter(|(d, _)| *d <= limit)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
-}
+/// The edit-distance cells one [`closest`] call may fill (about a millisecond): with many long
+/// candidates the first ones are compared, not all.
+const SUGGEST_BUDGET: usize = 1 << 18;
 
-/// Optimal-string-alignment distance (Levenshtein plus adjacent transpositions).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let (n, m) = (a.len(), b.len());
-    let mut d = vec![vec![0usize; m + 1]; n + 1];
-    for (i, row) in d.iter_mut().enumerate() {
-        row[0] = i;
+/// The candidate with the smallest edit distance (transpositions count 1) to `word`, if that
+/// distance is at most a third of the word's length (at least 1); ties go to the first. Words
+/// and candidates longer than [`MAX_NAME_LEN`] characters take no part.
+pub(crate) fn closest<'a>(word: &str, candidates: &[&'a str]) -> Option<&'a str> {
+    let word: Vec<char> = word.to_lowercase().chars().collect();
+    if word.len() > MAX_NAME_LEN {
+        return None;
     }
-    for (j, e) in d[0].iter_mut().enumerate() {
-        *e = j;
-    }
-    for i in 1..=n {
-        for j in 1..=m {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut v = (d[i - 1][j] + 1)
-                .min(d[i][j - 1] + 1)
-                .min(d[i - 1][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                v = v.min(d[i - 2][j - 2] + 1);
-            }
-            d[i][j] = v;
+    let mut best: Option<(usize, &str)> = None;
+    let mut budget = SUGGEST_BUDGET;
+    for c in candidates {
+        // Only a strictly closer candidate replaces the best so far.
+        let bound = match best {
+            None => (word.len() / 3).max(1),
+            Some((0, _)) => break,
+            Some((d, _)) => d - 1,
+        };
+        if c.len() > 4 * MAX_NAME_LEN {
+            continue;
+        }
+        let cand: Vec<char> = c.to_lowercase().chars().collect();
+        if cand.len() > MAX_NAME_LEN || cand.len().abs_diff(word.len()) > bound {
+            continue;
+        }
+        let cost = (word.len() + 1) * (cand.len() + 1);
+        if cost > budget {
+            break;
+        }
+        budget -= cost;
+        if let Some(d) = edit_distance_within(&word, &cand, bound) {
+            best = Some((d, c));
         }
     }
-    d[n][m]
+    best.map(|(_, c)| c)
+}
+
+/// The optimal-string-alignment distance (Levenshtein plus adjacent transpositions) of `a` and
+/// `b` when it is at most `bound`. Three rows, and an early exit once a whole row is past the
+/// bound (the distance never falls below a row's minimum).
+fn edit_distance_within(a: &[char], b: &[char], bound: usize) -> Option<usize> {
+    let m = b.len();
+    let mut before: Vec<usize> = vec![0; m + 1];
+    let mut prev: Vec<usize> = (0..=m).collect();
+    let mut cur: Vec<usize> = vec![0; m + 1];
+    for i in 1..=a.len() {
+        cur[0] = i;
+        for j in 1..=m {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(before[j - 2] + 1);
+            }
+            cur[j] = v;
+        }
+        if cur.iter().all(|&v| v > bound) {
+            return None;
+        }
+        std::mem::swap(&mut before, &mut prev);
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    Some(prev[m]).filter(|&d| d <= bound)
 }

@@ -102,10 +102,21 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
                 continue;
             }
             lines_seen.push(line);
+            // The reader's recursion limit on dotted keys comes without a span: find the key.
+            let (span, hint) = match e.span() {
+                Some(s) => (s, "see https://toml.io for the syntax"),
+                None if !e.message().contains("recursion") => {
+                    (0..0, "see https://toml.io for the syntax")
+                }
+                None => (
+                    deepest_dotted_key(source).unwrap_or(0..0),
+                    "a key has at most 80 dotted parts; nocdyn's keys have at most four, e.g. scene.payload.inertia.ixx",
+                ),
+            };
             diags.push(
                 Diagnostic::error(format!("TOML syntax error: {}", e.message().trim_end()))
-                    .with_span(e.span())
-                    .with_hint("see https://toml.io for the syntax"),
+                    .with_span(span)
+                    .with_hint(hint),
             );
         }
         return None;
@@ -116,6 +127,63 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         joints_incomplete: false,
     };
     Some(r.spec(&root))
+}
+
+/// The span of the dotted key (`a.b.c`, in a header or before `=`) with the most parts, when it
+/// has more than one: where the TOML reader's recursion limit on keys struck (the first key
+/// over it, more than 80 parts). Strings are skipped whole, so only dotted runs of bare or
+/// quoted parts count.
+fn deepest_dotted_key(source: &str) -> Option<Range<usize>> {
+    const LIMIT: usize = 80;
+    let b = source.as_bytes();
+    let bare = |c: u8| c.is_ascii_alphanumeric() || c == b'_' || c == b'-';
+    // The end of the key part starting at `i`: a bare word or a quoted string.
+    let part = |i: usize| -> Option<usize> {
+        match *b.get(i)? {
+            q @ (b'"' | b'\'') => {
+                let mut j = i + 1;
+                while j < b.len() && b[j] != q && b[j] != b'\n' {
+                    j += if q == b'"' && b[j] == b'\\' { 2 } else { 1 };
+                }
+                (j < b.len() && b[j] == q).then_some(j + 1)
+            }
+            c if bare(c) => Some(i + b[i..].iter().take_while(|&&c| bare(c)).count()),
+            _ => None,
+        }
+    };
+    let blank = |mut j: usize| {
+        while j < b.len() && matches!(b[j], b' ' | b'\t') {
+            j += 1;
+        }
+        j
+    };
+    let mut best: Option<(usize, Range<usize>)> = None;
+    let mut i = 0;
+    while i < b.len() {
+        let Some(mut end) = part(i) else {
+            i += 1;
+            continue;
+        };
+        let mut parts = 1;
+        loop {
+            let dot = blank(end);
+            if b.get(dot) != Some(&b'.') {
+                break;
+            }
+            match part(blank(dot + 1)) {
+                Some(e) => {
+                    end = e;
+                    parts += 1;
+                }
+                None => break,
+            }
+        }
+        if parts > 1 && best.as_ref().is_none_or(|(n, _)| parts > *n && *n <= LIMIT) {
+            best = Some((parts, i..end));
+        }
+        i = end.max(i + 1);
+    }
+    best.map(|(_, span)| span)
 }
 
 /// The walk's state. Entries with bad values are kept with placeholder values (the error is
@@ -363,7 +431,9 @@ impl Reader<'_> {
             .next()
             .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
             && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !valid {
+        if let Some(d) = super::name_too_long(&n) {
+            self.diags.push(d.with_key(key).with_span(v.span()));
+        } else if !valid {
             self.err(format!("invalid name {n:?}"), &key, v.span()).hint = Some(
                 "names consist of ASCII letters, digits and `_`, and do not start with a digit"
                     .into(),
@@ -396,7 +466,10 @@ impl Reader<'_> {
                         Some(nv) => {
                             if let Some(n) = self.string(nv, "mechanism.name") {
                                 anchor = Some(nv.span());
-                                if !super::is_module_name(&n) {
+                                if let Some(d) = super::name_too_long(&n) {
+                                    self.diags
+                                        .push(d.with_key("mechanism.name").with_span(nv.span()));
+                                } else if !super::is_module_name(&n) {
                                     self.err(
                                         format!("invalid mechanism name {n:?}"),
                                         "mechanism.name",
@@ -507,14 +580,14 @@ impl Reader<'_> {
             if let Some(v) = get(t, "snap")
                 && let Some(x) = self.number(v, "scene.snap")
             {
-                if x > 0.0 && x <= 1e-2 {
+                if super::is_snap_tolerance(x) {
                     scene.snap = Some(x);
                 } else {
                     self.diags.push(
                         Diagnostic::error("`snap` must be a tolerance in (0, 0.01]")
                             .with_key("scene.snap")
                             .with_span(Some(v.span()))
-                            .with_hint("angles within this many rad of a multiple of π/2, rotation entries within it of 0 or ±1 and offsets within it (m) of 0 are taken as exact; e.g. 1e-6"),
+                            .with_hint(super::SNAP_HINT),
                     );
                 }
             }

@@ -1139,3 +1139,51 @@ mod springs {
         assert!(e.contains("zero length at home"), "{e}");
     }
 }
+
+/// A snap tolerance from outside the spec (`Config::scene`, `Builder::snap`) takes the bounds of
+/// `[scene] snap`: 0.5 would zero the PUMA's a2 = 0.4318 m.
+#[test]
+fn snap_override_out_of_range_is_an_error() {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../mechanisms/specs/puma560.toml"
+    ))
+    .unwrap();
+    for tol in [0.5, f64::NAN, 0.0, -1.0, f64::INFINITY] {
+        let o = super::SceneOverrides {
+            snap: Some(tol),
+            ..Default::default()
+        };
+        let e = super::load_mechanism_with("puma560.toml", &src, &o).unwrap_err();
+        let r = e.render();
+        assert!(
+            r.contains("snap tolerance") && r.contains("(0, 0.01]"),
+            "{r}"
+        );
+    }
+    let o = super::SceneOverrides {
+        snap: Some(1e-2),
+        ..Default::default()
+    };
+    assert!(super::load_mechanism_with("puma560.toml", &src, &o).is_ok());
+}
+
+/// Suggestions: the closest candidate within a third of the word's length (transpositions
+/// count 1, ties to the first, case ignored); none for words longer than a name can be.
+#[test]
+fn suggestions_are_bounded() {
+    use super::closest;
+    assert_eq!(closest("inertai", &["mass", "inertia"]), Some("inertia"));
+    assert_eq!(closest("lnik1", &["link2", "link1"]), Some("link1"));
+    assert_eq!(closest("LINK1", &["link1"]), Some("link1"));
+    assert_eq!(closest("ab", &["ax", "xb"]), Some("ax"));
+    assert_eq!(closest("kitten", &["sitting"]), None);
+    assert_eq!(closest("shoulder", &["elbow", "wrist"]), None);
+    let n = super::MAX_NAME_LEN;
+    let long = "a".repeat(n);
+    let near = format!("{}b", &long[1..]);
+    assert_eq!(closest(&near, &[&long]), Some(long.as_str()));
+    let longer = "a".repeat(n + 1);
+    let near = format!("{}b", &longer[1..]);
+    assert_eq!(closest(&near, &[&longer]), None);
+}

@@ -84,12 +84,35 @@ impl<'s> Tag<'s> {
     }
 }
 
-/// A tolerant scanner of start tags with nesting. Reports unbalanced or malformed tags (then
-/// stops: what follows would be noise).
+/// The deepest element nesting read (`<robot>` is level 1). URDF needs six levels or so; the
+/// XML reader behind urdf-rs recurses once per level and overflows its stack at a few
+/// thousand.
+pub(crate) const MAX_XML_DEPTH: usize = 64;
+
+/// An error at the first character of `src[from..to]` that is not white space (a BOM at the
+/// very start counts as white space), if any: the text lies outside the root element.
+fn text_outside_root(src: &str, from: usize, to: usize) -> Option<Diagnostic> {
+    let text = &src[from..to];
+    let (k, c) = text
+        .char_indices()
+        .find(|&(k, c)| !(c.is_ascii_whitespace() || (c == '\u{feff}' && from + k == 0)))?;
+    Some(
+        Diagnostic::error("XML: text outside the root element")
+            .with_span(from + k..from + k + c.len_utf8())
+            .with_hint(
+                "a URDF file is one <robot> element, with only comments and white space around it",
+            ),
+    )
+}
+
+/// A tolerant scanner of start tags with nesting. Reports unbalanced or malformed tags, text
+/// outside the root element, a second root element and nesting deeper than [`MAX_XML_DEPTH`]
+/// (then stops: what follows would be noise). Iterative: any depth of input is safe here.
 fn scan<'s>(src: &'s str, diags: &mut Diagnostics) -> Vec<Tag<'s>> {
     let b = src.as_bytes();
     let mut tags: Vec<Tag<'s>> = Vec::new();
     let mut stack: Vec<usize> = Vec::new();
+    let mut root_seen = false;
     let mut i = 0;
     let find = |from: usize, pat: &str| src.get(from..).and_then(|s| s.find(pat)).map(|p| from + p);
     let is_name = |c: u8| !(c.is_ascii_whitespace() || c == b'/' || c == b'>' || c == b'=');
@@ -100,6 +123,12 @@ fn scan<'s>(src: &'s str, diags: &mut Diagnostics) -> Vec<Tag<'s>> {
         j
     };
     while let Some(lt) = find(i, "<") {
+        if stack.is_empty()
+            && let Some(d) = text_outside_root(src, i, lt)
+        {
+            diags.push(d);
+            return tags;
+        }
         let rest = &src[lt..];
         let skip_to = |pat: &str| find(lt, pat).map(|p| p + pat.len());
         let next = if rest.starts_with("<!--") {
@@ -196,6 +225,24 @@ fn scan<'s>(src: &'s str, diags: &mut Diagnostics) -> Vec<Tag<'s>> {
                 );
                 return tags;
             };
+            if stack.is_empty() && std::mem::replace(&mut root_seen, true) {
+                diags.push(
+                    Diagnostic::error(format!("XML: a second root element <{name}>"))
+                        .with_span(lt..end)
+                        .with_hint("a URDF file has one top-level <robot> element"),
+                );
+                return tags;
+            }
+            if stack.len() >= MAX_XML_DEPTH {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "XML: <{name}> is nested deeper than {MAX_XML_DEPTH} elements"
+                    ))
+                    .with_span(lt..end)
+                    .with_hint("a URDF robot needs a few levels (robot, link, inertial, origin); is this the right file?"),
+                );
+                return tags;
+            }
             tags.push(Tag {
                 name,
                 span: lt..end,
@@ -220,6 +267,8 @@ fn scan<'s>(src: &'s str, diags: &mut Diagnostics) -> Vec<Tag<'s>> {
             Diagnostic::error(format!("XML: <{}> is never closed", tags[open].name))
                 .with_span(tags[open].span.clone()),
         );
+    } else if let Some(d) = text_outside_root(src, i, src.len()) {
+        diags.push(d);
     }
     tags
 }
@@ -236,16 +285,27 @@ fn line_col(src: &str, at: usize) -> String {
 struct Doc<'s> {
     tags: Vec<Tag<'s>>,
     robot: usize,
+    /// The children of each tag, in document order (lookups stay linear in the file).
+    kids: Vec<Vec<usize>>,
 }
 
 impl<'s> Doc<'s> {
+    fn new(tags: Vec<Tag<'s>>, robot: usize) -> Self {
+        let mut kids = vec![Vec::new(); tags.len()];
+        for (i, t) in tags.iter().enumerate() {
+            if let Some(p) = t.parent {
+                kids[p].push(i);
+            }
+        }
+        Doc { tags, robot, kids }
+    }
+
     /// Direct children of `parent` named `name`.
     fn children(&self, parent: usize, name: &'s str) -> impl Iterator<Item = usize> + '_ {
-        self.tags
+        self.kids[parent]
             .iter()
-            .enumerate()
-            .filter(move |(_, t)| t.parent == Some(parent) && t.name == name)
-            .map(|(i, _)| i)
+            .copied()
+            .filter(move |&i| self.tags[i].name == name)
     }
     fn child(&self, parent: usize, name: &'s str) -> Option<usize> {
         self.children(parent, name).next()
@@ -341,6 +401,14 @@ fn check_number(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
 fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, Vec<usize>) {
     let links: Vec<usize> = doc.children(doc.robot, "link").collect();
     let joints: Vec<usize> = doc.children(doc.robot, "joint").collect();
+    for &t in [doc.robot].iter().chain(&links).chain(&joints) {
+        if let Some(a) = doc.tags[t].attr("name")
+            && let Some(d) = super::name_too_long(a.value)
+        {
+            let what = doc.tags[t].name;
+            diags.push(d.with_key(format!("{what}.name")).with_span(a.span.clone()));
+        }
+    }
     for &l in &links {
         let t = &doc.tags[l];
         let lk = format!("link \"{}\"", t.attr("name").map_or("", |a| a.value));
@@ -528,7 +596,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
     if diags.has_errors() {
         return None;
     }
-    let doc = Doc { tags, robot };
+    let doc = Doc::new(tags, robot);
     let (link_tags, joint_tags) = precheck(&doc, diags);
     if diags.has_errors() {
         return None;
