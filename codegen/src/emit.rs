@@ -275,6 +275,21 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                 }
             }
         }
+    } else if matches!(f.shape, Shape::FallibleVector) {
+        // Tree `forward_dynamics`: a non-finite input that passed the pivots (a `q̇` or `τ`, or
+        // an angle that only enters gravity or Coriolis terms) or an overflow is an `Err` at
+        // the one index past the pivots, never an `Ok` with NaN or ∞.
+        quote! {
+            for v in [#(#outs),*].iter() {
+                if !v.is_finite() {
+                    return Err(Singular {
+                        pivot: DOF,
+                        value: *v,
+                        condition_estimate: f64::INFINITY,
+                    });
+                }
+            }
+        }
     } else {
         TokenStream::new()
     };
@@ -501,11 +516,13 @@ pub fn module(
             /// (`1e-12` times the diagonal entry it came from); `condition_estimate` is that
             /// diagonal entry divided by the pivot, a lower bound of the 2-norm condition number
             /// of the mass matrix (`f64::INFINITY` when the pivot is not positive).
+            /// `pivot == DOF` is no pivot: the pivots passed but an input was not finite or the
+            /// result overflowed (`value` is the first non-finite entry of the result).
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct Singular {
-                /// Index (joint) of the failed pivot.
+                /// Index (joint) of the failed pivot; `DOF` for a non-finite input or result.
                 pub pivot: usize,
-                /// The pivot's value.
+                /// The pivot's value (the non-finite entry when `pivot == DOF`).
                 pub value: f64,
                 /// Lower bound of the mass matrix's 2-norm condition number.
                 pub condition_estimate: f64,

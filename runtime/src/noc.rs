@@ -29,7 +29,9 @@ use crate::model::{JointKind, Mat3, Model, Transform, Vec3, axis_angle};
 /// that is not `> 1e-12 · max_k I_kk` (or is NaN).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Singular {
-    /// Index of the failing pivot (= the generalized coordinate, no pivoting is done).
+    /// Index of the failing pivot (= the generalized coordinate, no pivoting is done); the
+    /// number of coordinates when the pivots passed but the result is not finite (a non-finite
+    /// input or an overflow).
     pub pivot: usize,
     /// The failing pivot `d_pivot` of `LDLᵀ` (may be `≤ 0` or NaN).
     pub value: f64,
@@ -381,7 +383,16 @@ pub fn forward_dynamics(
     let bias = inverse_dynamics(model, q, qd, &zero);
     let rhs = DVector::from_column_slice(tau) - bias;
     let f = ldlt(&mass_matrix(model, q))?;
-    Ok(f.solve(&rhs))
+    let qdd = f.solve(&rhs);
+    // A non-finite input that passed the pivots, or an overflow: `Err`, never `Ok(NaN)`.
+    if let Some(v) = qdd.iter().find(|v| !v.is_finite()) {
+        return Err(Singular {
+            pivot: model.dof(),
+            value: *v,
+            condition_estimate: f64::INFINITY,
+        });
+    }
+    Ok(qdd)
 }
 
 /// `A = L D Lᵀ` with `L` unit lower triangular and `D` diagonal (no pivoting), for a symmetric

@@ -244,7 +244,8 @@ fn planar_2r_matches_the_textbook_closed_form() {
 /// Bad input to the generated tree functions (docs/spec.md, "Bad input"): NaN and ∞ propagate
 /// through `inverse_dynamics` and its parts by IEEE arithmetic (no panic, no check);
 /// `forward_dynamics` returns `Err(Singular)` when a NaN reaches a pivot of the mass matrix
-/// (here `q[1]`, which sets the 2R arm's mass matrix) and otherwise an `Ok` holding NaN.
+/// (here `q[1]`, which sets the 2R arm's mass matrix), and `Err` with `pivot == DOF` when the
+/// pivots pass but the result is not finite: never an `Ok` holding NaN.
 #[test]
 fn nan_and_infinity_propagate_as_documented() {
     use mechanisms::planar_2r as mech;
@@ -262,6 +263,52 @@ fn nan_and_infinity_propagate_as_documented() {
     );
     assert!(mech::gravity(&[nan, 0.0]).iter().any(|g| g.is_nan()));
     assert!(mech::forward_dynamics(&[0.1, nan], &[0.0; 2], &[1.0; 2]).is_err());
-    let qdd = mech::forward_dynamics(&[0.1, 0.2], &[0.0; 2], &[nan, 1.0]).unwrap();
-    assert!(qdd.iter().any(|x| x.is_nan()), "{qdd:?}");
+    for (q, qd, tau) in [
+        ([0.1, 0.2], [0.0; 2], [nan, 1.0]),
+        ([0.1, 0.2], [inf, 0.0], [0.0; 2]),
+        ([nan, 0.2], [0.0; 2], [0.0; 2]),
+    ] {
+        let e = mech::forward_dynamics(&q, &qd, &tau).unwrap_err();
+        assert_eq!(e.pivot, mech::DOF, "{q:?} {qd:?} {tau:?}: {e:?}");
+        assert!(!e.value.is_finite() && e.condition_estimate == f64::INFINITY);
+    }
+}
+
+/// Issue 18, 4c: finite inputs whose result overflows. The PUMA 560 with a base rate of 1e155
+/// rad/s (its square overflows) gave `Ok` holding NaN; the `f32` module did so from 1e20.
+/// Both, and the runtime, now return `Err` with `pivot == DOF`; at an ordinary rate they still
+/// answer.
+#[test]
+fn tree_forward_dynamics_never_returns_a_nan() {
+    use mechanisms::f32::puma560 as m32;
+    use mechanisms::puma560 as m64;
+    let model = model(
+        "puma560.toml",
+        include_str!("../../mechanisms/specs/puma560.toml"),
+    );
+    let tau = [1.0; 6];
+    for (q, w) in [
+        ([0.0; 6], 1e155),
+        ([0.1, -0.4, 0.3, 0.2, 0.5, -0.1], 1e155),
+        ([0.1, -0.4, 0.3, 0.2, 0.5, -0.1], f64::MAX),
+    ] {
+        let mut qd = [0.0; 6];
+        qd[0] = w;
+        let e = m64::forward_dynamics(&q, &qd, &tau).unwrap_err();
+        assert_eq!(e.pivot, m64::DOF, "f64 at {w:e}: {e:?}");
+        let e = runtime::noc::forward_dynamics(&model, &q, &qd, &tau).unwrap_err();
+        assert_eq!(e.pivot, 6, "runtime at {w:e}: {e:?}");
+    }
+    let q = [0.1, -0.4, 0.3, 0.2, 0.5, -0.1];
+    let mut qd = [0.0; 6];
+    qd[0] = 1e3;
+    let ok = m64::forward_dynamics(&q, &qd, &tau).unwrap();
+    assert!(ok.iter().all(|v| v.is_finite()));
+    let (q32, tau32) = (q.map(|v| v as f32), tau.map(|v| v as f32));
+    for w in [1e20f32, 1e30, f32::MAX] {
+        let mut qd = [0.0f32; 6];
+        qd[0] = w;
+        let e = m32::forward_dynamics(&q32, &qd, &tau32).unwrap_err();
+        assert_eq!(e.pivot, m32::DOF, "f32 at {w:e}: {e:?}");
+    }
 }

@@ -375,7 +375,20 @@ fn tree_guards_match_the_runtime_tests() {
             name,
             "forward_dynamics",
             n,
-            body(&code, "forward_dynamics").matches("pivot:").count(),
+            // The result's finiteness check (`pivot: DOF`) is no pivot test.
+            body(&code, "forward_dynamics").matches("pivot:").count()
+                - body(&code, "forward_dynamics")
+                    .matches("pivot: DOF")
+                    .count(),
+        ));
+        // And one check of the result: never an `Ok` holding NaN or ∞.
+        rows.push((
+            name,
+            "forward_dynamics (finite result)",
+            1,
+            body(&code, "forward_dynamics")
+                .matches("pivot: DOF")
+                .count(),
         ));
         for f in ["mass_matrix", "inverse_dynamics", "coriolis", "gravity"] {
             rows.push((name, f, 0, body(&code, f).matches("Err(").count()));
