@@ -18,7 +18,12 @@
 //!   far kept as the fraction `n / d`, so the test needs neither a square root nor a division;
 //!   those are spent only on the error path (the scaled pivot and the condition estimate
 //!   `max_j (|p_j|/‖a_j‖) / (|p_k|/‖a_k‖)` reported in `Singular`);
-//! - back substitution multiplies by the reciprocal pivots kept from the elimination.
+//! - back substitution multiplies by the reciprocal pivots kept from the elimination;
+//! - `Aᵀ τ = f` factorizes `A`, not `Aᵀ`: its swaps and multipliers are kept, and the solve
+//!   runs `Uᵀ` forward, then `Lᵀ` and the swaps backward (LINPACK's `dgesl`). All three
+//!   functions therefore test the same pivots of the same matrix, so at a given `x` the
+//!   inverse dynamics, the actuator-space inertia and a Newton step agree on `Ok` versus
+//!   `Err(Actuation(i))`.
 //!
 //! The operation count is [`crate::parallel::lu_many_ops`]; the error paths are not counted.
 
@@ -59,6 +64,42 @@ fn x(i: usize, c: usize) -> Ident {
     format_ident!("x{}_{}", i, c)
 }
 
+/// The swap flag of rows `k` and `i` at step `k` (transposed solve).
+fn swap(k: usize, i: usize) -> Ident {
+    format_ident!("s{}_{}", k, i)
+}
+
+/// The multiplier of row `i` at step `k` (transposed solve).
+fn l(i: usize, k: usize) -> Ident {
+    format_ident!("l{}_{}", i, k)
+}
+
+/// `aᵀ x = b` from the factorization `U = E_{n−2} P_{n−2} ⋯ E_0 P_0 a` (`P_k` the conditional
+/// swaps of step `k`, `E_k = I − l_k e_kᵀ` its elimination; LINPACK's `dgesl` with `job ≠ 0`):
+/// `Uᵀ z = b` forward, then `x = P_0ᵀ E_0ᵀ ⋯ P_{n−2}ᵀ E_{n−2}ᵀ z`, applied from the right.
+fn transposed_solve(n: usize, st: &mut Vec<TokenStream>) {
+    for i in 0..n {
+        let (xi, ri) = (x(i, 0), format_ident!("r{}", i));
+        let terms = (0..i).map(|j| {
+            let (ji, xj) = (m(j, i), x(j, 0));
+            quote!(- #ji * #xj)
+        });
+        st.push(quote!(let #xi = (#xi #(#terms)*) * #ri;));
+    }
+    for k in (0..n.saturating_sub(1)).rev() {
+        let xk = x(k, 0);
+        let terms = (k + 1..n).map(|i| {
+            let (lik, xi) = (l(i, k), x(i, 0));
+            quote!(- #lik * #xi)
+        });
+        st.push(quote!(let #xk = #xk #(#terms)*;));
+        for i in (k + 1..n).rev() {
+            let (u, v, sw) = (x(k, 0), x(i, 0), swap(k, i));
+            st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
+        }
+    }
+}
+
 fn abs(v: &Ident) -> TokenStream {
     quote!((if #v < 0.0 { -#v } else { #v }))
 }
@@ -74,14 +115,16 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
     let doc = s.doc;
     let tol2 = Literal::f64_unsuffixed(s.tol2);
     let mut st: Vec<TokenStream> = Vec::new();
+    // `aᵀ x = b` factorizes `a` itself (so that its pivots and verdict are those of the other
+    // solves) and keeps the swaps and multipliers for the transposed solve after it.
+    let tr = s.transpose;
     // The matrix and the right-hand sides as locals.
     for i in 0..n {
         for j in 0..n {
-            let (r, c) = if s.transpose { (j, i) } else { (i, j) };
             let (mi, r, c) = (
                 m(i, j),
-                Literal::usize_unsuffixed(r),
-                Literal::usize_unsuffixed(c),
+                Literal::usize_unsuffixed(i),
+                Literal::usize_unsuffixed(j),
             );
             st.push(quote!(let #mi = a[#r][#c];));
         }
@@ -115,12 +158,16 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
         // Conditional swaps: row k ends with the largest |entry| of column k.
         for i in k + 1..n {
             let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
-            st.push(quote!(let s = #a_ik > #a_kk;));
+            let sw = if tr { swap(k, i) } else { format_ident!("s") };
+            st.push(quote!(let #sw = #a_ik > #a_kk;));
             for j in k..n {
                 let (u, v) = (m(k, j), m(i, j));
-                st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
+                st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
             }
             for c in 0..k_rhs {
+                if tr {
+                    break;
+                }
                 let (u, v) = (x(k, c), x(i, c));
                 st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
             }
@@ -156,19 +203,29 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
         // Elimination below the pivot.
         for i in k + 1..n {
             let ik = m(i, k);
-            st.push(quote!(let f = #ik * #rk;));
+            let f = if tr { l(i, k) } else { format_ident!("f") };
+            st.push(quote!(let #f = #ik * #rk;));
             for j in k + 1..n {
                 let (ij, kj) = (m(i, j), m(k, j));
-                st.push(quote!(let #ij = #ij - f * #kj;));
+                st.push(quote!(let #ij = #ij - #f * #kj;));
             }
             for c in 0..k_rhs {
+                if tr {
+                    break;
+                }
                 let (ic, kc) = (x(i, c), x(k, c));
                 st.push(quote!(let #ic = #ic - f * #kc;));
             }
         }
     }
+    if tr {
+        transposed_solve(n, &mut st);
+    }
     // Back substitution by the reciprocal pivots.
     for c in 0..k_rhs {
+        if tr {
+            break;
+        }
         for i in (0..n).rev() {
             let (ic, ri) = (x(i, c), format_ident!("r{}", i));
             let terms = (i + 1..n).map(|j| {

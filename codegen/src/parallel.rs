@@ -762,7 +762,23 @@ fn templates(
         false,
         lu::Rhs::Identity,
     );
+    // Rounded to 13 significant digits, as the squared tolerance below.
+    let fk_tol = fk_tol * plan.fk_scale();
+    let fk_tol = format!("{fk_tol:.12e}").parse().unwrap_or(fk_tol);
     let fk_tol_lit = Literal::f64_unsuffixed(fk_tol);
+    let fk_doc = [
+        " Forward kinematics: the platform coordinates whose actuated joint positions are `q`,"
+            .to_string(),
+        " by Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it"
+            .to_string(),
+        format!(" does not reduce the residual), at most {fk_max} iterations, converged when"),
+        format!(" `max |q(x) − q| ≤ {fk_tol:e}` (angles modulo 2π; a bound that does not grow"),
+        " with `q`). A non-finite `q` or `guess` is `Err` at once. The result's quaternion is"
+            .to_string(),
+        " unit.".to_string(),
+    ];
+    let sin_cos_q = emit::math_call(cfg, "sin_cos", quote!(v));
+    let atan2_sc = emit::math_call(cfg, "atan2", quote!(s, c));
     let fk_max_lit = Literal::usize_unsuffixed(fk_max);
     let leg_doc = format!(
         " Leg `k`'s Jacobian is singular: `|det J| ≤ {leg_tol:e} · ∏‖columns‖` (a leg, type-I, singularity)."
@@ -878,7 +894,8 @@ fn templates(
 
         #retract
 
-        /// The residual `q − q(x)` (angles wrapped to (−π, π]), its max norm, and `A(x)`.
+        /// The residual `q − q(x)` (angles wrapped to (−π, π]: `q`'s revolute entries are already
+        /// in [−π, π], as `q(x)`'s are), its max norm, and `A(x)`.
         #[allow(clippy::all)]
         fn fk_residual(q: &[f64; DOF], x: &[f64; NX]) -> Option<([f64; DOF], f64, [[f64; DOF]; DOF])> {
             let (qx, a) = fk_parts(x).ok()?;
@@ -888,10 +905,9 @@ fn templates(
                 let mut d = q[i] - qx[i];
                 if REVOLUTE[i] {
                     let t = 2.0 * core::f64::consts::PI;
-                    while d > core::f64::consts::PI {
+                    if d > core::f64::consts::PI {
                         d -= t;
-                    }
-                    while d <= -core::f64::consts::PI {
+                    } else if d <= -core::f64::consts::PI {
                         d += t;
                     }
                 }
@@ -904,20 +920,25 @@ fn templates(
             if m < f64::INFINITY { Some((r, m, a)) } else { None }
         }
 
-        /// Forward kinematics: the platform coordinates whose actuated joint positions are `q`,
-        /// by Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it
-        /// does not reduce the residual), at most 50 iterations, converged when
-        /// `max |q(x) − q| ≤ 1e-12 · (1 + max |q|)`. The result's quaternion is unit.
+        #(#[doc = #fk_doc])*
         #[allow(clippy::all)]
         pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            let mut qmax: f64 = 0.0;
-            for v in q {
-                let a = if *v < 0.0 { -*v } else { *v };
-                if a > qmax {
-                    qmax = a;
+            for v in q.iter().chain(guess.iter()) {
+                if !v.is_finite() {
+                    return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
                 }
             }
-            let tol = #fk_tol_lit * (1.0 + qmax);
+            // Revolute targets reduced to [−π, π] once (sin and cos reduce accurately).
+            let mut q = *q;
+            for i in 0..DOF {
+                if REVOLUTE[i] {
+                    let v = q[i];
+                    let (s, c) = #sin_cos_q;
+                    q[i] = #atan2_sc;
+                }
+            }
+            let q = &q;
+            let tol = #fk_tol_lit;
             let mut x = retract(guess, &[0.0; DOF]);
             let Some(mut cur) = fk_residual(q, &x) else {
                 return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });

@@ -400,7 +400,7 @@ pub fn solve_pivots(a: &[Vec<DD>], b: &[DD], transpose: bool) -> (Vec<DD>, Vec<D
 }
 
 /// Condition data of the actuation matrix, computed in double-double on the matrix the runtime
-/// factorizes (`Aᵀ` with its columns scaled to unit 2-norm).
+/// factorizes (`A` with its columns scaled to unit 2-norm).
 #[derive(Clone, Copy, Debug)]
 pub struct Conditioning {
     /// Largest over smallest pivot of the partially pivoted LU (the runtime's estimate,
@@ -410,12 +410,12 @@ pub struct Conditioning {
     pub kappa1: f64,
 }
 
-/// [`Conditioning`] of `Aᵀ` (columns scaled to unit norm), as `noc::lu_solve(A, ·, true)`
-/// sees it.
+/// [`Conditioning`] of `A` (columns scaled to unit norm), as `noc::lu_solve(A, ·, _)` sees it
+/// for either solve.
 pub fn conditioning(a: &[Vec<DD>]) -> Conditioning {
     let n = a.len();
-    // mᵢⱼ = a_ji, columns scaled.
-    let mut m: Vec<Vec<DD>> = (0..n).map(|i| (0..n).map(|j| a[j][i]).collect()).collect();
+    // mᵢⱼ = a_ij, columns scaled.
+    let mut m: Vec<Vec<DD>> = a.to_vec();
     for j in 0..n {
         let mut s = DD::ZERO;
         for row in m.iter() {

@@ -9,7 +9,7 @@
 //! ~32 digits): `tests::dd::inverse_dynamics_dd`.
 //!
 //! Run `cargo test -p tests --test singularities -- --nocapture` to print the tables below.
-//! In them "κ pivots" is the largest over the smallest pivot of the column-scaled LU of `Aᵀ`
+//! In them "κ pivots" is the largest over the smallest pivot of the column-scaled LU of `A`
 //! (the runtime's estimate, computed in double-double), "κ₁" the 1-norm condition number of
 //! that scaled matrix; a route's cell is `Ok e` (relative error against double-double) or
 //! `Err site κ̂` (the reported condition estimate). Dynamic states: three random `(u, u̇)`

@@ -478,6 +478,16 @@ impl Plan {
     pub fn dof(&self) -> usize {
         self.motion.dof()
     }
+    /// The scale of [`forward_kinematics`]' tolerance: `1 +` the longest leg (m, at home) among
+    /// the legs with a prismatic actuator (their residuals are lengths of that order), `1` when
+    /// every actuator is revolute (radians).
+    pub fn fk_scale(&self) -> f64 {
+        1.0 + self
+            .legs
+            .iter()
+            .filter(|l| l.joints[l.actuated] == JointKind::Prismatic)
+            .fold(0.0f64, |m, l| m.max(l.length))
+    }
     /// Position coordinates.
     pub fn nx(&self) -> usize {
         self.motion.nx()
@@ -494,7 +504,7 @@ pub struct Platform<R> {
 }
 
 /// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`); the quaternion need not
-/// be unit (it is normalized), but it must not be zero.
+/// be unit (it is normalized), but it must not be zero (`Err(Site::Platform)`).
 pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> {
     let (origin, q) = match plan.motion {
         PlatformMotion::Pose => ([x[0], x[1], x[2]], [x[3], x[4], x[5], x[6]]),
@@ -506,9 +516,17 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             });
         }
     };
+    // Divided by its largest component first, so that no square under- or overflows: any
+    // finite non-zero multiple of a unit quaternion is the same rotation (the sign of the
+    // largest component may flip the quaternion, which is the same rotation too).
     let [w, a, b, c] = q;
+    let big = R::select_abs_gt(w, a, w, a);
+    let big = R::select_abs_gt(big, b, big, b);
+    let big = R::select_abs_gt(big, c, big, c);
+    let big = R::check(big, R::c(0.0), R::c(1.0), Site::Platform, true)?;
+    // Divided, not multiplied by `1/big`, which overflows for a subnormal `big`.
+    let [w, a, b, c] = [w / big, a / big, b / big, c / big];
     let n = w * w + a * a + b * b + c * c;
-    let n = R::check(n, R::c(0.0), R::c(1.0), Site::Platform, false)?;
     let s = R::c(2.0) / n;
     let one = R::c(1.0);
     let rot = [
@@ -1863,22 +1881,20 @@ pub fn forward_dynamics_with<R: Real>(
     solve_spd(&m, &rhs)
 }
 
-/// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting after scaling the
-/// columns of `a` to unit 2-norm; a pivot `≤ ACTUATION_TOLERANCE` times the largest pivot (or a
+/// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting of `a` with its columns
+/// scaled to unit 2-norm; a pivot `≤ ACTUATION_TOLERANCE` times the largest pivot (or a
 /// non-finite one) is reported as `Site::Actuation(pivot)` with the ratio of the largest to the
-/// smallest pivot as the condition estimate. Fixed-size, no allocation.
+/// smallest pivot as the condition estimate. Both solves factorize the same matrix, so they
+/// give the same verdict at every `a` (LAPACK's `dgetrf` and `dgetrs`). Fixed-size, no
+/// allocation.
 pub fn lu_solve<const N: usize>(
     a: &[[f64; N]; N],
     b: &[f64; N],
     transpose: bool,
 ) -> Result<[f64; N], Singular> {
-    // Work on m = a·S (column scaling S) or, for the transpose, on aᵀ·S.
-    let mut m = [[0.0; N]; N];
-    for i in 0..N {
-        for j in 0..N {
-            m[i][j] = if transpose { a[j][i] } else { a[i][j] };
-        }
-    }
+    // m = a·S (column scaling S), factorized in place as P m = L U: the multipliers below the
+    // diagonal, swapped with their rows.
+    let mut m = *a;
     let mut sc = [1.0; N];
     for j in 0..N {
         let mut s = 0.0;
@@ -1893,9 +1909,8 @@ pub fn lu_solve<const N: usize>(
             }
         }
     }
-    let mut x = *b;
+    let mut piv = [0usize; N];
     let mut pmax: f64 = 0.0;
-    let mut pmin = f64::INFINITY;
     for k in 0..N {
         let mut p = k;
         let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
@@ -1907,7 +1922,7 @@ pub fn lu_solve<const N: usize>(
             }
         }
         m.swap(k, p);
-        x.swap(k, p);
+        piv[k] = p;
         // NaN never passes.
         if !(best > 0.0) || !best.is_finite() {
             return Err(Singular {
@@ -1917,7 +1932,6 @@ pub fn lu_solve<const N: usize>(
             });
         }
         pmax = if best > pmax { best } else { pmax };
-        pmin = if best < pmin { best } else { pmin };
         if !(best > ACTUATION_TOLERANCE * pmax) {
             return Err(Singular {
                 site: Site::Actuation(k),
@@ -1928,24 +1942,59 @@ pub fn lu_solve<const N: usize>(
         let inv = 1.0 / m[k][k];
         for i in k + 1..N {
             let f = m[i][k] * inv;
+            m[i][k] = f;
             if f != 0.0 {
-                for j in k..N {
+                for j in k + 1..N {
                     m[i][j] -= f * m[k][j];
                 }
-                x[i] -= f * x[k];
             }
         }
     }
-    for i in (0..N).rev() {
-        let mut s = x[i];
-        for j in i + 1..N {
-            s -= m[i][j] * x[j];
+    let mut x = *b;
+    if transpose {
+        // aᵀ x = b ⇔ (a S)ᵀ x = S b = Uᵀ Lᵀ P x: forward with Uᵀ, back with Lᵀ, then Pᵀ.
+        for j in 0..N {
+            x[j] *= sc[j];
         }
-        x[i] = s / m[i][i];
-    }
-    let _ = pmin;
-    for j in 0..N {
-        x[j] *= sc[j];
+        for i in 0..N {
+            let mut s = x[i];
+            for j in 0..i {
+                s -= m[j][i] * x[j];
+            }
+            x[i] = s / m[i][i];
+        }
+        for i in (0..N).rev() {
+            let mut s = x[i];
+            for j in i + 1..N {
+                s -= m[j][i] * x[j];
+            }
+            x[i] = s;
+        }
+        for k in (0..N).rev() {
+            x.swap(k, piv[k]);
+        }
+    } else {
+        // a x = b ⇔ L U (S⁻¹ x) = P b.
+        for k in 0..N {
+            x.swap(k, piv[k]);
+        }
+        for i in 0..N {
+            let mut s = x[i];
+            for j in 0..i {
+                s -= m[i][j] * x[j];
+            }
+            x[i] = s;
+        }
+        for i in (0..N).rev() {
+            let mut s = x[i];
+            for j in i + 1..N {
+                s -= m[i][j] * x[j];
+            }
+            x[i] = s / m[i][i];
+        }
+        for j in 0..N {
+            x[j] *= sc[j];
+        }
     }
     check_finite(&[&x])?;
     Ok(x)
@@ -2132,7 +2181,9 @@ pub struct NoConvergence {
 
 /// Newton iterations of [`forward_kinematics`] at most.
 pub const FK_MAX_ITERATIONS: usize = 50;
-/// Convergence of [`forward_kinematics`]: `max |q(x) − q| ≤ FK_TOLERANCE · (1 + max |q|)`.
+/// Convergence of [`forward_kinematics`]: `max |q(x) − q| ≤ FK_TOLERANCE · Plan::fk_scale()`
+/// (angle residuals wrapped to `(−π, π]`). The bound does not grow with `q`: a huge target is
+/// met as closely as a small one, or not at all.
 pub const FK_TOLERANCE: f64 = 1e-12;
 
 /// Wrap an angle difference to `(−π, π]`.
@@ -2185,7 +2236,8 @@ pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
 /// Forward kinematics: the platform coordinates `x` whose actuated joint positions are `q`, by
 /// Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it does not
 /// reduce the residual), at most [`FK_MAX_ITERATIONS`] iterations, converged when the residual
-/// is within [`FK_TOLERANCE`]. The quaternion of the result is unit.
+/// is within [`FK_TOLERANCE`] times [`Plan::fk_scale`]. Revolute targets count modulo 2π. A
+/// non-finite `q` or `guess` is `Err` at once. The quaternion of the result is unit.
 pub fn forward_kinematics(
     plan: &Plan,
     q: &[f64],
@@ -2203,8 +2255,22 @@ pub fn forward_kinematics(
             residual: f64::INFINITY,
         });
     }
-    let qmax = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tol = FK_TOLERANCE * (1.0 + qmax);
+    let tol = FK_TOLERANCE * plan.fk_scale();
+    // Revolute targets reduced to [−π, π] once, with the accurate range reduction of sin and
+    // cos, so that every residual below is a difference of two such angles (O(1) to wrap,
+    // whatever the size of `q`).
+    let q: Vec<f64> = q
+        .iter()
+        .zip(&revolute)
+        .map(|(&v, &r)| {
+            if r {
+                let (s, c) = crate::math::sin_cos(v);
+                crate::math::atan2(s, c)
+            } else {
+                v
+            }
+        })
+        .collect();
     let residual = |x: &[f64]| -> Option<(Vec<f64>, f64, Vec<Vec<f64>>)> {
         let (_, legs) = kinematics(plan, x).ok()?;
         let qx = actuated_positions(plan, &legs);
