@@ -1,6 +1,6 @@
 //! Symbolic dynamics of a kinematic tree: the NOC products `Tᵀ(M ṫ + W M t − w^G)` and
-//! `TᵀMT` built in the expression DAG with the cheap association (noc-method.md, "Evaluation
-//! order matters").
+//! `TᵀMT` built in the expression DAG with the cheap association (docs/method.md,
+//! "Evaluation order").
 //!
 //! # From the NOC to the recursions
 //! The lecture's twist-shaping matrix of a serial chain is block lower-triangular (eq. 34): body

@@ -1,4 +1,4 @@
-//! A structure-aware fuzzer that runs in `cargo test` with a fixed budget (issue 7): random and
+//! A structure-aware fuzzer that runs in `cargo test` with a fixed budget: random and
 //! mutated specs go to `codegen::spec::load_mechanism` and, when they load and are small, to
 //! `codegen::compile`. Nothing may panic (both calls run under `catch_unwind`, and `load`'s own
 //! panic guard must never fire: no "internal error"), and every `Err` must render with at least

@@ -273,8 +273,8 @@ def gough_stewart():
     s = Spec("""
 Gough-Stewart platform, 6-UPS: the example of L.-W. Tsai, "Solving the inverse dynamics of a
 Stewart-Gough manipulator by the principle of virtual work", ASME J. Mech. Des. 122(1):3-9, 2000.
-Numbers as in a public re-implementation citing the paper (as collected in the project's
-reference notes, pkm-literature.md):
+Numbers as in a public re-implementation citing the paper (as collected in docs/method.md,
+"Test cases from the literature"):
   base joints b_i (world, z = 0), platform joints p_i (platform frame, origin at the platform's
   mass centre), platform m = 1.5 kg, I = diag(0.08) kg m^2, cylinder and piston 0.1 kg each,
   gravity 9.81 m/s^2 along -z.
@@ -339,7 +339,7 @@ def sliding_hexapod():
     plat_pts = semi_regular(rp, ap, 30.0, zp)
     s = Spec("""
 Sliding-leg (fixed-length leg) hexapod, 6-PUS, in the manner of the HexaM (Toyoda), Hexaglide
-(ETH) and Linapod (Stuttgart) machines (pkm-literature.md; Sinatra & Xi 2008). ILLUSTRATIVE
+(ETH) and Linapod (Stuttgart) machines (docs/method.md, "Test cases from the literature"; Sinatra & Xi 2008). ILLUSTRATIVE
 numbers, not a real machine: six vertical rails on a semi-regular hexagon of radius 0.6 m (pairs
 +-10 deg about 90, 210, 330 deg), an actuated slider (P, along z) on each, a U on the slider,
 a fixed-length leg of 0.6 m (steel tube: 0.8 kg, radius 15 mm) to an S joint on the platform, whose

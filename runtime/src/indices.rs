@@ -643,7 +643,7 @@ mod tests {
     }
 
     /// Ma & Angeles (ICRA 1990) normalizations, checked on the example in
-    /// `shared/reference/pkm-literature.md`, "Index definitions": M = [[2, .5], [.5, 1]] gives
+    /// docs/method.md, "Dynamic performance indices": M = [[2, .5], [.5, 1]] gives
     /// σ₁ = 1.5, ψ₁ = 0.5 and σ₂ = 1.833333, ψ₂ = 0.181818 with Frobenius weights.
     #[test]
     fn published_two_by_two_check() {

@@ -16,8 +16,8 @@
 //!   own body frame. Massless bodies (mass 0, zero inertia) are allowed: the intermediate bodies
 //!   of an expanded U or S joint, or URDF links without `<inertial>`.
 //!
-//! Closed chains (issue 3) will add loop-closing joints beside this spanning tree; the tree part
-//! stays as it is.
+//! Closed loops (`crate::closed`) add loop-closing joints beside such a spanning tree; the tree
+//! part stays as it is.
 
 use alloc::string::String;
 use alloc::vec::Vec;

@@ -2,7 +2,7 @@
 //! the generic runtime and the first oracle for generated code.
 //!
 //! Every quantity is the one of R. Sinatra, "Dynamics of PKM" (EURON 2007; the method of Angeles
-//! & Lee, 1988), in the conventions of `shared/reference/noc-method.md`; equation numbers in the
+//! & Lee, 1988), in the conventions of docs/method.md, "Conventions"; equation numbers in the
 //! comments refer to that lecture. Body `i` is moved by joint `i` (see [`crate::model`]):
 //!
 //! * twist `t_i = [ω_i; ċ_i]` (1), wrench `w_i = [n_i; f_i]` about the mass centre (2);
@@ -343,7 +343,7 @@ pub fn gravity(model: &Model, q: &[f64]) -> DVector<f64> {
     -(twist_shaping(model, q).transpose() * gravity_wrench(model))
 }
 
-/// Inverse dynamics `τ = I q̈ + C q̇ − γ + δ(q̇)`, evaluated in the association of noc-method.md:
+/// Inverse dynamics `τ = I q̈ + C q̇ − γ + δ(q̇)`, evaluated in the association of docs/method.md, "Evaluation order":
 /// `Tᵀ ( M (T q̈ + Ṫ q̇) + W M (T q̇) − w^G )` — body twists `t = T q̇` (14) and twist rates
 /// `ṫ = T q̈ + Ṫ q̇` first, then the body Newton–Euler wrenches `M_i ṫ_i + W_i M_i t_i − w^G_i`
 /// (7)–(12), then one projection by `Tᵀ` (the constraint wrenches drop out, (15)–(20)). The

@@ -1,5 +1,5 @@
 //! The generic NOC runtime (`runtime::noc`) against the independent spatial-algebra route
-//! (`runtime::rnea`), closed forms, and the structural properties of noc-method.md.
+//! (`runtime::rnea`), closed forms, and the structural properties of docs/method.md, "Properties used as checks".
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the matrix algebra
 

@@ -1,5 +1,5 @@
 //! The parallel-manipulator evaluator on a Gough–Stewart platform built by hand (Tsai 2000's
-//! geometry, see ../shared/reference/pkm-literature.md): kinematic closure, rates against
+//! geometry, see docs/method.md, "Test cases from the literature"): kinematic closure, rates against
 //! finite differences, symmetry and definiteness of the inertia, power balance, forward
 //! kinematics and forward dynamics round trips.
 

@@ -2,9 +2,8 @@
 //! mechanisms: the full Newton–Euler equations of every rigid body in Cartesian coordinates, with
 //! the joint reaction wrenches and the actuator efforts solved together as Lagrange multipliers.
 //!
-//! This is the second route of noc-method.md, property 5 ("for closed chains, the full
-//! Newton–Euler of every body with constraint (reaction) forces solved by Lagrange
-//! multipliers"). It shares no code with `runtime::noc` or `runtime::parallel`: it uses only the
+//! This is the second route of docs/method.md, "Properties used as checks", item 5 (the full
+//! Newton–Euler of every body, the joint reactions solved as Lagrange multipliers). It shares no code with `runtime::noc` or `runtime::parallel`: it uses only the
 //! model data types and the helpers of `runtime::model` (`Transform`, `mat_vec`, `axis_angle`,
 //! …) to place the bodies, nalgebra's dense matrices, and a one-sided Jacobi SVD written here
 //! (nalgebra 0.35's own SVD was found to miss `U Σ Vᵀ = A` by up to 1e-4 on some
@@ -15,7 +14,7 @@
 //! Everything is in the base frame at one instant: body `b` has mass `m_b`, mass centre `c_b`
 //! and inertia `I_b` about `c_b` ([`CBody`]); each joint ([`CJoint`]) joins a child body to a
 //! parent body or to the fixed base. The unknowns are the body twists `t_b = [ω_b; ċ_b]` (6 per
-//! body, noc-method.md "One rigid body"); the base has zero twist. For a point `P` the vector
+//! body, docs/method.md, "Rigid bodies: twists, wrenches, Newton–Euler"); the base has zero twist. For a point `P` the vector
 //! `r_b = P − c_b` is its arm from body `b`'s mass centre.
 //!
 //! # 1. Velocity level: `K t = ρ`
@@ -64,7 +63,7 @@
 //! The same (factorized) `K` gives the twist rates `ṫ`.
 //!
 //! # 3. Dynamics: `Kᵀ_J λ + A τ = h`
-//! Newton–Euler of every body about its mass centre (noc-method.md):
+//! Newton–Euler of every body about its mass centre (docs/method.md, "Rigid bodies: twists, wrenches, Newton–Euler"):
 //! `h_b = M_b ṫ_b + W_b M_b t_b − w^G_b = [I ω̇ + ω × Iω; m c̈ − m g]` must equal the sum of the
 //! reaction and actuator wrenches on the body (moments about its own mass centre). A constraint
 //! row is power-conjugate to the wrench `λ k_c` on the child and `λ k_p` on the parent: the point

@@ -1,7 +1,7 @@
 //! The compiled generated code of every bundled mechanism (crate `mechanisms`) against the
 //! runtime NOC (`runtime::noc`, the literal `TᵀMT`, `Tᵀ(MṪ+WMT)` matrices) and the independent
 //! spatial recursive Newton–Euler / composite-body route (`runtime::rnea`), on 1,000 random
-//! states each; plus the properties a correct model satisfies (noc-method.md, "Properties").
+//! states each; plus the properties a correct model satisfies (docs/method.md, "Properties used as checks").
 //!
 //! Error norm: ‖a − b‖∞ / max(‖b‖∞, 1).
 
@@ -118,7 +118,7 @@ macro_rules! mechanism_tests {
                 }
             }
 
-            /// q̇ᵀ(İ − 2C)q̇ = 0 (skew symmetry, noc-method.md property 2) and, with gravity off,
+            /// q̇ᵀ(İ − 2C)q̇ = 0 (skew symmetry, docs/method.md, "Properties used as checks", item 2) and, with gravity off,
             /// d/dt(½ q̇ᵀ I q̇) = q̇ᵀ τ (power balance, property 3), along q(t) = q0 + v t + ½ a t².
             #[test]
             fn skew_symmetry_and_power_balance() {

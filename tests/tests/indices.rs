@@ -3,8 +3,8 @@
 //! `tests/indices/template_std.rs`, kept current by `codegen/tests/indices_template.rs`).
 //!
 //! Reference values never come from the code under test:
-//! * Ma & Angeles' DCI on the published check of `shared/reference/pkm-literature.md`
-//!   ("Index definitions"): M = [[2, .5], [.5, 1]] gives σ₁ = 1.5, ψ₁ = 0.5 and
+//! * Ma & Angeles' DCI on the published check in docs/method.md
+//!   ("Dynamic performance indices"): M = [[2, .5], [.5, 1]] gives σ₁ = 1.5, ψ₁ = 0.5 and
 //!   σ₂ = 1.833333, ψ₂ = 0.181818 with Frobenius weights;
 //! * matrices built as `Q diag(λ) Qᵀ` with chosen eigenvalues (eigenvalues, condition number,
 //!   Yoshikawa's `1/det`, DCI from `λ` alone);

@@ -87,7 +87,7 @@ fn matrix_quaternion(r: &Mat3) -> [f64; 4] {
     tests::pkm::matrix_quaternion(r)
 }
 
-/// Body wrench `h_b = [I ω̇ + ω × Iω; m (c̈ − g)]` (noc-method.md, Newton–Euler).
+/// Body wrench `h_b = [I ω̇ + ω × Iω; m (c̈ − g)]` (docs/method.md, "Rigid bodies: twists, wrenches, Newton–Euler").
 fn ne_wrench(sys: &CSystem, sol: &Solution, b: usize) -> [f64; 6] {
     let body = &sys.bodies[b];
     let (t, td) = (&sol.twists[b], &sol.twist_rates[b]);

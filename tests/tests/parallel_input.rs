@@ -1,5 +1,5 @@
-//! Regression tests of issue 18 (parts 3 and 4) on the bundled parallel mechanisms' generated
-//! modules and the runtime:
+//! Bad and extreme input to the bundled parallel mechanisms' generated modules and the
+//! runtime (each case a defect that was once there):
 //! - `forward_kinematics` with a non-finite or huge revolute target returns at once (it hung:
 //!   the residual was wrapped by a loop of `2π` steps), and its tolerance does not grow with
 //!   the target (in `f32`, targets of 1e7 … 1.2e8 rad returned `Ok(HOME)`);

@@ -1,6 +1,6 @@
 //! Walks toward the singularities of the bundled parallel manipulators and checks the documented
-//! failure behaviour of the `f64` routes (noc-method.md, "where the method fails";
-//! pkm-literature.md, "Where methods fail"): near a leg (type-I) or parallel (type-II)
+//! failure behaviour of the `f64` routes (docs/method.md, "Where the method fails";
+//! docs/method.md, "Where the method fails"): near a leg (type-I) or parallel (type-II)
 //! singularity an evaluation either returns a result accurate to 1e-6 (relative, ∞-norm) or
 //! says `Err(Singular)` with a large condition estimate — never NaN, never garbage, never a
 //! panic — and once it fails it keeps failing closer to the singularity.
@@ -524,24 +524,24 @@ fn reference_agrees_with_runtime_at_generic_states() {
 ///
 /// | δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) | runtime, static | runtime, dynamic (worst) | generated, static | generated, dynamic (worst) |
 /// |---:|---:|---:|---:|---|---|---|---|
-/// | 1e-1 | 3.54e2 | 5.27e3 | 7.94e3 | Ok 7.8e-14 | Ok 7.8e-14 | Ok 7.8e-14 | Ok 7.8e-14 |
-/// | 1e-2 | 3.55e3 | 5.27e4 | 7.96e4 | Ok 7.3e-13 | Ok 7.3e-13 | Ok 7.3e-13 | Ok 7.3e-13 |
-/// | 1e-3 | 3.55e4 | 5.27e5 | 7.96e5 | Ok 1.9e-12 | Ok 1.9e-12 | Ok 1.9e-12 | Ok 1.9e-12 |
-/// | 1e-4 | 3.55e5 | 5.27e6 | 7.96e6 | Ok 1.4e-10 | Ok 1.4e-10 | Ok 1.4e-10 | Ok 1.4e-10 |
-/// | 1e-5 | 3.55e6 | 5.27e7 | 7.96e7 | Ok 4.6e-10 | Ok 4.6e-10 | Ok 4.6e-10 | Ok 4.6e-10 |
-/// | 1e-6 | 3.55e7 | 5.27e8 | 7.96e8 | Ok 3.3e-9 | Ok 3.3e-9 | Ok 3.3e-9 | Ok 3.3e-9 |
-/// | 1e-7 | 3.55e8 | 5.27e9 | 7.96e9 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 | Err Act(5) 3.6e8 |
-/// | 1e-8 | 3.55e9 | 5.27e10 | 7.96e10 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 | Err Act(5) 3.6e9 |
-/// | 1e-9 | 3.55e10 | 5.27e11 | 7.96e11 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 | Err Act(5) 3.6e10 |
-/// | 1e-10 | 3.55e11 | 5.27e12 | 7.96e12 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 | Err Act(5) 3.6e11 |
-/// | 1e-11 | 3.55e12 | 5.27e13 | 7.95e13 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 | Err Act(5) 3.6e12 |
-/// | 1e-12 | 3.56e13 | 5.28e14 | 7.97e14 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 | Err Act(5) 3.6e13 |
-/// | 0 | 5.54e31 | 8.23e32 | 3.45e33 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 | Err Act(5) 2.9e16 |
+/// | 1e-1 | 2.22e2 | 1.72e3 | 7.94e3 | Ok 5.2e-14 | Ok 5.2e-14 | Ok 7.1e-14 | Ok 7.1e-14 |
+/// | 1e-2 | 2.22e3 | 1.71e4 | 7.96e4 | Ok 1.2e-12 | Ok 1.2e-12 | Ok 1.7e-12 | Ok 1.7e-12 |
+/// | 1e-3 | 2.22e4 | 1.71e5 | 7.96e5 | Ok 7.6e-12 | Ok 7.6e-12 | Ok 1.3e-11 | Ok 1.3e-11 |
+/// | 1e-4 | 2.22e5 | 1.71e6 | 7.96e6 | Ok 4.8e-11 | Ok 4.8e-11 | Ok 5.1e-11 | Ok 5.1e-11 |
+/// | 1e-5 | 2.22e6 | 1.71e7 | 7.96e7 | Ok 4.1e-10 | Ok 4.1e-10 | Ok 2.0e-10 | Ok 2.0e-10 |
+/// | 1e-6 | 2.22e7 | 1.71e8 | 7.96e8 | Ok 4.5e-9 | Ok 4.5e-9 | Ok 8.0e-10 | Ok 8.0e-10 |
+/// | 1e-7 | 2.22e8 | 1.71e9 | 7.96e9 | Err Act(5) 2.2e8 | Err Act(5) 2.2e8 | Err Act(5) 2.2e8 | Err Act(5) 2.2e8 |
+/// | 1e-8 | 2.22e9 | 1.71e10 | 7.96e10 | Err Act(5) 2.2e9 | Err Act(5) 2.2e9 | Err Act(5) 2.2e9 | Err Act(5) 2.2e9 |
+/// | 1e-9 | 2.22e10 | 1.71e11 | 7.96e11 | Err Act(5) 2.2e10 | Err Act(5) 2.2e10 | Err Act(5) 2.2e10 | Err Act(5) 2.2e10 |
+/// | 1e-10 | 2.22e11 | 1.71e12 | 7.96e12 | Err Act(5) 2.2e11 | Err Act(5) 2.2e11 | Err Act(5) 2.2e11 | Err Act(5) 2.2e11 |
+/// | 1e-11 | 2.22e12 | 1.71e13 | 7.95e13 | Err Act(5) 2.2e12 | Err Act(5) 2.2e12 | Err Act(5) 2.2e12 | Err Act(5) 2.2e12 |
+/// | 1e-12 | 2.22e13 | 1.72e14 | 7.97e14 | Err Act(5) 2.2e13 | Err Act(5) 2.2e13 | Err Act(5) 2.2e13 | Err Act(5) 2.2e13 |
+/// | 0 | 1.03e32 | 7.98e32 | 3.45e33 | Err Act(5) 4.2e15 | Err Act(5) 4.2e15 | Err Act(5) 1.4e16 | Err Act(5) 1.4e16 |
 ///
-/// The conditioning grows exactly like 1/δ (pivot ratio ≈ 35.5/δ°), so the singularity is at
+/// The conditioning grows exactly like 1/δ (pivot ratio ≈ 22.2/δ°), so the singularity is at
 /// 90° to within the rounding of the spec's constants (at δ = 0 double-double sees a pivot
-/// ratio of 5.5e31: `A`'s rows, `[(R p_i) × s_i; s_i]` in the closed-form UPS leg, are singular
-/// to its precision). Both `f64` routes are accurate to ≤ 3.3e-9 (about `ε` times the pivot
+/// ratio of 1.0e32: `A`'s rows, `[(R p_i) × s_i; s_i]` in the closed-form UPS leg, are singular
+/// to its precision). Both `f64` routes are accurate to ≤ 4.5e-9 (about `ε` times the pivot
 /// ratio) while they answer and switch to `Err(Actuation(5))` between δ = 1e-6° and 1e-7°
 /// (the 1e-8 pivot-ratio tolerance), with condition estimates that track the double-double
 /// pivot ratio. The relative error is the same for every state: near the singularity `τ` is
@@ -584,7 +584,7 @@ fn gough_stewart_yaw_singularity() {
 /// Agile Eye (spherical 3-RRR, exact Agile-Eye geometry): the platform turned by
 /// `R_x(30°)·R_y(90° − δ)`, which carries the platform axis `v₁ = z` of leg 1 onto its base axis
 /// `u₁ = x` at `δ = 0` while `v₂`, `v₃` stay generic. There `u₁, w₁, v₁` become coplanar (a leg
-/// singularity of leg 1) and, as pkm-literature.md says for this geometry, the actuation matrix
+/// singularity of leg 1) and, as docs/method.md, "Where the method fails", says for this geometry, the actuation matrix
 /// becomes singular with it (its scaled pivot ratio grows like 1/δ). `δ = 0` uses the exact
 /// quarter-turn quaternion for `R_y(90°)`.
 ///
@@ -592,35 +592,27 @@ fn gough_stewart_yaw_singularity() {
 ///
 /// | δ (deg) | κ pivots (dd) | κ₁ (dd) | ‖τ‖∞ static (dd) | runtime, static | runtime, dynamic (worst) | generated, static | generated, dynamic (worst) |
 /// |---:|---:|---:|---:|---|---|---|---|
-/// | 1e-1 | 6.62e2 | 1.57e3 | 8.46e1 | Ok 1.2e-13 | Ok 6.0e-11 | Ok 1.2e-13 | Ok 6.0e-11 |
-/// | 1e-2 | 6.62e3 | 1.57e4 | 8.47e2 | Ok 1.8e-12 | Ok 9.1e-9 | Ok 1.8e-12 | Ok 9.1e-9 |
-/// | 1e-3 | 6.62e4 | 1.57e5 | 8.47e3 | Ok 1.0e-11 | Ok 5.2e-7 | Ok 1.0e-11 | Ok 5.2e-7 |
-/// | 1e-4 | 6.62e5 | 1.57e6 | 8.47e4 | Ok 2.0e-10 | **Ok 1.0e-4** | Ok 2.0e-10 | **Ok 1.0e-4** |
-/// | 1e-5 | 6.62e6 | 1.57e7 | 8.47e5 | Ok 1.4e-9 | **Ok 7.0e-3** | Ok 1.4e-9 | **Ok 7.0e-3** |
-/// | 1e-6 | 6.62e7 | 1.57e8 | 8.47e6 | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
+/// | 1e-1 | 4.96e2 | 9.98e2 | 8.46e1 | Ok 2.2e-14 | Ok 2.1e-13 | Ok 2.2e-14 | Ok 2.0e-13 |
+/// | 1e-2 | 4.96e3 | 9.93e3 | 8.47e2 | Ok 3.5e-13 | Ok 2.0e-12 | Ok 3.5e-13 | Ok 1.8e-12 |
+/// | 1e-3 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e4 | Err Leg(0) 5.7e4 | Err Leg(0) 5.7e4 | Err Leg(0) 5.7e4 |
+/// | 1e-4 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e5 | Err Leg(0) 5.7e5 | Err Leg(0) 5.7e5 | Err Leg(0) 5.7e5 |
+/// | 1e-5 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e6 | Err Leg(0) 5.7e6 | Err Leg(0) 5.7e6 | Err Leg(0) 5.7e6 |
+/// | 1e-6 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e7 | Err Leg(0) 5.7e7 | Err Leg(0) 5.7e7 | Err Leg(0) 5.7e7 |
 /// | 1e-7 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 | Err Leg(0) 5.7e8 |
-/// | 1e-8 … 1e-11 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
-/// | 1e-12 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 | Err Leg(0) 5.7e13 |
+/// | 1e-8 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e9 | Err Leg(0) 5.7e9 | Err Leg(0) 5.7e9 | Err Leg(0) 5.7e9 |
+/// | 1e-9 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e10 | Err Leg(0) 5.7e10 | Err Leg(0) 5.7e10 | Err Leg(0) 5.7e10 |
+/// | 1e-10 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e11 | Err Leg(0) 5.7e11 | Err Leg(0) 5.7e11 | Err Leg(0) 5.7e11 |
+/// | 1e-11 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.7e12 | Err Leg(0) 5.7e12 | Err Leg(0) 5.7e12 | Err Leg(0) 5.7e12 |
+/// | 1e-12 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) 5.8e13 | Err Leg(0) 5.8e13 | Err Leg(0) 5.8e13 | Err Leg(0) 5.8e13 |
 /// | 0 | Err Leg(0) | — | Err Leg(0) | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf | Err Leg(0) inf |
 ///
-/// (The double-double route applies the runtime's leg tolerance too, hence its `Err Leg(0)`
-/// from δ = 1e-7°, where the leg's Hadamard ratio, ≈ δ in radians, falls below 1e-8.)
-///
-/// **The `f64` routes (runtime and generated) violate the contract here** (bold cells), so this
-/// test fails until `runtime/src/parallel/noc.rs` is fixed: the closed-form inverse kinematics
-/// of the spherical leg (`two_axes`, Paden–Kahan subproblem 2,
-/// `γ² = (|p|² − α² − β² − 2wαβ)/|k|²`) cancels catastrophically as `v₁ → u₁` (`γ² ~ δ²` formed
-/// as `1 − α²` with an absolute error ~ε), so the first joint's angle is wrong by ~ε/δ²
-/// (measured 3.8e-3 rad at δ = 1e-5° = 1.7e-7 rad) instead of the intrinsic ~ε/δ (2e-10);
-/// results with relative errors up to 7e-3 are returned as `Ok` (velocity-dependent terms,
-/// which grow like 1/δ², carry the error) before the leg Hadamard-ratio test (1e-8) fires.
-/// Forming `|p|² − α²` as `|e₁ × q|²` (Lagrange's identity; here `w = 0`, `β = 0`) brings
-/// `γ²`'s relative error at δ = 1e-5° from 8.7e-3 to 1.3e-9 (measured); alternatively the leg
-/// tolerance would have to be ~1e-5 instead of 1e-8 for this leg type.
-///
-/// (Closer in, `γ²` rounds to ≤ 0. Before the `γ² ≈ 0 → Site::Leg` check was added to
-/// `two_axes` during this work, that was reported as `Site::Reach(0)`, "outside the
-/// workspace", for a reachable pose; the walk now sees `Leg(0)` throughout.)
+/// Both `f64` routes answer to ≤ 2.1e-13 at δ ≥ 1e-2° and return `Err(Leg(0))` from
+/// δ = 1e-3° on, where the leg's scaled determinant (≈ δ in radians) falls below
+/// `LEG_TOLERANCE` (1e-4), with condition estimates growing like 1/δ. The double-double route
+/// applies the same leg test, hence its `Err Leg(0)`. The tolerance is what keeps this leg's
+/// closed-form inverse kinematics (Paden–Kahan subproblem 2, whose `γ² ~ δ²` is formed with an
+/// absolute error ~ε, so the first angle is off by ~ε/δ²) out of `Ok` answers: the
+/// velocity-dependent terms grow like 1/δ² and would carry that error.
 #[test]
 fn agile_eye_leg_and_parallel_singularity() {
     let m = model("agile_eye");

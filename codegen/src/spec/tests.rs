@@ -743,7 +743,7 @@ mod parallel_specs {
         }
     }
 
-    /// The Gough–Stewart spec against Tsai's numbers (pkm-literature.md), independently of the
+    /// The Gough–Stewart spec against Tsai's numbers (docs/method.md, "Test cases from the literature"), independently of the
     /// runtime's closure check.
     #[test]
     fn gough_stewart_matches_tsai_data() {

@@ -15,8 +15,8 @@
 //!   the others `x_d` through `Φ`; their rates `u = ẋ_i` are the speeds and their efforts are
 //!   the generalized forces (the actuator efforts when those joints are the actuated ones).
 //!
-//! # The method (noc-method.md, "Closed chains"; the lecture's eqs. 49–53 with the joint rates
-//! as the twist-shaping coordinates)
+//! # The method (docs/method.md, "Closed loops in joint coordinates"; the lecture's eqs. 21–24
+//! with the tree's joint rates, shaped by the loop equations, as the twist-shaping coordinates)
 //! * Redundant loop equations are common (a planar loop written in 3-D has 5 equations per cut
 //!   joint of which 2 are independent; the Bricard linkage has one redundant equation). At home,
 //!   [`Plan::new`] keeps `NX − DOF` rows of `Φ_x` that are independent over the dependent
@@ -34,7 +34,7 @@
 //!   accelerations with `ẍ = 0`.
 //! * Dynamics: each body's Newton–Euler wrench for `(x, ẋ, ẍ)` at its mass centre, projected by
 //!   its twist per unit speed (column `k` of `S` through the velocity recursion): `f_k =
-//!   Σ_b ω_b⁽ᵏ⁾·n_b + v_b⁽ᵏ⁾·f_b`, the lecture's `f = Tᵀ w` (eq. 53). This equals `Sᵀ τ_T` with
+//!   Σ_b ω_b⁽ᵏ⁾·n_b + v_b⁽ᵏ⁾·f_b`, the lecture's `f = Tᵀ w` (eqs. 21–24). This equals `Sᵀ τ_T` with
 //!   `τ_T` the open tree's joint efforts, but those hold whole subtrees on long lever arms and
 //!   cancel in the projection (by up to 1,600 times the result on the bundled loops), so
 //!   their rounding survived it; the bodies' powers cancel far less. The inertia `Sᵀ M_T S`

@@ -11,7 +11,9 @@
 //!    loop's redundant equations that do not vanish identically are spare rows of the LU
 //!    ([`Plan::spare`]): the pivoting chooses, per configuration, which equations to solve.
 //! 4. The body motions with `ẍ = 0` give the bias `Φ̇ ẋ`; `ẍ_d = −Φ_d⁻¹ (Φ_i u̇ + Φ̇ ẋ)`.
-//! 5. The tree's inverse dynamics, then `f = τ_i − Φ_iᵀ Φ_d⁻ᵀ τ_d`.
+//! 5. Each body's Newton–Euler wrench projected on its twists per unit speed (the columns of
+//!    `S` pushed through the tree's velocity recursion): `f = Tᵀ w`, the lecture's eqs. 21–24
+//!    (docs/method.md, "Closed loops in joint coordinates").
 
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
@@ -1110,7 +1112,7 @@ pub fn generalized_force_with<R: Real>(
         xdd[j] = xdd_d[k];
     }
     let m = motions(plan, &c.kin, &xd, Some(&xdd));
-    // Virtual power body by body (the lecture's eq. 53, `f = Tᵀ w` with `T`'s block rows the
+    // Virtual power body by body (the lecture's eqs. 21–24, `f = Tᵀ w` with `T`'s block rows the
     // bodies' twists per unit speed): f_k = Σ_b ω_b⁽ᵏ⁾·n_b + v_b⁽ᵏ⁾·f_b, each body's wrench
     // `w_b = M ṫ + W M t − w^G` (eq. 12) at its mass centre. Not `Sᵀ τ_T`: the open tree's
     // joint efforts hold whole subtrees on long lever arms and cancel in the projection (by up

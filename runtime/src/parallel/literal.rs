@@ -1,5 +1,5 @@
 //! The NOC of a simple-platform parallel manipulator evaluated literally, as the lecture writes
-//! it (noc-method.md, "Simple-platform parallel manipulators"; eqs. 49–72): the twist-shaping
+//! it (docs/method.md, "Parallel manipulators: actuation matrix"; eqs. 49–72): the twist-shaping
 //! matrix `T` of every body (`6r × n`), the twist rates `Ṫ u`, the extended matrices `M` and
 //! `W` (`6r × 6r`) and the gravity wrench `w^G`, as dense `nalgebra` matrices, then
 //! `I = TᵀMT`, `f = Tᵀ(M(T u̇ + Ṫ u) + W M T u − w^G)` and `τ = A⁻ᵀ f`.

@@ -1,6 +1,6 @@
 //! Simple-platform parallel manipulators: a moving platform carried by legs, each leg a serial
-//! chain from the base to the platform (noc-method.md, "Simple-platform parallel manipulators";
-//! the lecture's eqs. 49–72).
+//! chain from the base to the platform (docs/method.md, "Parallel manipulators: actuation
+//! matrix"; the lecture's eqs. 49–72).
 //!
 //! # The model
 //! * The platform's independent coordinates are its pose ([`PlatformMotion::Pose`]:

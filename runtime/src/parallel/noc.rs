@@ -1,5 +1,5 @@
-//! The NOC of a simple-platform parallel manipulator in actuator space (noc-method.md,
-//! "Simple-platform parallel manipulators"; the lecture's eqs. 49–72), written once over
+//! The NOC of a simple-platform parallel manipulator in actuator space (docs/method.md,
+//! "Parallel manipulators: actuation matrix"; the lecture's eqs. 49–72), written once over
 //! [`Real`] so that the runtime (`f64`) and the generator (symbolic) evaluate the same
 //! equations.
 //!

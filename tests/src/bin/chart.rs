@@ -1,4 +1,4 @@
-//! Speed against accuracy, measured in one run (issue 4, "the chart"): for the PUMA 560 (a
+//! Speed against accuracy, measured in one run: for the PUMA 560 (a
 //! tree), the Gough–Stewart platform (a parallel mechanism), the five-bar in joint
 //! coordinates (closed loops) and a URDF with rounded angles (the iiwa 14, as written and
 //! snapped), every way nocdyn offers to compute the inverse dynamics — including fidelity
