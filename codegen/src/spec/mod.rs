@@ -123,7 +123,7 @@ pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagn
             Diagnostic::error("this spec describes a parallel mechanism (it has a [platform] table), which cannot be loaded as a tree")
                 .with_key("platform")
                 .with_span(span)
-                .with_hint("read it with codegen::spec::load_mechanism, which returns a ParallelModel; code generation for parallel mechanisms is not available yet"),
+                .with_hint("generate it with codegen::compile (or the CLI), which takes every mechanism kind; codegen::spec::load_mechanism returns its ParallelModel"),
         );
     }
     if let Some(Mechanism::Closed(_)) = &mechanism {
