@@ -1,5 +1,5 @@
 //! Closed loops in joint coordinates: the runtime's evaluator ([`runtime::closed::noc`],
-//! written over [`runtime::parallel::Real`]) run on the symbolic scalar, so the whole of every function — tree
+//! written over [`runtime::scalar::Real`]) run on the symbolic scalar, so the whole of every function — tree
 //! kinematics, loop Jacobian, the pivoted LU of `Φ_d` (its row swaps are `Select` nodes),
 //! the tree's Newton–Euler sweep and the projection `Sᵀ` — is one flat DAG kernel. Newton's
 //! assembly is the one loop, a fixed template around a DAG step.
@@ -8,10 +8,10 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
-use runtime::parallel::Singular;
+use runtime::scalar::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
-use crate::parallel::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
+use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount, schedule};
 use crate::sym::{Arg, ExprId, Graph};

@@ -166,7 +166,7 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
                     quote!(#v)
                 };
                 let at = if f.sites {
-                    site_tokens(runtime::parallel::Site::from_code(code))
+                    site_tokens(runtime::scalar::Site::from_code(code))
                 } else {
                     let i = Literal::usize_unsuffixed(code as usize);
                     quote!(pivot: #i)
@@ -397,8 +397,8 @@ fn chunked(
 }
 
 /// `site: Site::…` of a guard in a parallel module.
-fn site_tokens(site: runtime::parallel::Site) -> TokenStream {
-    use runtime::parallel::Site as S;
+fn site_tokens(site: runtime::scalar::Site) -> TokenStream {
+    use runtime::scalar::Site as S;
     match site {
         S::MassMatrix(i) => {
             let i = Literal::usize_unsuffixed(i);

@@ -41,6 +41,7 @@ pub mod indices;
 mod lu;
 pub mod macro_support;
 pub mod parallel;
+pub mod params;
 pub mod scalar;
 pub mod schedule;
 pub mod spec;
@@ -72,7 +73,7 @@ pub enum Float {
     F64,
     /// `f32`, for FPUs without double precision. The same equations; the thresholds of the
     /// guards and of Newton's method are rescaled to single precision (see
-    /// [`runtime::parallel::real::f32_tolerance`]) and the math calls are the `f32` ones.
+    /// [`runtime::scalar::f32_tolerance`]) and the math calls are the `f32` ones.
     F32,
 }
 

@@ -9,8 +9,11 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use runtime::model::JointKind;
 use runtime::parallel::noc::{self, Plan};
-use runtime::parallel::{ParallelModel, PlatformMotion, Real, Singular};
+use runtime::parallel::{ParallelModel, PlatformMotion};
+use runtime::scalar::{Real, Singular};
 
+pub use crate::params::Layout;
+use crate::params::{drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
@@ -45,118 +48,12 @@ pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
     kernels_with(plan, &Layout::default())
 }
 
-/// Which values of a parallel module are run-time parameters (`Arg::P`), and where they sit in
-/// the generated `Params::to_array`: entries 0–9 the platform payload (mass, mass centre,
-/// inertia `xx, xy, xz, yy, yz, zz`, platform frame; reserved even without one), then, per leg
-/// joint `3·leg + k`, the viscous coefficients and the Coulomb levels (with `friction`), then
-/// the rotor inertias (with `rotor_inertia`), then ten entries per run-time body
-/// (`[scene] runtime_inertia`, ordered as the payload's; [`Layout::body_base`]). Closed loops
-/// use the same layout with the tree joints and tree bodies.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Layout {
-    /// The platform payload.
-    pub payload: bool,
-    /// The leg joints' viscous and Coulomb friction.
-    pub friction: bool,
-    /// The leg joints' rotor inertias.
-    pub rotor_inertia: bool,
-    /// `v_s` of the regularized Coulomb law.
-    pub coulomb_velocity: f64,
-    /// Number of run-time bodies (`[scene] runtime_inertia`).
-    pub bodies: usize,
-}
-
-impl Layout {
-    /// The layout of a module's run-time parameters (`None`: constants).
-    pub fn of(params: Option<&crate::spec::RuntimeParams>) -> Layout {
-        match params {
-            None => Layout::default(),
-            Some(p) => Layout {
-                payload: p.payload.is_some(),
-                friction: p.leg_friction,
-                rotor_inertia: p.leg_rotor_inertia,
-                coulomb_velocity: p.coulomb_velocity,
-                bodies: p.bodies.len(),
-            },
-        }
-    }
-
-    /// Whether the module takes `Params`.
-    pub fn any(&self) -> bool {
-        self.payload || self.drives() || self.bodies > 0
-    }
-
-    /// Whether the leg joints' drives are run-time parameters.
-    pub fn drives(&self) -> bool {
-        self.friction || self.rotor_inertia
-    }
-
-    /// First index of the viscous coefficients, the Coulomb levels and the rotor inertias of
-    /// `nlj` leg joints (`None` where absent), and the total count.
-    pub fn offsets(&self, nlj: usize) -> (Option<usize>, Option<usize>, Option<usize>, usize) {
-        let mut at = 10;
-        let mut take = |on: bool| {
-            on.then(|| {
-                let k = at;
-                at += nlj;
-                k
-            })
-        };
-        let v = take(self.friction);
-        let c = take(self.friction);
-        let a = take(self.rotor_inertia);
-        (v, c, a, at)
-    }
-
-    /// First index of run-time body `k`'s ten parameters, with `nlj` leg (or tree) joints.
-    pub fn body_base(&self, nlj: usize, k: usize) -> usize {
-        self.offsets(nlj).3 + 10 * k
-    }
-
-    /// Number of run-time parameters (`Params::to_array`), with `nlj` leg (or tree) joints.
-    pub fn count(&self, nlj: usize) -> usize {
-        self.body_base(nlj, self.bodies)
-    }
-}
-
 /// [`kernels`] with run-time parameters: the payload's mass properties are added by
 /// [`noc::payload_force`] and [`noc::payload_inertia`], the drives enter as
-/// [`runtime::parallel::real::DriveInputs`].
+/// [`runtime::drive::DriveInputs`].
 pub fn kernels_with(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let (r, graph) = in_fresh_graph(|| build(plan, layout));
     r.map(|k| Kernels { graph, ..k })
-}
-
-/// The drives of `nlj` joints of the `Arg::P` inputs.
-pub(crate) fn drive_inputs(
-    nlj: usize,
-    layout: &Layout,
-) -> runtime::parallel::real::DriveInputs<Sx> {
-    let (v, c, a, np) = layout.offsets(nlj);
-    let p = inputs(Arg::P, np);
-    let at = |k: Option<usize>| k.map(|k| p[k..k + nlj].to_vec());
-    runtime::parallel::real::DriveInputs {
-        viscous: at(v),
-        coulomb: at(c),
-        armature: at(a),
-        coulomb_velocity: layout.coulomb_velocity,
-    }
-}
-
-/// The payload of the `Arg::P` inputs (entries 0–9).
-pub(crate) fn payload_inputs() -> noc::Payload<Sx> {
-    payload_inputs_at(0)
-}
-
-/// A rigid body's parameters of the `Arg::P` inputs `at..at + 10`, ordered as the payload's.
-pub(crate) fn payload_inputs_at(at: usize) -> noc::Payload<Sx> {
-    let p = inputs(Arg::P, at + 10);
-    let p = &p[at..];
-    noc::Payload {
-        mass: p[0],
-        com: [p[1], p[2], p[3]],
-        inertia: [[p[4], p[5], p[6]], [p[5], p[7], p[8]], [p[6], p[8], p[9]]],
-    }
 }
 
 fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
@@ -578,108 +475,6 @@ pub fn generate_with(
         warnings: crate::diag::Diagnostics::new("", ""),
         per: "DOF",
     })
-}
-
-/// The `NP` constant and the `Params` struct of a module with run-time parameters (parallel
-/// mechanisms and closed loops, in [`Layout`]'s layout): the payload's fields (on `payload.0`,
-/// its values in that frame), then one array per drive effect over `drives`, of length
-/// `per.0` (a constant of the module), each entry a `per.1`, then the run-time bodies' fields
-/// (`bodies`, on the model body `frame` names; [`crate::body_params`]).
-// The pieces of one struct: kept apart, they would only be regrouped by every caller.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn params_items(
-    layout: &Layout,
-    payload: Option<(String, f64, runtime::model::Vec3, runtime::model::Mat3)>,
-    drives: &[&runtime::model::Drive],
-    per: (&str, &str),
-    what: &str,
-    bodies: &[crate::spec::RuntimeBody],
-    frame: &dyn Fn(usize) -> String,
-) -> TokenStream {
-    let (mut fields, mut default, mut fill) = match &payload {
-        Some((on, m, c, i)) => crate::payload_params(on, *m, c, i),
-        None => (quote!(), quote!(), quote!()),
-    };
-    let (v0, c0, a0, _) = layout.offsets(drives.len());
-    let np = layout.count(drives.len());
-    let len = proc_macro2::Ident::new(per.0, proc_macro2::Span::call_site());
-    let mut drive_field =
-        |at: Option<usize>,
-         name: &str,
-         doc: &str,
-         value: &dyn Fn(&runtime::model::Drive) -> f64| {
-            let Some(at) = at else { return };
-            let ident = proc_macro2::Ident::new(name, proc_macro2::Span::call_site());
-            let vals: Vec<_> = drives.iter().map(|d| emit::float_lit(value(d))).collect();
-            let at = Literal::usize_unsuffixed(at);
-            let doc = format!(" {doc}, per {}.", per.1);
-            fields.extend(quote! {
-                #[doc = #doc]
-                pub #ident: [f64; #len],
-            });
-            default.extend(quote!(#ident: [#(#vals),*],));
-            fill.extend(quote! {
-                let mut i = 0;
-                while i < #len {
-                    a[#at + i] = self.#ident[i];
-                    i += 1;
-                }
-            });
-        };
-    drive_field(
-        v0,
-        "damping",
-        "Viscous friction (N·m·s/rad or N·s/m)",
-        &|d| d.viscous,
-    );
-    drive_field(
-        c0,
-        "friction",
-        "Coulomb friction level (N·m or N), regularized as in the spec docs",
-        &|d| d.coulomb,
-    );
-    drive_field(
-        a0,
-        "armature",
-        "Reflected rotor inertia (kg·m² or kg)",
-        &|d| d.armature,
-    );
-    let (body_items, body_fields, body_default, body_fill) =
-        crate::body_params(bodies, frame, layout.body_base(drives.len(), 0));
-    fields.extend(body_fields);
-    default.extend(body_default);
-    fill.extend(body_fill);
-    let np = Literal::usize_unsuffixed(np);
-    let doc = format!(
-        " Run-time parameters (`[scene] parameters = \"runtime\"`): {what}, so one binary serves several tools or drive calibrations. SI units. The functions of the masses take them last; the kinematics do not."
-    );
-    quote! {
-        #body_items
-        /// Number of run-time parameters in [`Params::to_array`].
-        pub const NP: usize = #np;
-        #[doc = #doc]
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Params {
-            #fields
-        }
-        impl Params {
-            /// The values of the spec (what a module with constants would fold in).
-            pub const DEFAULT: Params = Params {
-                #default
-            };
-            /// The flat layout the generated functions read.
-            pub fn to_array(&self) -> [f64; NP] {
-                let mut a = [0.0; NP];
-                #fill
-                a
-            }
-        }
-        impl Default for Params {
-            fn default() -> Self {
-                Self::DEFAULT
-            }
-        }
-    }
 }
 
 /// The fixed items of every parallel module: error types, the LU of `A`, and the public

@@ -1,11 +1,11 @@
-//! The symbolic scalar: [`runtime::parallel::Real`] implemented by recording one node of the
+//! The symbolic scalar: [`runtime::scalar::Real`] implemented by recording one node of the
 //! hash-consed DAG ([`crate::sym`]) per operation, so that the runtime's generic evaluators
 //! (parallel mechanisms, closed loops) become the generator's expression builders.
 
 use std::cell::RefCell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use runtime::parallel::{Real, Singular, Site};
+use runtime::scalar::{Real, Singular, Site};
 
 use crate::sym::{Arg, ExprId, Graph, TWO_SIDED};
 
@@ -34,7 +34,7 @@ pub(crate) fn with_precision<T>(single: bool, f: impl FnOnce() -> T) -> T {
 /// The threshold for the current target of a test whose `f64` threshold is `t`.
 pub(crate) fn tolerance(t: f64) -> f64 {
     if SINGLE.with(|c| c.get()) {
-        runtime::parallel::real::f32_tolerance(t)
+        runtime::scalar::f32_tolerance(t)
     } else {
         t
     }

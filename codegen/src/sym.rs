@@ -88,7 +88,7 @@ pub enum Node {
     /// Pivot `index` of a factorization: the operand when it is `> tol` (a node), else the
     /// function returns `Err(Singular)`; `scale` is the matrix diagonal entry the pivot came from
     /// (for the condition estimate). With [`TWO_SIDED`] set in `index` the test is
-    /// `|value| > tol`; the rest of `index` is a site code (`runtime::parallel::Site::code`;
+    /// `|value| > tol`; the rest of `index` is a site code (`runtime::scalar::Site::code`;
     /// for trees the pivot).
     Guard {
         value: ExprId,

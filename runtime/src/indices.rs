@@ -569,7 +569,7 @@ pub enum Space {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EvalError {
     /// The runtime failed: a singular or unreachable pose, or a bad input.
-    Singular(crate::parallel::Singular),
+    Singular(crate::scalar::Singular),
     /// The inertia matrix failed its checks.
     Index(IndexError),
 }
@@ -591,8 +591,8 @@ impl From<IndexError> for EvalError {
     }
 }
 
-impl From<crate::parallel::Singular> for EvalError {
-    fn from(e: crate::parallel::Singular) -> Self {
+impl From<crate::scalar::Singular> for EvalError {
+    fn from(e: crate::scalar::Singular) -> Self {
         EvalError::Singular(e)
     }
 }

@@ -25,6 +25,18 @@ extern crate std;
 
 pub mod math;
 
+// The shared floor every mechanism kind stands on.
+#[cfg(feature = "alloc")]
+pub(crate) mod algebra;
+#[cfg(feature = "alloc")]
+pub mod drive;
+#[cfg(feature = "alloc")]
+pub mod payload;
+#[cfg(feature = "alloc")]
+pub mod scalar;
+#[cfg(feature = "alloc")]
+pub mod solve;
+
 #[cfg(feature = "alloc")]
 pub mod closed;
 #[cfg(feature = "alloc")]

@@ -1,5 +1,5 @@
 //! A double-double scalar (`hi + lo`, about 32 significant decimal digits) implementing
-//! [`runtime::parallel::Real`], so that the parallel-manipulator evaluator
+//! [`runtime::scalar::Real`], so that the parallel-manipulator evaluator
 //! (`runtime::parallel::noc`, written once over `Real`) can be run in extended precision and
 //! serve as the reference for the `f64` routes near singularities.
 //!
@@ -23,8 +23,9 @@
 use core::cmp::Ordering;
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
+use runtime::parallel::Plan;
 use runtime::parallel::noc;
-use runtime::parallel::{Plan, Real, Singular, Site};
+use runtime::scalar::{Real, Singular, Site};
 
 /// A double-double number `hi + lo` with `|lo| ≤ ulp(hi)/2` (normalized).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

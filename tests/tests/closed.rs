@@ -172,11 +172,11 @@ fn inputs_that_do_not_close_the_loops_are_refused() {
         let j = plan.dependent[0];
         x[j] += 1e-3;
         let e = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap_err();
-        assert!(matches!(e.site, runtime::parallel::Site::Closure(_)), "{e}");
+        assert!(matches!(e.site, runtime::scalar::Site::Closure(_)), "{e}");
         let mut bad = x.clone();
         bad[0] = f64::NAN;
         let e = noc::inverse_dynamics(&plan, &bad, &u, &vec![0.0; n]).unwrap_err();
-        assert_eq!(e.site, runtime::parallel::Site::Input);
+        assert_eq!(e.site, runtime::scalar::Site::Input);
     }
 }
 
@@ -380,7 +380,7 @@ fn n_four_bar_walk_to_the_change_point() {
             }
             (Err(a), Err(b)) => {
                 assert!(
-                    matches!(a.site, runtime::parallel::Site::Constraint(_)),
+                    matches!(a.site, runtime::scalar::Site::Constraint(_)),
                     "{a}"
                 );
                 assert!(

@@ -117,7 +117,7 @@ fn parallel_mechanisms_in_single_precision() {
 }
 
 /// `f64` arithmetic on the model's constants rounded to `f32`: every constant the closed-loop
-/// evaluator takes (geometry, inertia, gravity: [`runtime::parallel::Real::c`]) is rounded to
+/// evaluator takes (geometry, inertia, gravity: [`runtime::scalar::Real::c`]) is rounded to
 /// single precision, every operation is done in double. What it computes is the exact
 /// dynamics of the mechanism an `f32` module describes, to `f64` rounding: the error no `f32`
 /// arithmetic, however careful, can remove.
@@ -146,7 +146,7 @@ impl core::ops::Neg for F32Constants {
     }
 }
 
-impl runtime::parallel::Real for F32Constants {
+impl runtime::scalar::Real for F32Constants {
     fn c(v: f64) -> Self {
         F32Constants(v as f32 as f64)
     }
@@ -167,9 +167,9 @@ impl runtime::parallel::Real for F32Constants {
         value: Self,
         threshold: Self,
         scale: Self,
-        site: runtime::parallel::Site,
+        site: runtime::scalar::Site,
         two_sided: bool,
-    ) -> Result<Self, runtime::parallel::Singular> {
+    ) -> Result<Self, runtime::scalar::Singular> {
         f64::check(value.0, threshold.0, scale.0, site, two_sided).map(F32Constants)
     }
 }

@@ -18,7 +18,7 @@ use std::cell::RefCell;
 use std::collections::BTreeSet;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use runtime::parallel::{Real, Singular, Site};
+use runtime::scalar::{Real, Singular, Site};
 
 /// An `f64` that also knows whether its value depends on a function input, and, when it does,
 /// a hash of the expression that computed it (commutative operations hashed in either order,

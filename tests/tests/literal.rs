@@ -8,9 +8,10 @@
 
 use rand::Rng;
 use runtime::model::Drive;
+use runtime::parallel::PlatformMotion;
 use runtime::parallel::literal;
 use runtime::parallel::noc::{self, Plan};
-use runtime::parallel::{PlatformMotion, Site};
+use runtime::scalar::Site;
 use tests::pkm::{PARALLEL, home_x, model, random_state, rel};
 
 /// States per mechanism and case.

@@ -9,8 +9,8 @@
 //!   (the Gough–Stewart's `actuator_mass_matrix` answered `Ok` with an entry of 7.2e19 where
 //!   `inverse_dynamics` reported `Err(Actuation(4))`).
 
-use runtime::parallel::Site;
 use runtime::parallel::noc::{self, Plan};
+use runtime::scalar::Site;
 use tests::pkm::{home_x, model};
 
 /// `a − b` wrapped to `(−π, π]`, for any `a` and `b` (exact `f64` values, each reduced by

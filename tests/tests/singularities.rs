@@ -18,7 +18,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use runtime::parallel::noc::{self, Plan};
-use runtime::parallel::{ParallelModel, PlatformMotion, Singular, Site};
+use runtime::parallel::{ParallelModel, PlatformMotion};
+use runtime::scalar::{Singular, Site};
 use tests::dd;
 
 /// The relative accuracy an `Ok` result must reach against the double-double reference.
@@ -124,7 +125,7 @@ macro_rules! generated_routes {
     ($m:ident) => {
         mod $m {
             use mechanisms::$m as g;
-            use runtime::parallel::Singular;
+            use runtime::scalar::Singular;
 
             pub fn err(e: g::Singular) -> Singular {
                 Singular {

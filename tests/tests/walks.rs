@@ -17,7 +17,7 @@
 //! workspace boundary), with every public function compared.
 
 use runtime::closed::noc::{self as cnoc, Plan as ClosedPlan};
-use runtime::parallel::Singular;
+use runtime::scalar::Singular;
 
 /// `Ok` or the `Debug` text of the `Err`'s site.
 type Verdict = Result<(), String>;

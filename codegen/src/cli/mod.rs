@@ -19,7 +19,8 @@ use clap::ValueEnum;
 use codegen::spec::Mechanism;
 use runtime::indices::{self, EvalError, IndexError, InertiaIndices, Space};
 use runtime::model::{JointKind, Model};
-use runtime::parallel::{ParallelModel, Plan, PlatformMotion, Site};
+use runtime::parallel::{ParallelModel, Plan, PlatformMotion};
+use runtime::scalar::Site;
 
 /// Which index to map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -249,7 +250,7 @@ impl Target {
     /// inertia), symmetrized and checked (`runtime::indices::validate_spd`).
     pub fn matrix(&self, x: &[f64]) -> Result<nalgebra::DMatrix<f64>, Failure> {
         use runtime::parallel::noc;
-        let singular = |s: runtime::parallel::Singular| match s.site {
+        let singular = |s: runtime::scalar::Singular| match s.site {
             Site::Reach(_) => Failure::Unreachable,
             site => Failure::Singular(site),
         };

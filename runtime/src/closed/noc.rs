@@ -21,13 +21,14 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{ClosedModel, CutKind, ancestry, perpendiculars};
-use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
-use crate::parallel::noc::Payload;
-use crate::parallel::noc::{
-    M, NoConvergence, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mtv, mv, rot,
-    scale, solve_spd, sub, zero3,
+use crate::algebra::{
+    M, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mtv, mv, rot, scale, sub, zero3,
 };
-use crate::parallel::real::{DriveInputs, Real, Singular, Site, drive_effort};
+use crate::drive::{DriveInputs, drive_effort};
+use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+use crate::payload::Payload;
+use crate::scalar::{Real, Singular, Site};
+use crate::solve::{NoConvergence, solve_spd};
 
 /// Pivot threshold of `Φ_d`'s LU (columns scaled to unit norm): a pivot `|p| ≤ 1e-4` is a
 /// configuration where the independent coordinates (nearly) fail to determine the others. The
@@ -1374,7 +1375,7 @@ pub fn newton_step<R: Real>(plan: &Plan, x: &[R]) -> Result<(Vec<R>, R, R), Sing
 // f64 API
 
 fn check_finite(inputs: &[&[f64]]) -> Result<(), Singular> {
-    crate::parallel::noc::check_finite(inputs)
+    crate::solve::check_finite(inputs)
 }
 
 fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {

@@ -25,11 +25,12 @@ use alloc::vec;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::PlatformMotion;
-use super::noc::{
-    self, ACTUATION_TOLERANCE, LegKin, PIVOT_TOLERANCE, Plan, V, check_finite, leg_motion,
-};
-use super::real::{Singular, Site, drive_effort};
+use super::noc::{self, ACTUATION_TOLERANCE, LegKin, Plan, leg_motion};
+use crate::algebra::V;
+use crate::drive::drive_effort;
 use crate::model::JointKind;
+use crate::scalar::{Singular, Site};
+use crate::solve::{PIVOT_TOLERANCE, check_finite};
 
 /// The literal terms of the NOC at one state `(x, u)`.
 #[derive(Clone, Debug)]

@@ -24,10 +24,10 @@ use crate::model::{Body, Joint, JointKind, Transform, Vec3, mat_vec};
 
 pub mod literal;
 pub mod noc;
-pub mod real;
 
 pub use noc::{NoConvergence, Plan};
-pub use real::{Real, Singular, Site};
+// The scalar and its failure live on the shared floor; named here too for the parallel API.
+pub use crate::scalar::{Real, Singular, Site};
 
 /// How the platform moves and which coordinates describe it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -40,9 +40,16 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::real::{DriveInputs, Real, Singular, Site, drive_effort};
+pub use crate::payload::Payload;
+pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, check_finite, solve_spd};
+
 use super::{LegEnd, LegKind, ParallelModel, PlatformMotion};
+use crate::algebra::{
+    M, V, add, cm, cross, cv, dot, euler, ident, inertia_quad, mm, mtv, mv, rot, scale, sub, zero3,
+};
+use crate::drive::{DriveInputs, drive_effort};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+use crate::scalar::{Real, Singular, Site};
 
 /// Leg-Jacobian threshold: a leg is singular when `|det J_J| ≤ LEG_TOLERANCE · ∏‖columns‖`
 /// (the Hadamard ratio `h`; its inverse, reported as the condition estimate, grows like the
@@ -54,91 +61,6 @@ pub const LEG_TOLERANCE: f64 = 1e-4;
 /// partially pivoted LU is `≤ ACTUATION_TOLERANCE` times the largest pivot; the condition
 /// estimate is the ratio of the largest to the smallest pivot.
 pub const ACTUATION_TOLERANCE: f64 = 1e-8;
-/// Generalized-inertia threshold of forward dynamics: pivot `i` of `LDLᵀ` must exceed
-/// `PIVOT_TOLERANCE` times the diagonal entry it came from (as for trees).
-pub const PIVOT_TOLERANCE: f64 = 1e-12;
-
-pub(crate) type V<R> = [R; 3];
-pub(crate) type M<R> = [[R; 3]; 3];
-
-pub(crate) fn cv<R: Real>(v: &Vec3) -> V<R> {
-    [R::c(v[0]), R::c(v[1]), R::c(v[2])]
-}
-pub(crate) fn cm<R: Real>(m: &Mat3) -> M<R> {
-    [cv(&m[0]), cv(&m[1]), cv(&m[2])]
-}
-pub(crate) fn add<R: Real>(a: V<R>, b: V<R>) -> V<R> {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn sub<R: Real>(a: V<R>, b: V<R>) -> V<R> {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn scale<R: Real>(s: R, a: V<R>) -> V<R> {
-    [s * a[0], s * a[1], s * a[2]]
-}
-pub(crate) fn dot<R: Real>(a: V<R>, b: V<R>) -> R {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross<R: Real>(a: V<R>, b: V<R>) -> V<R> {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn mv<R: Real>(m: &M<R>, v: V<R>) -> V<R> {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-pub(crate) fn mtv<R: Real>(m: &M<R>, v: V<R>) -> V<R> {
-    [
-        m[0][0] * v[0] + m[1][0] * v[1] + m[2][0] * v[2],
-        m[0][1] * v[0] + m[1][1] * v[1] + m[2][1] * v[2],
-        m[0][2] * v[0] + m[1][2] * v[1] + m[2][2] * v[2],
-    ]
-}
-pub(crate) fn mm<R: Real>(a: &M<R>, b: &M<R>) -> M<R> {
-    let col = |j: usize| [b[0][j], b[1][j], b[2][j]];
-    let (c0, c1, c2) = (col(0), col(1), col(2));
-    [
-        [dot(a[0], c0), dot(a[0], c1), dot(a[0], c2)],
-        [dot(a[1], c0), dot(a[1], c1), dot(a[1], c2)],
-        [dot(a[2], c0), dot(a[2], c1), dot(a[2], c2)],
-    ]
-}
-pub(crate) fn zero3<R: Real>() -> V<R> {
-    [R::c(0.0); 3]
-}
-pub(crate) fn ident<R: Real>() -> M<R> {
-    let (o, z) = (R::c(1.0), R::c(0.0));
-    [[o, z, z], [z, o, z], [z, z, o]]
-}
-
-/// Rotation by the angle whose `(sin, cos)` is `(s, c)` about the unit `axis` (Rodrigues:
-/// `c·1 + s·[e]× + (1 − c)·e eᵀ`).
-pub(crate) fn rot<R: Real>(e: &Vec3, s: R, c: R) -> M<R> {
-    let v = R::c(1.0) - c;
-    let e_ = cv::<R>(e);
-    let mut m = [[R::c(0.0); 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = if i == j {
-                // c + (1 − c) e_i² written as e_i² + c (1 − e_i²): exactly 1 on a coordinate
-                // axis (and c across it), so constants fold in the generator.
-                R::c(e[i] * e[i]) + c * R::c(1.0 - e[i] * e[i])
-            } else {
-                v * R::c(e[i] * e[j])
-            };
-        }
-    }
-    // s·[e]×
-    m[0][1] = m[0][1] - s * e_[2];
-    m[0][2] = m[0][2] + s * e_[1];
-    m[1][0] = m[1][0] + s * e_[2];
-    m[1][2] = m[1][2] - s * e_[0];
-    m[2][0] = m[2][0] - s * e_[1];
-    m[2][1] = m[2][1] + s * e_[0];
-    m
-}
 
 /// The constant data of one leg, resolved in the leg frame `L`.
 #[derive(Clone, Debug)]
@@ -1324,32 +1246,6 @@ pub fn generalized_force_with<R: Real>(
     f
 }
 
-/// A rigid body carried by the platform whose mass properties are scalars of the evaluator, not
-/// constants of the plan: a generated module's run-time payload (`[scene] parameters =
-/// "runtime"`), where they are symbolic inputs. The platform's own mass properties stay in the
-/// [`Plan`].
-#[derive(Clone, Copy, Debug)]
-pub struct Payload<R> {
-    /// Mass (kg).
-    pub mass: R,
-    /// Mass centre in the platform frame (m). Ignored by a planar point platform (a point).
-    pub com: V<R>,
-    /// Inertia about the mass centre, platform axes (kg·m²), symmetric. Ignored by a planar
-    /// point platform.
-    pub inertia: M<R>,
-}
-
-impl<R: Real> Payload<R> {
-    /// A payload of `f64` values.
-    pub fn from_f64(mass: f64, com: Vec3, inertia: Mat3) -> Payload<R> {
-        Payload {
-            mass: R::c(mass),
-            com: cv(&com),
-            inertia: cm(&inertia),
-        }
-    }
-}
-
 /// The payload's part of the generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`):
 /// the platform's own term of [`generalized_force`] (Newton–Euler of one rigid body moving with
 /// the platform, eq. 12, mapped by its twist-shaping block `T_Pᵀ`) with the payload's values.
@@ -1562,29 +1458,6 @@ fn euler_const<R: Real>(inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
     add(mv(&i, wd), cross(w, mv(&i, w)))
 }
 
-/// Euler's equation `I ω̇ + ω × I ω` (eq. 12's rotational row) for a body with rotation `rot`
-/// and inertia `inertia` (body frame), in the frame `rot` maps to. An isotropic inertia `c·1`
-/// needs no rotation: the moment is `c ω̇`.
-pub(crate) fn euler<R: Real>(rot: &M<R>, inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
-    let c = inertia[0][0];
-    let isotropic = inertia[1][1] == c
-        && inertia[2][2] == c
-        && inertia[0][1] == 0.0
-        && inertia[0][2] == 0.0
-        && inertia[1][2] == 0.0
-        && inertia[1][0] == 0.0
-        && inertia[2][0] == 0.0
-        && inertia[2][1] == 0.0;
-    if isotropic {
-        return scale(R::c(c), wd);
-    }
-    let wb = mtv(rot, w);
-    let ab = mtv(rot, wd);
-    let ib = cm::<R>(inertia);
-    let nb = add(mv(&ib, ab), cross(wb, mv(&ib, wb)));
-    mv(rot, nb)
-}
-
 /// The generalized inertia `I = TᵀMT` of the speeds `u`, column by column: column `j` is the
 /// generalized force of `u = 0`, `u̇ = e_j` without gravity. A second route to
 /// [`generalized_inertia`] (the tests compare them).
@@ -1609,21 +1482,6 @@ pub fn generalized_inertia_by_columns<R: Real>(
                 .collect()
         })
         .collect()
-}
-
-/// `aᵀ I b` for a body with rotation `rot` and inertia `inertia` (body frame); `c (a·b)` for an
-/// isotropic inertia `c·1`.
-pub(crate) fn inertia_quad<R: Real>(rot: &M<R>, inertia: &Mat3, a: V<R>, b: V<R>) -> R {
-    let c = inertia[0][0];
-    let isotropic = inertia[1][1] == c
-        && inertia[2][2] == c
-        && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
-        && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3];
-    if isotropic {
-        return R::c(c) * dot(a, b);
-    }
-    let (ab, bb) = (mtv(rot, a), mtv(rot, b));
-    dot(ab, mv(&cm::<R>(inertia), bb))
 }
 
 /// The generalized inertia `I = TᵀMT = Σ_b T_bᵀ M_b T_b` of the speeds `u` (exactly symmetric),
@@ -1781,51 +1639,6 @@ fn leg_end_inertia<R: Real>(lp: &LegPlan, lk: &LegKin<R>, armature: &[Option<R>;
         }
     }
     lam
-}
-
-/// Solve `m x = b` for a symmetric positive definite `m` by `LDLᵀ` (no pivoting), each pivot
-/// checked against [`PIVOT_TOLERANCE`] times its diagonal entry.
-pub fn solve_spd<R: Real>(m: &[Vec<R>], b: &[R]) -> Result<Vec<R>, Singular> {
-    let n = b.len();
-    let mut l: Vec<Vec<R>> = vec![vec![R::c(0.0); n]; n];
-    let mut d: Vec<R> = vec![R::c(0.0); n];
-    for j in 0..n {
-        let mut dj = m[j][j];
-        for k in 0..j {
-            dj = dj - l[j][k] * l[j][k] * d[k];
-        }
-        let dj = R::check(
-            dj,
-            R::c(R::tolerance(PIVOT_TOLERANCE)) * m[j][j],
-            m[j][j],
-            Site::MassMatrix(j),
-            false,
-        )?;
-        d[j] = dj;
-        let inv = R::c(1.0) / dj;
-        for i in j + 1..n {
-            let mut s = m[i][j];
-            for k in 0..j {
-                s = s - l[i][k] * l[j][k] * d[k];
-            }
-            l[i][j] = s * inv;
-        }
-    }
-    let mut y = b.to_vec();
-    for i in 0..n {
-        for k in 0..i {
-            y[i] = y[i] - l[i][k] * y[k];
-        }
-    }
-    for i in 0..n {
-        y[i] = y[i] / d[i];
-    }
-    for i in (0..n).rev() {
-        for k in i + 1..n {
-            y[i] = y[i] - l[k][i] * y[k];
-        }
-    }
-    Ok(y)
 }
 
 /// Forward dynamics: `u̇` with `I u̇ = Aᵀ τ − (C u − γ)`.
@@ -2025,20 +1838,6 @@ fn solve_dyn(a: &[Vec<f64>], b: &[f64], transpose: bool) -> Result<Vec<f64>, Sin
     }
 }
 
-/// `Err(Site::Input)` unless every value is finite.
-pub fn check_finite(inputs: &[&[f64]]) -> Result<(), Singular> {
-    for v in inputs.iter().flat_map(|s| s.iter()) {
-        if !v.is_finite() {
-            return Err(Singular {
-                site: Site::Input,
-                value: *v,
-                condition_estimate: f64::INFINITY,
-            });
-        }
-    }
-    Ok(())
-}
-
 /// `Ok(v)` when every entry is finite, else `Err(Site::Input)` (an overflow).
 fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {
     check_finite(&[&v])?;
@@ -2168,15 +1967,6 @@ pub fn forward_dynamics(
 ) -> Result<Vec<f64>, Singular> {
     check_finite(&[x, u, tau])?;
     finite(forward_dynamics_generic(plan, x, u, tau)?)
-}
-
-/// Forward kinematics did not converge.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoConvergence {
-    /// Newton iterations made.
-    pub iterations: usize,
-    /// The last residual `max |q(x) − q|` (m or rad; infinite when no pose was reachable).
-    pub residual: f64,
 }
 
 /// Newton iterations of [`forward_kinematics`] at most.

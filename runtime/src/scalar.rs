@@ -1,4 +1,4 @@
-//! The scalar the parallel-manipulator evaluators are written over.
+//! The scalar every evaluator is written over, and the failure it reports.
 //!
 //! [`Real`] is implemented for `f64` (the runtime evaluates with it) and, in the generator, for a
 //! symbolic scalar that records a node of the expression DAG per operation. The same source
@@ -6,7 +6,6 @@
 //! generated code. [`Real::check`] is the one operation with control flow: a test that makes
 //! the evaluation return [`Singular`] (in generated code: an early `return Err(..)`).
 
-use alloc::vec::Vec;
 use core::fmt;
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -107,7 +106,8 @@ pub struct Singular {
     /// The value that failed its test (a determinant, pivot or discriminant).
     pub value: f64,
     /// An estimate of the condition number of the matrix involved (`f64::INFINITY` when the
-    /// value is zero or not finite). See the thresholds in [`super::noc`].
+    /// value is zero or not finite). See the thresholds in [`crate::parallel::noc`] and
+    /// [`crate::closed::noc`].
     pub condition_estimate: f64,
 }
 
@@ -221,56 +221,4 @@ impl Real for f64 {
             })
         }
     }
-}
-
-/// The drive coefficients of a mechanism's joints as scalars of the evaluator, in place of the
-/// constants of its plan: a generated module's run-time drive parameters, where they are
-/// symbolic inputs. Entry `i` is the mechanism's `i`-th driven joint: joint `k` of leg `leg` at
-/// `3·leg + k` for a parallel mechanism, tree joint `i` for closed loops. An effect that is
-/// `None` is absent. The effort law is [`drive_effort`]'s.
-#[derive(Clone, Debug)]
-pub struct DriveInputs<R> {
-    /// Viscous coefficients (N·m·s/rad or N·s/m).
-    pub viscous: Option<Vec<R>>,
-    /// Coulomb levels (N·m or N).
-    pub coulomb: Option<Vec<R>>,
-    /// Reflected rotor inertias (kg·m² or kg).
-    pub armature: Option<Vec<R>>,
-    /// The speed scale `v_s` of the regularized Coulomb law.
-    pub coulomb_velocity: f64,
-}
-
-impl<R: Real> DriveInputs<R> {
-    /// The drive effort of joint `i` at the rate `qd` and acceleration `qdd`.
-    pub fn effort(&self, i: usize, qd: R, qdd: R) -> R {
-        let mut e = R::c(0.0);
-        if let Some(a) = &self.armature {
-            e = e + a[i] * qdd;
-        }
-        if let Some(b) = &self.viscous {
-            e = e + b[i] * qd;
-        }
-        if let Some(c) = &self.coulomb {
-            let vs = self.coulomb_velocity;
-            e = e + c[i] * qd / (qd * qd + R::c(vs * vs)).sqrt();
-        }
-        e
-    }
-}
-
-/// [`Drive::effort`](crate::model::Drive::effort) over [`Real`]: `I_a q̈ + b q̇ + c q̇ / √(q̇² + v_s²)`
-/// (terms with zero coefficients are not formed).
-pub fn drive_effort<R: Real>(d: &crate::model::Drive, qd: R, qdd: R) -> R {
-    let mut e = R::c(0.0);
-    if d.armature != 0.0 {
-        e = e + R::c(d.armature) * qdd;
-    }
-    if d.viscous != 0.0 {
-        e = e + R::c(d.viscous) * qd;
-    }
-    if d.coulomb != 0.0 {
-        let vs = d.coulomb_velocity;
-        e = e + R::c(d.coulomb) * qd / (qd * qd + R::c(vs * vs)).sqrt();
-    }
-    e
 }
