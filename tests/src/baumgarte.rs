@@ -13,7 +13,7 @@
 //! loop equations from `runtime::closed::noc::constraints`. This is the classical alternative to
 //! the NOC route of `runtime::simulate`, which integrates only the independent coordinates and
 //! assembles the others by Newton at every stage, so that its loops cannot drift open. The
-//! stability table (README) sets the two side by side.
+//! stability table (docs/accuracy.md) sets the two side by side.
 
 use nalgebra::{DMatrix, DVector};
 use runtime::closed::noc::{Plan, constraints};

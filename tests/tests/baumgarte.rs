@@ -1,6 +1,6 @@
 //! The Lagrange-multiplier route in redundant coordinates with Baumgarte stabilization
 //! (`tests::baumgarte`) beside the NOC route (`runtime::simulate`), released from rest at home
-//! under gravity, no actuation, RK4 at 1 kHz. The README's stability table comes from
+//! under gravity, no actuation, RK4 at 1 kHz. The stability table of docs/accuracy.md comes from
 //! `cargo test --release -p tests --test baumgarte -- --nocapture --ignored` (10 s); the tests
 //! here run 2 s.
 
@@ -82,7 +82,7 @@ fn print(
 }
 
 #[test]
-#[ignore = "10 s of simulated time per mechanism; run in release for the README table"]
+#[ignore = "10 s of simulated time per mechanism; run in release for the table of docs/accuracy.md"]
 fn stability_table_10_s() {
     print(&table(10_000));
 }
