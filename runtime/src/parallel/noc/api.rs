@@ -1,0 +1,164 @@
+//! The `f64` functions: inputs checked finite, the generic evaluators, outputs checked finite
+//! (inverse kinematics, the actuation matrix and actuator rates, inverse dynamics, the
+//! generalized inertia and the inertia in actuator space (eq. 68), forward dynamics, potential
+//! energy).
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::dynamics::forward_dynamics_generic;
+use super::force::generalized_force;
+use super::inertia::generalized_inertia;
+use super::legs::{JointPos, actuated_positions, actuation_matrix, kinematics, positions};
+use super::lu::solve_dyn;
+use super::plan::Plan;
+use crate::algebra::{V, add, dot, mv};
+use crate::scalar::Singular;
+use crate::solve::check_finite;
+
+/// `Ok(v)` when every entry is finite, else `Err(Site::Input)` (an overflow).
+fn finite(v: Vec<f64>) -> Result<Vec<f64>, Singular> {
+    check_finite(&[&v])?;
+    Ok(v)
+}
+
+/// Actuated joint positions (rad or m) for the platform coordinates `x`.
+pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = positions(plan, x)?;
+    finite(actuated_positions(plan, &legs))
+}
+
+/// Every leg's joint positions (rad or m, the spec's joint order after U expansion) at `x`.
+pub fn leg_joint_positions(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = kinematics(plan, x)?;
+    Ok(legs
+        .iter()
+        .map(|lk| {
+            lk.q.iter()
+                .map(|q| match *q {
+                    JointPos::R(s, c) => libm::atan2(s, c),
+                    JointPos::P(d) => d,
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// The actuation matrix `A` at `x` (`q̇ = A u`).
+pub fn actuation(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (_, legs) = kinematics(plan, x)?;
+    Ok(actuation_matrix(plan, &legs))
+}
+
+/// Actuator rates `q̇ = A u`.
+pub fn actuator_rates(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[u])?;
+    let a = actuation(plan, x)?;
+    finite(
+        a.iter()
+            .map(|row| row.iter().zip(u).map(|(a, b)| a * b).sum())
+            .collect(),
+    )
+}
+
+/// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m; gravity included).
+pub fn inverse_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let f = generalized_force(plan, &pl, &legs, u, ud, true);
+    let a = actuation_matrix(plan, &legs);
+    solve_dyn(&a, &f, true)
+}
+
+/// The generalized force `I u̇ + C u − γ` of the speeds `u` (before the actuation map).
+pub fn generalized_effort(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    finite(generalized_force(plan, &pl, &legs, u, ud, true))
+}
+
+/// The generalized inertia `I = TᵀMT` of the speeds `u`.
+pub fn mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let i = generalized_inertia(plan, &pl, &legs);
+    check_finite(&[&i.concat()])?;
+    Ok(i)
+}
+
+/// The inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68).
+pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
+    check_finite(&[x])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let i = generalized_inertia(plan, &pl, &legs);
+    let a = actuation_matrix(plan, &legs);
+    let n = plan.dof();
+    // B = I A⁻¹ column by column (A⁻¹ e_j), then A⁻ᵀ B.
+    let mut b = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        let mut e = vec![0.0; n];
+        e[j] = 1.0;
+        let c = solve_dyn(&a, &e, false)?;
+        for r in 0..n {
+            b[r][j] = (0..n).map(|k| i[r][k] * c[k]).sum();
+        }
+    }
+    let mut out = vec![vec![0.0; n]; n];
+    for j in 0..n {
+        let col: Vec<f64> = (0..n).map(|r| b[r][j]).collect();
+        let c = solve_dyn(&a, &col, true)?;
+        for r in 0..n {
+            out[r][j] = c[r];
+        }
+    }
+    // Symmetrize (the exact matrix is symmetric).
+    for r in 0..n {
+        for c in r + 1..n {
+            let m = 0.5 * (out[r][c] + out[c][r]);
+            out[r][c] = m;
+            out[c][r] = m;
+        }
+    }
+    check_finite(&[&out.concat()])?;
+    Ok(out)
+}
+
+/// Forward dynamics: `u̇` for the actuator efforts `tau`.
+pub fn forward_dynamics(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    tau: &[f64],
+) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u, tau])?;
+    finite(forward_dynamics_generic(plan, x, u, tau)?)
+}
+
+/// Potential energy of gravity at `x`, `−Σ m_b gᵀ c_b` over the platform and every leg body
+/// (J, zero at the base origin). `Err` where the legs cannot be solved.
+pub fn potential_energy(plan: &Plan, x: &[f64]) -> Result<f64, Singular> {
+    let (pl, legs) = kinematics(plan, x)?;
+    let g: V<f64> = plan.gravity;
+    let (mass, com, _) = plan.platform;
+    let mut v = -mass * dot(g, add(pl.origin, mv(&pl.rot, com)));
+    for (lp, lk) in plan.legs.iter().zip(&legs) {
+        for (k, (m, _, _)) in lp.bodies.iter().enumerate() {
+            let c = lp.frame.apply(&lk.com[k]);
+            v -= m * dot(g, c);
+        }
+    }
+    Ok(v)
+}

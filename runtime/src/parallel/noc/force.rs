@@ -1,0 +1,207 @@
+//! Step 5: the generalized force `f = I u̇ + C u − γ` of the speeds `u`, one Newton–Euler
+//! wrench per body (eq. 12) projected to the leg joints, the end point and `u`, the platform's
+//! directly; and a payload's part of it.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::legs::LegKin;
+use super::motion::leg_motion;
+use super::plan::Plan;
+use super::pose::Platform;
+use super::ups::ups_force;
+use crate::algebra::{V, add, cross, cv, dot, euler, mtv, mv, scale, sub, zero3};
+use crate::drive::{DriveInputs, drive_effort};
+use crate::model::{JointKind, Vec3};
+use crate::parallel::PlatformMotion;
+use crate::payload::Payload;
+use crate::scalar::Real;
+
+/// The generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`) of the speeds `u`.
+pub fn generalized_force<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    generalized_force_with(plan, pl, legs, u, ud, gravity, None)
+}
+
+/// [`generalized_force`] with the leg joints' drives from `drives` instead of the plan (closed-form
+/// UPS legs then take the generic route, where the joint efforts are formed).
+pub fn generalized_force_with<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+    drives: Option<&DriveInputs<R>>,
+) -> Vec<R> {
+    let dof = plan.dof();
+    let mut f: Vec<R> = vec![R::c(0.0); dof];
+    let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
+    let planar = matches!(plan.motion, PlatformMotion::PlanarPoint { .. });
+    // Platform angular velocity and acceleration (a planar point does not turn).
+    let (w, wd) = if planar {
+        (zero3::<R>(), zero3::<R>())
+    } else {
+        ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
+    };
+    for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
+        let n = lp.joints.len();
+        // End velocity and acceleration (base frame), then in L.
+        let (v_end, a_end) = match plan.motion {
+            PlatformMotion::Pose => {
+                let v = [u[3], u[4], u[5]];
+                let a = [ud[3], ud[4], ud[5]];
+                let v_end = add(v, cross(w, lk.arm));
+                let a_end = add(add(a, cross(wd, lk.arm)), cross(w, cross(w, lk.arm)));
+                (v_end, a_end)
+            }
+            PlatformMotion::Orientation { .. } => (w, wd),
+            PlatformMotion::PlanarPoint { .. } => {
+                let z = R::c(0.0);
+                ([u[0], u[1], z], [ud[0], ud[1], z])
+            }
+        };
+        if let (Some(up), Some(uk), None) = (&lp.ups, &lk.ups, drives) {
+            let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
+            let m = cross(lk.arm, y);
+            for i in 0..3 {
+                f[i] = f[i] + m[i];
+                f[3 + i] = f[3 + i] + y[i];
+            }
+            continue;
+        }
+        let (qd, qdd, motion) = leg_motion(lp, lk, v_end, a_end);
+        // Body wrenches (about each mass centre) and the leg's joint efforts.
+        let g_l = mtv(&lk.frame, cv::<R>(&g_world));
+        let mut force = zero3::<R>();
+        let mut moment0 = zero3::<R>(); // about the origin of L
+        let mut tau: Vec<R> = vec![R::c(0.0); 3];
+        for k in (0..n).rev() {
+            let (mass, _, inertia) = lp.bodies[k];
+            let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
+            if !massless {
+                let c = lk.com[k];
+                let m = &motion[k];
+                let a = m.accel_at(lk.o[k], c);
+                let nk = euler(&lk.rot[k], &inertia, m.w, m.alpha);
+                let fk = scale(R::c(mass), sub(a, g_l));
+                force = add(force, fk);
+                moment0 = add(moment0, add(nk, cross(c, fk)));
+            }
+            let mo = sub(moment0, cross(lk.o[k], force));
+            tau[k] = match lp.joints[k] {
+                JointKind::Revolute => dot(lk.e[k], mo),
+                JointKind::Prismatic => dot(lk.e[k], force),
+            };
+        }
+        // The joints' drives, actuated and passive (the lecture's dissipative term δ and the
+        // rotors' inertia), act at the joints beside the bodies' efforts.
+        for k in 0..n {
+            tau[k] = tau[k]
+                + match drives {
+                    Some(d) => d.effort(3 * li + k, qd[k], qdd[k]),
+                    None => drive_effort(&lp.drives[k], qd[k], qdd[k]),
+                };
+        }
+        // End force (or moment) y = J⁻ᵀ τ, to the base frame, then Gᵀ y.
+        let y_l = add(
+            add(scale(tau[0], lk.jinv[0]), scale(tau[1], lk.jinv[1])),
+            scale(tau[2], lk.jinv[2]),
+        );
+        let y = mv(&lk.frame, y_l);
+        match plan.motion {
+            PlatformMotion::Pose => {
+                let m = cross(lk.arm, y);
+                for i in 0..3 {
+                    f[i] = f[i] + m[i];
+                    f[3 + i] = f[3 + i] + y[i];
+                }
+            }
+            PlatformMotion::Orientation { .. } => {
+                for i in 0..3 {
+                    f[i] = f[i] + y[i];
+                }
+            }
+            PlatformMotion::PlanarPoint { .. } => {
+                for i in 0..2 {
+                    f[i] = f[i] + y[i];
+                }
+            }
+        }
+    }
+    // The platform.
+    if planar {
+        // A point mass at P.
+        let (mass, _, _) = plan.platform;
+        for i in 0..2 {
+            f[i] = f[i] + R::c(mass) * (ud[i] - R::c(g_world[i]));
+        }
+        return f;
+    }
+    let (mass, com, inertia) = plan.platform;
+    let r = mv(&pl.rot, cv::<R>(&com));
+    let (a0,) = match plan.motion {
+        PlatformMotion::Pose => ([ud[3], ud[4], ud[5]],),
+        PlatformMotion::Orientation { .. } | PlatformMotion::PlanarPoint { .. } => (zero3::<R>(),),
+    };
+    let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
+    let fp = scale(R::c(mass), sub(a, cv(&g_world)));
+    let np = add(euler(&pl.rot, &inertia, w, wd), cross(r, fp));
+    for i in 0..3 {
+        f[i] = f[i] + np[i];
+    }
+    if let PlatformMotion::Pose = plan.motion {
+        for i in 0..3 {
+            f[3 + i] = f[3 + i] + fp[i];
+        }
+    }
+    f
+}
+
+/// The payload's part of the generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`):
+/// the platform's own term of [`generalized_force`] (Newton–Euler of one rigid body moving with
+/// the platform, eq. 12, mapped by its twist-shaping block `T_Pᵀ`) with the payload's values.
+pub fn payload_force<R: Real>(
+    plan: &Plan,
+    pl: &Platform<R>,
+    payload: &Payload<R>,
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    let n = plan.dof();
+    let mut f = vec![R::c(0.0); n];
+    let g: V<R> = cv(&if gravity { plan.gravity } else { [0.0; 3] });
+    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+        for i in 0..2 {
+            f[i] = payload.mass * (ud[i] - g[i]);
+        }
+        return f;
+    }
+    let (w, wd) = ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]);
+    let a0 = match plan.motion {
+        PlatformMotion::Pose => [ud[3], ud[4], ud[5]],
+        _ => zero3::<R>(),
+    };
+    let r = mv(&pl.rot, payload.com);
+    let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
+    let fp = scale(payload.mass, sub(a, g));
+    // Euler's equation in the platform frame, then to the base frame.
+    let (wb, ab) = (mtv(&pl.rot, w), mtv(&pl.rot, wd));
+    let nb = add(
+        mv(&payload.inertia, ab),
+        cross(wb, mv(&payload.inertia, wb)),
+    );
+    let np = add(mv(&pl.rot, nb), cross(r, fp));
+    f[..3].copy_from_slice(&np);
+    if let PlatformMotion::Pose = plan.motion {
+        f[3..6].copy_from_slice(&fp);
+    }
+    f
+}

@@ -1,0 +1,341 @@
+//! Steps 2–3 for each leg: [`leg_kinematics`] solves its inverse kinematics in closed form
+//! (or by `generic_leg`'s Newton steps), poses its bodies by the product of exponentials and
+//! inverts its Jacobian `J_J` by the adjugate, checked against [`LEG_TOLERANCE`] ([`LegKin`]);
+//! [`kinematics`] and [`positions`] do it for every leg at `x`; the legs' actuated positions
+//! and the actuation matrix `A` (`q̇ = A u`, the actuated rows of their `J_J⁻¹ G`; the
+//! lecture's eqs. 66–72).
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::LEG_TOLERANCE;
+use super::generic_leg::generic_ik;
+use super::plan::{Plan, sub3};
+use super::pose::{Platform, platform};
+use super::subproblems::{one_axis, rus_crank, two_axes};
+use super::ups::UpsKin;
+use crate::algebra::{M, V, add, cm, cross, cv, dot, ident, mm, mtv, mv, rot, scale, sub, zero3};
+use crate::model::JointKind;
+use crate::parallel::{LegKind, PlatformMotion};
+use crate::scalar::{Real, Singular, Site};
+
+#[cfg(doc)]
+use super::plan::LegPlan;
+
+/// A joint's position: `(sin, cos)` for a revolute, the displacement for a prismatic joint.
+#[derive(Clone, Copy, Debug)]
+pub enum JointPos<R> {
+    /// Revolute.
+    R(R, R),
+    /// Prismatic.
+    P(R),
+}
+
+/// The kinematic state of one leg at a configuration, resolved in its frame `L`.
+#[derive(Clone, Debug)]
+pub struct LegKin<R> {
+    /// Joint positions.
+    pub q: Vec<JointPos<R>>,
+    /// Current joint axes.
+    pub e: Vec<V<R>>,
+    /// Current joint points.
+    pub o: Vec<V<R>>,
+    /// Body rotations (body → `L`).
+    pub rot: Vec<M<R>>,
+    /// Body mass centres.
+    pub com: Vec<V<R>>,
+    /// End point (spherical end) or end axis (revolute end).
+    pub end: V<R>,
+    /// Rows of `J_J⁻¹` (the adjugate rows divided by the determinant).
+    pub jinv: [V<R>; 3],
+    /// Base-frame rotation of `L` (constant).
+    pub frame: M<R>,
+    /// The end point relative to the platform origin, base frame (spherical end; zero else).
+    pub arm: V<R>,
+    /// The closed-form UPS leg's frame (when [`LegPlan::ups`] is set).
+    pub ups: Option<UpsKin<R>>,
+}
+
+/// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`. Each test is
+/// made where its value is used: the Jacobian's (`Site::Leg`) only with `jacobian` (positions
+/// alone do not need it), and a closed-form UPS leg's by its own leg vector (reach: `ρ > 0`;
+/// the U's singularity: `|e₀ × s| > 0`), since nothing it returns uses its U angles or `J⁻¹`.
+pub fn leg_kinematics<R: Real>(
+    plan: &Plan,
+    k: usize,
+    pl: &Platform<R>,
+    jacobian: bool,
+) -> Result<LegKin<R>, Singular> {
+    let lp = &plan.legs[k];
+    let fr: M<R> = cm(&lp.frame.rotation);
+    let ft: V<R> = cv(&lp.frame.translation);
+    let n = lp.joints.len();
+    // The end target in L.
+    let (target, arm, end_base) = match lp.kind {
+        LegKind::SphericalRr => {
+            let axis = mv(&pl.rot, cv(&lp.end_platform));
+            (mtv(&fr, axis), zero3(), zero3())
+        }
+        LegKind::Ups => {
+            // The target is not needed: the leg vector is formed in the base frame.
+            let arm = mv(&pl.rot, cv(&lp.end_platform));
+            (zero3(), arm, add(pl.origin, arm))
+        }
+        _ => {
+            let arm = mv(&pl.rot, cv(&lp.end_platform));
+            let a = add(pl.origin, arm);
+            (mtv(&fr, sub(a, ft)), arm, a)
+        }
+    };
+    // Closed-form inverse kinematics.
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(n);
+    let mut ups = None;
+    match lp.kind {
+        LegKind::Ups => {
+            // The leg vector U centre → S centre in the base frame (the same as in L, rotated).
+            let r = sub(end_base, cv(&lp.frame.apply(&lp.u_centre)));
+            let rr = dot(r, r);
+            let rr = R::check(rr, R::c(0.0), R::c(1.0), Site::Reach(k), false)?;
+            let rho = rr.sqrt();
+            let d = R::c(lp.sigma_first) * (rho - R::c(lp.length));
+            let inv_rho = R::c(1.0) / rho;
+            let s = scale(inv_rho, r);
+            if let Some(up) = &lp.ups {
+                // The leg frame (UpsPlan): c = e₀·s, d² = |e₀ × s|² (= 1 − c², formed so that
+                // it keeps its relative accuracy near the U's singularity d → 0, where e₀ ∥ s;
+                // the same test as `two_axes`' γ² ≤ 0).
+                let e0 = cv::<R>(&up.e0);
+                let c = dot(e0, s);
+                let m = cross(e0, s);
+                let d2 = R::check(dot(m, m), R::c(0.0), R::c(1.0), Site::Leg(k), false)?;
+                let dd = R::c(lp.sigma_u) * d2.sqrt();
+                let inv_d = R::c(1.0) / dd;
+                ups = Some(UpsKin {
+                    rho,
+                    inv_rho,
+                    cot: c * inv_d,
+                    inv_d,
+                    t: scale(inv_d, sub(e0, scale(c, s))),
+                    e1: scale(-inv_d, m),
+                    s,
+                });
+            }
+            let dir = mtv(&fr, s);
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
+            let closed = lp.ups.is_some();
+            let [a, b] = two_axes(
+                &lp.axes[0],
+                &lp.axes[1],
+                cv(&p),
+                dir,
+                lp.sigma_u,
+                k,
+                !closed,
+            )?;
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+            q.push(JointPos::P(d));
+        }
+        LegKind::Pus => {
+            let e0 = lp.axes[0];
+            let dd = sub(target, cv(&lp.u_centre));
+            let t = dot(cv(&e0), dd);
+            let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
+            let disc = R::check(
+                disc,
+                R::c(0.0),
+                R::c(lp.length * lp.length),
+                Site::Reach(k),
+                false,
+            )?;
+            let s = t - R::c(lp.sigma_first) * disc.sqrt();
+            let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+            let qv = sub(target, u);
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
+            q.push(JointPos::P(s));
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+        LegKind::Rus => {
+            let (s0, c0) = rus_crank(lp, target, k)?;
+            let r0 = rot(&lp.axes[0], s0, c0);
+            let o0 = cv(&lp.points[0]);
+            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+            // The rod direction in the crank's home frame.
+            let qv = mtv(&r0, sub(target, u));
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
+            q.push(JointPos::R(s0, c0));
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+        LegKind::PlanarRr => {
+            let (s0, c0) = rus_crank(lp, target, k)?;
+            let r0 = rot(&lp.axes[0], s0, c0);
+            let o0 = cv(&lp.points[0]);
+            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+            // The distal link's direction in the proximal link's home frame.
+            let qv = mtv(&r0, sub(target, u));
+            let p = sub3(&lp.end_home, &lp.u_centre);
+            let (s1, c1) = one_axis(&lp.axes[1], cv(&p), qv);
+            q.push(JointPos::R(s0, c0));
+            q.push(JointPos::R(s1, c1));
+        }
+        LegKind::SphericalRr => {
+            let [a, b] = two_axes(
+                &lp.axes[0],
+                &lp.axes[1],
+                cv(&lp.end_home),
+                target,
+                lp.sigma_u,
+                k,
+                true,
+            )?;
+            q.push(JointPos::R(a.0, a.1));
+            q.push(JointPos::R(b.0, b.1));
+        }
+        LegKind::Generic => q = generic_ik(lp, target, k)?,
+    }
+    // Product of exponentials from the home configuration: D = Π exp(ξ_j θ_j), x ↦ G x + t.
+    let mut g: M<R> = ident();
+    let mut t: V<R> = zero3();
+    let mut e = Vec::with_capacity(n);
+    let mut o = Vec::with_capacity(n);
+    let mut rots = Vec::with_capacity(n);
+    let mut coms = Vec::with_capacity(n);
+    for j in 0..n {
+        let ej = mv(&g, cv(&lp.axes[j]));
+        let oj = add(mv(&g, cv(&lp.points[j])), t);
+        match q[j] {
+            JointPos::R(s, c) => {
+                g = mm(&g, &rot(&lp.axes[j], s, c));
+                t = sub(oj, mv(&g, cv(&lp.points[j])));
+            }
+            JointPos::P(d) => {
+                t = add(t, scale(d, ej));
+            }
+        }
+        let h = &lp.homes[j];
+        rots.push(mm(&g, &cm(&h.rotation)));
+        let (_, com, _) = lp.bodies[j];
+        let ch = h.apply(&com);
+        coms.push(add(mv(&g, cv(&ch)), t));
+        e.push(ej);
+        o.push(oj);
+    }
+    let end = match lp.kind {
+        LegKind::SphericalRr => target,
+        _ => add(mv(&g, cv(&lp.end_home)), t),
+    };
+    // Jacobian columns and their adjugate.
+    let cols: Vec<V<R>> = match lp.kind {
+        LegKind::SphericalRr => vec![e[0], e[1], end],
+        // A virtual third column along the plane normal keeps J_J 3 × 3; its rate is zero
+        // because the end point moves in the plane.
+        LegKind::PlanarRr => vec![
+            cross(e[0], sub(end, o[0])),
+            cross(e[1], sub(end, o[1])),
+            e[0],
+        ],
+        _ => (0..n)
+            .map(|j| match lp.joints[j] {
+                JointKind::Revolute => cross(e[j], sub(end, o[j])),
+                JointKind::Prismatic => e[j],
+            })
+            .collect(),
+    };
+    let r0 = cross(cols[1], cols[2]);
+    let r1 = cross(cols[2], cols[0]);
+    let r2 = cross(cols[0], cols[1]);
+    let det = dot(cols[0], r0);
+    let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
+    let det = if jacobian && lp.ups.is_none() {
+        R::check(
+            det,
+            R::c(R::tolerance(LEG_TOLERANCE)) * hn,
+            hn,
+            Site::Leg(k),
+            true,
+        )?
+    } else {
+        det
+    };
+    let id = R::c(1.0) / det;
+    Ok(LegKin {
+        q,
+        e,
+        o,
+        rot: rots,
+        com: coms,
+        end,
+        jinv: [scale(id, r0), scale(id, r1), scale(id, r2)],
+        frame: fr,
+        arm,
+        ups,
+    })
+}
+
+/// The legs' kinematics at `x`, their Jacobians tested.
+pub fn kinematics<R: Real>(
+    plan: &Plan,
+    x: &[R],
+) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    kinematics_of(plan, x, true)
+}
+
+/// The legs' joint positions at `x`: [`kinematics`] without the Jacobians' tests (their
+/// `J⁻¹` is not to be used).
+pub fn positions<R: Real>(plan: &Plan, x: &[R]) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    kinematics_of(plan, x, false)
+}
+
+fn kinematics_of<R: Real>(
+    plan: &Plan,
+    x: &[R],
+    jacobian: bool,
+) -> Result<(Platform<R>, Vec<LegKin<R>>), Singular> {
+    let pl = platform(plan, x)?;
+    let mut legs = Vec::with_capacity(plan.legs.len());
+    for k in 0..plan.legs.len() {
+        legs.push(leg_kinematics(plan, k, &pl, jacobian)?);
+    }
+    Ok((pl, legs))
+}
+
+/// Actuated joint positions (rad or m) of the legs, in leg order.
+pub fn actuated_positions<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<R> {
+    plan.legs
+        .iter()
+        .zip(legs)
+        .map(|(lp, lk)| match lk.q[lp.actuated] {
+            JointPos::R(s, c) => s.atan2(c),
+            JointPos::P(d) => d,
+        })
+        .collect()
+}
+
+/// The actuation matrix `A` (`q̇ = A u`), row-major `DOF × DOF`.
+pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>> {
+    plan.legs
+        .iter()
+        .zip(legs)
+        .map(|(lp, lk)| {
+            // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a; for a
+            // closed-form UPS leg the prismatic rate is ±ρ̇ = ±s·v_end.
+            let g = match &lk.ups {
+                Some(uk) => scale(R::c(lp.sigma_first), uk.s),
+                None => mv(&lk.frame, lk.jinv[lp.actuated]),
+            };
+            match plan.motion {
+                PlatformMotion::Pose => {
+                    let m = cross(lk.arm, g);
+                    vec![m[0], m[1], m[2], g[0], g[1], g[2]]
+                }
+                PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
+                PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,259 @@
+//! The constant data of a parallel manipulator, prepared once: [`Plan`] and its legs'
+//! [`LegPlan`]s, resolved in each leg's frame `L` by [`Plan::new`] (the joints' home axes and
+//! points, the U centre, the fixed length and the branches of the subproblems), with the
+//! constant-geometry helpers it uses.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::api::inverse_dynamics;
+use super::subproblems::rus_crank;
+use super::ups::{UpsPlan, ups_plan};
+use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
+use crate::parallel::{LegEnd, LegKind, ParallelModel, PlatformMotion};
+
+#[cfg(doc)]
+use super::assembly::forward_kinematics;
+
+/// The constant data of one leg, resolved in the leg frame `L`.
+#[derive(Clone, Debug)]
+pub struct LegPlan {
+    /// Leg type.
+    pub kind: LegKind,
+    /// The leg frame `L` in the base frame (the home frame of the first joint).
+    pub frame: Transform,
+    /// Joint kinds.
+    pub joints: Vec<JointKind>,
+    /// Home joint axes (unit, `L`).
+    pub axes: Vec<Vec3>,
+    /// Home joint points (on the axes, `L`).
+    pub points: Vec<Vec3>,
+    /// Home body poses in `L`.
+    pub homes: Vec<Transform>,
+    /// Body inertial data: mass, mass centre (body frame), inertia (body frame).
+    pub bodies: Vec<(f64, Vec3, Mat3)>,
+    /// Index of the actuated joint.
+    pub actuated: usize,
+    /// Friction and rotor inertia of each leg joint (actuated or passive).
+    pub drives: Vec<crate::model::Drive>,
+    /// Spherical end: the S centre at home (`L`); revolute end: the end axis at home (`L`).
+    pub end_home: Vec3,
+    /// The end point (S centre) or end axis in the platform frame.
+    pub end_platform: Vec3,
+    /// The U centre at home (`L`) (the orientation centre for a spherical leg).
+    pub u_centre: Vec3,
+    /// Fixed length: UPS the home distance U centre → S centre; PUS, RUS the rod length.
+    pub length: f64,
+    /// Branch of the two-intersecting-axes subproblem (±1), from the home configuration.
+    pub sigma_u: f64,
+    /// Branch of the first joint's subproblem (PUS, RUS) or the prismatic direction (UPS).
+    pub sigma_first: f64,
+    /// The closed form of a UPS leg (see [`UpsPlan`]); `None` for other legs, or a UPS leg
+    /// whose geometry it does not cover (those take the generic route).
+    pub ups: Option<UpsPlan>,
+}
+
+/// The constant data of a whole mechanism: what the evaluators need, prepared once.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Platform motion.
+    pub motion: PlatformMotion,
+    /// Gravity (base frame).
+    pub gravity: Vec3,
+    /// Platform mass, mass centre, inertia (platform frame).
+    pub platform: (f64, Vec3, Mat3),
+    /// Legs.
+    pub legs: Vec<LegPlan>,
+}
+
+pub(super) fn sub3(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(super) fn dot3(a: &Vec3, b: &Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(super) fn cross3(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The point of line `(p, e)` closest to line `(q, f)` (the intersection when they meet).
+fn meet(p: &Vec3, e: &Vec3, q: &Vec3, f: &Vec3) -> Vec3 {
+    // p + s e = q + t f (least squares): [e·e −e·f; e·f −f·f][s t]ᵀ = [(q−p)·e; (q−p)·f]
+    let w = dot3(e, f);
+    let d = sub3(q, p);
+    let (de, df) = (dot3(&d, e), dot3(&d, f));
+    let den = 1.0 - w * w;
+    let s = if den.abs() < 1e-300 {
+        0.0
+    } else {
+        (de - w * df) / den
+    };
+    [p[0] + s * e[0], p[1] + s * e[1], p[2] + s * e[2]]
+}
+
+fn sign(x: f64) -> f64 {
+    if x < 0.0 { -1.0 } else { 1.0 }
+}
+
+impl Plan {
+    /// Prepare `model` (validating it first).
+    pub fn new(model: &ParallelModel) -> Result<Plan, alloc::string::String> {
+        let kinds = model.validate()?;
+        let mut legs = Vec::with_capacity(model.legs.len());
+        for (leg, kind) in model.legs.iter().zip(kinds) {
+            let first = leg.joints[0].origin;
+            // Home poses relative to L (the first joint's frame), composed from the joint
+            // origins directly so that exact placements stay exact.
+            let mut homes: Vec<Transform> = Vec::with_capacity(leg.joints.len());
+            let mut h = Transform::IDENTITY;
+            for (j, joint) in leg.joints.iter().enumerate() {
+                if j > 0 {
+                    h = h.compose(&joint.origin);
+                }
+                homes.push(h);
+            }
+            let axes: Vec<Vec3> = homes
+                .iter()
+                .zip(&leg.joints)
+                .map(|(h, j)| mat_vec(&h.rotation, &j.axis))
+                .collect();
+            let points: Vec<Vec3> = homes.iter().map(|h| h.translation).collect();
+            let last = *homes.last().unwrap_or(&Transform::IDENTITY);
+            let (end_home, end_platform) = match leg.end {
+                LegEnd::Spherical {
+                    on_leg,
+                    on_platform,
+                } => (last.apply(&on_leg), on_platform),
+                LegEnd::Revolute {
+                    on_leg,
+                    on_platform,
+                } => (mat_vec(&last.rotation, &on_leg), on_platform),
+            };
+            let u_centre = match kind {
+                LegKind::Ups | LegKind::SphericalRr => {
+                    meet(&points[0], &axes[0], &points[1], &axes[1])
+                }
+                LegKind::Pus | LegKind::Rus => meet(&points[1], &axes[1], &points[2], &axes[2]),
+                // The elbow of a planar RR leg.
+                LegKind::PlanarRr => points[1],
+                // Not used by the Newton route.
+                LegKind::Generic => points[0],
+            };
+            let (ui, uj) = match kind {
+                LegKind::Ups | LegKind::SphericalRr | LegKind::PlanarRr | LegKind::Generic => {
+                    (0, 1)
+                }
+                LegKind::Pus | LegKind::Rus => (1, 2),
+            };
+            let (e1, e2) = (axes[ui], axes[uj]);
+            let k = cross3(&e1, &e2);
+            let mut plan = LegPlan {
+                kind,
+                frame: first,
+                joints: leg.joints.iter().map(|j| j.kind).collect(),
+                axes: axes.clone(),
+                points,
+                homes,
+                bodies: leg
+                    .bodies
+                    .iter()
+                    .map(|b| (b.mass, b.com, b.inertia))
+                    .collect(),
+                actuated: leg.actuated,
+                drives: leg.joints.iter().map(|j| j.drive).collect(),
+                end_home,
+                end_platform,
+                u_centre,
+                length: 0.0,
+                sigma_u: 1.0,
+                sigma_first: 1.0,
+                ups: None,
+            };
+            match kind {
+                LegKind::Ups => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    plan.sigma_first = sign(dot3(&d, &axes[2]));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                    plan.ups = ups_plan(&plan);
+                }
+                LegKind::Pus => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    // s = e·d − σ √(…) = 0 at home.
+                    plan.sigma_first = sign(dot3(&axes[0], &d));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                }
+                LegKind::Rus | LegKind::PlanarRr => {
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    plan.sigma_u = sign(dot3(&d, &k));
+                    // Pick the crank branch that reproduces θ = 0 at home.
+                    let mut best = (f64::INFINITY, 1.0);
+                    for s in [1.0, -1.0] {
+                        plan.sigma_first = s;
+                        if let Ok((sn, cs)) = rus_crank::<f64>(&plan, end_home, 0) {
+                            let err = sn.abs() + (cs - 1.0).abs();
+                            if err < best.0 {
+                                best = (err, s);
+                            }
+                        }
+                    }
+                    plan.sigma_first = best.1;
+                }
+                LegKind::SphericalRr => {
+                    plan.sigma_u = sign(dot3(&end_home, &k));
+                }
+                LegKind::Generic => {
+                    // The leg's size: the reach from its first joint to the S centre at home.
+                    let d = sub3(&end_home, &plan.points[0]);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                }
+            }
+            legs.push(plan);
+        }
+        let plan = Plan {
+            motion: model.motion,
+            gravity: model.gravity,
+            platform: (
+                model.platform.mass,
+                model.platform.com,
+                model.platform.inertia,
+            ),
+            legs,
+        };
+        // The constraint Jacobian must have full rank at home: every leg Jacobian and the
+        // actuation matrix regular there.
+        let home = model.home_x();
+        let n = plan.dof();
+        inverse_dynamics(&plan, &home, &vec![0.0; n], &vec![0.0; n]).map_err(|e| {
+            alloc::format!(
+                "the mechanism is singular at its home pose ({e}); the constraint Jacobian must have full rank there"
+            )
+        })?;
+        Ok(plan)
+    }
+
+    /// Degrees of freedom.
+    pub fn dof(&self) -> usize {
+        self.motion.dof()
+    }
+    /// The scale of [`forward_kinematics`]' tolerance: `1 +` the longest leg (m, at home) among
+    /// the legs with a prismatic actuator (their residuals are lengths of that order), `1` when
+    /// every actuator is revolute (radians).
+    pub fn fk_scale(&self) -> f64 {
+        1.0 + self
+            .legs
+            .iter()
+            .filter(|l| l.joints[l.actuated] == JointKind::Prismatic)
+            .fold(0.0f64, |m, l| m.max(l.length))
+    }
+    /// Position coordinates.
+    pub fn nx(&self) -> usize {
+        self.motion.nx()
+    }
+}

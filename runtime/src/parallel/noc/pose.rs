@@ -1,0 +1,62 @@
+//! Step 1: the platform's pose from `x` ([`Platform`]: its rotation from the quaternion,
+//! normalized on the fly, and its origin).
+
+use super::plan::Plan;
+use crate::algebra::{M, V, cv, ident};
+use crate::parallel::PlatformMotion;
+use crate::scalar::{Real, Singular, Site};
+
+/// The platform's pose from `x`.
+#[derive(Clone, Copy, Debug)]
+pub struct Platform<R> {
+    /// Rotation (platform → base).
+    pub rot: M<R>,
+    /// Origin of the platform frame (base frame).
+    pub origin: V<R>,
+}
+
+/// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`); the quaternion need not
+/// be unit (it is normalized), but it must not be zero (`Err(Site::Platform)`).
+pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> {
+    let (origin, q) = match plan.motion {
+        PlatformMotion::Pose => ([x[0], x[1], x[2]], [x[3], x[4], x[5], x[6]]),
+        PlatformMotion::Orientation { centre } => (cv(&centre), [x[0], x[1], x[2], x[3]]),
+        PlatformMotion::PlanarPoint { height } => {
+            return Ok(Platform {
+                rot: ident(),
+                origin: [x[0], x[1], R::c(height)],
+            });
+        }
+    };
+    // Divided by its largest component first, so that no square under- or overflows: any
+    // finite non-zero multiple of a unit quaternion is the same rotation (the sign of the
+    // largest component may flip the quaternion, which is the same rotation too).
+    let [w, a, b, c] = q;
+    let big = R::select_abs_gt(w, a, w, a);
+    let big = R::select_abs_gt(big, b, big, b);
+    let big = R::select_abs_gt(big, c, big, c);
+    let big = R::check(big, R::c(0.0), R::c(1.0), Site::Platform, true)?;
+    // Divided, not multiplied by `1/big`, which overflows for a subnormal `big`.
+    let [w, a, b, c] = [w / big, a / big, b / big, c / big];
+    let n = w * w + a * a + b * b + c * c;
+    let s = R::c(2.0) / n;
+    let one = R::c(1.0);
+    let rot = [
+        [
+            one - s * (b * b + c * c),
+            s * (a * b - w * c),
+            s * (a * c + w * b),
+        ],
+        [
+            s * (a * b + w * c),
+            one - s * (a * a + c * c),
+            s * (b * c - w * a),
+        ],
+        [
+            s * (a * c - w * b),
+            s * (b * c + w * a),
+            one - s * (a * a + b * b),
+        ],
+    ];
+    Ok(Platform { rot, origin })
+}
