@@ -14,6 +14,7 @@ use crate::emit::{self, Function, Part, Shape};
 use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount, schedule};
+use crate::spec::{Kind, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
 
@@ -113,40 +114,13 @@ fn build(
     })
 }
 
-/// Generate the module of a closed-loop mechanism.
-pub fn generate(model: &ClosedModel, cfg: &Config) -> Result<Generated, String> {
-    generate_selected(model, cfg, None)
-}
-
-/// The public functions of a closed-loop module that `[scene] functions` can leave out
-/// (`inverse_kinematics`, `actuator_rates` and `forward_kinematics` are always emitted;
-/// `actuator_mass_matrix` with `mass_matrix`).
-pub const SELECTABLE: [&str; 4] = [
-    "joint_rates",
-    "inverse_dynamics",
-    "mass_matrix",
-    "forward_dynamics",
-];
-
-/// [`generate`] with only the selectable functions named in `only` (`None`: all).
-pub fn generate_selected(
-    model: &ClosedModel,
-    cfg: &Config,
-    only: Option<&[String]>,
-) -> Result<Generated, String> {
-    generate_with(model, cfg, only, None)
-}
-
-/// [`generate_selected`] with run-time parameters (`[scene] parameters = "runtime"`: a payload
-/// on a tree body and the tree joints' drives, [`crate::spec::scene_params`]); `None`:
-/// constants. `inverse_dynamics`, `mass_matrix` and `forward_dynamics` then take `p: &Params`
-/// last.
-pub fn generate_with(
-    model: &ClosedModel,
-    cfg: &Config,
-    only: Option<&[String]>,
-    params: Option<&crate::spec::RuntimeParams>,
-) -> Result<Generated, String> {
+/// Generate the module of a closed-loop mechanism for `scene`: only the functions it selects
+/// (`inverse_kinematics`, `actuator_rates` and `forward_kinematics` are always emitted,
+/// `actuator_mass_matrix` with `mass_matrix`), with its run-time parameters (a payload on a
+/// tree body, the run-time bodies and the tree joints' drives; `None`: constants).
+/// `inverse_dynamics`, `mass_matrix` and `forward_dynamics` then take `p: &Params` last.
+pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Generated, String> {
+    let params = scene.params.as_ref();
     let plan = Plan::new(model)?;
     let layout = Layout::of(params);
     let payload = params.and_then(|p| p.payload);
@@ -236,11 +210,11 @@ pub fn generate_with(
             .map(|f| f.schedule.ops)
             .unwrap_or_default()
     };
-    let wanted = |name: &str| {
-        !SELECTABLE.contains(&name) || only.is_none_or(|o| o.iter().any(|f| f == name))
-    };
-    let mut stats: Vec<(String, OpCount)> = SELECTABLE
+    let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
+    let mut stats: Vec<(String, OpCount)> = Kind::Closed
+        .selectable()
         .iter()
+        .map(|f| f.name())
         .filter(|n| wanted(n))
         .map(|n| (n.to_string(), ops(n)))
         .collect();

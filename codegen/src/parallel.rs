@@ -18,6 +18,7 @@ use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::schedule::{Kernel, OpCount, schedule};
+use crate::spec::{Kind, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, lu};
 
@@ -170,45 +171,17 @@ fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
     }
 }
 
-/// Generate the module of a parallel mechanism.
-pub fn generate(model: &ParallelModel, cfg: &Config) -> Result<Generated, String> {
-    generate_selected(model, cfg, None)
-}
-
-/// The public functions of a parallel module that `[scene] functions` can leave out
-/// (`inverse_kinematics` and `forward_kinematics` are always emitted).
-pub const SELECTABLE: [&str; 5] = [
-    "actuator_rates",
-    "inverse_dynamics",
-    "mass_matrix",
-    "actuator_mass_matrix",
-    "forward_dynamics",
-];
-
-/// [`generate`] with only the selectable functions named in `only` (`None`: all).
-pub fn generate_selected(
-    model: &ParallelModel,
-    cfg: &Config,
-    only: Option<&[String]>,
-) -> Result<Generated, String> {
-    generate_with(model, cfg, only, None)
-}
-
-/// [`generate_selected`] with run-time parameters (`[scene] parameters = "runtime"`: the
-/// platform's payload, [`crate::spec::scene_params`]); `None`: constants. The functions whose
-/// values depend on the masses (`inverse_dynamics`, `mass_matrix`, `actuator_mass_matrix`,
-/// `forward_dynamics`) then take `p: &Params` last.
-pub fn generate_with(
-    model: &ParallelModel,
-    cfg: &Config,
-    only: Option<&[String]>,
-    params: Option<&crate::spec::RuntimeParams>,
-) -> Result<Generated, String> {
+/// Generate the module of a parallel mechanism for `scene`: only the functions it selects
+/// (`inverse_kinematics` and `forward_kinematics` are always emitted), with its run-time
+/// parameters (`[scene] parameters = "runtime"`: the platform's payload, the run-time bodies
+/// and the leg joints' drives; `None`: constants). The functions whose values depend on the
+/// masses (`inverse_dynamics`, `mass_matrix`, `actuator_mass_matrix`, `forward_dynamics`)
+/// then take `p: &Params` last.
+pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Generated, String> {
+    let params = scene.params.as_ref();
     let payload = params.and_then(|p| p.payload);
     let layout = Layout::of(params);
-    let want = |name: &str| {
-        !SELECTABLE.contains(&name) || only.is_none_or(|o| o.iter().any(|f| f == name))
-    };
+    let want = |name: &str| scene.functions.wants(Kind::Parallel, name);
     let plan = Plan::new(model)?;
     let k = kernels_with(&plan, &layout).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")

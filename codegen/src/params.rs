@@ -9,6 +9,7 @@ use runtime::payload::Payload;
 
 use crate::emit;
 use crate::scalar::{Sx, inputs};
+use crate::spec;
 use crate::sym::Arg;
 
 /// Which values of a parallel module are run-time parameters (`Arg::P`), and where they sit in
@@ -118,7 +119,7 @@ pub(crate) fn payload_inputs_at(at: usize) -> Payload<Sx> {
 /// mechanisms and closed loops, in [`Layout`]'s layout): the payload's fields (on `payload.0`,
 /// its values in that frame), then one array per drive effect over `drives`, of length
 /// `per.0` (a constant of the module), each entry a `per.1`, then the run-time bodies' fields
-/// (`bodies`, on the model body `frame` names; [`crate::body_params`]).
+/// (`bodies`, on the model body `frame` names; [`body_params`]).
 // The pieces of one struct: kept apart, they would only be regrouped by every caller.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn params_items(
@@ -131,7 +132,7 @@ pub(crate) fn params_items(
     frame: &dyn Fn(usize) -> String,
 ) -> TokenStream {
     let (mut fields, mut default, mut fill) = match &payload {
-        Some((on, m, c, i)) => crate::payload_params(on, *m, c, i),
+        Some((on, m, c, i)) => payload_params(on, *m, c, i),
         None => (quote!(), quote!(), quote!()),
     };
     let (v0, c0, a0, _) = layout.offsets(drives.len());
@@ -179,7 +180,7 @@ pub(crate) fn params_items(
         &|d| d.armature,
     );
     let (body_items, body_fields, body_default, body_fill) =
-        crate::body_params(bodies, frame, layout.body_base(drives.len(), 0));
+        body_params(bodies, frame, layout.body_base(drives.len(), 0));
     fields.extend(body_fields);
     default.extend(body_default);
     fill.extend(body_fill);
@@ -214,4 +215,157 @@ pub(crate) fn params_items(
             }
         }
     }
+}
+
+/// The payload's fields of a `Params` struct, their `DEFAULT` values and their part of
+/// `to_array` (entries 0–9: mass, mass centre, inertia `xx, xy, xz, yy, yz, zz`); `on` names the
+/// frame's owner ("body `link6`", "the platform").
+pub(crate) fn payload_params(
+    on: &str,
+    m: f64,
+    c: &runtime::model::Vec3,
+    i: &runtime::model::Mat3,
+) -> (
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+) {
+    use quote::quote;
+    let doc_m = format!(" Payload mass (kg), rigidly attached to {on}.");
+    let doc_c = format!(" Payload mass centre in {on}'s frame (m).");
+    let doc_i = format!(" Payload inertia about its mass centre, {on}'s axes (kg·m²), symmetric.");
+    let m = emit::float_lit(m);
+    let c: Vec<_> = c.iter().map(|v| emit::float_lit(*v)).collect();
+    let rows: Vec<_> = i
+        .iter()
+        .map(|r| {
+            let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
+            quote!([#(#r),*])
+        })
+        .collect();
+    (
+        quote! {
+            #[doc = #doc_m]
+            pub payload_mass: f64,
+            #[doc = #doc_c]
+            pub payload_com: [f64; 3],
+            #[doc = #doc_i]
+            pub payload_inertia: [[f64; 3]; 3],
+        },
+        quote! {
+            payload_mass: #m,
+            payload_com: [#(#c),*],
+            payload_inertia: [#(#rows),*],
+        },
+        quote! {
+            a[0] = self.payload_mass;
+            a[1] = self.payload_com[0];
+            a[2] = self.payload_com[1];
+            a[3] = self.payload_com[2];
+            a[4] = self.payload_inertia[0][0];
+            a[5] = self.payload_inertia[0][1];
+            a[6] = self.payload_inertia[0][2];
+            a[7] = self.payload_inertia[1][1];
+            a[8] = self.payload_inertia[1][2];
+            a[9] = self.payload_inertia[2][2];
+        },
+    )
+}
+
+/// The run-time bodies' items of a module (`[scene] runtime_inertia`; nothing without any):
+/// `NB` and `RUNTIME_BODY_NAMES` (outside `Params`), the fields `body_mass`, `body_com` and
+/// `body_inertia` of `Params`, their `DEFAULT` values and their part of `to_array` (ten entries
+/// per body from `base`, ordered as the payload's). `frame` names the owner of the frame of a
+/// model body ("model body `link6`", "the platform").
+pub(crate) fn body_params(
+    bodies: &[spec::RuntimeBody],
+    frame: &dyn Fn(usize) -> String,
+    base: usize,
+) -> (
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+    proc_macro2::TokenStream,
+) {
+    use proc_macro2::Literal;
+    use quote::quote;
+    if bodies.is_empty() {
+        return (quote!(), quote!(), quote!(), quote!());
+    }
+    let nb = Literal::usize_unsuffixed(bodies.len());
+    let base = Literal::usize_unsuffixed(base);
+    let names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut names_doc = vec![
+        " The bodies whose inertial parameters are run-time parameters (`[scene] runtime_inertia`), \
+         in the order of `Params::body_mass`, `body_com` and `body_inertia`. Each body's mass \
+         centre and inertia are in the frame of the model body it is part of (after fixed-joint \
+         merging):"
+            .to_string(),
+    ];
+    for (k, b) in bodies.iter().enumerate() {
+        names_doc.push(format!(" {k}. `{}`: {}.", b.name, frame(b.body)));
+    }
+    let mass: Vec<_> = bodies.iter().map(|b| emit::float_lit(b.mass)).collect();
+    let com: Vec<_> = bodies
+        .iter()
+        .map(|b| {
+            let c: Vec<_> = b.com.iter().map(|v| emit::float_lit(*v)).collect();
+            quote!([#(#c),*])
+        })
+        .collect();
+    let inertia: Vec<_> = bodies
+        .iter()
+        .map(|b| {
+            let rows: Vec<_> = b
+                .inertia
+                .iter()
+                .map(|r| {
+                    let r: Vec<_> = r.iter().map(|v| emit::float_lit(*v)).collect();
+                    quote!([#(#r),*])
+                })
+                .collect();
+            quote!([#(#rows),*])
+        })
+        .collect();
+    (
+        quote! {
+            /// Number of bodies with run-time inertial parameters ([`RUNTIME_BODY_NAMES`]).
+            pub const NB: usize = #nb;
+            #(#[doc = #names_doc])*
+            pub const RUNTIME_BODY_NAMES: [&str; NB] = [#(#names),*];
+        },
+        quote! {
+            /// Mass of each body of [`RUNTIME_BODY_NAMES`] (kg).
+            pub body_mass: [f64; NB],
+            /// Mass centre of each body of [`RUNTIME_BODY_NAMES`] (m), in the frame of the
+            /// model body it is part of (listed there).
+            pub body_com: [[f64; 3]; NB],
+            /// Inertia of each body of [`RUNTIME_BODY_NAMES`] about its mass centre (kg·m²,
+            /// symmetric), in the axes of the model body it is part of.
+            pub body_inertia: [[[f64; 3]; 3]; NB],
+        },
+        quote! {
+            body_mass: [#(#mass),*],
+            body_com: [#(#com),*],
+            body_inertia: [#(#inertia),*],
+        },
+        quote! {
+            let mut k = 0;
+            while k < NB {
+                let b = #base + 10 * k;
+                let (c, j) = (&self.body_com[k], &self.body_inertia[k]);
+                a[b] = self.body_mass[k];
+                a[b + 1] = c[0];
+                a[b + 2] = c[1];
+                a[b + 3] = c[2];
+                a[b + 4] = j[0][0];
+                a[b + 5] = j[0][1];
+                a[b + 6] = j[0][2];
+                a[b + 7] = j[1][1];
+                a[b + 8] = j[1][2];
+                a[b + 9] = j[2][2];
+                k += 1;
+            }
+        },
+    )
 }

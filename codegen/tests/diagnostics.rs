@@ -13,7 +13,7 @@ use codegen::spec::Mechanism;
 fn render_bad(path: &Path) -> String {
     let name = path.file_name().unwrap().to_str().unwrap();
     let source = std::fs::read_to_string(path).unwrap();
-    match codegen::spec::load(name, &source) {
+    match codegen::spec::load_tree(name, &source) {
         Ok((model, warnings)) => panic!(
             "{name} was accepted ({} joints), warnings:\n{}",
             model.dof(),
@@ -48,7 +48,7 @@ fn bad_urdf_specs() {
 fn render_warnings(path: &Path) -> String {
     let name = path.file_name().unwrap().to_str().unwrap();
     let source = std::fs::read_to_string(path).unwrap();
-    match codegen::spec::load(name, &source) {
+    match codegen::spec::load_tree(name, &source) {
         Ok((_, warnings)) => {
             assert!(!warnings.is_empty(), "{name}: no warning");
             for d in warnings.iter() {
@@ -109,7 +109,7 @@ fn specs_too_large_are_refused_up_front() {
         r
     };
     // Exactly at the limit is fine (only loaded here: generating 64 joints takes a while).
-    codegen::spec::load("at_limit.toml", &chain_toml(MAX_DOF)).unwrap();
+    codegen::spec::load_tree("at_limit.toml", &chain_toml(MAX_DOF)).unwrap();
     let dof = check(
         "too_many_dof.toml",
         &chain_toml(MAX_DOF + 1),
@@ -209,7 +209,7 @@ fn good_parallel_specs_load_and_validate() {
             };
             m.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
             // `load` refuses it, pointing at the [platform] table.
-            let e = codegen::spec::load(&name, &source).unwrap_err();
+            let e = codegen::spec::load_tree(&name, &source).unwrap_err();
             assert!(e.render().contains("parallel mechanism"), "{}", e.render());
             n += 1;
         }
@@ -218,7 +218,7 @@ fn good_parallel_specs_load_and_validate() {
 }
 
 fn load_clean(name: &str, source: &str) -> runtime::model::Model {
-    match codegen::spec::load(name, source) {
+    match codegen::spec::load_tree(name, source) {
         Ok((model, warnings)) => {
             assert!(warnings.is_empty(), "{name}:\n{}", warnings.render());
             model

@@ -28,8 +28,8 @@ macro_rules! bench_mechanism {
             const N: usize = generated::DOF;
             let name = stringify!($module);
             let src = include_str!(concat!("../../mechanisms/specs/", $spec_file));
-            let (model, _warnings): (Model, _) =
-                codegen::spec::load($spec_file, src).unwrap_or_else(|d| panic!("{}", d.render()));
+            let (model, _warnings): (Model, _) = codegen::spec::load_tree($spec_file, src)
+                .unwrap_or_else(|d| panic!("{}", d.render()));
             assert_eq!(model.dof(), N);
 
             let (q, qd, qdd) = random_state(&mut rng($seed), N);

@@ -23,7 +23,7 @@ const PUMA: &str = include_str!("../../mechanisms/specs/puma560.toml");
 
 fn puma(scene: &str) -> Model {
     let src = format!("{PUMA}\n[scene]\n{scene}\n");
-    codegen::spec::load("puma560.toml", &src).unwrap().0
+    codegen::spec::load_tree("puma560.toml", &src).unwrap().0
 }
 
 /// The toolbox's motor-side drive data (mdl_puma560.m, "params of 8/95").
@@ -192,14 +192,14 @@ fn rigid_module_has_no_friction_function_and_bad_values_are_diagnostics() {
     let s = codegen::symbolic(&puma(""));
     assert!(s.friction.is_none());
     let bad = PUMA.replacen("damping = 5.8018", "damping = -1.0", 1);
-    let err = codegen::spec::load("puma560.toml", &bad).unwrap_err();
+    let err = codegen::spec::load_tree("puma560.toml", &bad).unwrap_err();
     let text = err.render();
     assert!(
         text.contains("damping") && text.contains("non-negative"),
         "{text}"
     );
     let bad = format!("{PUMA}\n[scene]\nfriction = true\ncoulomb_velocity = 0.0\n");
-    let err = codegen::spec::load("puma560.toml", &bad).unwrap_err();
+    let err = codegen::spec::load_tree("puma560.toml", &bad).unwrap_err();
     assert!(err.render().contains("coulomb_velocity"));
 }
 
@@ -283,10 +283,10 @@ fn urdf_dynamics_apply_with_the_override() {
     <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
     <dynamics damping="0.5" friction="0.1"/></joint>
 </robot>"#;
-    let load = |o: codegen::spec::SceneOverrides| match codegen::spec::load_mechanism_with(
-        "p.urdf", urdf, &o,
-    ) {
-        Ok((codegen::spec::Mechanism::Tree(m), _)) => m,
+    let load = |o: codegen::spec::SceneOverrides| match codegen::spec::load("p.urdf", urdf, &o)
+        .map(|l| l.mechanism)
+    {
+        Ok(codegen::spec::Mechanism::Tree(m)) => m,
         _ => panic!("not a tree"),
     };
     assert!(load(Default::default()).joints[0].drive.is_none());

@@ -13,7 +13,7 @@ const STATES: usize = 1000;
 const TOL: f64 = 1e-12;
 
 fn model(file: &str, src: &str) -> Model {
-    match codegen::spec::load(file, src) {
+    match codegen::spec::load_tree(file, src) {
         Ok((m, _)) => m,
         Err(d) => panic!("{d}"),
     }

@@ -1280,6 +1280,8 @@ fn generic_leg_by_newton_agrees() {
     far[2] += 5.0;
     assert!(pn::inverse_dynamics(&plan, &far, &[0.0; 6], &[0.0; 6]).is_err());
     // The generator takes it, and its inverse dynamics is the runtime's.
-    let g = codegen::parallel::generate(&hx.model, &codegen::Config::default()).expect("generated");
+    let g =
+        codegen::parallel::generate(&hx.model, &Default::default(), &codegen::Config::default())
+            .expect("generated");
     assert!(g.code.contains("generic (Newton)"));
 }

@@ -15,7 +15,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use codegen::{Config, generate, schedule::OpCount};
+use codegen::{Config, schedule::OpCount, tree::generate};
 use runtime::model::{Body, Joint, JointKind, Model, Transform, exact_sin_cos};
 use tests::{Shape, random_model, rng};
 
@@ -85,7 +85,7 @@ fn generic_chain(seed: u64, n: usize) -> Model {
 
 /// Operation counts of one generated module by function name.
 fn counts(model: &Model) -> (OpCount, OpCount) {
-    let out = generate(model, &Config::default());
+    let out = generate(model, &Default::default(), &Config::default());
     assert_eq!(out.dof, model.dof());
     let get = |name: &str| {
         out.stats

@@ -7,7 +7,12 @@
 //! from the body's.
 
 use codegen::dynamics::{ParamKind, param_index};
-use codegen::spec::{Mechanism, SceneOverrides, load_mechanism, scene_params};
+use codegen::spec::{Mechanism, SceneOverrides, load_mechanism};
+
+/// The run-time parameters `codegen::spec::load` places for a spec.
+fn scene_params(file: &str, src: &str, o: &SceneOverrides) -> Option<codegen::spec::RuntimeParams> {
+    codegen::spec::load(file, src, o).ok()?.scene.params
+}
 use codegen::sym::Arg;
 use rand::Rng;
 use runtime::model::{Drive, Model};

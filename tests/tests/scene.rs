@@ -2,7 +2,7 @@
 //! bodies and a gravity override gives exactly the model of the spec edited by hand, and
 //! `functions` emits only the functions asked for.
 
-use codegen::spec::load;
+use codegen::spec::load_tree as load;
 
 const ARM: &str = r#"
 [mechanism]

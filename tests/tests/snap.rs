@@ -5,7 +5,7 @@
 //! is the full-precision model again, number for number, at the same cost; every change is
 //! listed as a warning.
 
-use codegen::spec::{Mechanism, SceneOverrides, load_mechanism_with};
+use codegen::spec::{Mechanism, SceneOverrides, load};
 use codegen::{Config, compile};
 use runtime::model::Model;
 
@@ -21,7 +21,7 @@ fn model(src: &str, snap: Option<f64>) -> (Model, usize) {
         snap,
         ..Default::default()
     };
-    match load_mechanism_with("iiwa14.urdf", src, &o) {
+    match load("iiwa14.urdf", src, &o).map(|l| (l.mechanism, l.warnings)) {
         Ok((Mechanism::Tree(m), warnings)) => (m, warnings.len()),
         _ => panic!("not a tree"),
     }

@@ -42,7 +42,7 @@ fn energy_is_conserved_without_actuation() {
     ] {
         let path = tests::pkm::spec_path(name);
         let src = std::fs::read_to_string(&path).unwrap();
-        let (model, _) = codegen::spec::load(&path.to_string_lossy(), &src).unwrap();
+        let (model, _) = codegen::spec::load_tree(&path.to_string_lossy(), &src).unwrap();
         let mech = runtime::simulate::Mechanism::Tree(&model);
         for method in [Method::Rk4, Method::SymplecticEuler] {
             let r = simulate(mech, &q0, &vec![0.0; q0.len()], DT, STEPS, method).unwrap();

@@ -112,7 +112,7 @@ fn turned_closed_loops_are_accepted_with_the_same_efforts() {
         let tplan =
             cnoc::Plan::new(&turned).unwrap_or_else(|e| panic!("{name} turned is refused: {e}"));
         assert_eq!(tplan.dof(), plan.dof(), "{name}");
-        codegen::closed::generate(&turned, &codegen::Config::default())
+        codegen::closed::generate(&turned, &Default::default(), &codegen::Config::default())
             .unwrap_or_else(|e| panic!("{name} turned: no code: {e}"));
         let mut rng = tests::rng(41);
         let mut worst: f64 = 0.0;
@@ -142,7 +142,7 @@ fn turned_platforms_are_accepted_with_the_same_efforts() {
         let turned = turn_parallel(&m, &t);
         let tplan =
             pnoc::Plan::new(&turned).unwrap_or_else(|e| panic!("{name} turned is refused: {e}"));
-        codegen::parallel::generate(&turned, &codegen::Config::default())
+        codegen::parallel::generate(&turned, &Default::default(), &codegen::Config::default())
             .unwrap_or_else(|e| panic!("{name} turned: no code: {e}"));
         let home = m.home_x();
         let mut rng = tests::rng(42);
@@ -221,7 +221,7 @@ fn lagrange_efforts(m: &ClosedModel, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<f6
 /// Lagrange route; returns the worst relative error (∞-norm).
 fn check_against_lagrange(m: &ClosedModel, dof: usize, reach: f64) -> f64 {
     let plan = cnoc::Plan::new(m).unwrap_or_else(|e| panic!("{}: {e}", m.name));
-    codegen::closed::generate(m, &codegen::Config::default())
+    codegen::closed::generate(m, &Default::default(), &codegen::Config::default())
         .unwrap_or_else(|e| panic!("{}: no code: {e}", m.name));
     assert_eq!(plan.dof(), dof);
     assert_eq!(plan.rows.len(), plan.nx() - dof);

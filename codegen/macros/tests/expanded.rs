@@ -48,7 +48,7 @@ fn states() -> Vec<[[f64; 2]; 3]> {
 
 #[test]
 fn planar_2r_agrees_with_the_runtime_noc() {
-    let (model, _) = codegen::spec::load(
+    let (model, _) = codegen::spec::load_tree(
         "planar_2r.toml",
         include_str!("../../../mechanisms/specs/planar_2r.toml"),
     )

@@ -22,12 +22,8 @@ pub(crate) fn is_closed(spec: &Spec) -> bool {
     spec.platform.is_none() && spec.joints.iter().any(|j| j.child_origin.is_some())
 }
 
-/// Validate a closed-loop spec and build its model; `None` when there was any error.
-pub(crate) fn lower_closed(spec: &Spec, diags: &mut Diagnostics) -> Option<ClosedModel> {
-    lower_closed_attached(spec, diags).map(|(m, _)| m)
-}
-
-/// [`lower_closed`], also returning where each spec body went in the tree (`lower::Attach`:
+/// Validate a closed-loop spec and build its model (`None` when there was any error), also
+/// returning where each spec body went in the tree (`lower::Attach`:
 /// the model body and the pose in its frame; a run-time payload's place).
 pub(crate) fn lower_closed_attached(
     spec: &Spec,

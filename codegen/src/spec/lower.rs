@@ -11,13 +11,9 @@ use super::ir::{BASE, BodySpec, JointSpec, Kind, Placement, Span, Spec};
 use super::suggest_hint;
 use crate::diag::{Diagnostic, Diagnostics};
 
-/// Validates `spec` (a tree: no `[platform]`) and builds the model. Errors and warnings go to
-/// `diags`; `None` when there was any error.
-pub(crate) fn lower(spec: &Spec, diags: &mut Diagnostics) -> Option<Model> {
-    lower_built(spec, diags).map(|b| b.model)
-}
-
-/// [`lower`] with the bookkeeping: where every spec body ended up.
+/// Validates `spec` (a tree: no `[platform]`) and builds the model, with the bookkeeping:
+/// where every spec body ended up. Errors and warnings go to `diags`; `None` when there was
+/// any error.
 pub(super) fn lower_built(spec: &Spec, diags: &mut Diagnostics) -> Option<Built> {
     let axes = check_values(spec, diags);
     check_no_parallel_keys(spec, diags);

@@ -12,6 +12,7 @@
 
 mod angle;
 mod closed;
+mod function;
 mod geom;
 mod ir;
 mod lower;
@@ -28,6 +29,8 @@ use runtime::model::Model;
 use runtime::parallel::ParallelModel;
 
 use crate::diag::{Diagnostic, Diagnostics};
+
+pub use function::{Function, FunctionSet, Kind};
 
 /// The largest spec file read, in bytes (16 MiB). Larger input is refused before parsing.
 pub const MAX_SOURCE_BYTES: usize = 16 << 20;
@@ -107,17 +110,68 @@ impl Mechanism {
             Mechanism::Closed(m) => &m.name,
         }
     }
+
+    /// Its kind.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Mechanism::Tree(_) => Kind::Tree,
+            Mechanism::Parallel(_) => Kind::Parallel,
+            Mechanism::Closed(_) => Kind::Closed,
+        }
+    }
 }
 
-/// Parse and validate a tree spec. The format is chosen by `file_name`'s extension: `.urdf` →
-/// URDF, anything else → TOML. A parallel mechanism (a TOML spec with a `[platform]` table) is
-/// an error here: read it with [`load_mechanism`].
+/// What the application needs of the mechanism (the spec's `[scene]` table, with the
+/// [`SceneOverrides`] applied), as the generators read it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scene {
+    /// The public functions to emit (`[scene] functions`).
+    pub functions: FunctionSet,
+    /// The run-time parameters (`[scene] parameters = "runtime"`; `None`: constants).
+    pub params: Option<RuntimeParams>,
+}
+
+/// A spec read, checked and lowered in one pass.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The validated mechanism.
+    pub mechanism: Mechanism,
+    /// What its module is to contain.
+    pub scene: Scene,
+    /// The spec's warnings (e.g. an axis normalized).
+    pub warnings: Diagnostics,
+}
+
+/// Read, check and lower a spec of any kind in one pass: the mechanism, its scene (the
+/// functions `[scene] functions` selects and the run-time parameters) and the warnings. The
+/// format is chosen by `file_name`'s extension: `.urdf` → URDF, anything else → TOML.
 ///
 /// Pure: no I/O; `file_name` is only used for messages and the format choice. Never panics on
-/// any input. On success the warnings (e.g. an axis that was normalized) are returned beside
-/// the model; on failure all errors (and warnings) found, sorted by position.
-pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
-    let (mechanism, mut diags, platform) = load_any(file_name, source, &SceneOverrides::default());
+/// any input. On failure all errors (and warnings) found, sorted by position.
+pub fn load(
+    file_name: &str,
+    source: &str,
+    overrides: &SceneOverrides,
+) -> Result<Loaded, Diagnostics> {
+    let (read, diags, _) = load_any(file_name, source, overrides);
+    let (mechanism, scene) = match read {
+        Some((m, s)) => (Some(m), Some(s)),
+        None => (None, None),
+    };
+    let (mechanism, warnings) = finish(mechanism, diags)?;
+    Ok(Loaded {
+        mechanism,
+        scene: scene.unwrap_or_default(),
+        warnings,
+    })
+}
+
+/// [`load`] for a tree spec, without overrides: the model and the warnings. A parallel
+/// mechanism (a TOML spec with a `[platform]` table) or closed loops are an error here: read
+/// them with [`load`] or [`load_mechanism`].
+pub fn load_tree(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
+    let (read, mut diags, platform) = load_any(file_name, source, &SceneOverrides::default());
+    let mechanism = read.map(|(m, _)| m);
     if let Some(span) = platform {
         diags.push(
             Diagnostic::error("this spec describes a parallel mechanism (it has a [platform] table), which cannot be loaded as a tree")
@@ -141,16 +195,12 @@ pub fn load(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagn
     })
 }
 
-/// Parse and validate a spec of either kind: a tree (as [`load`]) or, for a TOML spec with a
-/// `[platform]` table, a parallel mechanism (see `docs/spec.md`, "Parallel mechanisms").
-///
-/// Pure and panic-free like [`load`]; on success the warnings are returned beside the
-/// mechanism, on failure all errors (and warnings) found, sorted by position.
+/// [`load`] without overrides, keeping the mechanism and the warnings.
 pub fn load_mechanism(
     file_name: &str,
     source: &str,
 ) -> Result<(Mechanism, Diagnostics), Diagnostics> {
-    load_mechanism_with(file_name, source, &SceneOverrides::default())
+    load(file_name, source, &SceneOverrides::default()).map(|l| (l.mechanism, l.warnings))
 }
 
 /// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect
@@ -167,23 +217,14 @@ pub struct SceneOverrides {
     pub snap: Option<f64>,
 }
 
-/// [`load_mechanism`] with [`SceneOverrides`].
-pub fn load_mechanism_with(
-    file_name: &str,
-    source: &str,
-    overrides: &SceneOverrides,
-) -> Result<(Mechanism, Diagnostics), Diagnostics> {
-    let (mechanism, diags, _) = load_any(file_name, source, overrides);
-    finish(mechanism, diags)
-}
-
-/// Reads and lowers; also returns the span of the `[platform]` header for a parallel spec.
+/// Reads, checks and lowers once; also returns the span of the `[platform]` header for a
+/// parallel spec.
 fn load_any(
     file_name: &str,
     source: &str,
     overrides: &SceneOverrides,
 ) -> (
-    Option<Mechanism>,
+    Option<(Mechanism, Scene)>,
     Diagnostics,
     Option<std::ops::Range<usize>>,
 ) {
@@ -266,18 +307,35 @@ fn load_any(
                 );
                 return None;
             }
-            if s.platform.is_some() {
-                parallel::lower_parallel(&s, &mut d).map(Mechanism::Parallel)
+            // Lowered once; where each spec body went places the run-time bodies.
+            let (mechanism, attach) = if s.platform.is_some() {
+                (
+                    Mechanism::Parallel(parallel::lower_parallel(&s, &mut d)?),
+                    None,
+                )
             } else if closed::is_closed(&s) {
-                closed::lower_closed(&s, &mut d).map(Mechanism::Closed)
+                let (m, attach) = closed::lower_closed_attached(&s, &mut d)?;
+                (Mechanism::Closed(m), Some(attach))
             } else {
-                lower::lower(&s, &mut d).map(Mechanism::Tree)
-            }
+                let built = lower::lower_built(&s, &mut d)?;
+                (Mechanism::Tree(built.model), Some(built.attach))
+            };
+            let params = runtime_params(&s, attach.as_deref());
+            Some((mechanism, params))
         });
-        if let (Some(m), Some(fs)) = (&mechanism, &functions) {
-            check_scene_functions(m, fs, &mut d);
-        }
-        (mechanism, d, platform)
+        let read = mechanism.map(|(m, params)| {
+            if let Some(fs) = &functions {
+                check_scene_functions(&m, fs, &mut d);
+            }
+            let functions = match &functions {
+                None => FunctionSet::all(),
+                Some(fs) => {
+                    FunctionSet::only(fs.iter().filter_map(|f| f.name.parse().ok()).collect())
+                }
+            };
+            (m, Scene { functions, params })
+        });
+        (read, d, platform)
     }));
     match result {
         Ok((mechanism, d, platform)) => {
@@ -342,16 +400,6 @@ fn too_large(len: usize, whole: bool) -> Diagnostic {
         .with_span(0..0)
         .with_hint(format!("nocdyn generates mechanisms of at most {MAX_DOF} degrees of freedom and {MAX_ENTRIES} bodies or joints; is this the right file?"))
 }
-
-/// The public functions a tree module has (`[scene] functions` picks among them).
-pub const TREE_FUNCTIONS: [&str; 6] = [
-    "mass_matrix",
-    "coriolis",
-    "gravity",
-    "inverse_dynamics",
-    "forward_dynamics",
-    "friction",
-];
 
 /// An error when joint `j`, which `role` (e.g. "closes a loop"), has a drive: friction and rotor
 /// inertia are modelled only where the joint's rate is known.
@@ -605,31 +653,29 @@ fn resolve_runtime_inertia(
 }
 
 fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostics) {
+    let kind = m.kind();
+    let offered = || kind.selectable().iter().chain(kind.always());
     for f in fs {
-        const CLOSED: [&str; 6] = [
-            "joint_rates",
-            "inverse_dynamics",
-            "mass_matrix",
-            "forward_dynamics",
-            "inverse_kinematics",
-            "forward_kinematics",
-        ];
-        let ok = match m {
-            Mechanism::Tree(_) => TREE_FUNCTIONS.contains(&f.name.as_str()),
-            Mechanism::Closed(_) => CLOSED.contains(&f.name.as_str()),
-            Mechanism::Parallel(_) => crate::parallel::SELECTABLE.contains(&f.name.as_str()),
-        };
+        let ok = f
+            .name
+            .parse::<Function>()
+            .is_ok_and(|f| offered().any(|&g| g == f));
         if !ok {
-            let hint = match m {
-                Mechanism::Tree(_) => format!("a tree module offers {}", TREE_FUNCTIONS.join(", ")),
-                Mechanism::Closed(_) => format!(
-                    "a closed-loop module offers {} (the last two are always emitted)",
-                    CLOSED.join(", ")
-                ),
-                Mechanism::Parallel(_) => format!(
-                    "a parallel module offers {} (inverse_kinematics and forward_kinematics are always emitted)",
-                    crate::parallel::SELECTABLE.join(", ")
-                ),
+            let names: Vec<&str> = offered().map(|f| f.name()).collect();
+            let always: Vec<&str> = kind.always().iter().map(|f| f.name()).collect();
+            let what = match kind {
+                Kind::Tree => "a tree module",
+                Kind::Parallel => "a parallel module",
+                Kind::Closed => "a closed-loop module",
+            };
+            let hint = if always.is_empty() {
+                format!("{what} offers {}", names.join(", "))
+            } else {
+                format!(
+                    "{what} offers {} ({} are always emitted)",
+                    names.join(", "),
+                    always.join(" and ")
+                )
             };
             diags.push(
                 Diagnostic::error(format!("cannot select function {:?}", f.name))
@@ -652,8 +698,8 @@ pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
     Some(spec.bodies.into_iter().map(|b| b.name).collect())
 }
 
-/// The run-time parameters of a tree spec with `[scene] parameters = "runtime"` (`None`
-/// without). Pure: reads and lowers the spec again; call it on a spec that loads.
+/// The run-time parameters of a spec with `[scene] parameters = "runtime"` ([`Scene::params`];
+/// `None` without).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RuntimeParams {
     /// The payload: the model body it rides on, its mass (kg), mass centre (m) and inertia about
@@ -718,17 +764,13 @@ impl RuntimeBody {
     }
 }
 
-/// See [`RuntimeParams`].
-pub fn scene_params(
-    file_name: &str,
-    source: &str,
-    overrides: &SceneOverrides,
+/// The run-time parameters of a prepared spec (see [`RuntimeParams`]), placed by `attach`
+/// (where each spec body went in the tree of a tree or closed-loop mechanism; `None` for a
+/// parallel one, whose payload rides on the platform).
+fn runtime_params(
+    spec: &ir::Spec,
+    attach: Option<&[Option<lower::Attach>]>,
 ) -> Option<RuntimeParams> {
-    if is_urdf(file_name) {
-        return None;
-    }
-    let mut d = Diagnostics::new(file_name, source);
-    let mut spec = read_toml::read(source, &mut d)?;
     if !spec.scene.runtime_params {
         return None;
     }
@@ -771,40 +813,35 @@ pub fn scene_params(
             })
             .collect()
     };
-    if spec.platform.is_some() {
-        prepare(&mut spec, overrides, &mut d);
+    let Some(attach) = attach else {
         let payload = match spec.scene.payload.as_ref() {
             None => None,
-            Some(p) => placed(&spec, 0, &parallel::pose_on_platform(&spec, &p.body.name)?),
+            Some(p) => placed(spec, 0, &parallel::pose_on_platform(spec, &p.body.name)?),
         };
         let bodies = spec
             .scene
             .runtime_bodies
             .iter()
             .filter_map(|r| {
-                let pose = parallel::pose_on_platform(&spec, &spec.bodies[r.body].name)?;
-                Some(RuntimeBody::placed(&spec, r, 0, &pose))
+                let pose = parallel::pose_on_platform(spec, &spec.bodies[r.body].name)?;
+                Some(RuntimeBody::placed(spec, r, 0, &pose))
             })
             .collect();
-        return with_drives(&spec, payload, bodies);
-    }
-    if closed::is_closed(&spec) {
-        prepare(&mut spec, overrides, &mut d);
-        let (_, attach) = closed::lower_closed_attached(&spec, &mut d)?;
+        return with_drives(spec, payload, bodies);
+    };
+    if closed::is_closed(spec) {
         // A payload on a body fixed to the base moves with nothing: it is left out.
         let payload = spec.scene.payload.as_ref().and_then(|p| {
             let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
             let at = attach[b]?;
-            placed(&spec, at.target?, &at.pose)
+            placed(spec, at.target?, &at.pose)
         });
-        let bodies = attached(&spec, &attach);
-        return with_drives(&spec, payload, bodies);
+        let bodies = attached(spec, attach);
+        return with_drives(spec, payload, bodies);
     }
-    prepare(&mut spec, overrides, &mut d);
-    let built = lower::lower_built(&spec, &mut d)?;
     let payload = spec.scene.payload.as_ref().and_then(|p| {
         let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
-        let at = built.attach[b]?;
+        let at = attach[b]?;
         let target = at.target?;
         let m = geom::MassProps {
             mass: p.mass,
@@ -819,20 +856,8 @@ pub fn scene_params(
         coulomb_velocity: spec.scene.coulomb_velocity,
         leg_friction: false,
         leg_rotor_inertia: false,
-        bodies: attached(&spec, &built.attach),
+        bodies: attached(spec, attach),
     })
-}
-
-/// The functions `[scene] functions` selects (`None`: all). Pure: reads the TOML again.
-pub fn scene_functions(file_name: &str, source: &str) -> Option<Vec<String>> {
-    if is_urdf(file_name) {
-        return None;
-    }
-    let mut d = Diagnostics::new(file_name, source);
-    let spec = read_toml::read(source, &mut d)?;
-    spec.scene
-        .functions
-        .map(|v| v.into_iter().map(|n| n.name).collect())
 }
 
 /// The size limits ([`MAX_ENTRIES`], [`MAX_DOF`]), checked before lowering so that no stage

@@ -5,10 +5,10 @@ use runtime::model::{JointKind, Mat3, Model, Transform, Vec3, axis_angle};
 
 use super::geom::{MassProps, dh_matrix, mdh_matrix};
 use super::ir::{Dh, Kind};
-use super::load;
+use super::load_tree;
 
 fn ok(name: &str, src: &str) -> Model {
-    match load(name, src) {
+    match load_tree(name, src) {
         Ok((m, w)) => {
             assert!(w.is_empty(), "unexpected warnings:\n{}", w.render());
             m
@@ -412,7 +412,7 @@ parent = "base"
 child = "a"
 axis = [0, 3, 4]
 "#;
-    let (m, w) = load("w.toml", src).unwrap();
+    let (m, w) = load_tree("w.toml", src).unwrap();
     assert_eq!(m.joints[0].axis, [0.0, 0.6, 0.8]);
     assert_eq!(w.len(), 1);
     assert!(!w.has_errors());
@@ -532,7 +532,7 @@ mod urdf {
     #[test]
     fn urdf_conventions() {
         // The massless links l2, l3 and l2b draw one warning per joint moving only them.
-        let (m, w) = load("r.urdf", URDF).unwrap_or_else(|e| panic!("{}", e.render()));
+        let (m, w) = load_tree("r.urdf", URDF).unwrap_or_else(|e| panic!("{}", e.render()));
         let w: Vec<String> = w.iter().map(|d| d.message.clone()).collect();
         assert_eq!(
             w,
@@ -583,7 +583,7 @@ mod urdf {
     #[test]
     fn urdf_rejects_lenient_vectors_with_a_position() {
         let bad = URDF.replace(r#"<axis xyz="1 0 0"/>"#, r#"<axis xyz="1 x 0 0"/>"#);
-        let e = load("r.urdf", &bad).unwrap_err();
+        let e = load_tree("r.urdf", &bad).unwrap_err();
         let r = e.render();
         assert!(r.contains("r.urdf:47:"), "{r}");
         assert!(r.contains("invalid number \"x\""), "{r}");
@@ -659,7 +659,7 @@ fn load_never_panics_on_mutated_input() {
                 }
             }
             // `load` catches panics and turns them into an "internal error".
-            if let Err(e) = load(name, &s) {
+            if let Err(e) = load_tree(name, &s) {
                 let r = e.render();
                 assert!(!r.contains("internal error"), "panicked on:\n{s}\n{r}");
             }
@@ -672,7 +672,7 @@ mod parallel_specs {
     use runtime::model::{JointKind, Transform, mat_vec};
     use runtime::parallel::{LegEnd, LegKind, ParallelModel, PlatformMotion, leg_home_poses};
 
-    use super::super::{Mechanism, load, load_mechanism};
+    use super::super::{Mechanism, load_mechanism, load_tree};
     use super::{assert_vec, close};
 
     fn load_parallel(name: &str, src: &str) -> ParallelModel {
@@ -738,7 +738,7 @@ mod parallel_specs {
                 );
             }
             // `load` refuses a parallel spec and says why.
-            let e = load(name, src).unwrap_err().render();
+            let e = load_tree(name, src).unwrap_err().render();
             assert!(e.contains("parallel mechanism"), "{e}");
         }
     }
@@ -1154,7 +1154,7 @@ fn snap_override_out_of_range_is_an_error() {
             snap: Some(tol),
             ..Default::default()
         };
-        let e = super::load_mechanism_with("puma560.toml", &src, &o).unwrap_err();
+        let e = super::load("puma560.toml", &src, &o).unwrap_err();
         let r = e.render();
         assert!(
             r.contains("snap tolerance") && r.contains("(0, 0.01]"),
@@ -1165,7 +1165,7 @@ fn snap_override_out_of_range_is_an_error() {
         snap: Some(1e-2),
         ..Default::default()
     };
-    assert!(super::load_mechanism_with("puma560.toml", &src, &o).is_ok());
+    assert!(super::load("puma560.toml", &src, &o).is_ok());
 }
 
 /// Suggestions: the closest candidate within a third of the word's length (transpositions

@@ -62,7 +62,7 @@ fn puma(points: &mut Vec<Point>) {
     use mechanisms::f32::puma560 as s;
     use mechanisms::puma560 as g;
     let path = tests::pkm::spec_path("puma560");
-    let (model, _) = codegen::spec::load(
+    let (model, _) = codegen::spec::load_tree(
         &path.to_string_lossy(),
         &std::fs::read_to_string(&path).unwrap(),
     )
@@ -252,7 +252,7 @@ fn iiwa(points: &mut Vec<Point>) {
         .unwrap()
         .replace("1.5707963267948966", "1.5708")
         .replace("3.141592653589793", "3.1416");
-    let (model, _) = codegen::spec::load("iiwa14.urdf", &src).unwrap();
+    let (model, _) = codegen::spec::load_tree("iiwa14.urdf", &src).unwrap();
     let plan = runtime::closed::noc::Plan::tree(&model);
     let mut rng = tests::rng(34);
     let states: Vec<[[f64; 7]; 3]> = (0..STATES)

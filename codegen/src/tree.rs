@@ -1,0 +1,335 @@
+//! Trees: the symbolic dynamics of a validated model ([`crate::dynamics`]) scheduled and
+//! emitted as the module's functions, with the `Params` struct of a module whose payload,
+//! bodies or drives are run-time parameters.
+
+use runtime::model::Model;
+
+use crate::dynamics::{self, Terms, Tree};
+use crate::emit::{self, Function, Shape};
+use crate::schedule::{Kernel, OpCount, schedule};
+use crate::spec::{self, Kind, Scene};
+use crate::sym::{self, Arg, Graph};
+use crate::{Config, Generated, MathBackend, VERSION, diag};
+
+/// The symbolic dynamics of a model: one expression DAG and the output nodes of each function.
+pub struct Symbolic {
+    /// The shared DAG.
+    pub graph: Graph,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// `I(q)`, row-major.
+    pub mass_matrix: Vec<sym::ExprId>,
+    /// `C(q, q̇) q̇`.
+    pub coriolis: Vec<sym::ExprId>,
+    /// `−γ(q)`.
+    pub gravity: Vec<sym::ExprId>,
+    /// `I q̈ + C q̇ − γ`.
+    pub inverse_dynamics: Vec<sym::ExprId>,
+    /// `I⁻¹ (τ − C q̇ + γ)` with checked pivots.
+    pub forward_dynamics: Vec<sym::ExprId>,
+    /// The pivot guards of `forward_dynamics`, in the order of its factorization (the other
+    /// functions test nothing).
+    pub forward_dynamics_guards: Vec<sym::ExprId>,
+    /// Joint friction `δ(q̇)`, when some joint's drive has friction (`[scene] friction`).
+    pub friction: Option<Vec<sym::ExprId>>,
+}
+
+/// Build the symbolic dynamics of a validated model.
+pub fn symbolic(model: &Model) -> Symbolic {
+    symbolic_with(model, None)
+}
+
+/// [`symbolic`] with run-time parameters (`[scene] parameters = "runtime"`): every output also
+/// reads `Arg::P` (layout: [`dynamics::param_index`]).
+pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Symbolic {
+    let mut tree = Tree::new(model);
+    if let Some(rp) = params {
+        tree = tree.with_runtime_params(rp.payload.as_ref().map(|p| p.0), rp.coulomb_velocity);
+        let bodies: Vec<usize> = rp.bodies.iter().map(|b| b.body).collect();
+        tree = tree.with_runtime_bodies(&bodies);
+    }
+    let mut g = Graph::new();
+    let mm = dynamics::mass_matrix(&mut g, &tree);
+    let mass_matrix: Vec<_> = mm.iter().flatten().copied().collect();
+    let coriolis = dynamics::inverse_dynamics(
+        &mut g,
+        &tree,
+        Terms {
+            velocity: true,
+            ..Terms::NONE
+        },
+    );
+    let gravity = dynamics::inverse_dynamics(
+        &mut g,
+        &tree,
+        Terms {
+            gravity: true,
+            ..Terms::NONE
+        },
+    );
+    let inverse_dynamics = dynamics::inverse_dynamics(&mut g, &tree, Terms::ALL);
+    debug_assert!(
+        g.take_guards().is_empty(),
+        "a tree function other than FD tests"
+    );
+    let forward_dynamics = dynamics::forward_dynamics(&mut g, &tree);
+    let forward_dynamics_guards = g.take_guards();
+    let friction = model
+        .joints
+        .iter()
+        .any(|j| j.drive.viscous != 0.0 || j.drive.coulomb != 0.0)
+        .then(|| {
+            dynamics::inverse_dynamics(
+                &mut g,
+                &tree,
+                Terms {
+                    friction: true,
+                    ..Terms::NONE
+                },
+            )
+        });
+    Symbolic {
+        graph: g,
+        dof: tree.dof(),
+        mass_matrix,
+        coriolis,
+        gravity,
+        inverse_dynamics,
+        forward_dynamics,
+        forward_dynamics_guards,
+        friction,
+    }
+}
+
+/// The `Params` struct of a module with run-time parameters: fields named for the user, its
+/// `DEFAULT` (the values the spec gives), and `to_array` in [`dynamics::param_index`]'s layout.
+fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::TokenStream {
+    use proc_macro2::Literal;
+    use quote::quote;
+    let n = model.dof();
+    let np = Literal::usize_unsuffixed(dynamics::param_count_with(n, rp.bodies.len()));
+    let arr = |f: &dyn Fn(&runtime::model::Drive) -> f64| {
+        let v: Vec<_> = model
+            .joints
+            .iter()
+            .map(|j| emit::float_lit(f(&j.drive)))
+            .collect();
+        quote!([#(#v),*])
+    };
+    let damping = arr(&|d| d.viscous);
+    let friction = arr(&|d| d.coulomb);
+    let armature = arr(&|d| d.armature);
+    let at = |k| Literal::usize_unsuffixed(dynamics::param_index(k, 0, n));
+    let (d0, f0, a0) = (
+        at(dynamics::ParamKind::Damping),
+        at(dynamics::ParamKind::Friction),
+        at(dynamics::ParamKind::Armature),
+    );
+    let (payload_fields, payload_default, payload_fill) = match &rp.payload {
+        None => (quote!(), quote!(), quote!()),
+        Some((b, m, c, i)) => {
+            crate::params::payload_params(&format!("body `{}`", model.bodies[*b].name), *m, c, i)
+        }
+    };
+    let (body_items, body_fields, body_default, body_fill) = crate::params::body_params(
+        &rp.bodies,
+        &|b| format!("model body `{}`", model.bodies[b].name),
+        dynamics::body_param_index(0, n),
+    );
+    quote! {
+        #body_items
+        /// Number of run-time parameters in [`Params::to_array`].
+        pub const NP: usize = #np;
+        /// Run-time parameters (`[scene] parameters = "runtime"`): every function takes them, so
+        /// one binary serves several payloads or drive calibrations. SI units.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Params {
+            #payload_fields
+            /// Viscous friction per joint (N·m·s/rad or N·s/m).
+            pub damping: [f64; DOF],
+            /// Coulomb friction level per joint (N·m or N), regularized as in the spec docs.
+            pub friction: [f64; DOF],
+            /// Reflected rotor inertia per joint (kg·m² or kg).
+            pub armature: [f64; DOF],
+            #body_fields
+        }
+        impl Params {
+            /// The values of the spec (what a module with constants would fold in).
+            pub const DEFAULT: Params = Params {
+                #payload_default
+                damping: #damping,
+                friction: #friction,
+                armature: #armature,
+                #body_default
+            };
+            /// The flat layout the generated functions read.
+            pub fn to_array(&self) -> [f64; NP] {
+                let mut a = [0.0; NP];
+                #payload_fill
+                let mut i = 0;
+                while i < DOF {
+                    a[#d0 + i] = self.damping[i];
+                    a[#f0 + i] = self.friction[i];
+                    a[#a0 + i] = self.armature[i];
+                    i += 1;
+                }
+                #body_fill
+                a
+            }
+        }
+        impl Default for Params {
+            fn default() -> Self {
+                Self::DEFAULT
+            }
+        }
+    }
+}
+
+/// Generate the module of a validated tree for `scene`: only the functions it selects (those
+/// not asked for are not emitted, so their operations cost nothing), with its run-time
+/// parameters (`None`: constants).
+pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
+    let params = scene.params.as_ref();
+    let Symbolic {
+        graph: g,
+        dof: n,
+        mass_matrix: mm_out,
+        coriolis: cor,
+        gravity: grav,
+        inverse_dynamics: id,
+        forward_dynamics: fd,
+        forward_dynamics_guards: fd_guards,
+        friction,
+    } = symbolic_with(model, params);
+    type Spec = (&'static str, Vec<String>, Vec<Arg>, Kernel, Shape);
+    let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
+    let mut specs: Vec<Spec> = vec![
+        (
+            "mass_matrix",
+            vec![
+                "Generalized inertia matrix `I(q) = TᵀMT` (lecture eq. 21), symmetric positive \
+                 definite away from singularities; kg·m² (revolute rows/columns), kg (prismatic)."
+                    .into(),
+            ],
+            vec![Arg::Q],
+            k(mm_out),
+            Shape::Matrix,
+        ),
+        (
+            "coriolis",
+            vec![
+                "Velocity-dependent efforts `C(q, q̇) q̇` with `C = Tᵀ(MṪ + WMT)` (lecture eq. 22): \
+                 Coriolis and centrifugal terms, no gravity."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd],
+            k(cor),
+            Shape::Vector,
+        ),
+        (
+            "gravity",
+            vec![
+                "Efforts that hold the mechanism still against gravity, `−γ(q) = −Tᵀ w^G`; equal \
+                 to `inverse_dynamics(q, 0, 0)`."
+                    .into(),
+            ],
+            vec![Arg::Q],
+            k(grav),
+            Shape::Vector,
+        ),
+        (
+            "inverse_dynamics",
+            vec![
+                "Joint efforts (N·m for revolute, N for prismatic joints) that produce the motion: \
+                 `τ = I q̈ + C q̇ − γ` (lecture eq. 24). Units: q in rad or m, q̇ in rad/s or m/s, \
+                 q̈ in rad/s² or m/s²."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd, Arg::Qdd],
+            k(id),
+            Shape::Vector,
+        ),
+        (
+            "forward_dynamics",
+            vec![
+                "Joint accelerations `q̈ = I⁻¹ (τ − C q̇ + γ)`; `Err(Singular)` when a pivot of \
+                 the mass matrix's factorization is not above `1e-12` times its diagonal entry \
+                 (or an input is NaN)."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd, Arg::Tau],
+            Kernel::new(fd, fd_guards),
+            Shape::FallibleVector,
+        ),
+    ];
+    if let Some(friction) = friction {
+        specs.push((
+            "friction",
+            vec![
+                "Joint friction efforts `δ(q̇) = b q̇ + c q̇ / √(q̇² + v_s²)` (viscous and \
+                 regularized Coulomb, `[scene] friction = true`); included in \
+                 `inverse_dynamics` and `forward_dynamics`."
+                    .into(),
+            ],
+            vec![Arg::Qd],
+            k(friction),
+            Shape::Vector,
+        ));
+    }
+    if params.is_some() {
+        for spec in &mut specs {
+            spec.2.push(Arg::P);
+        }
+    }
+    let functions: Vec<Function<'_>> = specs
+        .into_iter()
+        .filter(|s| scene.functions.wants(Kind::Tree, s.0))
+        .map(|(name, doc, args, kernel, shape)| {
+            let schedule = schedule(&g, &kernel);
+            let outputs = kernel.outputs;
+            Function {
+                name,
+                doc,
+                args,
+                outputs,
+                shape,
+                schedule,
+                dof: n,
+                public: true,
+                sites: false,
+            }
+        })
+        .collect();
+    let stats: Vec<(String, OpCount)> = functions
+        .iter()
+        .map(|f| (f.name.to_string(), f.schedule.ops))
+        .collect();
+    let mut header = vec![
+        format!(
+            "@generated by nocdyn codegen {VERSION} from mechanism `{}` — do not edit.",
+            model.name
+        ),
+        format!("Degrees of freedom: {n}. Units: SI (m, kg, s, rad, N, N·m)."),
+        match &cfg.math {
+            MathBackend::Libm => {
+                "Math backend: the `libm` crate (sin/cos, sqrt); otherwise core only.".into()
+            }
+            MathBackend::Std => "Math backend: std (`f64::sin_cos`).".into(),
+            MathBackend::Runtime(p) => format!("Math backend: `{p}::math` (nocdyn runtime)."),
+        },
+        "Operation counts per call:".into(),
+    ];
+    header.extend(emit::stats_table(&stats, n));
+    let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let extra = params
+        .map(|rp| params_template(model, rp))
+        .unwrap_or_default();
+    let code = emit::module(&g, cfg, &header, n, &joint_names, &functions, extra);
+    Generated {
+        code,
+        stats,
+        dof: n,
+        warnings: diag::Diagnostics::new("", ""),
+        per: "joint",
+    }
+}
