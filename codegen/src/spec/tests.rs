@@ -1172,7 +1172,7 @@ fn snap_override_out_of_range_is_an_error() {
 /// count 1, ties to the first, case ignored); none for words longer than a name can be.
 #[test]
 fn suggestions_are_bounded() {
-    use super::closest;
+    use super::names::closest;
     assert_eq!(closest("inertai", &["mass", "inertia"]), Some("inertia"));
     assert_eq!(closest("lnik1", &["link2", "link1"]), Some("link1"));
     assert_eq!(closest("LINK1", &["link1"]), Some("link1"));

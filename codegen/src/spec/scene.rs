@@ -1,0 +1,492 @@
+//! The `[scene]` table and the [`SceneOverrides`] on top of it: the passes between reading and
+//! lowering (point masses, massless bodies, locked joints, drives, snapping), the functions a
+//! scene selects, and the run-time parameters placed on their model bodies.
+
+use super::{Function, MAX_SNAP, SNAP_HINT, is_snap_tolerance, suggest_hint};
+use super::{
+    FunctionSet, Kind, Mechanism, closed, geom, ir, is_urdf, lower, parallel, read_toml, snap,
+};
+use crate::diag::{Diagnostic, Diagnostics};
+
+/// What the application needs of the mechanism (the spec's `[scene]` table, with the
+/// [`SceneOverrides`] applied), as the generators read it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scene {
+    /// The public functions to emit (`[scene] functions`).
+    pub functions: FunctionSet,
+    /// The run-time parameters (`[scene] parameters = "runtime"`; `None`: constants).
+    pub params: Option<RuntimeParams>,
+}
+
+/// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect
+/// on in addition to what the spec's `[scene]` says (a URDF has no `[scene]`; its
+/// `<dynamics damping friction>` apply only with `friction`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneOverrides {
+    /// Apply the joints' viscous (`damping`) and Coulomb (`friction`) friction.
+    pub friction: bool,
+    /// Apply the joints' reflected rotor inertia (`armature`).
+    pub rotor_inertia: bool,
+    /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
+    /// replaces the spec's value). Out of (0, [`MAX_SNAP`]] it is an error.
+    pub snap: Option<f64>,
+}
+
+/// An error when joint `j`, which `role` (e.g. "closes a loop"), has a drive: friction and rotor
+/// inertia are modelled only where the joint's rate is known.
+pub(super) fn no_drive(j: &ir::JointSpec, role: &str, hint: &str, diags: &mut Diagnostics) {
+    if j.drive != Default::default() {
+        diags.push(
+            Diagnostic::error(format!(
+                "joint \"{}\" {role}: friction and rotor inertia are not modelled there",
+                j.name
+            ))
+            .with_key(j.key.clone())
+            .with_span(j.span.clone())
+            .with_hint(hint),
+        );
+    }
+}
+
+/// The passes between reading and lowering: the overrides on top of the spec's `[scene]`,
+/// snapping, then the scene's changes to the bodies and joints.
+pub(super) fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {
+    spec.scene.friction |= overrides.friction;
+    spec.scene.rotor_inertia |= overrides.rotor_inertia;
+    if let Some(tol) = overrides.snap {
+        if is_snap_tolerance(tol) {
+            spec.scene.snap = Some(tol);
+        } else {
+            // Set outside the file (`--snap`, `Builder::snap`): no place in it to point at.
+            diags.push(
+                Diagnostic::error(format!(
+                    "the snap tolerance {tol} is not in (0, {MAX_SNAP}]"
+                ))
+                .with_hint(SNAP_HINT),
+            );
+        }
+    }
+    snap::snap(spec, diags);
+    apply_scene(spec, diags);
+}
+
+/// `[scene]`: point masses and massless bodies replace the bodies' inertial data before
+/// lowering (so everything downstream, fixed-joint merging included, sees the scene's model).
+pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
+    let scene = spec.scene.clone();
+    let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
+    let find = |n: &ir::Named, diags: &mut Diagnostics| -> Option<usize> {
+        let i = names.iter().position(|b| *b == n.name);
+        if i.is_none() {
+            let mut d = Diagnostic::error(format!("unknown body {:?}", n.name))
+                .with_key(n.key.clone())
+                .with_span(n.span.clone());
+            if let Some(h) = suggest_hint(&n.name, &names) {
+                d = d.with_hint(h);
+            }
+            diags.push(d);
+        }
+        i
+    };
+    let mut point = Vec::new();
+    let mut massless = Vec::new();
+    for n in &scene.point_mass {
+        point.extend(find(n, diags));
+    }
+    for n in &scene.massless {
+        massless.extend(find(n, diags));
+    }
+    let runtime = resolve_runtime_inertia(spec, &scene, &point, &massless, &find, diags);
+    if let Some(p) = &scene.payload
+        && let Some(i) = find(&p.body, diags)
+    {
+        let runtime = scene.runtime_params;
+        if !(p.mass.is_finite() && p.mass >= 0.0) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "payload mass {} is not a finite, non-negative number",
+                    p.mass
+                ))
+                .with_key("scene.payload.mass")
+                .with_span(p.body.span.clone()),
+            );
+        } else if !runtime {
+            // Run-time parameters keep the payload apart (`scene_params`).
+            let b = &mut spec.bodies[i];
+            let c = geom::MassProps::combine(&[
+                geom::MassProps {
+                    mass: b.mass,
+                    com: b.com,
+                    inertia: b.inertia,
+                },
+                geom::MassProps {
+                    mass: p.mass,
+                    com: p.com,
+                    inertia: p.inertia,
+                },
+            ]);
+            b.mass = c.mass;
+            b.com = c.com;
+            b.inertia = c.inertia;
+        }
+    }
+    // Locked joints become fixed joints placed at their value.
+    for (n, value) in &scene.locked {
+        let Some(j) = spec.joints.iter_mut().find(|j| j.name == n.name) else {
+            let names: Vec<&str> = spec.joints.iter().map(|j| j.name.as_str()).collect();
+            let mut d = Diagnostic::error(format!("unknown joint {:?}", n.name))
+                .with_key(n.key.clone())
+                .with_span(n.span.clone());
+            if let Some(h) = suggest_hint(&n.name, &names) {
+                d = d.with_hint(h);
+            }
+            diags.push(d);
+            continue;
+        };
+        if !matches!(j.kind, ir::Kind::Revolute | ir::Kind::Prismatic) {
+            diags.push(
+                Diagnostic::error(format!("cannot lock a {} joint", j.kind.word()))
+                    .with_key(n.key.clone())
+                    .with_span(n.span.clone())
+                    .with_hint("only revolute and prismatic joints can be locked"),
+            );
+            continue;
+        }
+        let axis = j
+            .axes
+            .first()
+            .map(|a| a.v)
+            .filter(|v| geom::norm(v) > 1e-12)
+            .map(|v| {
+                let l = geom::norm(&v);
+                [v[0] / l, v[1] / l, v[2] / l]
+            })
+            .unwrap_or([0.0, 0.0, 1.0]);
+        let motion = if j.kind == ir::Kind::Revolute {
+            runtime::model::Transform {
+                rotation: runtime::model::axis_angle(&axis, *value),
+                translation: [0.0; 3],
+            }
+        } else {
+            geom::trans([axis[0] * value, axis[1] * value, axis[2] * value])
+        };
+        let (origin, offset) = lower::placement_frames(&j.placement);
+        j.placement =
+            ir::Placement::Origin(geom::compose(&geom::compose(&origin, &motion), &offset));
+        j.kind = ir::Kind::Fixed;
+        j.axes.clear();
+        j.actuated = false;
+    }
+    // Run-time inertia: the spec's values are kept apart as the defaults, the constants go.
+    for r in &runtime {
+        let b = &mut spec.bodies[r.body];
+        b.mass = 0.0;
+        b.com = [0.0; 3];
+        b.inertia = [[0.0; 3]; 3];
+    }
+    spec.scene.runtime_bodies = runtime;
+    for i in point {
+        spec.bodies[i].inertia = [[0.0; 3]; 3];
+    }
+    for i in massless {
+        spec.bodies[i].mass = 0.0;
+        spec.bodies[i].inertia = [[0.0; 3]; 3];
+    }
+}
+
+/// `[scene] runtime_inertia`: the bodies whose inertial parameters become run-time
+/// parameters, with the spec's values (see [`ir::RuntimeBodySpec`]). `"all"` takes every body
+/// with mass or inertia that is neither a point mass nor massless (in a parallel mechanism:
+/// the platform and the bodies fixed to it). Errors: the key without `parameters = "runtime"`,
+/// unknown names (with a suggestion), a body named twice or also in `point_mass` / `massless`,
+/// and a leg body of a parallel mechanism.
+pub(super) fn resolve_runtime_inertia(
+    spec: &ir::Spec,
+    scene: &ir::SceneSpec,
+    point: &[usize],
+    massless: &[usize],
+    find: &dyn Fn(&ir::Named, &mut Diagnostics) -> Option<usize>,
+    diags: &mut Diagnostics,
+) -> Vec<ir::RuntimeBodySpec> {
+    let Some((which, span)) = &scene.runtime_inertia else {
+        return Vec::new();
+    };
+    if !scene.runtime_params {
+        diags.push(
+            Diagnostic::error("`runtime_inertia` makes bodies' inertial parameters run-time parameters, but the scene's parameters are constants")
+                .with_key("scene.runtime_inertia")
+                .with_span(span.clone())
+                .with_hint("add `parameters = \"runtime\"` to [scene] (the module then takes a `Params` struct), or remove `runtime_inertia`"),
+        );
+        return Vec::new();
+    }
+    let on_platform =
+        |name: &str| spec.platform.is_none() || parallel::pose_on_platform(spec, name).is_some();
+    let mut chosen: Vec<(usize, Option<ir::Named>)> = Vec::new();
+    match which {
+        ir::RuntimeInertia::All => {
+            for (i, b) in spec.bodies.iter().enumerate() {
+                let has_mass = b.mass != 0.0 || b.inertia.iter().flatten().any(|x| *x != 0.0);
+                if has_mass && !point.contains(&i) && !massless.contains(&i) && on_platform(&b.name)
+                {
+                    chosen.push((i, None));
+                }
+            }
+        }
+        ir::RuntimeInertia::Bodies(names) => {
+            for n in names {
+                let Some(i) = find(n, diags) else { continue };
+                let error = |msg: String, hint: &str| {
+                    Diagnostic::error(msg)
+                        .with_key(n.key.clone())
+                        .with_span(n.span.clone())
+                        .with_hint(hint)
+                };
+                if chosen.iter().any(|(k, _)| *k == i) {
+                    diags.push(error(
+                        format!("body {:?} is named twice in `runtime_inertia`", n.name),
+                        "name each body once",
+                    ));
+                } else if point.contains(&i) || massless.contains(&i) {
+                    let what = if point.contains(&i) {
+                        "point_mass"
+                    } else {
+                        "massless"
+                    };
+                    diags.push(error(
+                        format!("body {:?} is in both `runtime_inertia` and `{what}`", n.name),
+                        "a body's inertia is either given at run time or simplified as a constant: remove it from one of the two lists",
+                    ));
+                } else if !on_platform(&n.name) {
+                    diags.push(error(
+                        format!("body {:?} is not the platform or fixed to it: leg bodies' inertia is constant; only the platform's can be a run-time parameter", n.name),
+                        "name the platform body (or a body fixed to it), or drop this body from `runtime_inertia`; its inertia stays folded into the leg dynamics",
+                    ));
+                } else {
+                    chosen.push((i, Some(n.clone())));
+                }
+            }
+        }
+    }
+    chosen
+        .into_iter()
+        .map(|(i, named)| {
+            let b = &spec.bodies[i];
+            ir::RuntimeBodySpec {
+                body: i,
+                named,
+                mass: b.mass,
+                com: b.com,
+                inertia: b.inertia,
+            }
+        })
+        .collect()
+}
+
+pub(super) fn check_scene_functions(m: &Mechanism, fs: &[ir::Named], diags: &mut Diagnostics) {
+    let kind = m.kind();
+    let offered = || kind.selectable().iter().chain(kind.always());
+    for f in fs {
+        let ok = f
+            .name
+            .parse::<Function>()
+            .is_ok_and(|f| offered().any(|&g| g == f));
+        if !ok {
+            let names: Vec<&str> = offered().map(|f| f.name()).collect();
+            let always: Vec<&str> = kind.always().iter().map(|f| f.name()).collect();
+            let what = match kind {
+                Kind::Tree => "a tree module",
+                Kind::Parallel => "a parallel module",
+                Kind::Closed => "a closed-loop module",
+            };
+            let hint = if always.is_empty() {
+                format!("{what} offers {}", names.join(", "))
+            } else {
+                format!(
+                    "{what} offers {} ({} are always emitted)",
+                    names.join(", "),
+                    always.join(" and ")
+                )
+            };
+            diags.push(
+                Diagnostic::error(format!("cannot select function {:?}", f.name))
+                    .with_key(f.key.clone())
+                    .with_span(f.span.clone())
+                    .with_hint(hint),
+            );
+        }
+    }
+}
+
+/// The spec's body names in file order (TOML only; `None` when it cannot be read). For tools
+/// that write `[scene]` tables (`codegen reduce`).
+pub fn body_names(file_name: &str, source: &str) -> Option<Vec<String>> {
+    if is_urdf(file_name) {
+        return None;
+    }
+    let mut d = Diagnostics::new(file_name, source);
+    let spec = read_toml::read(source, &mut d)?;
+    Some(spec.bodies.into_iter().map(|b| b.name).collect())
+}
+
+/// The run-time parameters of a spec with `[scene] parameters = "runtime"` ([`Scene::params`];
+/// `None` without).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeParams {
+    /// The payload: the model body it rides on, its mass (kg), mass centre (m) and inertia about
+    /// the mass centre (kg·m²), both in that body's frame. For a parallel mechanism the body is
+    /// the platform (index 0) and the values are in the platform frame; for closed loops it is
+    /// the body of the spanning tree.
+    pub payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
+    /// The speed scale `v_s` of the regularized Coulomb law (`[scene] coulomb_velocity`).
+    pub coulomb_velocity: f64,
+    /// Parallel mechanisms (leg joints) and closed loops (tree joints): the joints' viscous and
+    /// Coulomb friction are run-time parameters (the scene's `friction` is on). Trees take every
+    /// drive at run time.
+    pub leg_friction: bool,
+    /// Parallel mechanisms and closed loops: the joints' rotor inertias are run-time parameters
+    /// (the scene's `rotor_inertia` is on).
+    pub leg_rotor_inertia: bool,
+    /// `[scene] runtime_inertia`: the bodies whose inertial parameters are run-time parameters,
+    /// in the order of the list (`"all"`: the spec's body order), bodies fixed to the base left
+    /// out. Their constants are zero in the model.
+    pub bodies: Vec<RuntimeBody>,
+}
+
+/// A body whose inertial parameters are run-time parameters (`[scene] runtime_inertia`): it
+/// enters the dynamics exactly as a run-time payload on the model body it is part of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeBody {
+    /// The spec body's name (the generated `RUNTIME_BODY_NAMES`).
+    pub name: String,
+    /// The model body it is rigidly part of (after fixed-joint merging; for a parallel
+    /// mechanism 0, the platform; for closed loops a body of the spanning tree).
+    pub body: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Mass centre in the model body's frame (m).
+    pub com: runtime::model::Vec3,
+    /// Inertia about the mass centre, model body's axes (kg·m²).
+    pub inertia: runtime::model::Mat3,
+}
+
+impl RuntimeBody {
+    /// The spec's values of `r` placed on model body `body` at `pose` (the spec body's frame in
+    /// the model body's frame).
+    fn placed(
+        spec: &ir::Spec,
+        r: &ir::RuntimeBodySpec,
+        body: usize,
+        pose: &runtime::model::Transform,
+    ) -> RuntimeBody {
+        let m = geom::MassProps {
+            mass: r.mass,
+            com: r.com,
+            inertia: r.inertia,
+        }
+        .transformed(pose);
+        RuntimeBody {
+            name: spec.bodies[r.body].name.clone(),
+            body,
+            mass: m.mass,
+            com: m.com,
+            inertia: m.inertia,
+        }
+    }
+}
+
+/// The run-time parameters of a prepared spec (see [`RuntimeParams`]), placed by `attach`
+/// (where each spec body went in the tree of a tree or closed-loop mechanism; `None` for a
+/// parallel one, whose payload rides on the platform).
+pub(super) fn runtime_params(
+    spec: &ir::Spec,
+    attach: Option<&[Option<lower::Attach>]>,
+) -> Option<RuntimeParams> {
+    if !spec.scene.runtime_params {
+        return None;
+    }
+    // Parallel mechanisms and closed loops: the payload (if any) placed on its model body, and
+    // the drives the scene models.
+    let placed = |spec: &ir::Spec, body: usize, pose: &runtime::model::Transform| {
+        let p = spec.scene.payload.as_ref()?;
+        let m = geom::MassProps {
+            mass: p.mass,
+            com: p.com,
+            inertia: p.inertia,
+        }
+        .transformed(pose);
+        Some((body, m.mass, m.com, m.inertia))
+    };
+    let with_drives =
+        |spec: &ir::Spec,
+         payload: Option<(usize, f64, runtime::model::Vec3, runtime::model::Mat3)>,
+         bodies: Vec<RuntimeBody>| {
+            let (friction, rotor) = (spec.scene.friction, spec.scene.rotor_inertia);
+            (payload.is_some() || friction || rotor || !bodies.is_empty()).then_some(
+                RuntimeParams {
+                    payload,
+                    coulomb_velocity: spec.scene.coulomb_velocity,
+                    leg_friction: friction,
+                    leg_rotor_inertia: rotor,
+                    bodies,
+                },
+            )
+        };
+    // The run-time bodies placed by `attach` (closed loops, trees): on the model body each
+    // spec body is part of; those fixed to the base move with nothing and are left out.
+    let attached = |spec: &ir::Spec, attach: &[Option<lower::Attach>]| -> Vec<RuntimeBody> {
+        spec.scene
+            .runtime_bodies
+            .iter()
+            .filter_map(|r| {
+                let at = attach[r.body]?;
+                Some(RuntimeBody::placed(spec, r, at.target?, &at.pose))
+            })
+            .collect()
+    };
+    let Some(attach) = attach else {
+        let payload = match spec.scene.payload.as_ref() {
+            None => None,
+            Some(p) => placed(spec, 0, &parallel::pose_on_platform(spec, &p.body.name)?),
+        };
+        let bodies = spec
+            .scene
+            .runtime_bodies
+            .iter()
+            .filter_map(|r| {
+                let pose = parallel::pose_on_platform(spec, &spec.bodies[r.body].name)?;
+                Some(RuntimeBody::placed(spec, r, 0, &pose))
+            })
+            .collect();
+        return with_drives(spec, payload, bodies);
+    };
+    if closed::is_closed(spec) {
+        // A payload on a body fixed to the base moves with nothing: it is left out.
+        let payload = spec.scene.payload.as_ref().and_then(|p| {
+            let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
+            let at = attach[b]?;
+            placed(spec, at.target?, &at.pose)
+        });
+        let bodies = attached(spec, attach);
+        return with_drives(spec, payload, bodies);
+    }
+    let payload = spec.scene.payload.as_ref().and_then(|p| {
+        let b = spec.bodies.iter().position(|b| b.name == p.body.name)?;
+        let at = attach[b]?;
+        let target = at.target?;
+        let m = geom::MassProps {
+            mass: p.mass,
+            com: p.com,
+            inertia: p.inertia,
+        }
+        .transformed(&at.pose);
+        Some((target, m.mass, m.com, m.inertia))
+    });
+    Some(RuntimeParams {
+        payload,
+        coulomb_velocity: spec.scene.coulomb_velocity,
+        leg_friction: false,
+        leg_rotor_inertia: false,
+        bodies: attached(spec, attach),
+    })
+}
