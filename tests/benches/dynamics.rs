@@ -222,7 +222,7 @@ macro_rules! bench_closed {
             let tau = generated::inverse_dynamics(&x, &u, &ud).expect("regular state");
             let reference = noc::inverse_dynamics(&plan, &x, &u, &ud).expect("regular state");
             assert!(rel_err(&tau, &reference) < 1e-9, "{name}: ID vs runtime");
-            let sys = tests::lagrange::from_closed(&model, &x);
+            let sys = references::lagrange::from_closed(&model, &x);
 
             let mut g = c.benchmark_group(format!("{name}/inverse_dynamics"));
             g.bench_function("generated", |b| {
@@ -240,9 +240,9 @@ macro_rules! bench_closed {
             });
             g.bench_function("lagrange_multipliers", |b| {
                 b.iter(|| {
-                    tests::lagrange::inverse_dynamics(
+                    references::lagrange::inverse_dynamics(
                         black_box(&sys),
-                        &tests::lagrange::Prescribed::ActuatedJoints,
+                        &references::lagrange::Prescribed::ActuatedJoints,
                         black_box(&u),
                         black_box(&ud),
                     )

@@ -1,14 +1,10 @@
 //! Shared helpers for nocdyn's integration tests: random models and states, error norms.
 #![allow(clippy::needless_range_loop)]
 
-pub mod baumgarte;
 pub mod closed;
-pub mod dd;
 
 pub mod pkm;
 pub mod variants;
-
-pub mod lagrange;
 
 use rand::{Rng, SeedableRng, rngs::StdRng};
 use runtime::model::{Body, Joint, JointKind, Model, Transform, rpy_to_matrix};

@@ -1,11 +1,11 @@
 //! The Lagrange-multiplier route in redundant coordinates with Baumgarte stabilization
-//! (`tests::baumgarte`) beside the NOC route (`runtime::simulate`), released from rest at home
+//! (`references::baumgarte`) beside the NOC route (`runtime::simulate`), released from rest at home
 //! under gravity, no actuation, RK4 at 1 kHz. The stability table of docs/accuracy.md comes from
 //! `cargo test --release -p tests --test baumgarte -- --nocapture --ignored` (10 s); the tests
 //! here run 2 s.
 
+use references::baumgarte;
 use runtime::simulate::{Mechanism, Method, simulate};
-use tests::baumgarte;
 
 const DT: f64 = 1e-3;
 /// Baumgarte's parameters (1/s): critically damped constraint error, `Φ ~ e^{−αt}`, fast against

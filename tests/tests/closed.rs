@@ -3,9 +3,9 @@
 //! the runtime, power balance, assembly round trips and the failure behaviour.
 
 use rand::Rng;
+use references::lagrange::{self, Prescribed};
 use runtime::closed::noc::{self, Plan};
 use tests::closed::{CLOSED, model, random_state, reach};
-use tests::lagrange::{self, Prescribed};
 use tests::pkm::rel;
 
 /// Efforts of the independent joints by the Lagrange route, in `independent` order.

@@ -281,7 +281,7 @@ macro_rules! closed {
                     worst_arith = worst_arith.max(rel(&to64(&t32), &same));
                     // Against double-double at the same input: how many units of its own
                     // rounding each precision loses (f32: 2⁻²⁴, f64: 2⁻⁵³).
-                    let dd = tests::dd::closed_inverse_dynamics_dd(&plan, &xa64, &ua64, &uda64).unwrap();
+                    let dd = references::dd::closed_inverse_dynamics_dd(&plan, &xa64, &ua64, &uda64).unwrap();
                     loss32 = loss32.max(rel(&to64(&t32), &dd) / f32::EPSILON as f64 * 2.0);
                     loss64 = loss64.max(rel(&same, &dd) / f64::EPSILON * 2.0);
                     let m = d::mass_matrix(&xr).unwrap();

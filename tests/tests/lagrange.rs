@@ -1,4 +1,4 @@
-//! The Lagrange-multiplier route (`tests::lagrange`: full Newton–Euler of every body, reactions
+//! The Lagrange-multiplier route (`references::lagrange`: full Newton–Euler of every body, reactions
 //! and efforts as multipliers) against independent routes:
 //! * trees and serial chains (R and P joints, massless U/S-style expansions): the spatial RNEA
 //!   (`runtime::rnea`) and the literal NOC (`runtime::noc`);
@@ -14,13 +14,13 @@
 //! Error norm (unless stated): ‖a − b‖∞ / max(‖b‖∞, 1) (`tests::rel_err`).
 
 use rand::Rng;
-use runtime::model::{Body, Joint, JointKind, Mat3, Model, Transform, Vec3, mat_vec, transpose};
-use runtime::parallel::{Leg, LegEnd, ParallelModel, PlatformMotion};
-use tests::lagrange::{
+use references::lagrange::{
     CBody, CJoint, CJointKind, CSystem, Prescribed, Solution, actuated_accelerations,
     actuated_rates, closure_residual, energy_rate, from_parallel, from_tree, inverse_dynamics,
     quaternion_matrix,
 };
+use runtime::model::{Body, Joint, JointKind, Mat3, Model, Transform, Vec3, mat_vec, transpose};
+use runtime::parallel::{Leg, LegEnd, ParallelModel, PlatformMotion};
 use tests::{Shape, inertia, random_model, random_state, rel_err, rng, unit};
 
 const TOL: f64 = 1e-10;

@@ -199,13 +199,13 @@ macro_rules! against_lagrange {
     ($test:ident, $name:ident) => {
         /// The generated inverse dynamics against the independent route: Newton–Euler of every
         /// body with the joint reactions and actuator efforts solved as Lagrange multipliers
-        /// (`tests::lagrange`, dense least squares in Cartesian body coordinates). The body
+        /// (`references::lagrange`, dense least squares in Cartesian body coordinates). The body
         /// poses come from the runtime's leg inverse kinematics, so the loop closure is
         /// checked first.
         #[test]
         fn $test() {
             use mechanisms::$name as g;
-            use tests::lagrange::{self, Prescribed};
+            use references::lagrange::{self, Prescribed};
             const DOF: usize = g::DOF;
             let m = model(stringify!($name));
             let plan = Plan::new(&m).unwrap();

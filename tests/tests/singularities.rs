@@ -5,8 +5,8 @@
 //! says `Err(Singular)` with a large condition estimate — never NaN, never garbage, never a
 //! panic — and once it fails it keeps failing closer to the singularity.
 //!
-//! The reference is the same NOC equations evaluated in double-double (`tests::dd`,
-//! ~32 digits): `tests::dd::inverse_dynamics_dd`.
+//! The reference is the same NOC equations evaluated in double-double (`references::dd`,
+//! ~32 digits): `references::dd::inverse_dynamics_dd`.
 //!
 //! Run `cargo test -p tests --test singularities -- --nocapture` to print the tables below.
 //! In them "κ pivots" is the largest over the smallest pivot of the column-scaled LU of `A`
@@ -17,10 +17,10 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use references::dd;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion};
 use runtime::scalar::{Singular, Site};
-use tests::dd;
 
 /// The relative accuracy an `Ok` result must reach against the double-double reference.
 const ACCURACY: f64 = 1e-6;
@@ -481,7 +481,7 @@ fn deltas() -> Vec<f64> {
 // Tests.
 
 /// The double-double reference agrees with the `f64` runtime at generic states away from
-/// singularities (sanity check of `tests::dd::inverse_dynamics_dd`).
+/// singularities (sanity check of `references::dd::inverse_dynamics_dd`).
 #[test]
 fn reference_agrees_with_runtime_at_generic_states() {
     for name in [

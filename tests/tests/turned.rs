@@ -2,12 +2,12 @@
 //! depend on how the mechanism sits in the base frame (a loop turned in space has rounding
 //! noise where the axis-aligned one has exact zeros), and the efforts must not either.
 
+use references::lagrange;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc as cnoc;
 use runtime::model::{Mat3, Transform, Vec3, mat_vec, matrix_quaternion};
 use runtime::parallel::noc as pnoc;
 use runtime::parallel::{ParallelModel, PlatformMotion};
-use tests::lagrange;
 use tests::pkm::{PARALLEL, rel};
 
 /// A generic turn (no axis along a coordinate axis, no special angle).

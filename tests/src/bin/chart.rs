@@ -4,7 +4,7 @@
 //! snapped), every way nocdyn offers to compute the inverse dynamics — including fidelity
 //! levels and the `libm` math backend (modules from `tests/build.rs`) — timed
 //! (median over repeated batches of 256 random regular states, ns per call) and compared with a
-//! double-double evaluation of the same equations (`tests::dd`; the worst relative error in the
+//! double-double evaluation of the same equations (`references::dd`; the worst relative error in the
 //! ∞-norm over the states). Writes `PREFIX.csv`, `PREFIX.md` and `PREFIX.svg` (log–log).
 //!
 //! ```text
@@ -79,7 +79,7 @@ fn puma(points: &mut Vec<Point>) {
         .collect();
     let reference: Vec<Vec<f64>> = states
         .iter()
-        .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
+        .map(|[q, qd, qdd]| references::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
         .collect();
     let m = "PUMA 560";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
@@ -138,10 +138,10 @@ fn puma(points: &mut Vec<Point>) {
     add("RNEA (spatial algebra)", &rnea);
     let lag = |i: usize| {
         let [q, qd, qdd] = &states[i];
-        let sys = tests::lagrange::from_tree(&model, q);
-        tests::lagrange::inverse_dynamics(
+        let sys = references::lagrange::from_tree(&model, q);
+        references::lagrange::inverse_dynamics(
             &sys,
-            &tests::lagrange::Prescribed::ActuatedJoints,
+            &references::lagrange::Prescribed::ActuatedJoints,
             qd,
             qdd,
         )
@@ -169,7 +169,7 @@ fn gough_stewart(points: &mut Vec<Point>) {
         .collect();
     let reference: Vec<Vec<f64>> = states
         .iter()
-        .map(|(x, u, ud)| tests::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .map(|(x, u, ud)| references::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
         .collect();
     let m = "Gough–Stewart";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
@@ -230,13 +230,13 @@ fn gough_stewart(points: &mut Vec<Point>) {
     let lag = |i: usize| {
         let (x, u, ud) = &states[i];
         let legs = noc::leg_joint_positions(&plan, x).unwrap();
-        let sys = tests::lagrange::from_parallel(&model, &legs, x);
+        let sys = references::lagrange::from_parallel(&model, &legs, x);
         let p = sys.bodies.len() - 1;
-        let pre = tests::lagrange::Prescribed::Pose {
+        let pre = references::lagrange::Prescribed::Pose {
             body: p,
             point: [x[0], x[1], x[2]],
         };
-        tests::lagrange::inverse_dynamics(&sys, &pre, u, ud)
+        references::lagrange::inverse_dynamics(&sys, &pre, u, ud)
             .unwrap()
             .efforts
     };
@@ -260,7 +260,7 @@ fn iiwa(points: &mut Vec<Point>) {
         .collect();
     let reference: Vec<Vec<f64>> = states
         .iter()
-        .map(|[q, qd, qdd]| tests::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
+        .map(|[q, qd, qdd]| references::dd::closed_inverse_dynamics_dd(&plan, q, qd, qdd).unwrap())
         .collect();
     let m = "iiwa 14 (URDF angles to 5 digits)";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
@@ -334,7 +334,7 @@ fn five_bar(points: &mut Vec<Point>) {
     }
     let reference: Vec<Vec<f64>> = states
         .iter()
-        .map(|(x, u, ud)| tests::dd::closed_inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .map(|(x, u, ud)| references::dd::closed_inverse_dynamics_dd(&plan, x, u, ud).unwrap())
         .collect();
     let m = "five-bar (joint coordinates)";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
@@ -369,10 +369,15 @@ fn five_bar(points: &mut Vec<Point>) {
     add("runtime (generic, f64)", &rt);
     let lag = |i: usize| {
         let (x, u, ud) = &states[i];
-        let sys = tests::lagrange::from_closed(&model, x);
-        tests::lagrange::inverse_dynamics(&sys, &tests::lagrange::Prescribed::ActuatedJoints, u, ud)
-            .unwrap()
-            .efforts
+        let sys = references::lagrange::from_closed(&model, x);
+        references::lagrange::inverse_dynamics(
+            &sys,
+            &references::lagrange::Prescribed::ActuatedJoints,
+            u,
+            ud,
+        )
+        .unwrap()
+        .efforts
     };
     add("Newton–Euler + Lagrange multipliers", &lag);
 }
@@ -414,14 +419,14 @@ fn walk(prefix: &str) -> Result<(), Box<dyn std::error::Error>> {
         let x: Vec<f64> = vec![home[0], home[1], home[2], q[0], q[1], q[2], q[3]];
         // The f32 code gets the state rounded to f32; its reference is taken there.
         let x32: Vec<f64> = x.iter().map(|&v| v as f32 as f64).collect();
-        let cond = tests::dd::conditioning(
-            &tests::dd::actuation_dd(&plan, &x).map_err(|e| e.to_string())?,
+        let cond = references::dd::conditioning(
+            &references::dd::actuation_dd(&plan, &x).map_err(|e| e.to_string())?,
         )
         .pivot_ratio;
-        let Ok(reference) = tests::dd::inverse_dynamics_dd(&plan, &x, &u, &ud) else {
+        let Ok(reference) = references::dd::inverse_dynamics_dd(&plan, &x, &u, &ud) else {
             continue;
         };
-        let reference32 = tests::dd::inverse_dynamics_dd(&plan, &x32, &u, &ud).ok();
+        let reference32 = references::dd::inverse_dynamics_dd(&plan, &x32, &u, &ud).ok();
         let err = |t: Vec<f64>| tests::pkm::rel(&t, &reference);
         let xa: [f64; 7] = x.clone().try_into().unwrap();
         let e64 = g::inverse_dynamics(&xa, &u, &ud)
@@ -437,13 +442,13 @@ fn walk(prefix: &str) -> Result<(), Box<dyn std::error::Error>> {
         .map(|(t, r)| tests::pkm::rel(&t.iter().map(|&v| v as f64).collect::<Vec<_>>(), &r));
         let ert = noc::inverse_dynamics(&plan, &x, &u, &ud).ok().map(err);
         let elg = noc::leg_joint_positions(&plan, &x).ok().and_then(|legs| {
-            let sys = tests::lagrange::from_parallel(&model, &legs, &x);
+            let sys = references::lagrange::from_parallel(&model, &legs, &x);
             let p = sys.bodies.len() - 1;
-            let pre = tests::lagrange::Prescribed::Pose {
+            let pre = references::lagrange::Prescribed::Pose {
                 body: p,
                 point: [x[0], x[1], x[2]],
             };
-            tests::lagrange::inverse_dynamics(&sys, &pre, &u, &ud)
+            references::lagrange::inverse_dynamics(&sys, &pre, &u, &ud)
                 .ok()
                 .map(|s| err(s.efforts))
         });
