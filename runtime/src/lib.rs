@@ -40,6 +40,8 @@ pub mod solve;
 #[cfg(feature = "alloc")]
 pub mod closed;
 #[cfg(feature = "alloc")]
+pub mod evaluator;
+#[cfg(feature = "alloc")]
 pub mod indices;
 #[cfg(feature = "alloc")]
 pub mod model;

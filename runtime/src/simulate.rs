@@ -1,11 +1,9 @@
 //! Forward-dynamics simulation of any mechanism the runtime evaluates, with its energy: the
 //! stability test of the charter ("test stability where methods fail").
 //!
-//! The state is `(x, u)`: a tree's joint positions and rates; a parallel mechanism's platform
-//! coordinates (the quaternion kept on the unit sphere by [`parallel::noc::retract`]) and
-//! speeds; a closed loop's joint positions (all of them) and the independent rates. A closed
-//! loop is integrated in its independent coordinates and reassembled by Newton after every
-//! stage (coordinate partitioning): its loops cannot drift open.
+//! Any [`Evaluator`]: the state is `(x, u)` as it defines them. A closed loop is integrated in
+//! its independent coordinates and reassembled by Newton after every stage (coordinate
+//! partitioning, its `advance`): its loops cannot drift open.
 //!
 //! Two fixed-step schemes: classical Runge–Kutta 4 (on a manifold: every stage moves `x` by
 //! `h·c·u` through the retraction) and semi-implicit (symplectic) Euler,
@@ -16,20 +14,7 @@ use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::closed;
-use crate::model::Model;
-use crate::parallel;
-
-/// What to simulate.
-#[derive(Clone, Copy, Debug)]
-pub enum Mechanism<'a> {
-    /// A tree (`runtime::noc`).
-    Tree(&'a Model),
-    /// A simple-platform parallel mechanism.
-    Parallel(&'a parallel::Plan),
-    /// Closed loops in joint coordinates.
-    Closed(&'a closed::Plan),
-}
+use crate::evaluator::Evaluator;
 
 /// The integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,85 +54,9 @@ impl Report {
     }
 }
 
-impl Mechanism<'_> {
-    /// Speed rates `u̇` with no actuation.
-    pub fn acceleration(&self, x: &[f64], u: &[f64]) -> Result<Vec<f64>, String> {
-        self.acceleration_driven(x, u, &vec![0.0; u.len()])
-    }
-
-    /// Speed rates `u̇` under the actuator efforts `tau` (N or N·m).
-    pub fn acceleration_driven(
-        &self,
-        x: &[f64],
-        u: &[f64],
-        tau: &[f64],
-    ) -> Result<Vec<f64>, String> {
-        match self {
-            Mechanism::Tree(m) => crate::noc::forward_dynamics(m, x, u, tau)
-                .map(|v| v.iter().copied().collect())
-                .map_err(|e| format!("{e:?}")),
-            Mechanism::Parallel(p) => {
-                parallel::noc::forward_dynamics(p, x, u, tau).map_err(|e| format!("{e}"))
-            }
-            Mechanism::Closed(p) => {
-                closed::noc::forward_dynamics(p, x, u, tau).map_err(|e| format!("{e}"))
-            }
-        }
-    }
-
-    /// `x ⊕ d` (`d` in speed coordinates).
-    pub fn advance(&self, x: &[f64], d: &[f64]) -> Result<Vec<f64>, String> {
-        match self {
-            Mechanism::Tree(_) => Ok(x.iter().zip(d).map(|(a, b)| a + b).collect()),
-            Mechanism::Parallel(p) => Ok(parallel::noc::retract(p.motion, x, d)),
-            Mechanism::Closed(p) => {
-                let xi: Vec<f64> = p
-                    .independent
-                    .iter()
-                    .zip(d)
-                    .map(|(&j, dj)| x[j] + dj)
-                    .collect();
-                closed::noc::forward_kinematics(p, &xi, x)
-                    .map_err(|e| format!("assembly failed: {e:?}"))
-            }
-        }
-    }
-
-    /// Kinetic and potential energy (J).
-    pub fn energy(&self, x: &[f64], u: &[f64]) -> Result<(f64, f64), String> {
-        let quad = |m: &[Vec<f64>]| {
-            0.5 * (0..u.len())
-                .map(|i| (0..u.len()).map(|j| u[i] * m[i][j] * u[j]).sum::<f64>())
-                .sum::<f64>()
-        };
-        match self {
-            Mechanism::Tree(m) => Ok((
-                crate::noc::kinetic_energy(m, x, u),
-                crate::noc::potential_energy(m, x),
-            )),
-            Mechanism::Parallel(p) => {
-                let mm = parallel::noc::mass_matrix(p, x).map_err(|e| format!("{e}"))?;
-                let v = parallel::noc::potential_energy(p, x).map_err(|e| format!("{e}"))?;
-                Ok((quad(&mm), v))
-            }
-            Mechanism::Closed(p) => {
-                let mm = closed::noc::mass_matrix(p, x).map_err(|e| format!("{e}"))?;
-                Ok((quad(&mm), closed::noc::potential_energy(p, x)))
-            }
-        }
-    }
-
-    fn closure(&self, x: &[f64]) -> f64 {
-        match self {
-            Mechanism::Closed(p) => closed::noc::closure_residual(p, x),
-            _ => 0.0,
-        }
-    }
-}
-
 /// Simulate from `(x0, u0)` with no actuation for `steps` steps of `dt` s.
 pub fn simulate(
-    mech: Mechanism<'_>,
+    mech: &dyn Evaluator,
     x0: &[f64],
     u0: &[f64],
     dt: f64,
@@ -172,7 +81,7 @@ pub struct Driven {
 /// [`simulate`] under constant actuator efforts `tau` (N or N·m, one per speed), returning the
 /// last state too: e.g. a benchmark driven by a motor torque.
 pub fn simulate_driven(
-    mech: Mechanism<'_>,
+    mech: &dyn Evaluator,
     x0: &[f64],
     u0: &[f64],
     tau: &[f64],
@@ -201,23 +110,23 @@ pub fn simulate_driven(
         let step = || -> Result<(Vec<f64>, Vec<f64>), String> {
             match method {
                 Method::SymplecticEuler => {
-                    let a = mech.acceleration_driven(&x, &u, tau)?;
+                    let a = mech.forward_dynamics(&x, &u, tau)?;
                     let un = axpy(&u, dt, &a);
                     let xn = mech.advance(&x, &scale(dt, &un))?;
                     Ok((xn, un))
                 }
                 Method::Rk4 => {
-                    let a1 = mech.acceleration_driven(&x, &u, tau)?;
+                    let a1 = mech.forward_dynamics(&x, &u, tau)?;
                     let u1 = u.clone();
                     let x2 = mech.advance(&x, &scale(0.5 * dt, &u1))?;
                     let u2 = axpy(&u, 0.5 * dt, &a1);
-                    let a2 = mech.acceleration_driven(&x2, &u2, tau)?;
+                    let a2 = mech.forward_dynamics(&x2, &u2, tau)?;
                     let x3 = mech.advance(&x, &scale(0.5 * dt, &u2))?;
                     let u3 = axpy(&u, 0.5 * dt, &a2);
-                    let a3 = mech.acceleration_driven(&x3, &u3, tau)?;
+                    let a3 = mech.forward_dynamics(&x3, &u3, tau)?;
                     let x4 = mech.advance(&x, &scale(dt, &u3))?;
                     let u4 = axpy(&u, dt, &a3);
-                    let a4 = mech.acceleration_driven(&x4, &u4, tau)?;
+                    let a4 = mech.forward_dynamics(&x4, &u4, tau)?;
                     let dx: Vec<f64> = (0..u.len())
                         .map(|i| dt / 6.0 * (u1[i] + 2.0 * u2[i] + 2.0 * u3[i] + u4[i]))
                         .collect();

@@ -5,7 +5,7 @@
 //! here run 2 s.
 
 use references::baumgarte;
-use runtime::simulate::{Mechanism, Method, simulate};
+use runtime::simulate::{Method, simulate};
 
 const DT: f64 = 1e-3;
 /// Baumgarte's parameters (1/s): critically damped constraint error, `Φ ~ e^{−αt}`, fast against
@@ -32,15 +32,7 @@ fn table(
         let x0 = vec![0.0; plan.nx()];
         let stab = baumgarte::simulate(&plan, &model.tree, &x0, DT, steps, ALPHA, ALPHA);
         let raw = baumgarte::simulate(&plan, &model.tree, &x0, DT, steps, 0.0, 0.0);
-        let noc = simulate(
-            Mechanism::Closed(&plan),
-            &x0,
-            &vec![0.0; plan.dof()],
-            DT,
-            steps,
-            Method::Rk4,
-        )
-        .unwrap();
+        let noc = simulate(&plan, &x0, &vec![0.0; plan.dof()], DT, steps, Method::Rk4).unwrap();
         out.push((name.to_string(), stab, raw, noc));
     }
     out

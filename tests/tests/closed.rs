@@ -765,7 +765,7 @@ fn andrews_squeezer_reproduces_the_published_solution() {
     let model = model("andrews_squeezer");
     let plan = Plan::new(&model).unwrap();
     let run = runtime::simulate::simulate_driven(
-        runtime::simulate::Mechanism::Closed(&plan),
+        &plan,
         &g::HOME,
         &[0.0],
         &[0.033],

@@ -43,7 +43,7 @@ fn energy_is_conserved_without_actuation() {
         let path = tests::pkm::spec_path(name);
         let src = std::fs::read_to_string(&path).unwrap();
         let (model, _) = codegen::spec::load_tree(&path.to_string_lossy(), &src).unwrap();
-        let mech = runtime::simulate::Mechanism::Tree(&model);
+        let mech = &model;
         for method in [Method::Rk4, Method::SymplecticEuler] {
             let r = simulate(mech, &q0, &vec![0.0; q0.len()], DT, STEPS, method).unwrap();
             row(name, method, &r);
@@ -62,7 +62,7 @@ fn energy_is_conserved_without_actuation() {
             continue;
         }
         let plan = runtime::closed::Plan::new(&model).unwrap();
-        let mech = runtime::simulate::Mechanism::Closed(&plan);
+        let mech = &plan;
         let x0 = vec![0.0; plan.nx()];
         for method in [Method::Rk4, Method::SymplecticEuler] {
             let r = simulate(mech, &x0, &vec![0.0; plan.dof()], DT, STEPS, method).unwrap();
@@ -84,7 +84,7 @@ fn energy_is_conserved_without_actuation() {
     for name in ["agile_eye", "planar_five_bar", "gough_stewart"] {
         let model = tests::pkm::model(name);
         let plan = runtime::parallel::Plan::new(&model).unwrap();
-        let mech = runtime::simulate::Mechanism::Parallel(&plan);
+        let mech = &plan;
         let x0 = model.home_x();
         for method in [Method::Rk4, Method::SymplecticEuler] {
             let r = simulate(mech, &x0, &vec![0.0; plan.dof()], DT, STEPS, method).unwrap();
