@@ -1,0 +1,190 @@
+//! The `[scene]` table: which functions, gravity, the bodies' mass overrides, the payload,
+//! drives (friction, rotor inertia), run-time parameters, snapping and locked joints.
+
+use runtime::model::Vec3;
+use toml::de::{DeTable, DeValue};
+
+use super::keys::{PAYLOAD_KEYS, SCENE_KEYS};
+use super::{Reader, Val, get};
+use crate::diag::Diagnostic;
+use crate::spec::ir::{Named, Payload, RuntimeInertia, SceneSpec};
+
+impl Reader<'_> {
+    /// The keys of `[scene]` (table `t`) in their fixed order; `gravity` overrides the
+    /// mechanism's.
+    pub(super) fn scene(&mut self, t: &DeTable<'_>, scene: &mut SceneSpec, gravity: &mut Vec3) {
+        self.unknown_keys(t, SCENE_KEYS, "scene");
+        if let Some(f) = get(t, "functions") {
+            scene.functions = self.names(f, "scene.functions");
+        }
+        if let Some(g) = get(t, "gravity")
+            && let Some(g) = self.triple(g, "scene.gravity", false)
+        {
+            *gravity = g;
+        }
+        if let Some(b) = get(t, "point_mass") {
+            scene.point_mass = self.names(b, "scene.point_mass").unwrap_or_default();
+        }
+        if let Some(b) = get(t, "massless") {
+            scene.massless = self.names(b, "scene.massless").unwrap_or_default();
+        }
+        if let Some(p) = get(t, "payload") {
+            scene.payload = self.payload(p);
+        }
+        if let Some(v) = get(t, "friction") {
+            scene.friction = self.boolean(v, "scene.friction").unwrap_or(false);
+        }
+        if let Some(v) = get(t, "rotor_inertia") {
+            scene.rotor_inertia = self.boolean(v, "scene.rotor_inertia").unwrap_or(false);
+        }
+        if let Some(v) = get(t, "coulomb_velocity") {
+            self.coulomb_velocity(v, scene);
+        }
+        if let Some(v) = get(t, "parameters") {
+            self.parameters(v, scene);
+        }
+        if let Some(v) = get(t, "runtime_inertia") {
+            self.runtime_inertia(v, scene);
+        }
+        if let Some(v) = get(t, "snap") {
+            self.snap(v, scene);
+        }
+        if let Some(l) = get(t, "locked") {
+            self.locked(l, scene);
+        }
+    }
+
+    /// `scene.coulomb_velocity`: a positive number.
+    fn coulomb_velocity(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(x) = self.number(v, "scene.coulomb_velocity") else {
+            return;
+        };
+        if x > 0.0 && x.is_finite() {
+            scene.coulomb_velocity = x;
+        } else {
+            self.diags.push(
+                Diagnostic::error("`coulomb_velocity` must be a positive number")
+                    .with_key("scene.coulomb_velocity")
+                    .with_span(Some(v.span()))
+                    .with_hint("the speed scale v_s of the Coulomb law c·q̇/√(q̇² + v_s²), in rad/s or m/s; the default is 1e-4"),
+            );
+        }
+    }
+
+    /// `scene.parameters`: `"constants"` or `"runtime"`.
+    fn parameters(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(x) = self.string(v, "scene.parameters") else {
+            return;
+        };
+        match x.as_str() {
+            "constants" => {}
+            "runtime" => {
+                scene.runtime_params = true;
+                scene.runtime_params_span = Some(v.span());
+            }
+            _ => self.diags.push(
+                Diagnostic::error(format!("unknown parameter mode {x:?}"))
+                    .with_key("scene.parameters")
+                    .with_span(Some(v.span()))
+                    .with_hint("\"constants\" (the default: folded into the code) or \"runtime\" (a generated `Params` struct with the payload and the joints' damping, friction and armature, passed to every function)"),
+            ),
+        }
+    }
+
+    /// `scene.runtime_inertia`: `"all"` or a list of body names.
+    fn runtime_inertia(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let span = Some(v.span());
+        let which = match v.get_ref() {
+            DeValue::String(x) if x.as_ref() == "all" => Some(RuntimeInertia::All),
+            DeValue::String(x) => {
+                self.diags.push(
+                    Diagnostic::error(format!("unknown `runtime_inertia` value {:?}", x.as_ref()))
+                        .with_key("scene.runtime_inertia")
+                        .with_span(span.clone())
+                        .with_hint("write \"all\" (every body with mass) or a list of body names, e.g. [\"link5\", \"link6\"]"),
+                );
+                None
+            }
+            _ => self
+                .names(v, "scene.runtime_inertia")
+                .map(RuntimeInertia::Bodies),
+        };
+        scene.runtime_inertia = which.map(|w| (w, span));
+    }
+
+    /// `scene.snap`: a tolerance in (0, 0.01].
+    fn snap(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(x) = self.number(v, "scene.snap") else {
+            return;
+        };
+        if crate::spec::is_snap_tolerance(x) {
+            scene.snap = Some(x);
+        } else {
+            self.diags.push(
+                Diagnostic::error("`snap` must be a tolerance in (0, 0.01]")
+                    .with_key("scene.snap")
+                    .with_span(Some(v.span()))
+                    .with_hint(crate::spec::SNAP_HINT),
+            );
+        }
+    }
+
+    /// `scene.locked`: a table of joint names and angles.
+    fn locked(&mut self, l: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(lt) = self.table(l, "scene.locked") else {
+            return;
+        };
+        for (k, v) in lt.iter() {
+            let key = format!("scene.locked.{}", k.get_ref());
+            if let Some(x) = self.angle(v, &key) {
+                scene.locked.push((
+                    Named {
+                        name: k.get_ref().to_string(),
+                        key,
+                        span: Some(k.span()),
+                    },
+                    x,
+                ));
+            }
+        }
+    }
+
+    /// `[scene] payload`: `body` (required), `mass`, `com`, `inertia` (default zero).
+    fn payload(&mut self, v: &Val<'_>) -> Option<Payload> {
+        let path = "scene.payload";
+        let t = self.table(v, path)?;
+        self.unknown_keys(t, PAYLOAD_KEYS, path);
+        let Some(b) = get(t, "body") else {
+            self.missing(
+                "body",
+                path,
+                v.span(),
+                "the body that carries the payload: body = \"<its name>\"",
+            );
+            return None;
+        };
+        let name = self.string(b, "scene.payload.body")?;
+        let mass = match get(t, "mass") {
+            Some(m) => self.number(m, "scene.payload.mass")?,
+            None => 0.0,
+        };
+        let com = match get(t, "com") {
+            Some(c) => self.triple(c, "scene.payload.com", false)?,
+            None => [0.0; 3],
+        };
+        let inertia = match get(t, "inertia") {
+            Some(i) => self.inertia(i, "scene.payload.inertia")?,
+            None => [[0.0; 3]; 3],
+        };
+        Some(Payload {
+            body: Named {
+                name,
+                key: "scene.payload.body".into(),
+                span: Some(b.span()),
+            },
+            mass,
+            com,
+            inertia,
+        })
+    }
+}
