@@ -11,6 +11,7 @@ use runtime::closed::noc::{self, Plan};
 use runtime::scalar::Singular;
 
 use crate::emit::{self, Function, Part, Shape};
+use crate::module::{self, ModulePlan};
 use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount, schedule};
@@ -261,10 +262,6 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         );
     }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
-    let fns: Vec<TokenStream> = functions
-        .iter()
-        .map(|f| emit::function(g, cfg, f))
-        .collect();
     let nx_lit = Literal::usize_unsuffixed(nx);
     let n_lit = Literal::usize_unsuffixed(n);
     let indep: Vec<Literal> = plan
@@ -335,8 +332,7 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     } else {
         quote!()
     };
-    let indices = crate::indices::template(cfg);
-    let tokens = quote! {
+    let items = quote! {
         /// Number of position coordinates `x`: every joint of the spanning tree.
         pub const NX: usize = #nx_lit;
         /// Degrees of freedom: independent coordinates, speeds `u`, actuators.
@@ -358,11 +354,17 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         const WRAP: [bool; NX] = [#(#wrap),*];
         #params
         #items
-        #(#fns)*
-        #actuator_mass_matrix
-        #indices
     };
-    let code = emit::render(&header, tokens);
+    let code = module::render(
+        &ModulePlan {
+            header,
+            items,
+            graph: g,
+            functions,
+            after: actuator_mass_matrix,
+        },
+        cfg,
+    );
     Ok(Generated {
         code,
         stats,

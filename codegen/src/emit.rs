@@ -493,56 +493,6 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
     }
 }
 
-/// Emit the whole module for `functions`; `header` lines go first as `//` comments.
-pub fn module(
-    g: &Graph,
-    cfg: &Config,
-    header: &[String],
-    dof: usize,
-    joint_names: &[String],
-    functions: &[Function<'_>],
-    extra: TokenStream,
-) -> String {
-    let dof_lit = Literal::usize_unsuffixed(dof);
-    let names = joint_names.iter();
-    let fns = functions.iter().map(|f| function(g, cfg, f));
-    let needs_singular = functions
-        .iter()
-        .any(|f| matches!(f.shape, Shape::FallibleVector));
-    let singular = needs_singular.then(|| {
-        quote! {
-            /// A failed pivot of the mass-matrix factorization: the configuration is singular
-            /// (or an input is NaN). `value` is the pivot that was not above its tolerance
-            /// (`1e-12` times the diagonal entry it came from); `condition_estimate` is that
-            /// diagonal entry divided by the pivot, a lower bound of the 2-norm condition number
-            /// of the mass matrix (`f64::INFINITY` when the pivot is not positive).
-            /// `pivot == DOF` is no pivot: the pivots passed but an input was not finite or the
-            /// result overflowed (`value` is the first non-finite entry of the result).
-            #[derive(Clone, Copy, Debug, PartialEq)]
-            pub struct Singular {
-                /// Index (joint) of the failed pivot; `DOF` for a non-finite input or result.
-                pub pivot: usize,
-                /// The pivot's value (the non-finite entry when `pivot == DOF`).
-                pub value: f64,
-                /// Lower bound of the mass matrix's 2-norm condition number.
-                pub condition_estimate: f64,
-            }
-        }
-    });
-    let indices = crate::indices::template(cfg);
-    let tokens = quote! {
-        /// Number of degrees of freedom (joint coordinates).
-        pub const DOF: usize = #dof_lit;
-        /// Joint names, in coordinate order.
-        pub const JOINT_NAMES: [&str; DOF] = [#(#names),*];
-        #singular
-        #extra
-        #(#fns)*
-        #indices
-    };
-    render(header, tokens)
-}
-
 /// Header comment lines, then the items `tokens` pretty-printed.
 pub(crate) fn render(header: &[String], tokens: TokenStream) -> String {
     let file: syn::File = match syn::parse2(tokens) {

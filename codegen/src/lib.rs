@@ -40,6 +40,7 @@ pub mod emit;
 pub mod indices;
 mod lu;
 pub mod macro_support;
+mod module;
 pub mod parallel;
 pub mod params;
 pub mod scalar;

@@ -17,6 +17,7 @@ use crate::params::{drive_inputs, params_items, payload_inputs, payload_inputs_a
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
+use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount, schedule};
 use crate::spec::{Kind, Scene};
 use crate::sym::{Arg, ExprId, Graph};
@@ -362,10 +363,6 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         );
     }
     header.extend(emit::stats_table_per(&stats, n, "DOF"));
-    let fns: Vec<TokenStream> = functions
-        .iter()
-        .map(|f| emit::function(g, cfg, f))
-        .collect();
     let names: Vec<&str> = model
         .legs
         .iter()
@@ -423,8 +420,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         .iter()
         .map(|&v| Literal::f64_unsuffixed(v))
         .collect();
-    let indices = crate::indices::template(cfg);
-    let tokens = quote! {
+    let items = quote! {
         /// Number of position coordinates `x`.
         pub const NX: usize = #nx_lit;
         /// Degrees of freedom: speeds `u`, actuators.
@@ -437,10 +433,17 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         pub const HOME: [f64; NX] = [#(#home),*];
         #params_items
         #items
-        #(#fns)*
-        #indices
     };
-    let code = emit::render(&header, tokens);
+    let code = module::render(
+        &ModulePlan {
+            header,
+            items,
+            graph: g,
+            functions,
+            after: quote!(),
+        },
+        cfg,
+    );
     Ok(Generated {
         code,
         stats,

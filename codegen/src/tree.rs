@@ -2,10 +2,13 @@
 //! emitted as the module's functions, with the `Params` struct of a module whose payload,
 //! bodies or drives are run-time parameters.
 
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
 use runtime::model::Model;
 
 use crate::dynamics::{self, Terms, Tree};
 use crate::emit::{self, Function, Shape};
+use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount, schedule};
 use crate::spec::{self, Kind, Scene};
 use crate::sym::{self, Arg, Graph};
@@ -324,12 +327,65 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
     let extra = params
         .map(|rp| params_template(model, rp))
         .unwrap_or_default();
-    let code = emit::module(&g, cfg, &header, n, &joint_names, &functions, extra);
+    let items = items(n, &joint_names, &functions, extra);
+    let code = module::render(
+        &ModulePlan {
+            header,
+            items,
+            graph: &g,
+            functions,
+            after: quote!(),
+        },
+        cfg,
+    );
     Generated {
         code,
         stats,
         dof: n,
         warnings: diag::Diagnostics::new("", ""),
         per: "joint",
+    }
+}
+
+/// The tree module's items before its functions: `DOF`, `JOINT_NAMES`, the `Singular` error
+/// of `forward_dynamics` (when it is emitted) and `extra` (the `Params` items).
+fn items(
+    dof: usize,
+    joint_names: &[String],
+    functions: &[Function<'_>],
+    extra: TokenStream,
+) -> TokenStream {
+    let dof_lit = Literal::usize_unsuffixed(dof);
+    let names = joint_names.iter();
+    let needs_singular = functions
+        .iter()
+        .any(|f| matches!(f.shape, Shape::FallibleVector));
+    let singular = needs_singular.then(|| {
+        quote! {
+            /// A failed pivot of the mass-matrix factorization: the configuration is singular
+            /// (or an input is NaN). `value` is the pivot that was not above its tolerance
+            /// (`1e-12` times the diagonal entry it came from); `condition_estimate` is that
+            /// diagonal entry divided by the pivot, a lower bound of the 2-norm condition number
+            /// of the mass matrix (`f64::INFINITY` when the pivot is not positive).
+            /// `pivot == DOF` is no pivot: the pivots passed but an input was not finite or the
+            /// result overflowed (`value` is the first non-finite entry of the result).
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct Singular {
+                /// Index (joint) of the failed pivot; `DOF` for a non-finite input or result.
+                pub pivot: usize,
+                /// The pivot's value (the non-finite entry when `pivot == DOF`).
+                pub value: f64,
+                /// Lower bound of the mass matrix's 2-norm condition number.
+                pub condition_estimate: f64,
+            }
+        }
+    });
+    quote! {
+        /// Number of degrees of freedom (joint coordinates).
+        pub const DOF: usize = #dof_lit;
+        /// Joint names, in coordinate order.
+        pub const JOINT_NAMES: [&str; DOF] = [#(#names),*];
+        #singular
+        #extra
     }
 }

@@ -1,0 +1,46 @@
+//! The module plan: what a generated module contains, in the order it is written. Every
+//! mechanism kind returns one ([`crate::tree`], [`crate::parallel`], [`crate::closed`]), and
+//! [`render`] is the one place that writes a module: the header comment, the items before the
+//! functions (constants, error types, `Params`, the fixed templates), the scheduled functions,
+//! the items that wrap them, and the inertia-index template every module has.
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use crate::Config;
+use crate::emit::{self, Function};
+use crate::sym::Graph;
+
+/// A generated module before it is written.
+pub(crate) struct ModulePlan<'g> {
+    /// The header comment, one line an entry (without `// `).
+    pub header: Vec<String>,
+    /// The items before the functions.
+    pub items: TokenStream,
+    /// The DAG the functions read.
+    pub graph: &'g Graph,
+    /// The scheduled functions, in emission order.
+    pub functions: Vec<Function<'g>>,
+    /// Items after the functions (wrappers of them).
+    pub after: TokenStream,
+}
+
+/// The module's text: `plan` rendered in `cfg`'s math backend.
+pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
+    let items = &plan.items;
+    let fns = plan
+        .functions
+        .iter()
+        .map(|f| emit::function(plan.graph, cfg, f));
+    let after = &plan.after;
+    let indices = crate::indices::template(cfg);
+    emit::render(
+        &plan.header,
+        quote! {
+            #items
+            #(#fns)*
+            #after
+            #indices
+        },
+    )
+}
