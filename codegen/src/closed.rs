@@ -2,7 +2,9 @@
 //! written over [`runtime::scalar::Real`]) run on the symbolic scalar, so the whole of every function — tree
 //! kinematics, loop Jacobian, the pivoted LU of `Φ_d` (its row swaps are `Select` nodes),
 //! the tree's Newton–Euler sweep and the projection `Sᵀ` — is one flat DAG kernel. Newton's
-//! assembly is the one loop, a fixed template around a DAG step.
+//! assembly is the one loop, a fixed template around a DAG step. [`generate`] assembles the
+//! module from named pieces (the scheduled kernels, the op-count rows, the header, the
+//! constants and `Params`); the templates are in the `templates` submodule.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
@@ -15,9 +17,13 @@ use crate::module::{self, ModulePlan};
 use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount, schedule};
-use crate::spec::{Kind, Scene};
+use crate::spec::{Kind, RuntimeBody, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
+
+mod templates;
+
+use templates::templates;
 
 /// The DAG kernels of a closed-loop mechanism: each function's outputs with the guards its
 /// evaluation asked for (the closure tests of `x` among them: nothing reads their values, and
@@ -130,6 +136,48 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     let k = kernels_with(&plan, &layout, payload.map(|p| p.0), &body_links).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the loop geometry")
     })?;
+    let n = plan.dof();
+    let functions = functions(&k, &plan, &layout);
+    let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
+    let stats = stats(&functions, &wanted);
+    let functions: Vec<Function<'_>> = functions.into_iter().filter(|f| wanted(f.name)).collect();
+    let joint_names: Vec<String> = model.tree.joints.iter().map(|j| j.name.clone()).collect();
+    let act_names: Vec<String> = plan
+        .independent
+        .iter()
+        .map(|&j| joint_names[j].clone())
+        .collect();
+    let header = header(model, &plan, &layout, bodies, cfg, &act_names, &stats);
+    let items = items(model, &plan, params, &layout, &joint_names, &act_names);
+    // The names every actuator-space module has (parallel mechanisms): here the actuated
+    // joints are the independent coordinates, so `A = 1`.
+    let actuator_mass_matrix = if wanted("mass_matrix") {
+        actuator_mass_matrix(&layout)
+    } else {
+        quote!()
+    };
+    let code = module::render(
+        &ModulePlan {
+            header,
+            items,
+            graph: &k.graph,
+            functions,
+            after: actuator_mass_matrix,
+        },
+        cfg,
+    );
+    Ok(Generated {
+        code,
+        stats,
+        dof: n,
+        warnings: crate::diag::Diagnostics::new("", ""),
+        per: "DOF",
+    })
+}
+
+/// The DAG kernels as the module's scheduled functions, in emission order (all of them; the
+/// caller keeps those the scene selects).
+fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>> {
     let g = &k.graph;
     let n = plan.dof();
     let nx = plan.nx();
@@ -158,7 +206,7 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         sites: true,
     };
     let coords = "`x`: every tree joint's position (rad or m, `JOINT_NAMES` order), closing the loops (see `forward_kinematics`); `u`: the rates of the independent coordinates (`x[INDEPENDENT[k]]`)";
-    let functions = [
+    vec![
         make(
             "joint_rates",
             vec![format!(
@@ -203,7 +251,12 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
             fallible(&[Part::Coords(nx), Part::Scalar, Part::Scalar]),
             false,
         ),
-    ];
+    ]
+}
+
+/// The operation counts of the header's table: each selectable function `wanted` keeps, then
+/// a step of `forward_kinematics` (its `newton_step`).
+fn stats(functions: &[Function<'_>], wanted: &dyn Fn(&str) -> bool) -> Vec<(String, OpCount)> {
     let ops = |name: &str| {
         functions
             .iter()
@@ -211,7 +264,6 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
             .map(|f| f.schedule.ops)
             .unwrap_or_default()
     };
-    let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
     let mut stats: Vec<(String, OpCount)> = Kind::Closed
         .selectable()
         .iter()
@@ -223,13 +275,22 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         "forward_kinematics (per Newton step)".into(),
         ops("newton_step"),
     ));
-    let functions: Vec<Function<'_>> = functions.into_iter().filter(|f| wanted(f.name)).collect();
-    let joint_names: Vec<String> = model.tree.joints.iter().map(|j| j.name.clone()).collect();
-    let act_names: Vec<String> = plan
-        .independent
-        .iter()
-        .map(|&j| joint_names[j].clone())
-        .collect();
+    stats
+}
+
+/// The module's header comment: provenance, the loops and coordinates, the math backend, the
+/// run-time parameters (if any) and the operation-count table.
+fn header(
+    model: &ClosedModel,
+    plan: &Plan,
+    layout: &Layout,
+    bodies: &[RuntimeBody],
+    cfg: &Config,
+    act_names: &[String],
+    stats: &[(String, OpCount)],
+) -> Vec<String> {
+    let n = plan.dof();
+    let nx = plan.nx();
     let mut header = vec![
         format!(
             "@generated by nocdyn codegen {VERSION} from mechanism `{}` — do not edit.",
@@ -261,9 +322,22 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
             },
         );
     }
-    header.extend(emit::stats_table_per(&stats, n, "DOF"));
-    let nx_lit = Literal::usize_unsuffixed(nx);
-    let n_lit = Literal::usize_unsuffixed(n);
+    header.extend(emit::stats_table_per(stats, n, "DOF"));
+    header
+}
+
+/// The items before the functions: the constants (names, `INDEPENDENT`, `HOME`, and the
+/// assembly's `STEP` and `WRAP`), the run-time parameters' items and the fixed templates.
+fn items(
+    model: &ClosedModel,
+    plan: &Plan,
+    params: Option<&RuntimeParams>,
+    layout: &Layout,
+    joint_names: &[String],
+    act_names: &[String],
+) -> TokenStream {
+    let nx_lit = Literal::usize_unsuffixed(plan.nx());
+    let n_lit = Literal::usize_unsuffixed(plan.dof());
     let indep: Vec<Literal> = plan
         .independent
         .iter()
@@ -286,53 +360,9 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         })
         .collect();
     let items = templates(!plan.springs.is_empty());
-    let spring_names = if plan.springs.is_empty() {
-        quote!()
-    } else {
-        let names: Vec<&str> = plan.springs.iter().map(|s| s.name.as_str()).collect();
-        let ns = Literal::usize_unsuffixed(names.len());
-        quote! {
-            /// The spring-dampers (`[[spring]]`), in the order of `Site::Spring`: applied
-            /// forces, in every function's efforts with gravity.
-            pub const SPRING_NAMES: [&str; #ns] = [#(#names),*];
-        }
-    };
-    let params = if layout.any() {
-        let drives: Vec<&runtime::model::Drive> =
-            model.tree.joints.iter().map(|j| &j.drive).collect();
-        params_items(
-            &layout,
-            payload.map(|(b, m, c, i)| (format!("body `{}`", model.tree.bodies[b].name), m, c, i)),
-            &drives,
-            ("NX", "tree joint (`JOINT_NAMES` order)"),
-            "a payload on a body and the joints' drives the scene models",
-            bodies,
-            &|b| format!("tree body `{}`", model.tree.bodies[b].name),
-        )
-    } else {
-        quote!()
-    };
-    // The names every actuator-space module has (parallel mechanisms): here the actuated
-    // joints are the independent coordinates, so `A = 1`.
-    let actuator_mass_matrix = if wanted("mass_matrix") {
-        let (p_arg, p_call) = if layout.any() {
-            (quote!(, p: &Params), quote!(, p))
-        } else {
-            (quote!(), quote!())
-        };
-        quote! {
-            /// The mass matrix in actuator space, `A⁻ᵀ I A⁻¹` (the lecture's eq. 68): the
-            /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
-            #[allow(clippy::all)]
-            #[inline(always)]
-            pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
-                mass_matrix(x #p_call)
-            }
-        }
-    } else {
-        quote!()
-    };
-    let items = quote! {
+    let spring_names = spring_names(plan);
+    let params = runtime_params(model, params, layout);
+    quote! {
         /// Number of position coordinates `x`: every joint of the spanning tree.
         pub const NX: usize = #nx_lit;
         /// Degrees of freedom: independent coordinates, speeds `u`, actuators.
@@ -354,256 +384,61 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         const WRAP: [bool; NX] = [#(#wrap),*];
         #params
         #items
-    };
-    let code = module::render(
-        &ModulePlan {
-            header,
-            items,
-            graph: g,
-            functions,
-            after: actuator_mass_matrix,
-        },
-        cfg,
-    );
-    Ok(Generated {
-        code,
-        stats,
-        dof: n,
-        warnings: crate::diag::Diagnostics::new("", ""),
-        per: "DOF",
-    })
+    }
 }
 
-fn templates(springs: bool) -> TokenStream {
-    let tol = crate::scalar::tolerance;
-    let con_tol = tol(noc::CONSTRAINT_TOLERANCE);
-    let clo_tol = tol(noc::CLOSURE_TOLERANCE);
-    let fk_tol = Literal::f64_unsuffixed(tol(noc::FK_TOLERANCE));
-    // In single precision the loop equations' rounding floor can sit above the rescaled 1e-12
-    // (near 1e-5 of the size for poorly conditioned loops, measured on the four-bar and
-    // Bricard): when no step reduces the residual any more, a residual within the rescaled
-    // 1e-10 (3.7e-5) is accepted. In f64 the two are the same.
-    let stall_tol = Literal::f64_unsuffixed(if tol(1.0e-12) == 1.0e-12 {
-        noc::FK_TOLERANCE
+/// `SPRING_NAMES`, when the mechanism has spring-dampers.
+fn spring_names(plan: &Plan) -> TokenStream {
+    if plan.springs.is_empty() {
+        return quote!();
+    }
+    let names: Vec<&str> = plan.springs.iter().map(|s| s.name.as_str()).collect();
+    let ns = Literal::usize_unsuffixed(names.len());
+    quote! {
+        /// The spring-dampers (`[[spring]]`), in the order of `Site::Spring`: applied
+        /// forces, in every function's efforts with gravity.
+        pub const SPRING_NAMES: [&str; #ns] = [#(#names),*];
+    }
+}
+
+/// The run-time parameters' items (`Params`: the payload, the tree joints' drives, the run-time
+/// bodies), nothing without run-time parameters.
+fn runtime_params(
+    model: &ClosedModel,
+    params: Option<&RuntimeParams>,
+    layout: &Layout,
+) -> TokenStream {
+    if !layout.any() {
+        return quote!();
+    }
+    let payload = params.and_then(|p| p.payload);
+    let bodies = params.map_or(&[][..], |p| &p.bodies[..]);
+    let drives: Vec<&runtime::model::Drive> = model.tree.joints.iter().map(|j| &j.drive).collect();
+    params_items(
+        layout,
+        payload.map(|(b, m, c, i)| (format!("body `{}`", model.tree.bodies[b].name), m, c, i)),
+        &drives,
+        ("NX", "tree joint (`JOINT_NAMES` order)"),
+        "a payload on a body and the joints' drives the scene models",
+        bodies,
+        &|b| format!("tree body `{}`", model.tree.bodies[b].name),
+    )
+}
+
+/// `actuator_mass_matrix`, the name every actuator-space module has: `mass_matrix` itself.
+fn actuator_mass_matrix(layout: &Layout) -> TokenStream {
+    let (p_arg, p_call) = if layout.any() {
+        (quote!(, p: &Params), quote!(, p))
     } else {
-        tol(1e-10)
-    });
-    let fk_max = Literal::usize_unsuffixed(noc::FK_MAX_ITERATIONS);
-    let max_stages = Literal::usize_unsuffixed(noc::FK_MAX_STAGES);
-    let max_stages_f = Literal::f64_unsuffixed(noc::FK_MAX_STAGES as f64);
-    let full_tol = Literal::f64_unsuffixed(tol(noc::FULL_TOLERANCE));
-    let closure_doc = format!(
-        " Kept loop equation `k` exceeds `{clo_tol:e}` (times the mechanism's size for a point equation): `x` does not close the loops. `value` is `tol² − Φ_k²`."
-    );
-    let constraint_doc = format!(
-        " Pivot `i` of the LU of `Φ_d` (columns scaled to unit norm, partial pivoting) is `|p| ≤ {con_tol:e}`: the independent coordinates (nearly) fail to determine the others."
-    );
-    let spring_variant = if springs {
-        let doc = format!(
-            " Spring `k` (`SPRING_NAMES` order) is shorter than `{:e}` times the mechanism's size: its force has no direction.",
-            noc::SPRING_TOLERANCE
-        );
-        quote! {
-            #[doc = #doc]
-            Spring(usize),
-        }
-    } else {
-        quote!()
+        (quote!(), quote!())
     };
     quote! {
-        /// Where an evaluation failed.
-        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-        pub enum Site {
-            /// Pivot `i` of the generalized inertia's `LDLᵀ` (forward dynamics).
-            MassMatrix(usize),
-            #[doc = #closure_doc]
-            Closure(usize),
-            #[doc = #constraint_doc]
-            Constraint(usize),
-            #spring_variant
-            /// An input is NaN or infinite, or so large that a result overflows.
-            Input,
-        }
-
-        /// A configuration where the method fails, or a non-finite input: never a NaN result.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Singular {
-            /// Which matrix, equation or pivot.
-            pub site: Site,
-            /// The value that failed its test.
-            pub value: f64,
-            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
-            pub condition_estimate: f64,
-        }
-
-        /// Forward kinematics did not converge.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct NoConvergence {
-            /// Newton iterations made.
-            pub iterations: usize,
-            /// The last largest scaled loop-equation residual.
-            pub residual: f64,
-        }
-
-        /// The independent coordinates of `x` (rad or m, `ACTUATOR_NAMES` order).
+        /// The mass matrix in actuator space, `A⁻ᵀ I A⁻¹` (the lecture's eq. 68): the
+        /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
         #[allow(clippy::all)]
-        pub fn inverse_kinematics(x: &[f64; NX]) -> Result<[f64; DOF], Singular> {
-            let mut q = [0.0; DOF];
-            for k in 0..DOF {
-                let v = x[INDEPENDENT[k]];
-                if !v.is_finite() {
-                    return Err(Singular { site: Site::Input, value: v, condition_estimate: f64::INFINITY });
-                }
-                q[k] = v;
-            }
-            Ok(q)
-        }
-
-        /// The actuated joints' rates `q̇ = A u`: the actuated joints are the independent
-        /// coordinates (`A = 1`), so `u` itself. `Err(Site::Input)` for a non-finite independent
-        /// coordinate or speed;
-        /// whether `x` closes the loops is not needed here (`joint_rates` checks it).
-        #[allow(clippy::all)]
-        pub fn actuator_rates(x: &[f64; NX], u: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
-            inverse_kinematics(x)?;
-            for k in 0..DOF {
-                if !u[k].is_finite() {
-                    return Err(Singular { site: Site::Input, value: u[k], condition_estimate: f64::INFINITY });
-                }
-            }
-            Ok(*u)
-        }
-
-        /// Forward kinematics (assembly): the joint positions that close the loops with the
-        /// independent coordinates `q` (angles compared as given), on the branch of `guess`
-        /// (pass the last configuration to follow a motion, or `HOME`). The independent
-        /// coordinates move from `guess`'s to `q` in equal stages of at most `STEP` each (at
-        /// most 64 stages), each assembled by Newton's method from the last: a far target
-        /// stays on the guess's assembly mode. If a stage fails (the straight path crosses a
-        /// singularity), one Newton solve from `guess` decides. Each solve: the step halved
-        /// while it does not reduce the residual; at most 50 iterations, converged when every
-        /// kept loop equation is within `1e-12` (times the mechanism's size for a point
-        /// equation) and every loop equation (the redundant ones too) and revolute-axis
-        /// alignment within `1e-9` (else a spurious branch: `Err`), then one more full step
-        /// (kept unless it raises the residual); each dependent angle stays within ±π of its
-        /// guess.
-        #[allow(clippy::all)]
-        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            let mut need: f64 = 1.0;
-            for k in 0..DOF {
-                let d = q[k] - guess[INDEPENDENT[k]];
-                let a = (if d < 0.0 { -d } else { d }) / STEP[k];
-                if !(a <= need) {
-                    need = a;
-                }
-            }
-            if need > 1.0 {
-                let stages = if need < #max_stages_f {
-                    let n = need as usize;
-                    if (n as f64) < need { n + 1 } else { n }
-                } else {
-                    #max_stages
-                };
-                let mut x = *guess;
-                let mut followed = true;
-                for s in 1..=stages {
-                    let t = s as f64 / stages as f64;
-                    let mut qs = *q;
-                    if s < stages {
-                        for k in 0..DOF {
-                            let g = guess[INDEPENDENT[k]];
-                            qs[k] = g + t * (q[k] - g);
-                        }
-                    }
-                    match newton_assembly(&qs, &x) {
-                        Ok(xn) => x = xn,
-                        Err(_) => {
-                            followed = false;
-                            break;
-                        }
-                    }
-                }
-                if followed {
-                    return Ok(x);
-                }
-            }
-            newton_assembly(q, guess)
-        }
-
-        /// One Newton solve of `forward_kinematics` from `guess`.
-        #[allow(clippy::all)]
-        fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            // A dependent angle moved to within ±π of its guess (the same configuration): a
-            // long Newton step can land turns away, where f32 (and f64) keep fewer digits.
-            let wrap = |x: &mut [f64; NX]| {
-                let t = 2.0 * core::f64::consts::PI;
-                for i in 0..NX {
-                    let d = x[i] - guess[i];
-                    let ad = if d < 0.0 { -d } else { d };
-                    if WRAP[i] && ad > core::f64::consts::PI && ad < 1e9 {
-                        let k = d / t + 0.5;
-                        let mut n = k as i64 as f64;
-                        if n > k {
-                            n -= 1.0;
-                        }
-                        x[i] = guess[i] + (d - n * t);
-                    }
-                }
-            };
-            let mut x = *guess;
-            for k in 0..DOF {
-                x[INDEPENDENT[k]] = q[k];
-            }
-            let abs = |v: f64| if v < 0.0 { -v } else { v };
-            let Ok((mut dx, mut r, mut full)) = newton_step(&x) else {
-                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
-            };
-            for it in 0..#fk_max {
-                if abs(r) <= #fk_tol {
-                    if !(abs(full) <= #full_tol) {
-                        // The kept equations hold but not all of them: a spurious branch.
-                        return Err(NoConvergence { iterations: it, residual: abs(full) });
-                    }
-                    // One more full step: the coordinates to rounding.
-                    let mut xn = x;
-                    for i in 0..NX {
-                        xn[i] += dx[i];
-                    }
-                    if let Ok((_, rn, fulln)) = newton_step(&xn) {
-                        if abs(rn) <= abs(r) && abs(fulln) <= #full_tol {
-                            return Ok(xn);
-                        }
-                    }
-                    return Ok(x);
-                }
-                let mut step = 1.0;
-                let mut moved = false;
-                for _ in 0..20 {
-                    let mut xn = x;
-                    for i in 0..NX {
-                        xn[i] += step * dx[i];
-                    }
-                    wrap(&mut xn);
-                    if let Ok((dn, rn, fulln)) = newton_step(&xn) {
-                        if abs(rn) < abs(r) {
-                            x = xn;
-                            dx = dn;
-                            r = rn;
-                            full = fulln;
-                            moved = true;
-                            break;
-                        }
-                    }
-                    step *= 0.5;
-                }
-                if !moved {
-                    if abs(r) <= #stall_tol && abs(full) <= #full_tol {
-                        return Ok(x);
-                    }
-                    return Err(NoConvergence { iterations: it + 1, residual: abs(r) });
-                }
-            }
-            Err(NoConvergence { iterations: #fk_max, residual: abs(r) })
+        #[inline(always)]
+        pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
+            mass_matrix(x #p_call)
         }
     }
 }

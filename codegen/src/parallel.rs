@@ -3,7 +3,9 @@
 //! hash-consed DAG ([`crate::sym`]): constants fold, structural zeros vanish and common
 //! subexpressions are shared exactly as for trees. The DAG kernels are then wrapped by a few
 //! fixed templates (the partially pivoted LU of the actuation matrix, Newton's forward
-//! kinematics) into the module's public functions.
+//! kinematics) into the module's public functions. [`generate`] assembles the module from named
+//! pieces (the scheduled kernels, the op-count rows, the header, the constants and `Params`);
+//! the templates are in the `templates` submodule.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
@@ -19,9 +21,13 @@ use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount, schedule};
-use crate::spec::{Kind, Scene};
+use crate::spec::{Kind, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
-use crate::{Config, Generated, MathBackend, VERSION, lu};
+use crate::{Config, Generated, MathBackend, VERSION};
+
+mod templates;
+
+use templates::templates;
 
 /// The DAG kernels of a parallel mechanism: each function's outputs with the guards its
 /// evaluation asked for.
@@ -180,18 +186,40 @@ fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
 /// then take `p: &Params` last.
 pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Generated, String> {
     let params = scene.params.as_ref();
-    let payload = params.and_then(|p| p.payload);
     let layout = Layout::of(params);
     let want = |name: &str| scene.functions.wants(Kind::Parallel, name);
     let plan = Plan::new(model)?;
     let k = kernels_with(&plan, &layout).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
-    let g = &k.graph;
     let n = plan.dof();
-    let nx = plan.nx();
-    let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
-    let coords = match plan.motion {
+    let functions = functions(&k, &plan, &layout, &want);
+    let stats = stats(&functions, n, &want);
+    let header = header(model, &plan, &layout, cfg, &stats);
+    let items = items(model, &plan, params, &layout, cfg, &want);
+    let code = module::render(
+        &ModulePlan {
+            header,
+            items,
+            graph: &k.graph,
+            functions,
+            after: quote!(),
+        },
+        cfg,
+    );
+    Ok(Generated {
+        code,
+        stats,
+        dof: n,
+        warnings: crate::diag::Diagnostics::new("", ""),
+        per: "DOF",
+    })
+}
+
+/// The coordinates of `x` and `u` for the platform's motion, as the docs of
+/// `inverse_kinematics` state them.
+fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
+    match motion {
         PlatformMotion::Pose => {
             "`x = [px, py, pz, qw, qx, qy, qz]` (platform frame origin, m, and unit quaternion, base frame); `u = [ω; v]` (rad/s; m/s of the platform frame origin, base-frame components)"
         }
@@ -201,7 +229,21 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         PlatformMotion::PlanarPoint { .. } => {
             "`x = [px, py]` (the point where the legs meet, m, base frame); `u = [vx, vy]` (m/s)"
         }
-    };
+    }
+}
+
+/// The DAG kernels as the module's scheduled functions, in emission order: those `want`
+/// selects (`id_parts` with `inverse_dynamics`, `inertia_parts` with `actuator_mass_matrix`).
+fn functions(
+    k: &Kernels,
+    plan: &Plan,
+    layout: &Layout,
+    want: &dyn Fn(&str) -> bool,
+) -> Vec<Function<'static>> {
+    let g = &k.graph;
+    let n = plan.dof();
+    let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
+    let coords = coordinates_doc(&plan.motion);
     // The functions of the masses read the run-time payload.
     let with_p = |mut args: Vec<Arg>| {
         if layout.any() {
@@ -285,7 +327,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
             false,
         ),
     ];
-    let functions: Vec<Function<'_>> = functions
+    functions
         .into_iter()
         .filter(|f| {
             want(match f.name {
@@ -294,7 +336,17 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
                 n => n,
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The operation counts of the header's table: each public function `want` selects, a
+/// wrapper's LU (`inverse_dynamics`, `actuator_mass_matrix`, a step of `forward_kinematics`)
+/// added to its kernel's count.
+fn stats(
+    functions: &[Function<'_>],
+    n: usize,
+    want: &dyn Fn(&str) -> bool,
+) -> Vec<(String, OpCount)> {
     let ops = |name: &str| {
         functions
             .iter()
@@ -318,7 +370,20 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
             plus(ops("fk_parts"), lu, 1),
         ),
     ];
-    let stats: Vec<(String, OpCount)> = stats.into_iter().filter(|(n, _)| want(n)).collect();
+    stats.into_iter().filter(|(n, _)| want(n)).collect()
+}
+
+/// The module's header comment: provenance, the mechanism, the math backend, the run-time
+/// parameters (if any) and the operation-count table.
+fn header(
+    model: &ParallelModel,
+    plan: &Plan,
+    layout: &Layout,
+    cfg: &Config,
+    stats: &[(String, OpCount)],
+) -> Vec<String> {
+    let n = plan.dof();
+    let nx = plan.nx();
     let mut header = vec![
         format!(
             "@generated by nocdyn codegen {VERSION} from mechanism `{}` — do not edit.",
@@ -343,26 +408,41 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         "Operation counts per call (the LU of `A` counted with its pivot tests; error paths not counted):".into(),
     ];
     if layout.any() {
-        let mut parts = Vec::new();
-        if layout.payload {
-            parts.push("the platform's payload");
-        }
-        if layout.bodies > 0 {
-            parts.push("the platform's own inertia (`RUNTIME_BODY_NAMES`)");
-        }
-        if layout.drives() {
-            parts.push("the leg joints' drives");
-        }
-        let what = match parts.split_last() {
-            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
-            _ => parts.concat(),
-        };
-        header.insert(
-            3,
-            format!("Run-time parameters: {what} (`Params`, `[scene] parameters = \"runtime\"`)."),
-        );
+        header.insert(3, params_line(layout));
     }
-    header.extend(emit::stats_table_per(&stats, n, "DOF"));
+    header.extend(emit::stats_table_per(stats, n, "DOF"));
+    header
+}
+
+/// The header line naming the run-time parameters.
+fn params_line(layout: &Layout) -> String {
+    let mut parts = Vec::new();
+    if layout.payload {
+        parts.push("the platform's payload");
+    }
+    if layout.bodies > 0 {
+        parts.push("the platform's own inertia (`RUNTIME_BODY_NAMES`)");
+    }
+    if layout.drives() {
+        parts.push("the leg joints' drives");
+    }
+    let what = match parts.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => parts.concat(),
+    };
+    format!("Run-time parameters: {what} (`Params`, `[scene] parameters = \"runtime\"`).")
+}
+
+/// The items before the functions: the constants, the run-time parameters' items and the fixed
+/// templates.
+fn items(
+    model: &ParallelModel,
+    plan: &Plan,
+    params: Option<&RuntimeParams>,
+    layout: &Layout,
+    cfg: &Config,
+    want: &dyn Fn(&str) -> bool,
+) -> TokenStream {
     let names: Vec<&str> = model
         .legs
         .iter()
@@ -373,54 +453,16 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         .iter()
         .map(|l| l.joints[l.actuated] == JointKind::Revolute)
         .collect();
-    let items = templates(cfg, &plan, &revolute, &want, layout.any());
-    let params_items = if !layout.any() {
-        quote!()
-    } else {
-        let drives: Vec<&runtime::model::Drive> = model
-            .legs
-            .iter()
-            .flat_map(|l| l.joints.iter().take(3).map(|j| &j.drive))
-            .collect();
-        let joint_names: Vec<&str> = model
-            .legs
-            .iter()
-            .flat_map(|l| l.joints.iter().take(3).map(|j| j.name.as_str()))
-            .collect();
-        let nlj_lit = Literal::usize_unsuffixed(drives.len());
-        let leg_items = if layout.drives() {
-            quote! {
-                /// Number of leg joints (three per leg, base outwards), whose drives are run-time
-                /// parameters.
-                pub const LEG_JOINTS: usize = #nlj_lit;
-                /// The leg joints, in the order of the drive arrays of [`Params`].
-                pub const LEG_JOINT_NAMES: [&str; LEG_JOINTS] = [#(#joint_names),*];
-            }
-        } else {
-            quote!()
-        };
-        let items = params_items(
-            &layout,
-            payload.map(|(_, m, c, i)| ("the platform".to_string(), m, c, i)),
-            &drives,
-            ("LEG_JOINTS", "leg joint (`LEG_JOINT_NAMES` order)"),
-            "the payload on the platform and the leg joints' drives the scene models",
-            params.map_or(&[][..], |p| &p.bodies[..]),
-            &|_| "the platform".to_string(),
-        );
-        quote! {
-            #leg_items
-            #items
-        }
-    };
-    let nx_lit = Literal::usize_unsuffixed(nx);
-    let n_lit = Literal::usize_unsuffixed(n);
+    let items = templates(cfg, plan, &revolute, want, layout.any());
+    let params_items = runtime_params(model, params, layout);
+    let nx_lit = Literal::usize_unsuffixed(plan.nx());
+    let n_lit = Literal::usize_unsuffixed(plan.dof());
     let home: Vec<Literal> = model
         .home_x()
         .iter()
         .map(|&v| Literal::f64_unsuffixed(v))
         .collect();
-    let items = quote! {
+    quote! {
         /// Number of position coordinates `x`.
         pub const NX: usize = #nx_lit;
         /// Degrees of freedom: speeds `u`, actuators.
@@ -433,373 +475,53 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         pub const HOME: [f64; NX] = [#(#home),*];
         #params_items
         #items
-    };
-    let code = module::render(
-        &ModulePlan {
-            header,
-            items,
-            graph: g,
-            functions,
-            after: quote!(),
-        },
-        cfg,
-    );
-    Ok(Generated {
-        code,
-        stats,
-        dof: n,
-        warnings: crate::diag::Diagnostics::new("", ""),
-        per: "DOF",
-    })
-}
-
-/// The fixed items of every parallel module: error types, the LU of `A`, and the public
-/// functions that wrap the DAG kernels.
-fn templates(
-    cfg: &Config,
-    plan: &Plan,
-    revolute: &[bool],
-    want: &dyn Fn(&str) -> bool,
-    params: bool,
-) -> TokenStream {
-    // With run-time parameters the wrappers take and pass on `p: &Params`.
-    let (p_arg, p_pass) = if params {
-        (quote!(, p: &Params), quote!(, p))
-    } else {
-        (quote!(), quote!())
-    };
-    let sqrt_n = emit::math_call(cfg, "sqrt", quote!(n));
-    let sqrt_a = emit::math_call(cfg, "sqrt", quote!(a2));
-    let sin_cos = emit::math_call(cfg, "sin_cos", quote!(0.5 * a));
-    let tol = crate::scalar::tolerance;
-    let leg_tol = tol(noc::LEG_TOLERANCE);
-    let act_tol = tol(noc::ACTUATION_TOLERANCE);
-    let fk_tol = tol(noc::FK_TOLERANCE);
-    let fk_max = noc::FK_MAX_ITERATIONS;
-    let (qi, has_p) = match plan.motion {
-        PlatformMotion::Pose => (3usize, true),
-        PlatformMotion::Orientation { .. } => (0usize, false),
-        PlatformMotion::PlanarPoint { .. } => (0usize, false),
-    };
-    let planar = matches!(plan.motion, PlatformMotion::PlanarPoint { .. });
-    let qi = Literal::usize_unsuffixed(qi);
-    let translate = if has_p {
-        quote! {
-            for i in 0..3 {
-                out[i] += du[3 + i];
-            }
-        }
-    } else {
-        quote!()
-    };
-    let retract = retract_template(
-        planar,
-        qi.clone(),
-        translate.clone(),
-        sqrt_a.clone(),
-        sin_cos.clone(),
-        sqrt_n.clone(),
-    );
-    // The squared tolerance, rounded to 13 significant digits so that `1e-8²` reads `1e-16`.
-    let act_tol2 = act_tol * act_tol;
-    let act_tol2 = format!("{act_tol2:.12e}").parse().unwrap_or(act_tol2);
-    let sqrt_call = |t: TokenStream| emit::math_call(cfg, "sqrt", t);
-    let lu = |name: &str, doc: &str, transpose: bool, rhs: lu::Rhs| {
-        lu::lu_solve_fn(&lu::LuSolve {
-            name,
-            doc,
-            n: plan.dof(),
-            transpose,
-            rhs,
-            tol2: act_tol2,
-            sqrt: &sqrt_call,
-        })
-    };
-    let lu_solve = lu(
-        "lu_solve",
-        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with its columns scaled to unit 2-norm must exceed the tolerance times the\n largest so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of the largest scaled\n pivot to this one as the condition estimate.",
-        false,
-        lu::Rhs::Vector,
-    );
-    let lu_solve_t = lu(
-        "lu_solve_t",
-        " Solve `aᵀ x = b` (as `lu_solve`, on the transpose).",
-        true,
-        lu::Rhs::Vector,
-    );
-    let lu_inverse = lu(
-        "lu_inverse",
-        " `a⁻¹`: one factorization (as `lu_solve`) for the `DOF` columns of the identity.",
-        false,
-        lu::Rhs::Identity,
-    );
-    // Rounded to 13 significant digits, as the squared tolerance below.
-    let fk_tol = fk_tol * plan.fk_scale();
-    let fk_tol = format!("{fk_tol:.12e}").parse().unwrap_or(fk_tol);
-    let fk_tol_lit = Literal::f64_unsuffixed(fk_tol);
-    let fk_doc = [
-        " Forward kinematics: the platform coordinates whose actuated joint positions are `q`,"
-            .to_string(),
-        " by Newton's method from `guess` (`x ← x ⊕ A⁻¹ (q − q(x))`, the step halved while it"
-            .to_string(),
-        format!(" does not reduce the residual), at most {fk_max} iterations, converged when"),
-        format!(" `max |q(x) − q| ≤ {fk_tol:e}` (angles modulo 2π; a bound that does not grow"),
-        " with `q`). A non-finite `q` or `guess` is `Err` at once. The result's quaternion is"
-            .to_string(),
-        " unit.".to_string(),
-    ];
-    let sin_cos_q = emit::math_call(cfg, "sin_cos", quote!(v));
-    let atan2_sc = emit::math_call(cfg, "atan2", quote!(s, c));
-    let fk_max_lit = Literal::usize_unsuffixed(fk_max);
-    let leg_doc = format!(
-        " Leg `k`'s Jacobian is singular: `|det J| ≤ {leg_tol:e} · ∏‖columns‖` (a leg, type-I, singularity)."
-    );
-    let act_doc = format!(
-        " Pivot `i` of the actuation matrix `A` (columns scaled to unit norm, partial pivoting) is `≤ {act_tol:e}` times the largest pivot: a parallel (type-II) singularity."
-    );
-    // Wrappers of the kernels `[scene] functions` may leave out.
-    let id_wrapper = if want("inverse_dynamics") {
-        quote! {
-        /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
-        /// the platform motion `(x, u, ud)`; `Err` at a leg or parallel singularity.
-        #[inline]
-        pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF] #p_arg) -> Result<[f64; DOF], Singular> {
-            let (a, f) = id_parts(x, u, ud #p_pass)?;
-            lu_solve_t(&a, &f)
-        }
-
-        #lu_solve_t
-
-        }
-    } else {
-        quote!()
-    };
-    let amm_wrapper = if want("actuator_mass_matrix") {
-        quote! {
-        #lu_inverse
-
-        /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
-        #[allow(clippy::all)]
-        pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
-            let (a, i) = inertia_parts(x #p_pass)?;
-            let ai = lu_inverse(&a)?;
-            // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
-            let mut b = [[0.0; DOF]; DOF];
-            for r in 0..DOF {
-                for c in 0..DOF {
-                    let mut s = 0.0;
-                    for k in 0..DOF {
-                        s += i[r][k] * ai[k][c];
-                    }
-                    b[r][c] = s;
-                }
-            }
-            let mut out = [[0.0; DOF]; DOF];
-            for r in 0..DOF {
-                for c in r..DOF {
-                    let mut s = 0.0;
-                    for k in 0..DOF {
-                        s += ai[k][r] * b[k][c];
-                    }
-                    if !s.is_finite() {
-                        return Err(Singular { site: Site::Input, value: s, condition_estimate: f64::INFINITY });
-                    }
-                    out[r][c] = s;
-                    out[c][r] = s;
-                }
-            }
-            Ok(out)
-        }
-
-        }
-    } else {
-        quote!()
-    };
-    quote! {
-        /// Where an evaluation failed.
-        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-        pub enum Site {
-            /// Pivot `i` of the generalized inertia's `LDLᵀ` (forward dynamics).
-            MassMatrix(usize),
-            #[doc = #leg_doc]
-            Leg(usize),
-            /// Leg `k` cannot reach the platform: the pose is outside the workspace.
-            Reach(usize),
-            #[doc = #act_doc]
-            Actuation(usize),
-            /// The platform quaternion is zero (or not finite).
-            Platform,
-            /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite, or so large that a result
-            /// overflows.
-            Input,
-        }
-
-        /// A configuration where the method fails, or a non-finite input: never a NaN result.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Singular {
-            /// Which matrix, leg or pivot.
-            pub site: Site,
-            /// The determinant, pivot or discriminant that failed its test.
-            pub value: f64,
-            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
-            pub condition_estimate: f64,
-        }
-
-        /// Forward kinematics did not converge.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct NoConvergence {
-            /// Newton iterations made.
-            pub iterations: usize,
-            /// The last residual `max |q(x) − q|` (m or rad).
-            pub residual: f64,
-        }
-
-        /// Which actuators are revolute (angles are compared modulo 2π).
-        const REVOLUTE: [bool; DOF] = [#(#revolute),*];
-
-        #lu_solve
-
-        #id_wrapper
-
-        #amm_wrapper
-
-        #retract
-
-        /// The residual `q − q(x)` (angles wrapped to (−π, π]: `q`'s revolute entries are already
-        /// in [−π, π], as `q(x)`'s are), its max norm, and `A(x)`.
-        #[allow(clippy::all)]
-        fn fk_residual(q: &[f64; DOF], x: &[f64; NX]) -> Option<([f64; DOF], f64, [[f64; DOF]; DOF])> {
-            let (qx, a) = fk_parts(x).ok()?;
-            let mut r = [0.0; DOF];
-            let mut m: f64 = 0.0;
-            for i in 0..DOF {
-                let mut d = q[i] - qx[i];
-                if REVOLUTE[i] {
-                    let t = 2.0 * core::f64::consts::PI;
-                    if d > core::f64::consts::PI {
-                        d -= t;
-                    } else if d <= -core::f64::consts::PI {
-                        d += t;
-                    }
-                }
-                r[i] = d;
-                let ad = if d < 0.0 { -d } else { d };
-                if !(ad <= m) {
-                    m = ad;
-                }
-            }
-            if m < f64::INFINITY { Some((r, m, a)) } else { None }
-        }
-
-        #(#[doc = #fk_doc])*
-        #[allow(clippy::all)]
-        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            for v in q.iter().chain(guess.iter()) {
-                if !v.is_finite() {
-                    return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
-                }
-            }
-            // Revolute targets reduced to [−π, π] once (sin and cos reduce accurately).
-            let mut q = *q;
-            for i in 0..DOF {
-                if REVOLUTE[i] {
-                    let v = q[i];
-                    let (s, c) = #sin_cos_q;
-                    q[i] = #atan2_sc;
-                }
-            }
-            let q = &q;
-            let tol = #fk_tol_lit;
-            let mut x = retract(guess, &[0.0; DOF]);
-            let Some(mut cur) = fk_residual(q, &x) else {
-                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
-            };
-            for it in 0..#fk_max_lit {
-                if cur.1 <= tol {
-                    return Ok(x);
-                }
-                let Ok(du) = lu_solve(&cur.2, &cur.0) else {
-                    return Err(NoConvergence { iterations: it, residual: cur.1 });
-                };
-                let mut step = 1.0;
-                let mut moved = false;
-                for _ in 0..20 {
-                    let mut d = [0.0; DOF];
-                    for i in 0..DOF {
-                        d[i] = du[i] * step;
-                    }
-                    let xn = retract(&x, &d);
-                    if let Some(r) = fk_residual(q, &xn) {
-                        if r.1 < cur.1 {
-                            x = xn;
-                            cur = r;
-                            moved = true;
-                            break;
-                        }
-                    }
-                    step *= 0.5;
-                }
-                if !moved {
-                    return Err(NoConvergence { iterations: it + 1, residual: cur.1 });
-                }
-            }
-            if cur.1 <= tol {
-                Ok(x)
-            } else {
-                Err(NoConvergence { iterations: #fk_max_lit, residual: cur.1 })
-            }
-        }
     }
 }
 
-/// The `retract` template: `x ⊕ du`.
-fn retract_template(
-    planar: bool,
-    qi: Literal,
-    translate: TokenStream,
-    sqrt_a: TokenStream,
-    sin_cos: TokenStream,
-    sqrt_n: TokenStream,
+/// The run-time parameters' items (`Params`; with the drives, `LEG_JOINTS` and
+/// `LEG_JOINT_NAMES`), nothing without run-time parameters.
+fn runtime_params(
+    model: &ParallelModel,
+    params: Option<&RuntimeParams>,
+    layout: &Layout,
 ) -> TokenStream {
-    if planar {
-        return quote! {
-            /// `x` moved by `du` (the point's displacement, m).
-            #[allow(clippy::all)]
-            fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
-                let mut out = *x;
-                for i in 0..NX {
-                    out[i] += du[i];
-                }
-                out
-            }
-        };
+    if !layout.any() {
+        return quote!();
     }
-    quote! {
-        /// `x` moved by the small motion `du` (rotation vector, then translation; base frame).
-        #[allow(clippy::all)]
-        fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
-            let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
-            let a = #sqrt_a;
-            let (s, c) = #sin_cos;
-            let k = if a > 0.0 { s / a } else { 0.5 };
-            let d = [c, k * du[0], k * du[1], k * du[2]];
-            let i = #qi;
-            let q = [x[i], x[i + 1], x[i + 2], x[i + 3]];
-            let r = [
-                d[0] * q[0] - d[1] * q[1] - d[2] * q[2] - d[3] * q[3],
-                d[0] * q[1] + d[1] * q[0] + d[2] * q[3] - d[3] * q[2],
-                d[0] * q[2] - d[1] * q[3] + d[2] * q[0] + d[3] * q[1],
-                d[0] * q[3] + d[1] * q[2] - d[2] * q[1] + d[3] * q[0],
-            ];
-            let n = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3];
-            let n = #sqrt_n;
-            let mut out = *x;
-            for j in 0..4 {
-                out[i + j] = r[j] / n;
-            }
-            #translate
-            out
+    let payload = params.and_then(|p| p.payload);
+    let drives: Vec<&runtime::model::Drive> = model
+        .legs
+        .iter()
+        .flat_map(|l| l.joints.iter().take(3).map(|j| &j.drive))
+        .collect();
+    let joint_names: Vec<&str> = model
+        .legs
+        .iter()
+        .flat_map(|l| l.joints.iter().take(3).map(|j| j.name.as_str()))
+        .collect();
+    let nlj_lit = Literal::usize_unsuffixed(drives.len());
+    let leg_items = if layout.drives() {
+        quote! {
+            /// Number of leg joints (three per leg, base outwards), whose drives are run-time
+            /// parameters.
+            pub const LEG_JOINTS: usize = #nlj_lit;
+            /// The leg joints, in the order of the drive arrays of [`Params`].
+            pub const LEG_JOINT_NAMES: [&str; LEG_JOINTS] = [#(#joint_names),*];
         }
-
+    } else {
+        quote!()
+    };
+    let items = params_items(
+        layout,
+        payload.map(|(_, m, c, i)| ("the platform".to_string(), m, c, i)),
+        &drives,
+        ("LEG_JOINTS", "leg joint (`LEG_JOINT_NAMES` order)"),
+        "the payload on the platform and the leg joints' drives the scene models",
+        params.map_or(&[][..], |p| &p.bodies[..]),
+        &|_| "the platform".to_string(),
+    );
+    quote! {
+        #leg_items
+        #items
     }
 }

@@ -1,0 +1,271 @@
+//! The checks before urdf-rs reads the file: everything it would reject or misread (names,
+//! numbers, required elements and attributes, joint types, `<mimic>`), each reported at its
+//! span.
+
+use super::xml::{Attr, Doc};
+use crate::diag::{Diagnostic, Diagnostics};
+use crate::spec::suggest_hint;
+
+/// Everything urdf-rs would reject or misread, reported with spans. Returns the top-level
+/// `<link>` and `<joint>` tags in document order.
+pub(super) fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, Vec<usize>) {
+    let links: Vec<usize> = doc.children(doc.robot, "link").collect();
+    let joints: Vec<usize> = doc.children(doc.robot, "joint").collect();
+    check_names(doc, &links, &joints, diags);
+    for &l in &links {
+        check_link(doc, l, diags);
+    }
+    for &j in &joints {
+        check_joint(doc, j, diags);
+    }
+    (links, joints)
+}
+
+/// The name lengths of `<robot>`, then of the links, then of the joints.
+fn check_names(doc: &Doc<'_>, links: &[usize], joints: &[usize], diags: &mut Diagnostics) {
+    for &t in [doc.robot].iter().chain(links).chain(joints) {
+        if let Some(a) = doc.tags[t].attr("name")
+            && let Some(d) = crate::spec::name_too_long(a.value)
+        {
+            let what = doc.tags[t].name;
+            diags.push(d.with_key(format!("{what}.name")).with_span(a.span.clone()));
+        }
+    }
+}
+
+/// A `<link>`: its name, and its `<inertial>` (origin, mass, inertia) if it has one.
+fn check_link(doc: &Doc<'_>, l: usize, diags: &mut Diagnostics) {
+    let t = &doc.tags[l];
+    let lk = format!("link \"{}\"", t.attr("name").map_or("", |a| a.value));
+    if t.attr("name").is_none() {
+        diags.push(Diagnostic::error("<link> without a name").with_span(t.span.clone()));
+    }
+    let Some(inl) = doc.child(l, "inertial") else {
+        return;
+    };
+    if let Some(o) = doc.child(inl, "origin") {
+        for a in ["xyz", "rpy"] {
+            if let Some(at) = doc.tags[o].attr(a) {
+                check_triple(at, &format!("{lk}.inertial.origin.{a}"), diags);
+            }
+        }
+    }
+    match doc.child(inl, "mass") {
+        None => diags.push(
+            Diagnostic::error("<inertial> without <mass>")
+                .with_key(format!("{lk}.inertial"))
+                .with_span(doc.tags[inl].span.clone())
+                .with_hint(
+                    "add <mass value=\"...\"/> (kg), or remove <inertial> for a massless link",
+                ),
+        ),
+        Some(m) => match doc.tags[m].attr("value") {
+            Some(v) => check_number(v, &format!("{lk}.inertial.mass"), diags),
+            None => diags.push(
+                Diagnostic::error("<mass> without value")
+                    .with_key(format!("{lk}.inertial.mass"))
+                    .with_span(doc.tags[m].span.clone()),
+            ),
+        },
+    }
+    check_inertia(doc, inl, &lk, diags);
+}
+
+/// The `<inertia>` of the `<inertial>` `inl` of link `lk`: present, with six numbers.
+fn check_inertia(doc: &Doc<'_>, inl: usize, lk: &str, diags: &mut Diagnostics) {
+    match doc.child(inl, "inertia") {
+        None => diags.push(
+            Diagnostic::error("<inertial> without <inertia>")
+                .with_key(format!("{lk}.inertial"))
+                .with_span(doc.tags[inl].span.clone())
+                .with_hint(
+                    "add <inertia ixx=\"..\" ixy=\"..\" ixz=\"..\" iyy=\"..\" iyz=\"..\" izz=\"..\"/> (kg·m²)",
+                ),
+        ),
+        Some(it) => {
+            for a in ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"] {
+                let key = format!("{lk}.inertial.inertia.{a}");
+                match doc.tags[it].attr(a) {
+                    Some(v) => check_number(v, &key, diags),
+                    None => diags.push(
+                        Diagnostic::error(format!("<inertia> without {a}"))
+                            .with_key(key)
+                            .with_span(doc.tags[it].span.clone())
+                            .with_hint(
+                                "URDF requires all six of ixx, ixy, ixz, iyy, iyz, izz",
+                            ),
+                    ),
+                }
+            }
+        }
+    }
+}
+
+/// A `<joint>`: its name, type, `<mimic>`, the numbers of its origin and axis, and its ends.
+fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
+    let t = &doc.tags[j];
+    let name = t.attr("name").map_or("", |a| a.value);
+    let jk = format!("joint \"{name}\"");
+    if t.attr("name").is_none() {
+        diags.push(Diagnostic::error("<joint> without a name").with_span(t.span.clone()));
+    }
+    check_joint_type(doc, j, name, &jk, diags);
+    if let Some(m) = doc.child(j, "mimic") {
+        let of = doc.tags[m].attr("joint").map_or("?", |a| a.value);
+        // Read as an independent joint, as Pinocchio's URDF parser does by default (so the
+        // coordinates match), with a warning: the coupling is not modelled.
+        diags.push(
+            Diagnostic::warning(format!(
+                "joint \"{name}\" mimics \"{of}\": read as an independent joint"
+            ))
+            .with_key(format!("{jk}.mimic"))
+            .with_span(doc.tags[m].span.clone())
+            .with_hint(
+                "the coupling q = multiplier·q_other + offset is not modelled: the joint has its own coordinate (as in Pinocchio's default reading); lock it with [scene] locked in a TOML spec, or drive it yourself",
+            ),
+        );
+    }
+    for (tag, attrs) in [("origin", &["xyz", "rpy"][..]), ("axis", &["xyz"][..])] {
+        if let Some(o) = doc.child(j, tag) {
+            for a in attrs {
+                if let Some(at) = doc.tags[o].attr(a) {
+                    check_triple(at, &format!("{jk}.{tag}.{a}"), diags);
+                }
+            }
+        }
+    }
+    for end in ["parent", "child"] {
+        match doc.child(j, end).map(|e| &doc.tags[e]) {
+            Some(e) if e.attr("link").is_some() => {}
+            Some(e) => diags.push(
+                Diagnostic::error(format!("<{end}> without link"))
+                    .with_key(format!("{jk}.{end}"))
+                    .with_span(e.span.clone()),
+            ),
+            None => diags.push(
+                Diagnostic::error(format!("joint \"{name}\" has no <{end}>"))
+                    .with_key(format!("{jk}.{end}"))
+                    .with_span(t.span.clone()),
+            ),
+        }
+    }
+}
+
+/// The `type` of joint `j` (`name`, key `jk`): one of the kinds read here.
+fn check_joint_type(doc: &Doc<'_>, j: usize, name: &str, jk: &str, diags: &mut Diagnostics) {
+    let t = &doc.tags[j];
+    match t.attr("type") {
+        None => diags.push(
+            Diagnostic::error(format!("joint \"{name}\" has no type"))
+                .with_key(format!("{jk}.type"))
+                .with_span(t.span.clone()),
+        ),
+        Some(ty) => match ty.value {
+            "revolute" | "continuous" | "prismatic" | "fixed" => {}
+            "floating" | "planar" => diags.push(
+                Diagnostic::error(format!(
+                    "joint \"{name}\": {} joints are not supported",
+                    ty.value
+                ))
+                .with_key(format!("{jk}.type"))
+                .with_span(ty.span.clone())
+                .with_hint(
+                    "the base is fixed; model a free or planar base as a chain of prismatic and revolute joints with massless links",
+                ),
+            ),
+            other => {
+                const ALL: &[&str] = &["revolute", "continuous", "prismatic", "fixed"];
+                diags.push(
+                    Diagnostic::error(format!(
+                        "joint \"{name}\": unsupported joint type {other:?}"
+                    ))
+                    .with_key(format!("{jk}.type"))
+                    .with_span(ty.span.clone())
+                    .with_hint(suggest_hint(other, ALL).unwrap_or_else(|| {
+                        "the URDF joint types read here are revolute, continuous, prismatic and fixed".into()
+                    })),
+                )
+            }
+        },
+    }
+}
+
+/// Checks a `"x y z"` attribute strictly: three finite numbers.
+fn check_triple(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
+    let toks: Vec<&str> = attr.value.split_whitespace().collect();
+    let bad = toks.iter().find(|t| t.parse::<f64>().is_err());
+    let msg = if let Some(t) = bad {
+        Some(format!(
+            "invalid number {t:?} in {}=\"{}\"",
+            attr.name, attr.value
+        ))
+    } else if toks.len() != 3 {
+        Some(format!(
+            "expected three numbers in {}=\"{}\", found {}",
+            attr.name,
+            attr.value,
+            toks.len()
+        ))
+    } else if toks
+        .iter()
+        .any(|t| !t.parse::<f64>().is_ok_and(f64::is_finite))
+    {
+        Some(format!(
+            "non-finite number in {}=\"{}\"",
+            attr.name, attr.value
+        ))
+    } else if toks
+        .iter()
+        .any(|t| !t.parse::<f64>().is_ok_and(crate::spec::in_range))
+    {
+        Some(format!(
+            "number out of range in {}=\"{}\" (|x| <= 1e9)",
+            attr.name, attr.value
+        ))
+    } else {
+        None
+    };
+    if let Some(m) = msg {
+        let hint = if m.contains("out of range") {
+            crate::spec::RANGE_HINT
+        } else {
+            "write three finite numbers separated by spaces, e.g. \"0 0 1\""
+        };
+        diags.push(
+            Diagnostic::error(m)
+                .with_key(key)
+                .with_span(attr.span.clone())
+                .with_hint(hint),
+        );
+    }
+}
+
+/// Checks a single-number attribute strictly.
+fn check_number(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
+    match attr.value.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && crate::spec::in_range(x) => {}
+        Ok(x) if x.is_finite() => diags.push(
+            Diagnostic::error(format!(
+                "value out of range {}=\"{}\"",
+                attr.name, attr.value
+            ))
+            .with_key(key)
+            .with_span(attr.span.clone())
+            .with_hint(crate::spec::RANGE_HINT),
+        ),
+        Ok(_) => diags.push(
+            Diagnostic::error(format!("non-finite value {}=\"{}\"", attr.name, attr.value))
+                .with_key(key)
+                .with_span(attr.span.clone())
+                .with_hint("every value must be a finite number"),
+        ),
+        Err(_) => diags.push(
+            Diagnostic::error(format!("invalid number {}=\"{}\"", attr.name, attr.value))
+                .with_key(key)
+                .with_span(attr.span.clone())
+                .with_hint(
+                    "write a plain number such as 1.5 (decimal point, no units or expressions)",
+                ),
+        ),
+    }
+}
