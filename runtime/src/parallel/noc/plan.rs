@@ -242,15 +242,14 @@ impl Plan {
     pub fn dof(&self) -> usize {
         self.motion.dof()
     }
-    /// The scale of [`forward_kinematics`]' tolerance: `1 +` the longest leg (m, at home) among
-    /// the legs with a prismatic actuator (their residuals are lengths of that order), `1` when
-    /// every actuator is revolute (radians).
+    /// The scale of [`forward_kinematics`]' tolerance: the longest leg (m, at home) among the
+    /// legs with a prismatic actuator, at least 1 (a leg's position is rounded in proportion to
+    /// its length); `1` when every actuator is revolute (radians).
     pub fn fk_scale(&self) -> f64 {
-        1.0 + self
-            .legs
+        self.legs
             .iter()
             .filter(|l| l.joints[l.actuated] == JointKind::Prismatic)
-            .fold(0.0f64, |m, l| m.max(l.length))
+            .fold(1.0f64, |m, l| m.max(l.length))
     }
     /// Position coordinates.
     pub fn nx(&self) -> usize {
