@@ -44,7 +44,7 @@ pub(crate) fn in_range(x: f64) -> bool {
     x.abs() <= MAX_MAGNITUDE
 }
 
-/// The largest snapping tolerance (`[scene] snap`, `--snap`, [`SceneOverrides::snap`]): 0.01
+/// The largest snapping tolerance (`[scene] snap`, `--snap`, [`super::SceneOverrides::snap`]): 0.01
 /// (rad, m, or a rotation entry).
 pub const MAX_SNAP: f64 = 1e-2;
 
