@@ -244,6 +244,54 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
+    if let Err(code) = check_args(args) {
+        return code;
+    }
+    let design = match load_design(args) {
+        Ok(d) => d,
+        Err(code) => return code,
+    };
+    let (mut half, mut names) = search_box(&target, args);
+    let coordinate_names = names.clone();
+    if let Some(d) = &design {
+        half.push(0.5 * (d.hi - d.lo));
+        names.push(d.name.clone());
+    }
+    let norm = normalization(args.normalization);
+    let problem = Problem {
+        target: &target,
+        design: design.as_ref().map(|d| (d, 0.5 * (d.lo + d.hi))),
+        half: half.clone(),
+        norm,
+    };
+    let mut rng = Rng::new(args.seed);
+    let starts: Vec<Vec<f64>> = (0..args.samples)
+        .map(|_| half.iter().map(|h| rng.uniform(-h, *h)).collect())
+        .collect();
+    let t0 = Instant::now();
+    let found = search(&problem, starts);
+    let elapsed = t0.elapsed();
+
+    let minima = merge(found, &half, args.tolerance);
+    let isotropic: Vec<&Minimum> = minima
+        .iter()
+        .filter(|m| m.psi_dimensionless <= args.tolerance)
+        .collect();
+    let (matrix, unit, _) = target.matrix_words();
+    let report = Report {
+        args,
+        target: &target,
+        design: design.as_ref(),
+        unit: &unit,
+    };
+    report.print_head(&matrix, norm, elapsed.as_secs_f64());
+    let rows = report.select_rows(&minima, isotropic);
+    report.print_table(&coordinate_names, &rows);
+    ExitCode::SUCCESS
+}
+
+/// The numeric arguments' bounds.
+fn check_args(args: &IsotropyArgs) -> Result<(), ExitCode> {
     let valid = args.range > 0.0
         && args.range.is_finite()
         && args.angle_range > 0.0
@@ -254,25 +302,34 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         eprintln!(
             "error: --range and --angle-range must be positive, --samples at least 1, --tolerance non-negative"
         );
-        return ExitCode::from(2);
+        return Err(ExitCode::from(2));
     }
-    let design = match &args.design {
-        None => None,
+    Ok(())
+}
+
+/// `--design`, parsed against the spec's text.
+fn load_design(args: &IsotropyArgs) -> Result<Option<Design>, ExitCode> {
+    match &args.design {
+        None => Ok(None),
         Some(arg) => {
             let file = args.spec.to_string_lossy().into_owned();
             let parsed = std::fs::read_to_string(&args.spec)
                 .map_err(|e| e.to_string())
                 .and_then(|source| Design::parse(arg, &file, &source, args.space));
             match parsed {
-                Ok(d) => Some(d),
+                Ok(d) => Ok(Some(d)),
                 Err(e) => {
                     eprintln!("error: {e}");
-                    return ExitCode::from(2);
+                    Err(ExitCode::from(2))
                 }
             }
         }
-    };
-    let (mut half, mut names): (Vec<f64>, Vec<String>) = match &target {
+    }
+}
+
+/// The search box's half-widths and the coordinates' names (without the design variable).
+fn search_box(target: &Target, args: &IsotropyArgs) -> (Vec<f64>, Vec<String>) {
+    match target {
         Target::Tree(model) => (
             model
                 .joints
@@ -316,27 +373,18 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
             };
             (half, names.into_iter().map(String::from).collect())
         }
-    };
-    let coordinate_names = names.clone();
-    if let Some(d) = &design {
-        half.push(0.5 * (d.hi - d.lo));
-        names.push(d.name.clone());
     }
-    let norm = match args.normalization {
+}
+
+fn normalization(arg: NormArg) -> Normalization {
+    match arg {
         NormArg::Dimensionless => Normalization::Dimensionless,
         NormArg::Trace => Normalization::Trace,
-    };
-    let problem = Problem {
-        target: &target,
-        design: design.as_ref().map(|d| (d, 0.5 * (d.lo + d.hi))),
-        half: half.clone(),
-        norm,
-    };
-    let mut rng = Rng::new(args.seed);
-    let starts: Vec<Vec<f64>> = (0..args.samples)
-        .map(|_| half.iter().map(|h| rng.uniform(-h, *h)).collect())
-        .collect();
-    let t0 = Instant::now();
+    }
+}
+
+/// The local minima from each start (in parallel, progress on stderr when it is a terminal).
+fn search(problem: &Problem<'_>, starts: Vec<Vec<f64>>) -> Vec<Minimum> {
     let pb = progress(starts.len() as u64, "isotropy");
     let found: Vec<Minimum> = starts
         .into_par_iter()
@@ -361,13 +409,15 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
         })
         .collect();
     pb.finish_and_clear();
-    let elapsed = t0.elapsed();
+    found
+}
 
-    // Merge duplicates, best first: points closer than 1e-4 of the box; and, among points that
-    // are not isotropic, points with the same matrix to 1e-5 of its largest entry (a coordinate
-    // the inertia does not depend on, such as a tree's first joint about gravity, gives a
-    // continuum of equal minima). Distinct isotropic points may share σ·1 (mirror images), so
-    // they are merged by distance only.
+/// Merge duplicates, best first: points closer than 1e-4 of the box; and, among points that
+/// are not isotropic, points with the same matrix to 1e-5 of its largest entry (a coordinate
+/// the inertia does not depend on, such as a tree's first joint about gravity, gives a
+/// continuum of equal minima). Distinct isotropic points may share σ·1 (mirror images), so
+/// they are merged by distance only.
+fn merge(found: Vec<Minimum>, half: &[f64], tolerance: f64) -> Vec<Minimum> {
     let mut found = found;
     found.sort_by(|a, b| a.psi_dimensionless.total_cmp(&b.psi_dimensionless));
     let mut minima: Vec<Minimum> = Vec::new();
@@ -376,7 +426,7 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
             let near =
                 o.p.iter()
                     .zip(&m.p)
-                    .zip(&half)
+                    .zip(half)
                     .all(|((a, b), h)| ((a - b) / h).abs() < 1e-4);
             let big = o.matrix.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let same = o
@@ -384,75 +434,111 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
                 .iter()
                 .zip(&m.matrix)
                 .all(|(a, b)| (a - b).abs() <= 1e-5 * big);
-            near || (same && m.psi_dimensionless > args.tolerance)
+            near || (same && m.psi_dimensionless > tolerance)
         });
         if !dup {
             minima.push(m);
         }
     }
-    let isotropic: Vec<&Minimum> = minima
-        .iter()
-        .filter(|m| m.psi_dimensionless <= args.tolerance)
-        .collect();
-    let (matrix, unit, _) = target.matrix_words();
-    println!("mechanism: {} ({} DOF)", target.name(), target.dof());
-    println!("matrix: {matrix}; sigma in {unit}");
-    println!(
-        "search: {} random starts (seed {}), Levenberg-Marquardt on psi ({}), W = Frobenius (1 on the diagonal, 2 off it); {:.2} s",
-        args.samples,
-        args.seed,
-        match norm {
-            Normalization::Trace => "sigma = tr(M)/n",
-            Normalization::Dimensionless => "sigma = tr(M^2)/tr(M), dimensionless",
-        },
-        elapsed.as_secs_f64()
-    );
-    if let Some(d) = &design {
+    minima
+}
+
+/// What the printed report needs.
+struct Report<'a> {
+    args: &'a IsotropyArgs,
+    target: &'a Target,
+    design: Option<&'a Design>,
+    /// Unit of σ.
+    unit: &'a str,
+}
+
+impl Report<'_> {
+    /// The mechanism, the matrix, the search and the design.
+    fn print_head(&self, matrix: &str, norm: Normalization, seconds: f64) {
+        let (args, unit) = (self.args, self.unit);
         println!(
-            "design: {} in [{}, {}] (the spec has {}), searched with the coordinates",
-            d.name,
-            fmt_g(d.lo),
-            fmt_g(d.hi),
-            fmt_g(d.written)
+            "mechanism: {} ({} DOF)",
+            self.target.name(),
+            self.target.dof()
         );
+        println!("matrix: {matrix}; sigma in {unit}");
+        println!(
+            "search: {} random starts (seed {}), Levenberg-Marquardt on psi ({}), W = Frobenius (1 on the diagonal, 2 off it); {:.2} s",
+            args.samples,
+            args.seed,
+            match norm {
+                Normalization::Trace => "sigma = tr(M)/n",
+                Normalization::Dimensionless => "sigma = tr(M^2)/tr(M), dimensionless",
+            },
+            seconds
+        );
+        if let Some(d) = self.design {
+            println!(
+                "design: {} in [{}, {}] (the spec has {}), searched with the coordinates",
+                d.name,
+                fmt_g(d.lo),
+                fmt_g(d.hi),
+                fmt_g(d.written)
+            );
+        }
     }
-    let rows: Vec<&Minimum> = if isotropic.is_empty() {
+
+    /// The isotropic points or, when there is none, the best local minima; with the line
+    /// that says which.
+    fn select_rows<'m>(
+        &self,
+        minima: &'m [Minimum],
+        isotropic: Vec<&'m Minimum>,
+    ) -> Vec<&'m Minimum> {
+        let args = self.args;
+        if isotropic.is_empty() {
+            println!(
+                "no isotropic point found (psi2 <= {:e}); the {} best local minima of psi:",
+                args.tolerance,
+                args.top.min(minima.len())
+            );
+            minima.iter().take(args.top).collect()
+        } else {
+            println!(
+                "{} dynamically isotropic point(s) (psi2 <= {:e}):",
+                isotropic.len(),
+                args.tolerance
+            );
+            isotropic
+        }
+    }
+
+    /// The table of `rows`.
+    fn print_table(&self, coordinate_names: &[String], rows: &[&Minimum]) {
+        let unit = self.unit;
+        let design_head = self
+            .design
+            .map(|d| (format!(" {} |", d.name), "---:|"))
+            .unwrap_or_default();
         println!(
-            "no isotropic point found (psi2 <= {:e}); the {} best local minima of psi:",
-            args.tolerance,
-            args.top.min(minima.len())
+            "| point |{} coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
+            design_head.0,
+            coordinate_names.join(", ")
         );
-        minima.iter().take(args.top).collect()
-    } else {
-        println!(
-            "{} dynamically isotropic point(s) (psi2 <= {:e}):",
-            isotropic.len(),
-            args.tolerance
-        );
-        isotropic
-    };
-    let design_head = design
-        .as_ref()
-        .map(|d| (format!(" {} |", d.name), "---:|"))
-        .unwrap_or_default();
-    println!(
-        "| point |{} coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
-        design_head.0,
-        coordinate_names.join(", ")
-    );
-    println!("|---|{}---|---|---:|---:|---:|", design_head.1);
-    for (k, m) in rows.iter().enumerate() {
+        println!("|---|{}---|---|---:|---:|---:|", design_head.1);
+        for (k, m) in rows.iter().enumerate() {
+            self.print_row(k, m);
+        }
+    }
+
+    /// Row `k` of the table.
+    fn print_row(&self, k: usize, m: &Minimum) {
         let coords =
             m.x.iter()
                 .map(|v| fixed6(*v))
                 .collect::<Vec<_>>()
                 .join(", ");
         // The actuated joints of a parallel mechanism, with the row's design.
-        let redesigned = match (&design, m.design) {
+        let redesigned = match (self.design, m.design) {
             (Some(d), Some(v)) => d.target(v).ok(),
             _ => None,
         };
-        let q = match redesigned.as_ref().unwrap_or(&target) {
+        let q = match redesigned.as_ref().unwrap_or(self.target) {
             Target::Parallel { plan, .. } => runtime::parallel::noc::inverse_kinematics(plan, &m.x)
                 .map(|q| q.iter().map(|v| fixed6(*v)).collect::<Vec<_>>().join(", "))
                 .unwrap_or_else(|_| "-".into()),
@@ -470,7 +556,6 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
             fmt_g(m.psi_dimensionless)
         );
     }
-    ExitCode::SUCCESS
 }
 
 /// Six decimals, without a "-0.000000".

@@ -358,34 +358,8 @@ pub fn run(args: &MapArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
-    let usage = |msg: String| {
-        eprintln!("error: {msg}");
-        ExitCode::from(2)
-    };
-    let axes = match resolve_axes(&target, args.axes.as_deref()) {
-        Ok(a) => a,
-        Err(e) => return usage(e),
-    };
-    let ranges = match &args.range {
-        None => [axes[0].default_range(), axes[1].default_range()],
-        Some(s) => {
-            let parts: Vec<&str> = s.split(',').collect();
-            let parsed: Result<Vec<(f64, f64)>, String> =
-                parts.iter().map(|p| parse_range(p)).collect();
-            match parsed.as_deref() {
-                Ok([r]) => [*r, *r],
-                Ok([r, t]) => [*r, *t],
-                Ok(_) => return usage(format!("--range `{s}`: need LO:HI or LO:HI,LO:HI")),
-                Err(e) => return usage(e.clone()),
-            }
-        }
-    };
-    let (nu, nv) = match parse_steps(&args.steps) {
+    let slice = match Slice::parse(args, &target) {
         Ok(s) => s,
-        Err(e) => return usage(e),
-    };
-    let base = match base_point(&target, args.at.as_deref()) {
-        Ok(b) => b,
         Err(e) => return usage(e),
     };
     let prefix = args
@@ -394,35 +368,17 @@ pub fn run(args: &MapArgs) -> ExitCode {
         .unwrap_or_else(|| PathBuf::from(format!("{}_{}", target.name(), args.index.word())));
     let csv_path = prefix.with_extension("csv");
     let svg_path = prefix.with_extension("svg");
-    let us = grid(ranges[0].0, ranges[0].1, nu);
-    let vs = grid(ranges[1].0, ranges[1].1, nv);
+    let (us, vs) = slice.grids();
 
     let t0 = Instant::now();
-    let result = match args.threads {
-        Some(t) => match rayon::ThreadPoolBuilder::new().num_threads(t).build() {
-            Ok(pool) => pool.install(|| evaluate(&target, &axes, &base, args.index, us, vs)),
-            Err(e) => return usage(format!("--threads: {e}")),
-        },
-        None => evaluate(&target, &axes, &base, args.index, us, vs),
+    let result = match slice.evaluate(args, &target, us, vs) {
+        Ok(r) => r,
+        Err(e) => return usage(e),
     };
     let elapsed = t0.elapsed();
 
     // CSV: one row per grid point.
-    let mut csv = String::new();
-    csv.push_str(&format!(
-        "ix,iy,{},{},{},status\n",
-        axes[0].label(),
-        axes[1].label(),
-        args.index.word()
-    ));
-    for (k, r) in result.values.iter().enumerate() {
-        let (i, j) = (k % result.us.len(), k / result.us.len());
-        let (u, v) = (axes[0].shown(result.us[i]), axes[1].shown(result.vs[j]));
-        match r {
-            Ok(val) => csv.push_str(&format!("{i},{j},{u:.9},{v:.9},{val:.12e},ok\n")),
-            Err(f) => csv.push_str(&format!("{i},{j},{u:.9},{v:.9},,{}\n", f.word())),
-        }
-    }
+    let csv = csv_text(args.index, &slice.axes, &result);
     if let Err(e) = std::fs::File::create(&csv_path).and_then(|mut f| f.write_all(csv.as_bytes())) {
         eprintln!("error: cannot write {}: {e}", csv_path.display());
         return ExitCode::from(1);
@@ -434,33 +390,10 @@ pub fn run(args: &MapArgs) -> ExitCode {
         Scale::Linear => false,
         Scale::Auto => matches!(args.index, IndexKind::Cond | IndexKind::Manip),
     };
-    let finite: Vec<f64> = result
-        .values
-        .iter()
-        .filter_map(|r| r.clone().ok())
-        .collect();
-    let (vmin, vmax) = finite
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
-    let singular = result
-        .values
-        .iter()
-        .filter(|r| matches!(r, Err(Failure::Singular(_))))
-        .count();
-    let unreachable = result
-        .values
-        .iter()
-        .filter(|r| matches!(r, Err(Failure::Unreachable)))
-        .count();
-    let invalid = result
-        .values
-        .iter()
-        .filter(|r| matches!(r, Err(Failure::Invalid(_))))
-        .count();
+    let counts = Counts::new(&result);
     let title = format!("{}: {}", target.name(), args.index.word());
     let subtitle = format!("{}; {}", matrix, args.index.describe(&unit, &acc));
+    let axes = &slice.axes;
     let plot = svg::HeatMap {
         title: &title,
         subtitle: &subtitle,
@@ -478,29 +411,9 @@ pub fn run(args: &MapArgs) -> ExitCode {
     println!("mechanism: {} ({} DOF)", target.name(), target.dof());
     println!("matrix: {matrix}; unit {unit}");
     println!("index: {}", args.index.describe(&unit, &acc));
-    println!(
-        "grid: {} x {} = {} points ({} in [{}, {}], {} in [{}, {}])",
-        nu,
-        nv,
-        nu * nv,
-        axes[0].label(),
-        fmt_g(axes[0].shown(ranges[0].0)),
-        fmt_g(axes[0].shown(ranges[0].1)),
-        axes[1].label(),
-        fmt_g(axes[1].shown(ranges[1].0)),
-        fmt_g(axes[1].shown(ranges[1].1))
-    );
-    if finite.is_empty() {
-        println!("range: no regular point");
-    } else {
-        println!(
-            "range: {} .. {} over {} regular points",
-            fmt_g(vmin),
-            fmt_g(vmax),
-            finite.len()
-        );
-    }
-    println!("singular: {singular}, unreachable: {unreachable}, invalid: {invalid}");
+    slice.print_grid();
+    counts.print();
+    let (nu, nv) = (slice.nu, slice.nv);
     println!(
         "time: {:.3} s ({:.2} us per point, {} threads)",
         elapsed.as_secs_f64(),
@@ -509,6 +422,182 @@ pub fn run(args: &MapArgs) -> ExitCode {
     );
     println!("wrote {} and {}", csv_path.display(), svg_path.display());
     ExitCode::SUCCESS
+}
+
+/// A usage error: the message on stderr, exit code 2.
+fn usage(msg: String) -> ExitCode {
+    eprintln!("error: {msg}");
+    ExitCode::from(2)
+}
+
+/// The slice from the arguments: axes, ranges, grid sizes and the base point.
+struct Slice {
+    axes: [Axis; 2],
+    ranges: [(f64, f64); 2],
+    nu: usize,
+    nv: usize,
+    base: Vec<f64>,
+}
+
+impl Slice {
+    /// `--axes`, `--range`, `--steps` and `--at`, checked in that order.
+    fn parse(args: &MapArgs, target: &Target) -> Result<Slice, String> {
+        let axes = resolve_axes(target, args.axes.as_deref())?;
+        let ranges = match &args.range {
+            None => [axes[0].default_range(), axes[1].default_range()],
+            Some(s) => parse_ranges(s)?,
+        };
+        let (nu, nv) = parse_steps(&args.steps)?;
+        let base = base_point(target, args.at.as_deref())?;
+        Ok(Slice {
+            axes,
+            ranges,
+            nu,
+            nv,
+            base,
+        })
+    }
+
+    /// The grid values of the two axes.
+    fn grids(&self) -> (Vec<f64>, Vec<f64>) {
+        let us = grid(self.ranges[0].0, self.ranges[0].1, self.nu);
+        let vs = grid(self.ranges[1].0, self.ranges[1].1, self.nv);
+        (us, vs)
+    }
+
+    /// The map over the grid values `us`, `vs`, on `--threads` worker threads.
+    fn evaluate(
+        &self,
+        args: &MapArgs,
+        target: &Target,
+        us: Vec<f64>,
+        vs: Vec<f64>,
+    ) -> Result<MapResult, String> {
+        let (axes, base) = (&self.axes, &self.base);
+        Ok(match args.threads {
+            Some(t) => match rayon::ThreadPoolBuilder::new().num_threads(t).build() {
+                Ok(pool) => pool.install(|| evaluate(target, axes, base, args.index, us, vs)),
+                Err(e) => return Err(format!("--threads: {e}")),
+            },
+            None => evaluate(target, axes, base, args.index, us, vs),
+        })
+    }
+
+    /// The `grid:` line.
+    fn print_grid(&self) {
+        let (axes, ranges) = (&self.axes, &self.ranges);
+        println!(
+            "grid: {} x {} = {} points ({} in [{}, {}], {} in [{}, {}])",
+            self.nu,
+            self.nv,
+            self.nu * self.nv,
+            axes[0].label(),
+            fmt_g(axes[0].shown(ranges[0].0)),
+            fmt_g(axes[0].shown(ranges[0].1)),
+            axes[1].label(),
+            fmt_g(axes[1].shown(ranges[1].0)),
+            fmt_g(axes[1].shown(ranges[1].1))
+        );
+    }
+}
+
+/// `--range`: `LO:HI` for both axes or `LO:HI,LO:HI`.
+fn parse_ranges(s: &str) -> Result<[(f64, f64); 2], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let parsed: Result<Vec<(f64, f64)>, String> = parts.iter().map(|p| parse_range(p)).collect();
+    match parsed.as_deref() {
+        Ok([r]) => Ok([*r, *r]),
+        Ok([r, t]) => Ok([*r, *t]),
+        Ok(_) => Err(format!("--range `{s}`: need LO:HI or LO:HI,LO:HI")),
+        Err(e) => Err(e.clone()),
+    }
+}
+
+/// The CSV: one row per grid point.
+fn csv_text(index: IndexKind, axes: &[Axis; 2], result: &MapResult) -> String {
+    let mut csv = String::new();
+    csv.push_str(&format!(
+        "ix,iy,{},{},{},status\n",
+        axes[0].label(),
+        axes[1].label(),
+        index.word()
+    ));
+    for (k, r) in result.values.iter().enumerate() {
+        let (i, j) = (k % result.us.len(), k / result.us.len());
+        let (u, v) = (axes[0].shown(result.us[i]), axes[1].shown(result.vs[j]));
+        match r {
+            Ok(val) => csv.push_str(&format!("{i},{j},{u:.9},{v:.9},{val:.12e},ok\n")),
+            Err(f) => csv.push_str(&format!("{i},{j},{u:.9},{v:.9},,{}\n", f.word())),
+        }
+    }
+    csv
+}
+
+/// The values' range and the failures by kind.
+struct Counts {
+    /// The regular points' values.
+    finite: Vec<f64>,
+    vmin: f64,
+    vmax: f64,
+    singular: usize,
+    unreachable: usize,
+    invalid: usize,
+}
+
+impl Counts {
+    fn new(result: &MapResult) -> Counts {
+        let finite: Vec<f64> = result
+            .values
+            .iter()
+            .filter_map(|r| r.clone().ok())
+            .collect();
+        let (vmin, vmax) = finite
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            });
+        let singular = result
+            .values
+            .iter()
+            .filter(|r| matches!(r, Err(Failure::Singular(_))))
+            .count();
+        let unreachable = result
+            .values
+            .iter()
+            .filter(|r| matches!(r, Err(Failure::Unreachable)))
+            .count();
+        let invalid = result
+            .values
+            .iter()
+            .filter(|r| matches!(r, Err(Failure::Invalid(_))))
+            .count();
+        Counts {
+            finite,
+            vmin,
+            vmax,
+            singular,
+            unreachable,
+            invalid,
+        }
+    }
+
+    /// The `range:` and `singular:` lines.
+    fn print(&self) {
+        if self.finite.is_empty() {
+            println!("range: no regular point");
+        } else {
+            println!(
+                "range: {} .. {} over {} regular points",
+                fmt_g(self.vmin),
+                fmt_g(self.vmax),
+                self.finite.len()
+            );
+        }
+        println!(
+            "singular: {}, unreachable: {}, invalid: {}",
+            self.singular, self.unreachable, self.invalid
+        );
+    }
 }
 
 /// A compact number for messages.

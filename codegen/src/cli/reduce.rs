@@ -240,35 +240,90 @@ fn errors(m: &Mechanism, states: &[State], reference: &[Vec<f64>]) -> Option<(f6
 
 /// Run `reduce`.
 pub fn run(args: &ReduceArgs) -> ExitCode {
-    let (name, source) = match super::read_spec(&args.spec) {
+    let (name, source) = match read_checked(args) {
         Ok(r) => r,
         Err(code) => return code,
     };
+    let (full, bodies) = match load_full(&name, &source) {
+        Ok(r) => r,
+        Err(code) => return code,
+    };
+    let groups = groups(&full, &bodies);
+    let mut rng = Rng::new(args.seed);
+    let samples = states(&full, args.samples, &mut rng);
+    if samples.is_empty() {
+        eprintln!("error: {name}: no regular state found to compare on");
+        return ExitCode::from(2);
+    }
+    let reference: Vec<Vec<f64>> = samples
+        .iter()
+        .map(|s| efforts(&full, s).unwrap_or_default())
+        .collect();
+    let search = Search {
+        args,
+        name: &name,
+        source: &source,
+        full: &full,
+        samples: &samples,
+        reference: &reference,
+    };
+    let mut current = Level::default();
+    let Some((mut cost, _, _)) = search.evaluate(&current) else {
+        eprintln!("error: {name}: the full model cannot be generated");
+        return ExitCode::from(2);
+    };
+    let pb = super::progress(0, "reduce");
+    search.print_head(&current, cost);
+    while let Some((l, f)) = search.step(&current, cost, &groups, &pb) {
+        current = l;
+        cost = f;
+    }
+    pb.finish_and_clear();
+    println!(
+        "cheapest within tolerance: {} ({cost} flops)",
+        current.describe()
+    );
+    write_output(args, &source, &current)
+}
+
+/// The spec's name and text, with the arguments checked: no `[scene]` table of its own, a
+/// positive tolerance, at least one sample.
+fn read_checked(args: &ReduceArgs) -> Result<(String, String), ExitCode> {
+    let (name, source) = super::read_spec(&args.spec)?;
     if source
         .lines()
         .any(|l| l.trim_start().starts_with("[scene]"))
     {
         eprintln!("error: {name}: `reduce` writes the [scene] table itself; remove the spec's own");
-        return ExitCode::from(2);
+        return Err(ExitCode::from(2));
     }
     if args.tolerance.is_nan() || args.tolerance <= 0.0 || args.samples == 0 {
         eprintln!("error: --tolerance must be positive and --samples at least 1");
-        return ExitCode::from(2);
+        return Err(ExitCode::from(2));
     }
-    let full = match codegen::spec::load_mechanism(&name, &source) {
+    Ok((name, source))
+}
+
+/// The full model and the spec's body names (a TOML spec).
+fn load_full(name: &str, source: &str) -> Result<(Mechanism, Vec<String>), ExitCode> {
+    let full = match codegen::spec::load_mechanism(name, source) {
         Ok((m, _)) => m,
         Err(d) => {
             eprint!("{}", d.render());
-            return ExitCode::from(2);
+            return Err(ExitCode::from(2));
         }
     };
-    let Some(bodies) = codegen::spec::body_names(&name, &source) else {
+    let Some(bodies) = codegen::spec::body_names(name, source) else {
         eprintln!("error: {name}: `reduce` needs a TOML spec");
-        return ExitCode::from(2);
+        return Err(ExitCode::from(2));
     };
-    // Groups of bodies reduced together: a parallel mechanism's k-th body of every leg (the
-    // legs are alike); one body otherwise. The platform stays.
-    let groups: Vec<Vec<String>> = match &full {
+    Ok((full, bodies))
+}
+
+/// Groups of bodies reduced together: a parallel mechanism's k-th body of every leg (the
+/// legs are alike); one body otherwise. The platform stays.
+fn groups(full: &Mechanism, bodies: &[String]) -> Vec<Vec<String>> {
+    match full {
         Mechanism::Parallel(model) => {
             let longest = model.legs.iter().map(|l| l.bodies.len()).max().unwrap_or(0);
             (0..longest)
@@ -285,95 +340,96 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
                 .collect()
         }
         _ => bodies.iter().map(|b| vec![b.clone()]).collect(),
-    };
-    let mut rng = Rng::new(args.seed);
-    let samples = states(&full, args.samples, &mut rng);
-    if samples.is_empty() {
-        eprintln!("error: {name}: no regular state found to compare on");
-        return ExitCode::from(2);
     }
-    let reference: Vec<Vec<f64>> = samples
-        .iter()
-        .map(|s| efforts(&full, s).unwrap_or_default())
-        .collect();
-    let flops = |level: &Level| -> Option<usize> {
-        let src = format!("{source}{}", level.scene());
-        let g = codegen::compile(&name, &src, &codegen::Config::default()).ok()?;
+}
+
+/// The greedy search's fixed data: the spec, the full model and the states compared on.
+struct Search<'a> {
+    args: &'a ReduceArgs,
+    name: &'a str,
+    source: &'a str,
+    full: &'a Mechanism,
+    samples: &'a [State],
+    /// The full model's efforts at `samples`.
+    reference: &'a [Vec<f64>],
+}
+
+impl Search<'_> {
+    /// Inverse-dynamics flops of the code generated at `level`.
+    fn flops(&self, level: &Level) -> Option<usize> {
+        let src = format!("{}{}", self.source, level.scene());
+        let g = codegen::compile(self.name, &src, &codegen::Config::default()).ok()?;
         g.stats
             .iter()
             .find(|(n, _)| n == "inverse_dynamics")
             .map(|(_, c)| c.flops())
-    };
-    let evaluate = |level: &Level| -> Option<(usize, f64, f64)> {
-        let src = format!("{source}{}", level.scene());
-        let (m, _) = codegen::spec::load_mechanism(&name, &src).ok()?;
-        let (worst, rms) = errors(&m, &samples, &reference)?;
-        Some((flops(level)?, worst, rms))
-    };
-    let ns = |level: &Level| -> String {
-        if !args.time {
+    }
+
+    /// Flops, worst and RMS relative error at `level`.
+    fn evaluate(&self, level: &Level) -> Option<(usize, f64, f64)> {
+        let src = format!("{}{}", self.source, level.scene());
+        let (m, _) = codegen::spec::load_mechanism(self.name, &src).ok()?;
+        let (worst, rms) = errors(&m, self.samples, self.reference)?;
+        Some((self.flops(level)?, worst, rms))
+    }
+
+    /// The `ns per call` cell with `--time` (else nothing).
+    fn ns(&self, level: &Level) -> String {
+        if !self.args.time {
             return String::new();
         }
-        let src = format!("{source}{}", level.scene());
-        match time_generated(&name, &src, &full, &samples) {
+        let src = format!("{}{}", self.source, level.scene());
+        match time_generated(self.name, &src, self.full, self.samples) {
             Some(t) => format!(" {t:.0} |"),
             None => " (rustc failed) |".into(),
         }
-    };
-    let ns_head = if args.time { " ns per call |" } else { "" };
-    let ns_rule = if args.time { "---:|" } else { "" };
-    let mut current = Level::default();
-    let Some((mut cost, _, _)) = evaluate(&current) else {
-        eprintln!("error: {name}: the full model cannot be generated");
-        return ExitCode::from(2);
-    };
-    let pb = super::progress(0, "reduce");
-    println!(
-        "reduce: {} ({} states, tolerance {:e} on the worst relative actuator-effort error, inf-norm)",
-        full.name(),
-        samples.len(),
-        args.tolerance
-    );
-    println!(
-        "| fidelity | inverse dynamics flops |{ns_head} max relative error | RMS relative error | accepted |"
-    );
-    println!("|---|---:|{ns_rule}---:|---:|---|");
-    println!(
-        "| {} | {cost} |{} 0 | 0 | (reference) |",
-        current.describe(),
-        ns(&current)
-    );
-    loop {
+    }
+
+    /// The title, the table head and the reference row (`level`, the full model, at `cost`).
+    fn print_head(&self, level: &Level, cost: usize) {
+        let ns_head = if self.args.time { " ns per call |" } else { "" };
+        let ns_rule = if self.args.time { "---:|" } else { "" };
+        println!(
+            "reduce: {} ({} states, tolerance {:e} on the worst relative actuator-effort error, inf-norm)",
+            self.full.name(),
+            self.samples.len(),
+            self.args.tolerance
+        );
+        println!(
+            "| fidelity | inverse dynamics flops |{ns_head} max relative error | RMS relative error | accepted |"
+        );
+        println!("|---|---:|{ns_rule}---:|---:|---|");
+        println!(
+            "| {} | {cost} |{} 0 | 0 | (reference) |",
+            level.describe(),
+            self.ns(level)
+        );
+    }
+
+    /// One greedy step from `current` (at `cost` flops): tries reducing each group further,
+    /// prints a row per try, and returns the cheapest accepted level and its flops.
+    fn step(
+        &self,
+        current: &Level,
+        cost: usize,
+        groups: &[Vec<String>],
+        pb: &indicatif::ProgressBar,
+    ) -> Option<(Level, usize)> {
         let mut best: Option<(Level, usize, f64, f64)> = None;
-        for g in &groups {
+        for g in groups {
             if g.iter().any(|b| current.massless.contains(b)) {
                 continue;
             }
-            let mut tries = Vec::new();
-            if !g.iter().all(|b| current.point_mass.contains(b)) {
-                let mut l = current.clone();
-                let add: Vec<String> = g
-                    .iter()
-                    .filter(|b| !l.point_mass.contains(b))
-                    .cloned()
-                    .collect();
-                l.point_mass.extend(add);
-                tries.push(l);
-            }
-            let mut l = current.clone();
-            l.point_mass.retain(|b| !g.contains(b));
-            l.massless.extend(g.iter().cloned());
-            tries.push(l);
-            for l in tries {
+            for l in tries(current, g) {
                 pb.inc(1);
-                let Some((f, worst, rms)) = evaluate(&l) else {
+                let Some((f, worst, rms)) = self.evaluate(&l) else {
                     continue;
                 };
-                let ok = worst <= args.tolerance && f < cost;
+                let ok = worst <= self.args.tolerance && f < cost;
                 println!(
                     "| {} | {f} |{} {worst:.2e} | {rms:.2e} | {} |",
                     l.describe(),
-                    ns(&l),
+                    self.ns(&l),
                     if ok { "yes" } else { "no" }
                 );
                 if ok && best.as_ref().is_none_or(|b| f < b.1) {
@@ -381,23 +437,37 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
                 }
             }
         }
-        match best {
-            Some((l, f, _, _)) => {
-                current = l;
-                cost = f;
-            }
-            None => break,
-        }
+        best.map(|(l, f, _, _)| (l, f))
     }
-    pb.finish_and_clear();
-    println!(
-        "cheapest within tolerance: {} ({cost} flops)",
-        current.describe()
-    );
-    let out = if current == Level::default() {
-        source.clone()
+}
+
+/// The reductions of group `g` from `current`: point masses (unless they already are), then
+/// massless.
+fn tries(current: &Level, g: &[String]) -> Vec<Level> {
+    let mut tries = Vec::new();
+    if !g.iter().all(|b| current.point_mass.contains(b)) {
+        let mut l = current.clone();
+        let add: Vec<String> = g
+            .iter()
+            .filter(|b| !l.point_mass.contains(b))
+            .cloned()
+            .collect();
+        l.point_mass.extend(add);
+        tries.push(l);
+    }
+    let mut l = current.clone();
+    l.point_mass.retain(|b| !g.contains(b));
+    l.massless.extend(g.iter().cloned());
+    tries.push(l);
+    tries
+}
+
+/// Writes the spec at `level` to `-o` or standard output.
+fn write_output(args: &ReduceArgs, source: &str, level: &Level) -> ExitCode {
+    let out = if *level == Level::default() {
+        source.to_owned()
     } else {
-        format!("{source}{}", current.scene())
+        format!("{source}{}", level.scene())
     };
     match &args.output {
         Some(p) => {

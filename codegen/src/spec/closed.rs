@@ -13,7 +13,7 @@ use runtime::closed::{ClosedModel, Cut, CutKind, Plan};
 use runtime::model::Transform;
 
 use super::geom::compose;
-use super::ir::{Kind, Spec};
+use super::ir::{JointSpec, Kind, Spec};
 use super::lower::{self, Skip};
 use crate::diag::{Diagnostic, Diagnostics};
 
@@ -31,77 +31,9 @@ pub(crate) fn lower_closed_attached(
 ) -> Option<(ClosedModel, Vec<Option<lower::Attach>>)> {
     let axes = lower::check_values(spec, diags);
     let mut skip = Skip::none(spec);
-    // A joint with `child_origin` closes a loop only when its child is also reached by a tree
-    // joint (or is the base); otherwise `child_origin` is misplaced and the joint stays in the
-    // tree (one precise error instead of an echo about an unattached body).
-    let in_tree = |name: &str| {
-        name == super::ir::BASE
-            || spec
-                .joints
-                .iter()
-                .any(|k| k.child_origin.is_none() && k.child == name)
-    };
-    for j in &spec.joints {
-        if j.child_origin.is_some() && !in_tree(&j.child) {
-            diags.push(
-                Diagnostic::error(format!(
-                    "joint \"{}\" has `child_origin`, which marks a loop-closing joint, but its child \"{}\" is reached by no other joint",
-                    j.name, j.child
-                ))
-                .with_key(format!("{}.child_origin", j.key))
-                .with_span(j.child_origin_span.clone().or(j.span.clone()))
-                .with_hint("in a tree the child's frame is the joint frame: remove child_origin; a loop-closing joint joins two bodies that the other joints already place (a parallel mechanism's joints into the platform need a [platform] table)"),
-            );
-        }
-    }
-    for (ji, j) in spec.joints.iter().enumerate() {
-        if j.child_origin.is_some() && in_tree(&j.child) {
-            skip.joint[ji] = true;
-            if !matches!(j.kind, Kind::Revolute | Kind::Spherical) {
-                diags.push(
-                    Diagnostic::error(format!(
-                        "joint \"{}\" closes a loop (it has `child_origin`), but a {} joint cannot close a loop",
-                        j.name,
-                        j.kind.word()
-                    ))
-                    .with_key(format!("{}.kind", j.key))
-                    .with_span(j.kind_span.clone())
-                    .with_hint("loop-closing joints are revolute or spherical; put the other joint of the loop in the tree (without child_origin) and close the loop at a revolute or spherical joint"),
-                );
-            }
-            super::no_drive(
-                j,
-                "closes a loop",
-                "drives (damping, friction, armature) apply to tree joints, whose rates are coordinates; close the loop at a joint without them",
-                diags,
-            );
-            if j.actuated {
-                diags.push(
-                    Diagnostic::error(format!(
-                        "joint \"{}\" closes a loop and cannot be actuated",
-                        j.name
-                    ))
-                    .with_key(format!("{}.actuated", j.key))
-                    .with_span(j.actuated_span.clone().or(j.span.clone()))
-                    .with_hint("the independent coordinates are tree joints: close the loop at a passive joint"),
-                );
-            }
-        } else if j.actuated && !matches!(j.kind, Kind::Revolute | Kind::Prismatic) {
-            diags.push(
-                Diagnostic::error(format!("a {} joint cannot be actuated", j.kind.word()))
-                    .with_key(format!("{}.actuated", j.key))
-                    .with_span(j.actuated_span.clone().or(j.span.clone()))
-                    .with_hint("only revolute and prismatic joints can be actuated (be independent coordinates)"),
-            );
-        }
-    }
-    if !spec.joints.iter().any(|j| j.actuated) {
-        diags.push(
-            Diagnostic::error("no joint is actuated")
-                .with_span(spec.anchor.clone())
-                .with_hint("a closed-loop mechanism in joint coordinates takes its independent coordinates from the joints marked `actuated = true` (their efforts are the generalized forces); mark as many as it has degrees of freedom"),
-        );
-    }
+    check_misplaced_child_origin(spec, diags);
+    check_cut_joints(spec, diags, &mut skip);
+    check_some_actuated(spec, diags);
     let topo = lower::check_topology(spec, diags, &skip);
     if diags.has_errors() {
         return None;
@@ -114,32 +46,164 @@ pub(crate) fn lower_closed_attached(
     }
     let model = built.model;
     let attach = built.attach;
-    // Independent coordinates: the model joint of each actuated spec joint.
+    let independent = independent_coordinates(spec, &skip, &built.spec_joint);
+    let cuts = cuts(spec, &skip, &axes, &attach);
+    let springs = springs(spec, &attach, diags);
+    if diags.has_errors() {
+        return None;
+    }
+    let closed = ClosedModel {
+        name: spec.name.clone(),
+        tree: model,
+        cuts,
+        independent,
+        springs,
+    };
+    check_spring_lengths(spec, &closed, diags);
+    if diags.has_errors() {
+        return None;
+    }
+    check_plan(spec, &closed, diags)?;
+    Some((closed, attach))
+}
+
+/// A joint with `child_origin` closes a loop only when its child is also reached by a tree
+/// joint (or is the base).
+fn in_tree(spec: &Spec, name: &str) -> bool {
+    name == super::ir::BASE
+        || spec
+            .joints
+            .iter()
+            .any(|k| k.child_origin.is_none() && k.child == name)
+}
+
+/// A joint with `child_origin` whose child no tree joint reaches: `child_origin` is misplaced
+/// and the joint stays in the tree (one precise error instead of an echo about an unattached
+/// body).
+fn check_misplaced_child_origin(spec: &Spec, diags: &mut Diagnostics) {
+    for j in &spec.joints {
+        if j.child_origin.is_some() && !in_tree(spec, &j.child) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "joint \"{}\" has `child_origin`, which marks a loop-closing joint, but its child \"{}\" is reached by no other joint",
+                    j.name, j.child
+                ))
+                .with_key(format!("{}.child_origin", j.key))
+                .with_span(j.child_origin_span.clone().or(j.span.clone()))
+                .with_hint("in a tree the child's frame is the joint frame: remove child_origin; a loop-closing joint joins two bodies that the other joints already place (a parallel mechanism's joints into the platform need a [platform] table)"),
+            );
+        }
+    }
+}
+
+/// Marks the loop-closing joints in `skip` and checks them (kind, no drive, not actuated) and
+/// the actuated tree joints (revolute or prismatic).
+fn check_cut_joints(spec: &Spec, diags: &mut Diagnostics, skip: &mut Skip) {
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if j.child_origin.is_some() && in_tree(spec, &j.child) {
+            skip.joint[ji] = true;
+            check_cut_joint(j, diags);
+        } else if j.actuated && !matches!(j.kind, Kind::Revolute | Kind::Prismatic) {
+            diags.push(
+                Diagnostic::error(format!("a {} joint cannot be actuated", j.kind.word()))
+                    .with_key(format!("{}.actuated", j.key))
+                    .with_span(j.actuated_span.clone().or(j.span.clone()))
+                    .with_hint("only revolute and prismatic joints can be actuated (be independent coordinates)"),
+            );
+        }
+    }
+}
+
+/// A loop-closing joint: revolute or spherical, no drive, not actuated.
+fn check_cut_joint(j: &JointSpec, diags: &mut Diagnostics) {
+    if !matches!(j.kind, Kind::Revolute | Kind::Spherical) {
+        diags.push(
+            Diagnostic::error(format!(
+                "joint \"{}\" closes a loop (it has `child_origin`), but a {} joint cannot close a loop",
+                j.name,
+                j.kind.word()
+            ))
+            .with_key(format!("{}.kind", j.key))
+            .with_span(j.kind_span.clone())
+            .with_hint("loop-closing joints are revolute or spherical; put the other joint of the loop in the tree (without child_origin) and close the loop at a revolute or spherical joint"),
+        );
+    }
+    super::no_drive(
+        j,
+        "closes a loop",
+        "drives (damping, friction, armature) apply to tree joints, whose rates are coordinates; close the loop at a joint without them",
+        diags,
+    );
+    if j.actuated {
+        diags.push(
+            Diagnostic::error(format!(
+                "joint \"{}\" closes a loop and cannot be actuated",
+                j.name
+            ))
+            .with_key(format!("{}.actuated", j.key))
+            .with_span(j.actuated_span.clone().or(j.span.clone()))
+            .with_hint(
+                "the independent coordinates are tree joints: close the loop at a passive joint",
+            ),
+        );
+    }
+}
+
+/// At least one joint is actuated.
+fn check_some_actuated(spec: &Spec, diags: &mut Diagnostics) {
+    if !spec.joints.iter().any(|j| j.actuated) {
+        diags.push(
+            Diagnostic::error("no joint is actuated")
+                .with_span(spec.anchor.clone())
+                .with_hint("a closed-loop mechanism in joint coordinates takes its independent coordinates from the joints marked `actuated = true` (their efforts are the generalized forces); mark as many as it has degrees of freedom"),
+        );
+    }
+}
+
+/// Independent coordinates: the model joint of each actuated spec joint.
+fn independent_coordinates(spec: &Spec, skip: &Skip, spec_joint: &[usize]) -> Vec<usize> {
     let mut independent = Vec::new();
     for (ji, j) in spec.joints.iter().enumerate() {
         if j.actuated
             && !skip.joint[ji]
-            && let Some(k) = built.spec_joint.iter().position(|&s| s == ji)
+            && let Some(k) = spec_joint.iter().position(|&s| s == ji)
         {
             independent.push(k);
         }
     }
-    // A spec body's model body and its pose in that body's frame (`None` for the base).
-    let body_of = |name: &str| -> Option<(Option<usize>, Transform)> {
-        if name == super::ir::BASE {
-            return Some((None, Transform::IDENTITY));
-        }
-        let b = spec.bodies.iter().position(|b| b.name == name)?;
-        let a = attach[b]?;
-        Some((a.target, a.pose))
-    };
+    independent
+}
+
+/// A spec body's model body and its pose in that body's frame (`None` for the base).
+fn body_of(
+    spec: &Spec,
+    attach: &[Option<lower::Attach>],
+    name: &str,
+) -> Option<(Option<usize>, Transform)> {
+    if name == super::ir::BASE {
+        return Some((None, Transform::IDENTITY));
+    }
+    let b = spec.bodies.iter().position(|b| b.name == name)?;
+    let a = attach[b]?;
+    Some((a.target, a.pose))
+}
+
+/// The loop-closing joints, each between the model bodies its parent and child became part of.
+fn cuts(
+    spec: &Spec,
+    skip: &Skip,
+    axes: &lower::Axes,
+    attach: &[Option<lower::Attach>],
+) -> Vec<Cut> {
     let mut cuts = Vec::new();
     for (ji, j) in spec.joints.iter().enumerate() {
         if !skip.joint[ji] {
             continue;
         }
-        let (Some((pa, pose_a)), Some((cb, pose_b))) = (body_of(&j.parent), body_of(&j.child))
-        else {
+        let (Some((pa, pose_a)), Some((cb, pose_b))) = (
+            body_of(spec, attach, &j.parent),
+            body_of(spec, attach, &j.child),
+        ) else {
             continue; // reported by the topology check
         };
         let (origin, _) = lower::placement_frames(&j.placement);
@@ -160,11 +224,19 @@ pub(crate) fn lower_closed_attached(
             kind,
         });
     }
-    // Springs: each point in the frame of the model body its spec body became part of.
+    cuts
+}
+
+/// Springs: each point in the frame of the model body its spec body became part of.
+fn springs(
+    spec: &Spec,
+    attach: &[Option<lower::Attach>],
+    diags: &mut Diagnostics,
+) -> Vec<runtime::closed::Spring> {
     let mut springs = Vec::new();
     for sp in &spec.springs {
         let mut end = |body: &super::ir::Named, point: &runtime::model::Vec3| {
-            let place = body_of(&body.name);
+            let place = body_of(spec, attach, &body.name);
             if place.is_none() {
                 let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
                 diags.push(
@@ -196,17 +268,11 @@ pub(crate) fn lower_closed_attached(
             });
         }
     }
-    if diags.has_errors() {
-        return None;
-    }
-    let closed = ClosedModel {
-        name: spec.name.clone(),
-        tree: model,
-        cuts,
-        independent,
-        springs,
-    };
-    // A spring of zero length at home has no direction there (the functions' `Spring` guard).
+    springs
+}
+
+/// A spring of zero length at home has no direction there (the functions' `Spring` guard).
+fn check_spring_lengths(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) {
     let size = closed.size();
     for (k, sp) in spec.springs.iter().enumerate() {
         let l = closed.spring_length_at_home(k);
@@ -219,10 +285,11 @@ pub(crate) fn lower_closed_attached(
             );
         }
     }
-    if diags.has_errors() {
-        return None;
-    }
-    if let Err(e) = Plan::new(&closed) {
+}
+
+/// The loop analysis ([`Plan::new`]); `None` when it fails (reported).
+fn check_plan(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) -> Option<()> {
+    if let Err(e) = Plan::new(closed) {
         // Point at the first loop-closing joint (the loops are where the analysis failed).
         let at = spec.joints.iter().find(|j| j.child_origin.is_some());
         let mut d = Diagnostic::error(e).with_hint("the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)");
@@ -236,5 +303,5 @@ pub(crate) fn lower_closed_attached(
         diags.push(d);
         return None;
     }
-    Some((closed, attach))
+    Some(())
 }

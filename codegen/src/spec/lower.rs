@@ -271,6 +271,41 @@ pub(super) struct Topo {
 /// names and bodies must exist) but take no part in the tree rules.
 pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) -> Option<Topo> {
     // Unique names.
+    let body_index = unique_body_names(spec, diags);
+    check_unique_joint_names(spec, diags);
+
+    // Resolve parent and child.
+    let mut links = Links::new(spec, skip, body_index);
+    for (ji, j) in spec.joints.iter().enumerate() {
+        links.resolve_joint(ji, j, diags);
+    }
+    links.check_attached(diags);
+    if !links.ok {
+        return None;
+    }
+    let Links {
+        parent,
+        child,
+        child_of,
+        ..
+    } = links;
+
+    // Cycles.
+    if !check_cycles(spec, diags, skip, &parent, &child_of) {
+        return None;
+    }
+
+    let order = topological_order(spec, skip, &parent, &child)?;
+    Some(Topo {
+        parent,
+        child,
+        order,
+    })
+}
+
+/// Body names: not "base", not twice. Returns the index of each body by name (the first of
+/// duplicates).
+fn unique_body_names<'a>(spec: &'a Spec, diags: &mut Diagnostics) -> HashMap<&'a str, usize> {
     let mut body_index: HashMap<&str, usize> = HashMap::new();
     for (i, b) in spec.bodies.iter().enumerate() {
         if b.name == BASE {
@@ -295,6 +330,11 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
             body_index.insert(&b.name, i);
         }
     }
+    body_index
+}
+
+/// Joint names: not twice.
+fn check_unique_joint_names(spec: &Spec, diags: &mut Diagnostics) {
     let mut joint_index: HashMap<&str, usize> = HashMap::new();
     for (i, j) in spec.joints.iter().enumerate() {
         if let Some(&first) = joint_index.get(j.name.as_str()) {
@@ -312,20 +352,58 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
             joint_index.insert(&j.name, i);
         }
     }
+}
 
-    // Resolve parent and child.
-    let body_names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
-    let mut parent = vec![None; spec.joints.len()];
-    let mut child = vec![usize::MAX; spec.joints.len()];
-    let mut child_of: Vec<Option<usize>> = vec![None; spec.bodies.len()];
-    let mut ok = true;
-    for (ji, j) in spec.joints.iter().enumerate() {
+/// The parent and child bodies of the joints, being resolved.
+struct Links<'a> {
+    spec: &'a Spec,
+    skip: &'a Skip,
+    body_index: HashMap<&'a str, usize>,
+    body_names: Vec<&'a str>,
+    /// Per joint: parent body index (`None` = base).
+    parent: Vec<Option<usize>>,
+    /// Per joint: child body index (`usize::MAX` while unresolved).
+    child: Vec<usize>,
+    /// Per body: the (unskipped) joint it is the child of.
+    child_of: Vec<Option<usize>>,
+    /// No error so far.
+    ok: bool,
+}
+
+impl<'a> Links<'a> {
+    fn new(spec: &'a Spec, skip: &'a Skip, body_index: HashMap<&'a str, usize>) -> Self {
+        Links {
+            spec,
+            skip,
+            body_index,
+            body_names: spec.bodies.iter().map(|b| b.name.as_str()).collect(),
+            parent: vec![None; spec.joints.len()],
+            child: vec![usize::MAX; spec.joints.len()],
+            child_of: vec![None; spec.bodies.len()],
+            ok: true,
+        }
+    }
+
+    /// Resolves joint `ji`'s parent and child and, unless it is skipped, claims its child.
+    fn resolve_joint(&mut self, ji: usize, j: &JointSpec, diags: &mut Diagnostics) {
+        self.resolve_parent(ji, j, diags);
+        let Some(c) = self.resolve_child(j, diags) else {
+            return;
+        };
+        self.child[ji] = c;
+        if self.skip.joint[ji] {
+            return;
+        }
+        self.claim_child(ji, j, c, diags);
+    }
+
+    fn resolve_parent(&mut self, ji: usize, j: &JointSpec, diags: &mut Diagnostics) {
         if j.parent != BASE {
-            match body_index.get(j.parent.as_str()) {
-                Some(&b) => parent[ji] = Some(b),
+            match self.body_index.get(j.parent.as_str()) {
+                Some(&b) => self.parent[ji] = Some(b),
                 None => {
-                    ok = false;
-                    let mut cands = body_names.clone();
+                    self.ok = false;
+                    let mut cands = self.body_names.clone();
                     cands.push(BASE);
                     diags.push(
                         Diagnostic::error(format!("unknown parent body \"{}\"", j.parent))
@@ -338,35 +416,41 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
                 }
             }
         }
+    }
+
+    /// The child body of `j`, or `None` (reported) when it is the base or unknown.
+    fn resolve_child(&mut self, j: &JointSpec, diags: &mut Diagnostics) -> Option<usize> {
         if j.child == BASE {
-            ok = false;
+            self.ok = false;
             diags.push(
                 Diagnostic::error("the base cannot be a joint's child")
                     .with_key(format!("{}.child", j.key))
                     .with_span(j.child_span.clone())
                     .with_hint("\"base\" is the fixed world; swap `parent` and `child`?"),
             );
-            continue;
+            return None;
         }
-        let Some(&c) = body_index.get(j.child.as_str()) else {
-            ok = false;
+        let Some(&c) = self.body_index.get(j.child.as_str()) else {
+            self.ok = false;
             diags.push(
                 Diagnostic::error(format!("unknown child body \"{}\"", j.child))
                     .with_key(format!("{}.child", j.key))
                     .with_span(j.child_span.clone())
                     .with_hint(
-                        suggest_hint(&j.child, &body_names)
+                        suggest_hint(&j.child, &self.body_names)
                             .unwrap_or_else(|| "the child must be the name of a body".into()),
                     ),
             );
-            continue;
+            return None;
         };
-        child[ji] = c;
-        if skip.joint[ji] {
-            continue;
-        }
-        if skip.body[c] {
-            ok = false;
+        Some(c)
+    }
+
+    /// Makes body `c` the child of joint `ji`: not a platform body, not the child of another
+    /// joint.
+    fn claim_child(&mut self, ji: usize, j: &JointSpec, c: usize, diags: &mut Diagnostics) {
+        if self.skip.body[c] {
+            self.ok = false;
             diags.push(
                 Diagnostic::error(format!(
                     "body \"{}\" is part of the platform and cannot be the child of joint \"{}\"",
@@ -376,22 +460,22 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
                 .with_span(j.child_span.clone())
                 .with_hint("the platform and the bodies fixed to it are reached only through the joints into the platform (with `child_origin`) and the fixed joints hanging from it"),
             );
-            continue;
+            return;
         }
-        if let Some(first) = child_of[c] {
-            ok = false;
-            let d = if skip.body.iter().any(|s| *s) {
+        if let Some(first) = self.child_of[c] {
+            self.ok = false;
+            let d = if self.skip.body.iter().any(|s| *s) {
                 // A parallel mechanism: only the platform closes loops.
                 Diagnostic::error("only the platform may be the child of several joints: other closed loops are not supported")
                     .with_hint(format!(
                         "body \"{}\" is already the child of joint \"{}\"; the loops of a simple-platform mechanism close at the platform, every other body is the child of exactly one joint",
-                        j.child, spec.joints[first].name
+                        j.child, self.spec.joints[first].name
                     ))
             } else {
                 Diagnostic::error(format!("body \"{}\" is the child of two joints: this closes a loop", j.child))
                     .with_hint(format!(
                         "body \"{}\" is already the child of joint \"{}\"; to close a loop, give this joint `child_origin` (its frame in the child's body frame) and mark the independent joints `actuated` (docs/spec.md, \"Closed loops in joint coordinates\"), or add a [platform] table for a parallel mechanism",
-                        j.child, spec.joints[first].name
+                        j.child, self.spec.joints[first].name
                     ))
             };
             diags.push(
@@ -399,33 +483,45 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
                     .with_span(j.child_span.clone()),
             );
         } else {
-            child_of[c] = Some(ji);
+            self.child_of[c] = Some(ji);
         }
-    }
-    for (bi, b) in spec.bodies.iter().enumerate() {
-        if child_of[bi].is_none()
-            && !skip.body[bi]
-            && !spec.joints_incomplete
-            && b.name != BASE
-            && body_index.get(b.name.as_str()) == Some(&bi)
-        {
-            ok = false;
-            diags.push(
-                Diagnostic::error(format!("body \"{}\" is not attached to anything", b.name))
-                    .with_key(b.key.clone())
-                    .with_span(b.span.clone())
-                    .with_hint(format!(
-                        "add a joint with child = \"{}\" (use kind = \"fixed\" for a rigid attachment)",
-                        b.name
-                    )),
-            );
-        }
-    }
-    if !ok {
-        return None;
     }
 
-    // Cycles: follow parents from every joint; 0 = unseen, 1 = on the current walk, 2 = reaches base.
+    /// Every body (but skipped ones) is the child of a joint.
+    fn check_attached(&mut self, diags: &mut Diagnostics) {
+        let spec = self.spec;
+        for (bi, b) in spec.bodies.iter().enumerate() {
+            if self.child_of[bi].is_none()
+                && !self.skip.body[bi]
+                && !spec.joints_incomplete
+                && b.name != BASE
+                && self.body_index.get(b.name.as_str()) == Some(&bi)
+            {
+                self.ok = false;
+                diags.push(
+                    Diagnostic::error(format!("body \"{}\" is not attached to anything", b.name))
+                        .with_key(b.key.clone())
+                        .with_span(b.span.clone())
+                        .with_hint(format!(
+                            "add a joint with child = \"{}\" (use kind = \"fixed\" for a rigid attachment)",
+                            b.name
+                        )),
+                );
+            }
+        }
+    }
+}
+
+/// Cycles: follow parents from every joint; `false` when there is one (reported).
+fn check_cycles(
+    spec: &Spec,
+    diags: &mut Diagnostics,
+    skip: &Skip,
+    parent: &[Option<usize>],
+    child_of: &[Option<usize>],
+) -> bool {
+    let mut ok = true;
+    // 0 = unseen, 1 = on the current walk, 2 = reaches base.
     let mut state = vec![0u8; spec.joints.len()];
     for start in (0..spec.joints.len()).filter(|&j| !skip.joint[j]) {
         let mut walk = Vec::new();
@@ -434,27 +530,7 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
             match state[j] {
                 2 => break,
                 1 => {
-                    // Cycle: the part of `walk` from `j` on.
-                    let pos = walk.iter().position(|&x| x == j).unwrap_or(0);
-                    let cycle = &walk[pos..];
-                    let first = *cycle.iter().min().unwrap_or(&j);
-                    let mut names: Vec<String> = cycle
-                        .iter()
-                        .map(|&x| format!("\"{}\"", spec.joints[x].name))
-                        .collect();
-                    if let Some(f) = names.first().cloned() {
-                        names.push(f);
-                    }
-                    let js = &spec.joints[first];
-                    diags.push(
-                        Diagnostic::error(format!(
-                            "kinematic cycle: following the parents, joints {} never reach \"base\"",
-                            names.join(" → ")
-                        ))
-                        .with_key(format!("{}.parent", js.key))
-                        .with_span(js.parent_span.clone())
-                        .with_hint("every chain of parents must end at \"base\"; one of these joints needs another parent"),
-                    );
+                    report_cycle(spec, diags, &walk, j);
                     ok = false;
                     break;
                 }
@@ -474,11 +550,43 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
             state[w] = 2;
         }
     }
-    if !ok {
-        return None;
-    }
+    ok
+}
 
-    // Stable topological order: repeatedly the first declared joint whose parent is placed.
+/// Reports the cycle that the walk `walk` closes by coming back to joint `j`.
+fn report_cycle(spec: &Spec, diags: &mut Diagnostics, walk: &[usize], j: usize) {
+    // Cycle: the part of `walk` from `j` on.
+    let pos = walk.iter().position(|&x| x == j).unwrap_or(0);
+    let cycle = &walk[pos..];
+    let first = *cycle.iter().min().unwrap_or(&j);
+    let mut names: Vec<String> = cycle
+        .iter()
+        .map(|&x| format!("\"{}\"", spec.joints[x].name))
+        .collect();
+    if let Some(f) = names.first().cloned() {
+        names.push(f);
+    }
+    let js = &spec.joints[first];
+    diags.push(
+        Diagnostic::error(format!(
+            "kinematic cycle: following the parents, joints {} never reach \"base\"",
+            names.join(" → ")
+        ))
+        .with_key(format!("{}.parent", js.key))
+        .with_span(js.parent_span.clone())
+        .with_hint(
+            "every chain of parents must end at \"base\"; one of these joints needs another parent",
+        ),
+    );
+}
+
+/// Stable topological order: repeatedly the first declared joint whose parent is placed.
+fn topological_order(
+    spec: &Spec,
+    skip: &Skip,
+    parent: &[Option<usize>],
+    child: &[usize],
+) -> Option<Vec<usize>> {
     let n = spec.joints.len();
     let mut placed = skip.joint.clone();
     let mut body_placed = vec![false; spec.bodies.len()];
@@ -490,11 +598,7 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
         body_placed[child[next]] = true;
         order.push(next);
     }
-    Some(Topo {
-        parent,
-        child,
-        order,
-    })
+    Some(order)
 }
 
 /// `line:col` of a span's start, for hints.
