@@ -131,115 +131,133 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
     let s = &f.schedule;
     let mut stmts = Vec::with_capacity(s.steps.len());
     for step in &s.steps {
-        let st = match *step {
-            Step::SinCos { sin, cos, arg } => {
-                let (a, b) = (var(sin), var(cos));
-                let call = math_call(cfg, "sin_cos", operand(g, s, arg));
-                quote!(let (#a, #b) = #call;)
-            }
-            Step::Check { node } => {
-                let Node::Guard {
-                    value,
-                    tol,
-                    scale,
-                    index,
-                } = g.node(node)
-                else {
-                    stmts.push(TokenStream::new());
-                    continue;
-                };
-                let (v, t, sc) = (
-                    operand(g, s, value),
-                    operand(g, s, tol),
-                    operand(g, s, scale),
-                );
-                let two_sided = index & crate::sym::TWO_SIDED != 0;
-                let code = index & !crate::sym::TWO_SIDED;
-                let test = if two_sided {
-                    quote!(#v > #t || #v < -#t)
-                } else {
-                    quote!(#v > #t)
-                };
-                let magnitude = if two_sided {
-                    quote!(if #v < 0.0 { -#v } else { #v })
-                } else {
-                    quote!(#v)
-                };
-                let at = if f.sites {
-                    site_tokens(runtime::scalar::Site::from_code(code))
-                } else {
-                    let i = Literal::usize_unsuffixed(code as usize);
-                    quote!(pivot: #i)
-                };
-                if two_sided {
-                    quote! {
-                        if !(#test) {
-                            let a = #magnitude;
-                            return Err(Singular {
-                                #at,
-                                value: #v,
-                                condition_estimate: if a > 0.0 { #sc / a } else { f64::INFINITY },
-                            });
-                        }
-                    }
-                } else {
-                    quote! {
-                        if !(#test) {
-                            return Err(Singular {
-                                #at,
-                                value: #v,
-                                condition_estimate: if #v > 0.0 { #sc / #v } else { f64::INFINITY },
-                            });
-                        }
-                    }
-                }
-            }
-            Step::Let { name, node } => {
-                let x = var(name);
-                let e = match g.node(node) {
-                    Node::Add(a, b) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        quote!(#a + #b)
-                    }
-                    Node::Sub(a, b) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        quote!(#a - #b)
-                    }
-                    Node::Mul(a, b) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        quote!(#a * #b)
-                    }
-                    Node::Div(a, b) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        quote!(#a / #b)
-                    }
-                    Node::Neg(a) => {
-                        let a = operand(g, s, a);
-                        quote!(-#a)
-                    }
-                    Node::Sqrt(a) => math_call(cfg, "sqrt", operand(g, s, a)),
-                    Node::Atan2(a, b) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        math_call(cfg, "atan2", quote!(#a, #b))
-                    }
-                    Node::Select(a, b, x, y) => {
-                        let (a, b) = (operand(g, s, a), operand(g, s, b));
-                        let (x, y) = (operand(g, s, x), operand(g, s, y));
-                        quote!(if f64::abs(#a) > f64::abs(#b) { #x } else { #y })
-                    }
-                    _ => {
-                        stmts.push(TokenStream::new());
-                        continue;
-                    }
-                };
-                quote!(let #x = #e;)
-            }
-        };
-        stmts.push(st);
+        stmts.push(step_tokens(g, cfg, f, step));
     }
     let stmts = chunked(g, s, &f.outputs, stmts);
-    // Parallel modules: a NaN or infinite input is an error, not a NaN result.
-    let checks: Vec<TokenStream> = if f.sites {
+    let checks = input_checks(f);
+    let stmts: Vec<TokenStream> = checks.into_iter().chain(stmts).collect();
+    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| operand(g, s, o)).collect();
+    let out_check = output_check(f, &outs);
+    let ret = return_tokens(f, &outs);
+    quote! { #(#stmts)* #out_check #ret }
+}
+
+/// The statement of one step (empty for a `Check` of a node that is no guard, or a `Let` of a
+/// node that is no operation).
+fn step_tokens(g: &Graph, cfg: &Config, f: &Function<'_>, step: &Step) -> TokenStream {
+    let s = &f.schedule;
+    match *step {
+        Step::SinCos { sin, cos, arg } => {
+            let (a, b) = (var(sin), var(cos));
+            let call = math_call(cfg, "sin_cos", operand(g, s, arg));
+            quote!(let (#a, #b) = #call;)
+        }
+        Step::Check { node } => check_tokens(g, f, node),
+        Step::Let { name, node } => let_tokens(g, cfg, s, name, node),
+    }
+}
+
+/// A guard's test: `Err(Singular)` at its site (parallel) or pivot (trees) when it fails.
+fn check_tokens(g: &Graph, f: &Function<'_>, node: ExprId) -> TokenStream {
+    let s = &f.schedule;
+    let Node::Guard {
+        value,
+        tol,
+        scale,
+        index,
+    } = g.node(node)
+    else {
+        return TokenStream::new();
+    };
+    let (v, t, sc) = (
+        operand(g, s, value),
+        operand(g, s, tol),
+        operand(g, s, scale),
+    );
+    let two_sided = index & crate::sym::TWO_SIDED != 0;
+    let code = index & !crate::sym::TWO_SIDED;
+    let test = if two_sided {
+        quote!(#v > #t || #v < -#t)
+    } else {
+        quote!(#v > #t)
+    };
+    let magnitude = if two_sided {
+        quote!(if #v < 0.0 { -#v } else { #v })
+    } else {
+        quote!(#v)
+    };
+    let at = if f.sites {
+        site_tokens(runtime::scalar::Site::from_code(code))
+    } else {
+        let i = Literal::usize_unsuffixed(code as usize);
+        quote!(pivot: #i)
+    };
+    if two_sided {
+        quote! {
+            if !(#test) {
+                let a = #magnitude;
+                return Err(Singular {
+                    #at,
+                    value: #v,
+                    condition_estimate: if a > 0.0 { #sc / a } else { f64::INFINITY },
+                });
+            }
+        }
+    } else {
+        quote! {
+            if !(#test) {
+                return Err(Singular {
+                    #at,
+                    value: #v,
+                    condition_estimate: if #v > 0.0 { #sc / #v } else { f64::INFINITY },
+                });
+            }
+        }
+    }
+}
+
+/// `let x = …;` of one operation (empty for a node that is none).
+fn let_tokens(g: &Graph, cfg: &Config, s: &Schedule, name: usize, node: ExprId) -> TokenStream {
+    let x = var(name);
+    let e = match g.node(node) {
+        Node::Add(a, b) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            quote!(#a + #b)
+        }
+        Node::Sub(a, b) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            quote!(#a - #b)
+        }
+        Node::Mul(a, b) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            quote!(#a * #b)
+        }
+        Node::Div(a, b) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            quote!(#a / #b)
+        }
+        Node::Neg(a) => {
+            let a = operand(g, s, a);
+            quote!(-#a)
+        }
+        Node::Sqrt(a) => math_call(cfg, "sqrt", operand(g, s, a)),
+        Node::Atan2(a, b) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            math_call(cfg, "atan2", quote!(#a, #b))
+        }
+        Node::Select(a, b, x, y) => {
+            let (a, b) = (operand(g, s, a), operand(g, s, b));
+            let (x, y) = (operand(g, s, x), operand(g, s, y));
+            quote!(if f64::abs(#a) > f64::abs(#b) { #x } else { #y })
+        }
+        _ => return TokenStream::new(),
+    };
+    quote!(let #x = #e;)
+}
+
+/// Parallel modules: a NaN or infinite input is an error, not a NaN result.
+fn input_checks(f: &Function<'_>) -> Vec<TokenStream> {
+    if f.sites {
         f.args
             .iter()
             .map(|a| {
@@ -259,11 +277,12 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
             .collect()
     } else {
         Vec::new()
-    };
-    let stmts: Vec<TokenStream> = checks.into_iter().chain(stmts).collect();
-    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| operand(g, s, o)).collect();
-    // Parallel modules: a result that overflowed is an error, not an `Ok` with NaN or ∞.
-    let out_check = if f.sites {
+    }
+}
+
+/// Parallel modules: a result that overflowed is an error, not an `Ok` with NaN or ∞.
+fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
+    if f.sites {
         quote! {
             for v in [#(#outs),*].iter() {
                 if !v.is_finite() {
@@ -292,8 +311,12 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
         }
     } else {
         TokenStream::new()
-    };
-    let ret = match f.shape {
+    }
+}
+
+/// The returned expression of the function's shape.
+fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
+    match f.shape {
         Shape::Vector => quote!([#(#outs),*]),
         Shape::FallibleVector => quote!(Ok([#(#outs),*])),
         Shape::Matrix => {
@@ -301,31 +324,32 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
             let rows: Vec<TokenStream> = outs.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
             quote!([#(#rows),*])
         }
-        Shape::Fallible(ref parts) => {
-            let n = f.dof;
-            let mut rest = &outs[..];
-            let mut items = Vec::new();
-            for p in parts {
-                let (now, later) = rest.split_at(p.len(n).min(rest.len()));
-                rest = later;
-                items.push(match p {
-                    Part::Vector | Part::Coords(_) => quote!([#(#now),*]),
-                    Part::Scalar => quote!(#(#now)*),
-                    Part::Matrix => {
-                        let rows: Vec<TokenStream> =
-                            now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
-                        quote!([#(#rows),*])
-                    }
-                });
+        Shape::Fallible(ref parts) => fallible_tokens(parts, f.dof, outs),
+    }
+}
+
+/// `Ok` of one part or a tuple of parts, in output order.
+fn fallible_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
+    let mut rest = outs;
+    let mut items = Vec::new();
+    for p in parts {
+        let (now, later) = rest.split_at(p.len(n).min(rest.len()));
+        rest = later;
+        items.push(match p {
+            Part::Vector | Part::Coords(_) => quote!([#(#now),*]),
+            Part::Scalar => quote!(#(#now)*),
+            Part::Matrix => {
+                let rows: Vec<TokenStream> =
+                    now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
+                quote!([#(#rows),*])
             }
-            if items.len() == 1 {
-                quote!(Ok(#(#items)*))
-            } else {
-                quote!(Ok((#(#items),*)))
-            }
-        }
-    };
-    quote! { #(#stmts)* #out_check #ret }
+        });
+    }
+    if items.len() == 1 {
+        quote!(Ok(#(#items)*))
+    } else {
+        quote!(Ok((#(#items),*)))
+    }
 }
 
 /// Statements per block beyond which a function body is split into blocks.

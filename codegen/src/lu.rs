@@ -118,7 +118,26 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
     // `aᵀ x = b` factorizes `a` itself (so that its pivots and verdict are those of the other
     // solves) and keeps the swaps and multipliers for the transposed solve after it.
     let tr = s.transpose;
-    // The matrix and the right-hand sides as locals.
+    load_locals(s, k_rhs, &mut st);
+    column_norms(n, &mut st);
+    st.push(quote!(let pn: f64 = 0.0;));
+    st.push(quote!(let pd: f64 = 1.0;));
+    for k in 0..n {
+        elimination_step(s, k, k_rhs, &tol2, &mut st);
+    }
+    if tr {
+        transposed_solve(n, &mut st);
+    }
+    back_substitution(n, k_rhs, tr, &mut st);
+    match s.rhs {
+        Rhs::Vector => vector_fn(&name, doc, n, &st),
+        Rhs::Identity => identity_fn(&name, doc, n, &st),
+    }
+}
+
+/// The matrix and the right-hand sides as locals.
+fn load_locals(s: &LuSolve<'_>, k_rhs: usize, st: &mut Vec<TokenStream>) {
+    let n = s.n;
     for i in 0..n {
         for j in 0..n {
             let (mi, r, c) = (
@@ -142,7 +161,10 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
             });
         }
     }
-    // Squared column norms ‖a_j‖².
+}
+
+/// Squared column norms ‖a_j‖².
+fn column_norms(n: usize, st: &mut Vec<TokenStream>) {
     for j in 0..n {
         let nj = format_ident!("n{}", j);
         let terms = (0..n).map(|i| {
@@ -151,77 +173,101 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
         });
         st.push(quote!(let #nj = #(#terms)+*;));
     }
-    st.push(quote!(let pn: f64 = 0.0;));
-    st.push(quote!(let pd: f64 = 1.0;));
-    for k in 0..n {
-        let kk = m(k, k);
-        // Conditional swaps: row k ends with the largest |entry| of column k.
-        for i in k + 1..n {
-            let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
-            let sw = if tr { swap(k, i) } else { format_ident!("s") };
-            st.push(quote!(let #sw = #a_ik > #a_kk;));
-            for j in k..n {
-                let (u, v) = (m(k, j), m(i, j));
-                st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
-            }
-            for c in 0..k_rhs {
-                if tr {
-                    break;
-                }
-                let (u, v) = (x(k, c), x(i, c));
-                st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
-            }
-        }
-        let kl = Literal::usize_unsuffixed(k);
+}
+
+/// Step `k` of the elimination: the conditional swaps, the pivot's test, its reciprocal and
+/// the elimination below it.
+fn elimination_step(
+    s: &LuSolve<'_>,
+    k: usize,
+    k_rhs: usize,
+    tol2: &Literal,
+    st: &mut Vec<TokenStream>,
+) {
+    let (n, tr) = (s.n, s.transpose);
+    pivot_swaps(n, k, k_rhs, tr, st);
+    pivot_test(s, k, tol2, st);
+    if k + 1 < n {
         let nk = format_ident!("n{}", k);
-        let sqrt_n = (s.sqrt)(quote!(s));
-        st.push(quote! {
-            let best = if #kk < 0.0 { -#kk } else { #kk };
-            if !(best > 0.0 && best < f64::INFINITY) {
-                return Err(Singular { site: Site::Actuation(#kl), value: #kk, condition_estimate: f64::INFINITY });
-            }
-            let b2 = #kk * #kk;
-            let lhs = b2 * pd;
-            let rhs = pn * #nk;
-            if !(lhs > #tol2 * rhs) {
-                let s = #nk;
-                let n = #sqrt_n;
-                let s = rhs / lhs;
-                let c = #sqrt_n;
-                return Err(Singular {
-                    site: Site::Actuation(#kl),
-                    value: if n > 0.0 { #kk / n } else { #kk },
-                    condition_estimate: if c >= 0.0 { c } else { f64::INFINITY },
-                });
-            }
-        });
-        if k + 1 < n {
-            st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #nk) } else { (pn, pd) };));
+        st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #nk) } else { (pn, pd) };));
+    }
+    let (kk, rk) = (m(k, k), format_ident!("r{}", k));
+    st.push(quote!(let #rk = 1.0 / #kk;));
+    eliminate_below(n, k, k_rhs, tr, st);
+}
+
+/// Conditional swaps: row `k` ends with the largest |entry| of column `k`.
+fn pivot_swaps(n: usize, k: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStream>) {
+    let kk = m(k, k);
+    for i in k + 1..n {
+        let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
+        let sw = if tr { swap(k, i) } else { format_ident!("s") };
+        st.push(quote!(let #sw = #a_ik > #a_kk;));
+        for j in k..n {
+            let (u, v) = (m(k, j), m(i, j));
+            st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
         }
-        let rk = format_ident!("r{}", k);
-        st.push(quote!(let #rk = 1.0 / #kk;));
-        // Elimination below the pivot.
-        for i in k + 1..n {
-            let ik = m(i, k);
-            let f = if tr { l(i, k) } else { format_ident!("f") };
-            st.push(quote!(let #f = #ik * #rk;));
-            for j in k + 1..n {
-                let (ij, kj) = (m(i, j), m(k, j));
-                st.push(quote!(let #ij = #ij - #f * #kj;));
+        for c in 0..k_rhs {
+            if tr {
+                break;
             }
-            for c in 0..k_rhs {
-                if tr {
-                    break;
-                }
-                let (ic, kc) = (x(i, c), x(k, c));
-                st.push(quote!(let #ic = #ic - f * #kc;));
-            }
+            let (u, v) = (x(k, c), x(i, c));
+            st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
         }
     }
-    if tr {
-        transposed_solve(n, &mut st);
+}
+
+/// The pivot's test against the column-scaled tolerance, `Err(Actuation(k))` when it fails.
+fn pivot_test(s: &LuSolve<'_>, k: usize, tol2: &Literal, st: &mut Vec<TokenStream>) {
+    let kk = m(k, k);
+    let kl = Literal::usize_unsuffixed(k);
+    let nk = format_ident!("n{}", k);
+    let sqrt_n = (s.sqrt)(quote!(s));
+    st.push(quote! {
+        let best = if #kk < 0.0 { -#kk } else { #kk };
+        if !(best > 0.0 && best < f64::INFINITY) {
+            return Err(Singular { site: Site::Actuation(#kl), value: #kk, condition_estimate: f64::INFINITY });
+        }
+        let b2 = #kk * #kk;
+        let lhs = b2 * pd;
+        let rhs = pn * #nk;
+        if !(lhs > #tol2 * rhs) {
+            let s = #nk;
+            let n = #sqrt_n;
+            let s = rhs / lhs;
+            let c = #sqrt_n;
+            return Err(Singular {
+                site: Site::Actuation(#kl),
+                value: if n > 0.0 { #kk / n } else { #kk },
+                condition_estimate: if c >= 0.0 { c } else { f64::INFINITY },
+            });
+        }
+    });
+}
+
+/// Elimination below the pivot of step `k`.
+fn eliminate_below(n: usize, k: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStream>) {
+    let rk = format_ident!("r{}", k);
+    for i in k + 1..n {
+        let ik = m(i, k);
+        let f = if tr { l(i, k) } else { format_ident!("f") };
+        st.push(quote!(let #f = #ik * #rk;));
+        for j in k + 1..n {
+            let (ij, kj) = (m(i, j), m(k, j));
+            st.push(quote!(let #ij = #ij - #f * #kj;));
+        }
+        for c in 0..k_rhs {
+            if tr {
+                break;
+            }
+            let (ic, kc) = (x(i, c), x(k, c));
+            st.push(quote!(let #ic = #ic - f * #kc;));
+        }
     }
-    // Back substitution by the reciprocal pivots.
+}
+
+/// Back substitution by the reciprocal pivots (none for the transposed solve).
+fn back_substitution(n: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStream>) {
     for c in 0..k_rhs {
         if tr {
             break;
@@ -235,43 +281,45 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
             st.push(quote!(let #ic = (#ic #(#terms)*) * #ri;));
         }
     }
-    match s.rhs {
-        Rhs::Vector => {
-            let out = (0..n).map(|i| x(i, 0));
-            quote! {
-                #[doc = #doc]
-                #[allow(clippy::all, unused_variables)]
-                fn #name(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
-                    #(#st)*
-                    let out = [#(#out),*];
-                    for v in out.iter() {
-                        if !v.is_finite() {
-                            return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
-                        }
-                    }
-                    Ok(out)
+}
+
+/// The function of one right-hand side: `b: &[f64; DOF]`, solution `[f64; DOF]`.
+fn vector_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStream {
+    let out = (0..n).map(|i| x(i, 0));
+    quote! {
+        #[doc = #doc]
+        #[allow(clippy::all, unused_variables)]
+        fn #name(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+            #(#st)*
+            let out = [#(#out),*];
+            for v in out.iter() {
+                if !v.is_finite() {
+                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
                 }
             }
+            Ok(out)
         }
-        Rhs::Identity => {
-            let rows = (0..n).map(|i| {
-                let row = (0..n).map(|c| x(i, c));
-                quote!([#(#row),*])
-            });
-            quote! {
-                #[doc = #doc]
-                #[allow(clippy::all, unused_variables)]
-                fn #name(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
-                    #(#st)*
-                    let out = [#(#rows),*];
-                    for v in out.iter().flatten() {
-                        if !v.is_finite() {
-                            return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
-                        }
-                    }
-                    Ok(out)
+    }
+}
+
+/// The function of the identity's columns: the inverse, `[[f64; DOF]; DOF]`.
+fn identity_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStream {
+    let rows = (0..n).map(|i| {
+        let row = (0..n).map(|c| x(i, c));
+        quote!([#(#row),*])
+    });
+    quote! {
+        #[doc = #doc]
+        #[allow(clippy::all, unused_variables)]
+        fn #name(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+            #(#st)*
+            let out = [#(#rows),*];
+            for v in out.iter().flatten() {
+                if !v.is_finite() {
+                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
                 }
             }
+            Ok(out)
         }
     }
 }

@@ -107,40 +107,8 @@ impl Plan {
         let tree = &model.tree;
         let n = tree.dof();
         let joints = joint_plans(tree);
-        let cuts: Vec<CutPlan> = model
-            .cuts
-            .iter()
-            .map(|c| CutPlan {
-                parent: c.parent,
-                child: c.child,
-                point_parent: c.frame_parent.translation,
-                point_child: c.frame_child.translation,
-                axis_parent: match c.kind {
-                    CutKind::Revolute { axis } => Some(mat_vec(&c.frame_parent.rotation, &axis)),
-                    CutKind::Spherical => None,
-                },
-                axis_child: match c.kind {
-                    CutKind::Revolute { axis } => Some(mat_vec(&c.frame_child.rotation, &axis)),
-                    CutKind::Spherical => None,
-                },
-            })
-            .collect();
-        // Candidate rows: per cut, the three point rows, then (revolute) two axis rows.
-        let mut candidates: Vec<Row> = Vec::new();
-        for (ci, c) in model.cuts.iter().enumerate() {
-            for k in 0..3 {
-                candidates.push(Row::Point { cut: ci, k });
-            }
-            if let CutKind::Revolute { axis } = c.kind {
-                let (p1, p2) = perpendiculars(&axis);
-                for p in [p1, p2] {
-                    candidates.push(Row::Axis {
-                        cut: ci,
-                        m: mat_vec(&c.frame_child.rotation, &p),
-                    });
-                }
-            }
-        }
+        let cuts = cut_plans(model);
+        let candidates = candidate_rows(model);
         let independent = model.independent.clone();
         let dependent: Vec<usize> = (0..n).filter(|j| !independent.contains(j)).collect();
         let mut plan = Plan {
@@ -156,90 +124,12 @@ impl Plan {
             size: model.size(),
             springs: model.springs.clone(),
         };
-        // The Jacobian of every candidate at home, made dimensionless: point rows divided by
-        // the size, prismatic columns multiplied by it (a slide of one size weighs as a turn of
-        // one radian). Rounding leaves entries that are zero in exact arithmetic at about
-        // `ε‖J‖` (a loop turned in space): the rank decisions below take a residual as zero up
-        // to `tol = RANK_TOLERANCE · ‖J‖_F`, never up to exactly zero.
         let x0 = vec![0.0; n];
-        let kin = kinematics(&plan, &x0);
-        let jac: Vec<Vec<f64>> = candidates
-            .iter()
-            .map(|r| {
-                let s = row_scale(&plan, r);
-                let row = jacobian_row(&plan, &kin, r);
-                (0..n).map(|j| row[j] * col_scale(&plan, j) / s).collect()
-            })
-            .collect();
+        let jac = home_jacobian(&plan, &candidates, &x0);
         let tol = RANK_TOLERANCE * norm(&jac.concat());
-        let nd = plan.dependent.len();
-        // Mobility at home: NX − rank of the loop equations (all columns).
-        let rank = numerical_rank(&jac, tol);
-        if n - rank != plan.independent.len() {
-            return Err(alloc::format!(
-                "the mechanism has {} degree(s) of freedom at home ({n} joint coordinates, {rank} independent loop equations) but {} joint(s) are actuated; mark one actuated joint per degree of freedom",
-                n - rank,
-                plan.independent.len()
-            ));
-        }
-        // Greedy Gram–Schmidt over the dependent columns on unit rows (the best conditioned
-        // next row first); a row counts only while its residual, at the row's own size,
-        // exceeds `tol`.
-        let dep = |row: &[f64]| -> Vec<f64> { plan.dependent.iter().map(|&j| row[j]).collect() };
-        let dep_norm: Vec<f64> = jac.iter().map(|r| norm(&dep(r))).collect();
-        let mut resid: Vec<Vec<f64>> = jac
-            .iter()
-            .zip(&dep_norm)
-            .map(|(r, &s)| {
-                let d = dep(r);
-                if s > tol {
-                    d.iter().map(|x| x / s).collect()
-                } else {
-                    vec![0.0; nd]
-                }
-            })
-            .collect();
-        let mut kept: Vec<usize> = Vec::new();
-        for _ in 0..nd {
-            let mut best = (0usize, -1.0);
-            for (i, r) in resid.iter().enumerate() {
-                let s = r.iter().map(|x| x * x).sum::<f64>();
-                if !kept.contains(&i) && s > best.1 + 1e-12 && libm::sqrt(s) * dep_norm[i] > tol {
-                    best = (i, s);
-                }
-            }
-            if best.1 < 0.0 {
-                return Err(alloc::format!(
-                    "the actuated joints do not determine the others at home: the loop equations have rank {} over the {nd} other joint coordinates (mark a different set of joints as actuated)",
-                    kept.len()
-                ));
-            }
-            let s = libm::sqrt(best.1);
-            let b: Vec<f64> = resid[best.0].iter().map(|x| x / s).collect();
-            kept.push(best.0);
-            for r in resid.iter_mut() {
-                let d: f64 = r.iter().zip(&b).map(|(x, y)| x * y).sum();
-                for (x, y) in r.iter_mut().zip(&b) {
-                    *x -= d * y;
-                }
-            }
-        }
-        // Mobility: every candidate row (all columns) must depend on the kept ones.
-        let mut full: Vec<Vec<f64>> = Vec::new();
-        for &k in &kept {
-            let r = project_out(&jac[k], &full);
-            let s = norm(&r);
-            full.push(r.iter().map(|x| x / s).collect());
-        }
-        for (i, row) in jac.iter().enumerate() {
-            if !kept.contains(&i) && norm(&project_out(row, &full)) > tol {
-                return Err(alloc::format!(
-                    "the loop equations have more independent rows than the {nd} dependent coordinates: the mechanism has fewer degrees of freedom than the {} marked actuated (loop equation {i} of cut {} is independent of the rest)",
-                    plan.independent.len(),
-                    model.cuts[row_cut(&candidates[i])].name
-                ));
-            }
-        }
+        check_mobility(&plan, n, &jac, tol)?;
+        let (mut kept, dep_norm) = greedy_rows(&plan, &jac, tol)?;
+        check_kept_span(model, &plan, &candidates, &jac, &kept, tol)?;
         kept.sort_unstable();
         plan.rows = kept.iter().map(|&i| candidates[i]).collect();
         // Spare rows: the other equations whose dependent columns do not vanish at home.
@@ -303,6 +193,164 @@ fn joint_plans(tree: &crate::model::Model) -> Vec<JointPlan> {
             drive: j.drive,
         })
         .collect()
+}
+
+/// The cut joints' constant data.
+fn cut_plans(model: &ClosedModel) -> Vec<CutPlan> {
+    model
+        .cuts
+        .iter()
+        .map(|c| CutPlan {
+            parent: c.parent,
+            child: c.child,
+            point_parent: c.frame_parent.translation,
+            point_child: c.frame_child.translation,
+            axis_parent: match c.kind {
+                CutKind::Revolute { axis } => Some(mat_vec(&c.frame_parent.rotation, &axis)),
+                CutKind::Spherical => None,
+            },
+            axis_child: match c.kind {
+                CutKind::Revolute { axis } => Some(mat_vec(&c.frame_child.rotation, &axis)),
+                CutKind::Spherical => None,
+            },
+        })
+        .collect()
+}
+
+/// Candidate rows: per cut, the three point rows, then (revolute) two axis rows.
+fn candidate_rows(model: &ClosedModel) -> Vec<Row> {
+    let mut candidates: Vec<Row> = Vec::new();
+    for (ci, c) in model.cuts.iter().enumerate() {
+        for k in 0..3 {
+            candidates.push(Row::Point { cut: ci, k });
+        }
+        if let CutKind::Revolute { axis } = c.kind {
+            let (p1, p2) = perpendiculars(&axis);
+            for p in [p1, p2] {
+                candidates.push(Row::Axis {
+                    cut: ci,
+                    m: mat_vec(&c.frame_child.rotation, &p),
+                });
+            }
+        }
+    }
+    candidates
+}
+
+/// The Jacobian of every candidate at home (`x0`), made dimensionless: point rows divided by
+/// the size, prismatic columns multiplied by it (a slide of one size weighs as a turn of one
+/// radian). Rounding leaves entries that are zero in exact arithmetic at about `ε‖J‖` (a loop
+/// turned in space): the rank decisions take a residual as zero up to
+/// `tol = RANK_TOLERANCE · ‖J‖_F`, never up to exactly zero.
+fn home_jacobian(plan: &Plan, candidates: &[Row], x0: &[f64]) -> Vec<Vec<f64>> {
+    let n = x0.len();
+    let kin = kinematics(plan, x0);
+    candidates
+        .iter()
+        .map(|r| {
+            let s = row_scale(plan, r);
+            let row = jacobian_row(plan, &kin, r);
+            (0..n).map(|j| row[j] * col_scale(plan, j) / s).collect()
+        })
+        .collect()
+}
+
+/// Mobility at home: NX − rank of the loop equations (all columns) must be the number of
+/// actuated joints.
+fn check_mobility(
+    plan: &Plan,
+    n: usize,
+    jac: &[Vec<f64>],
+    tol: f64,
+) -> Result<(), alloc::string::String> {
+    let rank = numerical_rank(jac, tol);
+    if n - rank != plan.independent.len() {
+        return Err(alloc::format!(
+            "the mechanism has {} degree(s) of freedom at home ({n} joint coordinates, {rank} independent loop equations) but {} joint(s) are actuated; mark one actuated joint per degree of freedom",
+            n - rank,
+            plan.independent.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Greedy Gram–Schmidt over the dependent columns on unit rows (the best conditioned next row
+/// first); a row counts only while its residual, at the row's own size, exceeds `tol`. The
+/// kept rows in the order chosen, and every row's norm over the dependent columns.
+fn greedy_rows(
+    plan: &Plan,
+    jac: &[Vec<f64>],
+    tol: f64,
+) -> Result<(Vec<usize>, Vec<f64>), alloc::string::String> {
+    let nd = plan.dependent.len();
+    let dep = |row: &[f64]| -> Vec<f64> { plan.dependent.iter().map(|&j| row[j]).collect() };
+    let dep_norm: Vec<f64> = jac.iter().map(|r| norm(&dep(r))).collect();
+    let mut resid: Vec<Vec<f64>> = jac
+        .iter()
+        .zip(&dep_norm)
+        .map(|(r, &s)| {
+            let d = dep(r);
+            if s > tol {
+                d.iter().map(|x| x / s).collect()
+            } else {
+                vec![0.0; nd]
+            }
+        })
+        .collect();
+    let mut kept: Vec<usize> = Vec::new();
+    for _ in 0..nd {
+        let mut best = (0usize, -1.0);
+        for (i, r) in resid.iter().enumerate() {
+            let s = r.iter().map(|x| x * x).sum::<f64>();
+            if !kept.contains(&i) && s > best.1 + 1e-12 && libm::sqrt(s) * dep_norm[i] > tol {
+                best = (i, s);
+            }
+        }
+        if best.1 < 0.0 {
+            return Err(alloc::format!(
+                "the actuated joints do not determine the others at home: the loop equations have rank {} over the {nd} other joint coordinates (mark a different set of joints as actuated)",
+                kept.len()
+            ));
+        }
+        let s = libm::sqrt(best.1);
+        let b: Vec<f64> = resid[best.0].iter().map(|x| x / s).collect();
+        kept.push(best.0);
+        for r in resid.iter_mut() {
+            let d: f64 = r.iter().zip(&b).map(|(x, y)| x * y).sum();
+            for (x, y) in r.iter_mut().zip(&b) {
+                *x -= d * y;
+            }
+        }
+    }
+    Ok((kept, dep_norm))
+}
+
+/// Mobility: every candidate row (all columns) must depend on the kept ones.
+fn check_kept_span(
+    model: &ClosedModel,
+    plan: &Plan,
+    candidates: &[Row],
+    jac: &[Vec<f64>],
+    kept: &[usize],
+    tol: f64,
+) -> Result<(), alloc::string::String> {
+    let nd = plan.dependent.len();
+    let mut full: Vec<Vec<f64>> = Vec::new();
+    for &k in kept {
+        let r = project_out(&jac[k], &full);
+        let s = norm(&r);
+        full.push(r.iter().map(|x| x / s).collect());
+    }
+    for (i, row) in jac.iter().enumerate() {
+        if !kept.contains(&i) && norm(&project_out(row, &full)) > tol {
+            return Err(alloc::format!(
+                "the loop equations have more independent rows than the {nd} dependent coordinates: the mechanism has fewer degrees of freedom than the {} marked actuated (loop equation {i} of cut {} is independent of the rest)",
+                plan.independent.len(),
+                model.cuts[row_cut(&candidates[i])].name
+            ));
+        }
+    }
+    Ok(())
 }
 
 pub(super) fn row_cut(r: &Row) -> usize {

@@ -10,17 +10,14 @@ use alloc::vec::Vec;
 
 use super::LEG_TOLERANCE;
 use super::generic_leg::generic_ik;
-use super::plan::{Plan, sub3};
+use super::plan::{LegPlan, Plan, sub3};
 use super::pose::{Platform, platform};
 use super::subproblems::{one_axis, rus_crank, two_axes};
-use super::ups::UpsKin;
+use super::ups::{UpsKin, UpsPlan};
 use crate::algebra::{M, V, add, cm, cross, cv, dot, ident, mm, mtv, mv, rot, scale, sub, zero3};
 use crate::model::JointKind;
 use crate::parallel::{LegKind, PlatformMotion};
 use crate::scalar::{Real, Singular, Site};
-
-#[cfg(doc)]
-use super::plan::LegPlan;
 
 /// A joint's position: `(sin, cos)` for a revolute, the displacement for a prismatic joint.
 #[derive(Clone, Copy, Debug)]
@@ -69,12 +66,38 @@ pub fn leg_kinematics<R: Real>(
     let lp = &plan.legs[k];
     let fr: M<R> = cm(&lp.frame.rotation);
     let ft: V<R> = cv(&lp.frame.translation);
-    let n = lp.joints.len();
     // The end target in L.
-    let (target, arm, end_base) = match lp.kind {
+    let (target, arm, end_base) = end_target(lp, pl, &fr, ft);
+    // Closed-form inverse kinematics.
+    let (q, ups) = closed_form_ik(lp, k, &fr, target, end_base)?;
+    // Product of exponentials from the home configuration.
+    let chain = chain_pose(lp, &q);
+    let end = match lp.kind {
+        LegKind::SphericalRr => target,
+        _ => add(mv(&chain.g, cv(&lp.end_home)), chain.t),
+    };
+    let jinv = jacobian_inverse(lp, k, &chain.e, &chain.o, end, jacobian)?;
+    Ok(LegKin {
+        q,
+        e: chain.e,
+        o: chain.o,
+        rot: chain.rots,
+        com: chain.coms,
+        end,
+        jinv,
+        frame: fr,
+        arm,
+        ups,
+    })
+}
+
+/// The end target in `L`, the end point relative to the platform origin (base frame) and the
+/// end point in the base frame, as each leg kind needs them.
+fn end_target<R: Real>(lp: &LegPlan, pl: &Platform<R>, fr: &M<R>, ft: V<R>) -> (V<R>, V<R>, V<R>) {
+    match lp.kind {
         LegKind::SphericalRr => {
             let axis = mv(&pl.rot, cv(&lp.end_platform));
-            (mtv(&fr, axis), zero3(), zero3())
+            (mtv(fr, axis), zero3(), zero3())
         }
         LegKind::Ups => {
             // The target is not needed: the leg vector is formed in the base frame.
@@ -84,121 +107,202 @@ pub fn leg_kinematics<R: Real>(
         _ => {
             let arm = mv(&pl.rot, cv(&lp.end_platform));
             let a = add(pl.origin, arm);
-            (mtv(&fr, sub(a, ft)), arm, a)
+            (mtv(fr, sub(a, ft)), arm, a)
         }
-    };
-    // Closed-form inverse kinematics.
-    let mut q: Vec<JointPos<R>> = Vec::with_capacity(n);
-    let mut ups = None;
-    match lp.kind {
-        LegKind::Ups => {
-            // The leg vector U centre → S centre in the base frame (the same as in L, rotated).
-            let r = sub(end_base, cv(&lp.frame.apply(&lp.u_centre)));
-            let rr = dot(r, r);
-            let rr = R::check(rr, R::c(0.0), R::c(1.0), Site::Reach(k), false)?;
-            let rho = rr.sqrt();
-            let d = R::c(lp.sigma_first) * (rho - R::c(lp.length));
-            let inv_rho = R::c(1.0) / rho;
-            let s = scale(inv_rho, r);
-            if let Some(up) = &lp.ups {
-                // The leg frame (UpsPlan): c = e₀·s, d² = |e₀ × s|² (= 1 − c², formed so that
-                // it keeps its relative accuracy near the U's singularity d → 0, where e₀ ∥ s;
-                // the same test as `two_axes`' γ² ≤ 0).
-                let e0 = cv::<R>(&up.e0);
-                let c = dot(e0, s);
-                let m = cross(e0, s);
-                let d2 = R::check(dot(m, m), R::c(0.0), R::c(1.0), Site::Leg(k), false)?;
-                let dd = R::c(lp.sigma_u) * d2.sqrt();
-                let inv_d = R::c(1.0) / dd;
-                ups = Some(UpsKin {
-                    rho,
-                    inv_rho,
-                    cot: c * inv_d,
-                    inv_d,
-                    t: scale(inv_d, sub(e0, scale(c, s))),
-                    e1: scale(-inv_d, m),
-                    s,
-                });
-            }
-            let dir = mtv(&fr, s);
-            let p = sub3(&lp.end_home, &lp.u_centre);
-            let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
-            let closed = lp.ups.is_some();
-            let [a, b] = two_axes(
-                &lp.axes[0],
-                &lp.axes[1],
-                cv(&p),
-                dir,
-                lp.sigma_u,
-                k,
-                !closed,
-            )?;
-            q.push(JointPos::R(a.0, a.1));
-            q.push(JointPos::R(b.0, b.1));
-            q.push(JointPos::P(d));
-        }
-        LegKind::Pus => {
-            let e0 = lp.axes[0];
-            let dd = sub(target, cv(&lp.u_centre));
-            let t = dot(cv(&e0), dd);
-            let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
-            let disc = R::check(
-                disc,
-                R::c(0.0),
-                R::c(lp.length * lp.length),
-                Site::Reach(k),
-                false,
-            )?;
-            let s = t - R::c(lp.sigma_first) * disc.sqrt();
-            let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
-            let qv = sub(target, u);
-            let p = sub3(&lp.end_home, &lp.u_centre);
-            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
-            q.push(JointPos::P(s));
-            q.push(JointPos::R(a.0, a.1));
-            q.push(JointPos::R(b.0, b.1));
-        }
-        LegKind::Rus => {
-            let (s0, c0) = rus_crank(lp, target, k)?;
-            let r0 = rot(&lp.axes[0], s0, c0);
-            let o0 = cv(&lp.points[0]);
-            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
-            // The rod direction in the crank's home frame.
-            let qv = mtv(&r0, sub(target, u));
-            let p = sub3(&lp.end_home, &lp.u_centre);
-            let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
-            q.push(JointPos::R(s0, c0));
-            q.push(JointPos::R(a.0, a.1));
-            q.push(JointPos::R(b.0, b.1));
-        }
-        LegKind::PlanarRr => {
-            let (s0, c0) = rus_crank(lp, target, k)?;
-            let r0 = rot(&lp.axes[0], s0, c0);
-            let o0 = cv(&lp.points[0]);
-            let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
-            // The distal link's direction in the proximal link's home frame.
-            let qv = mtv(&r0, sub(target, u));
-            let p = sub3(&lp.end_home, &lp.u_centre);
-            let (s1, c1) = one_axis(&lp.axes[1], cv(&p), qv);
-            q.push(JointPos::R(s0, c0));
-            q.push(JointPos::R(s1, c1));
-        }
-        LegKind::SphericalRr => {
-            let [a, b] = two_axes(
-                &lp.axes[0],
-                &lp.axes[1],
-                cv(&lp.end_home),
-                target,
-                lp.sigma_u,
-                k,
-                true,
-            )?;
-            q.push(JointPos::R(a.0, a.1));
-            q.push(JointPos::R(b.0, b.1));
-        }
-        LegKind::Generic => q = generic_ik(lp, target, k)?,
     }
-    // Product of exponentials from the home configuration: D = Π exp(ξ_j θ_j), x ↦ G x + t.
+}
+
+/// A leg's joint positions with the closed-form UPS leg's frame.
+type LegIk<R> = (Vec<JointPos<R>>, Option<UpsKin<R>>);
+
+/// The joint positions of leg `k` by its kind's closed form (or `generic_leg`'s Newton steps),
+/// with the closed-form UPS leg's frame.
+fn closed_form_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    fr: &M<R>,
+    target: V<R>,
+    end_base: V<R>,
+) -> Result<LegIk<R>, Singular> {
+    match lp.kind {
+        LegKind::Ups => ups_ik(lp, k, fr, end_base),
+        LegKind::Pus => Ok((pus_ik(lp, k, target)?, None)),
+        LegKind::Rus => Ok((rus_ik(lp, k, target)?, None)),
+        LegKind::PlanarRr => Ok((planar_rr_ik(lp, k, target)?, None)),
+        LegKind::SphericalRr => Ok((spherical_rr_ik(lp, k, target)?, None)),
+        LegKind::Generic => Ok((generic_ik(lp, target, k)?, None)),
+    }
+}
+
+/// UPS: the U angles and the prismatic displacement from the leg vector (base frame).
+fn ups_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    fr: &M<R>,
+    end_base: V<R>,
+) -> Result<LegIk<R>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let mut ups = None;
+    // The leg vector U centre → S centre in the base frame (the same as in L, rotated).
+    let r = sub(end_base, cv(&lp.frame.apply(&lp.u_centre)));
+    let rr = dot(r, r);
+    let rr = R::check(rr, R::c(0.0), R::c(1.0), Site::Reach(k), false)?;
+    let rho = rr.sqrt();
+    let d = R::c(lp.sigma_first) * (rho - R::c(lp.length));
+    let inv_rho = R::c(1.0) / rho;
+    let s = scale(inv_rho, r);
+    if let Some(up) = &lp.ups {
+        ups = Some(ups_frame(lp, up, k, rho, inv_rho, s)?);
+    }
+    let dir = mtv(fr, s);
+    let p = sub3(&lp.end_home, &lp.u_centre);
+    let p = [p[0] / lp.length, p[1] / lp.length, p[2] / lp.length];
+    let closed = lp.ups.is_some();
+    let [a, b] = two_axes(
+        &lp.axes[0],
+        &lp.axes[1],
+        cv(&p),
+        dir,
+        lp.sigma_u,
+        k,
+        !closed,
+    )?;
+    q.push(JointPos::R(a.0, a.1));
+    q.push(JointPos::R(b.0, b.1));
+    q.push(JointPos::P(d));
+    Ok((q, ups))
+}
+
+/// The closed-form UPS leg's frame (`UpsPlan`): c = e₀·s, d² = |e₀ × s|² (= 1 − c², formed
+/// so that it keeps its relative accuracy near the U's singularity d → 0, where e₀ ∥ s; the
+/// same test as `two_axes`' γ² ≤ 0).
+fn ups_frame<R: Real>(
+    lp: &LegPlan,
+    up: &UpsPlan,
+    k: usize,
+    rho: R,
+    inv_rho: R,
+    s: V<R>,
+) -> Result<UpsKin<R>, Singular> {
+    let e0 = cv::<R>(&up.e0);
+    let c = dot(e0, s);
+    let m = cross(e0, s);
+    let d2 = R::check(dot(m, m), R::c(0.0), R::c(1.0), Site::Leg(k), false)?;
+    let dd = R::c(lp.sigma_u) * d2.sqrt();
+    let inv_d = R::c(1.0) / dd;
+    Ok(UpsKin {
+        rho,
+        inv_rho,
+        cot: c * inv_d,
+        inv_d,
+        t: scale(inv_d, sub(e0, scale(c, s))),
+        e1: scale(-inv_d, m),
+        s,
+    })
+}
+
+/// PUS: the slider's displacement on the rod-length sphere about `target`, then the U angles.
+fn pus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let e0 = lp.axes[0];
+    let dd = sub(target, cv(&lp.u_centre));
+    let t = dot(cv(&e0), dd);
+    let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
+    let disc = R::check(
+        disc,
+        R::c(0.0),
+        R::c(lp.length * lp.length),
+        Site::Reach(k),
+        false,
+    )?;
+    let s = t - R::c(lp.sigma_first) * disc.sqrt();
+    let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+    let qv = sub(target, u);
+    let p = sub3(&lp.end_home, &lp.u_centre);
+    let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
+    q.push(JointPos::P(s));
+    q.push(JointPos::R(a.0, a.1));
+    q.push(JointPos::R(b.0, b.1));
+    Ok(q)
+}
+
+/// RUS: the crank angle, then the U angles of the rod in the crank's home frame.
+fn rus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let (s0, c0) = rus_crank(lp, target, k)?;
+    let r0 = rot(&lp.axes[0], s0, c0);
+    let o0 = cv(&lp.points[0]);
+    let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+    // The rod direction in the crank's home frame.
+    let qv = mtv(&r0, sub(target, u));
+    let p = sub3(&lp.end_home, &lp.u_centre);
+    let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
+    q.push(JointPos::R(s0, c0));
+    q.push(JointPos::R(a.0, a.1));
+    q.push(JointPos::R(b.0, b.1));
+    Ok(q)
+}
+
+/// Planar RR: the proximal angle, then the distal one in the proximal link's home frame.
+fn planar_rr_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    target: V<R>,
+) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let (s0, c0) = rus_crank(lp, target, k)?;
+    let r0 = rot(&lp.axes[0], s0, c0);
+    let o0 = cv(&lp.points[0]);
+    let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+    // The distal link's direction in the proximal link's home frame.
+    let qv = mtv(&r0, sub(target, u));
+    let p = sub3(&lp.end_home, &lp.u_centre);
+    let (s1, c1) = one_axis(&lp.axes[1], cv(&p), qv);
+    q.push(JointPos::R(s0, c0));
+    q.push(JointPos::R(s1, c1));
+    Ok(q)
+}
+
+/// Spherical RR: the two angles that turn the end axis at home onto `target`.
+fn spherical_rr_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    target: V<R>,
+) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let [a, b] = two_axes(
+        &lp.axes[0],
+        &lp.axes[1],
+        cv(&lp.end_home),
+        target,
+        lp.sigma_u,
+        k,
+        true,
+    )?;
+    q.push(JointPos::R(a.0, a.1));
+    q.push(JointPos::R(b.0, b.1));
+    Ok(q)
+}
+
+/// A leg's bodies posed by the product of exponentials.
+struct Chain<R> {
+    /// The rotation `G` of the last joint's displacement.
+    g: M<R>,
+    /// The translation `t` of the last joint's displacement.
+    t: V<R>,
+    /// Current joint axes.
+    e: Vec<V<R>>,
+    /// Current joint points.
+    o: Vec<V<R>>,
+    /// Body rotations (body → `L`).
+    rots: Vec<M<R>>,
+    /// Body mass centres.
+    coms: Vec<V<R>>,
+}
+
+/// Product of exponentials from the home configuration: D = Π exp(ξ_j θ_j), x ↦ G x + t.
+fn chain_pose<R: Real>(lp: &LegPlan, q: &[JointPos<R>]) -> Chain<R> {
+    let n = lp.joints.len();
     let mut g: M<R> = ident();
     let mut t: V<R> = zero3();
     let mut e = Vec::with_capacity(n);
@@ -225,10 +329,27 @@ pub fn leg_kinematics<R: Real>(
         e.push(ej);
         o.push(oj);
     }
-    let end = match lp.kind {
-        LegKind::SphericalRr => target,
-        _ => add(mv(&g, cv(&lp.end_home)), t),
-    };
+    Chain {
+        g,
+        t,
+        e,
+        o,
+        rots,
+        coms,
+    }
+}
+
+/// The rows of `J_J⁻¹` from the Jacobian columns' adjugate, the determinant tested (with
+/// `jacobian`, and not for a closed-form UPS leg).
+fn jacobian_inverse<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    e: &[V<R>],
+    o: &[V<R>],
+    end: V<R>,
+    jacobian: bool,
+) -> Result<[V<R>; 3], Singular> {
+    let n = lp.joints.len();
     // Jacobian columns and their adjugate.
     let cols: Vec<V<R>> = match lp.kind {
         LegKind::SphericalRr => vec![e[0], e[1], end],
@@ -263,18 +384,7 @@ pub fn leg_kinematics<R: Real>(
         det
     };
     let id = R::c(1.0) / det;
-    Ok(LegKin {
-        q,
-        e,
-        o,
-        rot: rots,
-        com: coms,
-        end,
-        jinv: [scale(id, r0), scale(id, r1), scale(id, r2)],
-        frame: fr,
-        arm,
-        ups,
-    })
+    Ok([scale(id, r0), scale(id, r1), scale(id, r2)])
 }
 
 /// The legs' kinematics at `x`, their Jacobians tested.
