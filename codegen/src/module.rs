@@ -44,3 +44,34 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
         },
     )
 }
+
+/// The `Singular` and `NoConvergence` types of a platform or closed-loop module (each kind has
+/// its own `Site`); `site`, `value` and `residual` document what the kind's fields hold.
+pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStream {
+    let (site, value, residual) = (
+        format!(" {site}"),
+        format!(" {value}"),
+        format!(" {residual}"),
+    );
+    quote! {
+        /// A configuration where the method fails, or a non-finite input: never a NaN result.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Singular {
+            #[doc = #site]
+            pub site: Site,
+            #[doc = #value]
+            pub value: f64,
+            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
+            pub condition_estimate: f64,
+        }
+
+        /// Forward kinematics did not converge.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct NoConvergence {
+            /// Newton iterations made.
+            pub iterations: usize,
+            #[doc = #residual]
+            pub residual: f64,
+        }
+    }
+}

@@ -48,6 +48,11 @@ fn error_types(springs: bool) -> TokenStream {
     } else {
         quote!()
     };
+    let errors = crate::module::error_types(
+        "Which matrix, equation or pivot.",
+        "The value that failed its test.",
+        "The last largest scaled loop-equation residual.",
+    );
     quote! {
         /// Where an evaluation failed.
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,25 +68,7 @@ fn error_types(springs: bool) -> TokenStream {
             Input,
         }
 
-        /// A configuration where the method fails, or a non-finite input: never a NaN result.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Singular {
-            /// Which matrix, equation or pivot.
-            pub site: Site,
-            /// The value that failed its test.
-            pub value: f64,
-            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
-            pub condition_estimate: f64,
-        }
-
-        /// Forward kinematics did not converge.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct NoConvergence {
-            /// Newton iterations made.
-            pub iterations: usize,
-            /// The last largest scaled loop-equation residual.
-            pub residual: f64,
-        }
+        #errors
     }
 }
 

@@ -80,6 +80,11 @@ fn error_types() -> TokenStream {
     let act_doc = format!(
         " Pivot `i` of the actuation matrix `A` (columns scaled to unit norm, partial pivoting) is `≤ {act_tol:e}` times the largest pivot: a parallel (type-II) singularity."
     );
+    let errors = crate::module::error_types(
+        "Which matrix, leg or pivot.",
+        "The determinant, pivot or discriminant that failed its test.",
+        "The last residual `max |q(x) − q|` (m or rad).",
+    );
     quote! {
         /// Where an evaluation failed.
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,25 +104,7 @@ fn error_types() -> TokenStream {
             Input,
         }
 
-        /// A configuration where the method fails, or a non-finite input: never a NaN result.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Singular {
-            /// Which matrix, leg or pivot.
-            pub site: Site,
-            /// The determinant, pivot or discriminant that failed its test.
-            pub value: f64,
-            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
-            pub condition_estimate: f64,
-        }
-
-        /// Forward kinematics did not converge.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct NoConvergence {
-            /// Newton iterations made.
-            pub iterations: usize,
-            /// The last residual `max |q(x) − q|` (m or rad).
-            pub residual: f64,
-        }
+        #errors
     }
 }
 
