@@ -280,37 +280,28 @@ fn input_checks(f: &Function<'_>) -> Vec<TokenStream> {
     }
 }
 
-/// Parallel modules: a result that overflowed is an error, not an `Ok` with NaN or ∞.
+/// A result that overflowed, or a non-finite input that reached it, is an error, not an `Ok`
+/// with NaN or ∞: `Site::Input` in platform and closed-loop modules; in a tree's
+/// `forward_dynamics` (whose pivots a `q̇`, a `τ` or an angle that only enters gravity or
+/// Coriolis terms passes) the index one past the pivots.
 fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
-    if f.sites {
-        quote! {
-            for v in [#(#outs),*].iter() {
-                if !v.is_finite() {
-                    return Err(Singular {
-                        site: Site::Input,
-                        value: *v,
-                        condition_estimate: f64::INFINITY,
-                    });
-                }
-            }
-        }
+    let at = if f.sites {
+        quote!(site: Site::Input)
     } else if matches!(f.shape, Shape::FallibleVector) {
-        // Tree `forward_dynamics`: a non-finite input that passed the pivots (a `q̇` or `τ`, or
-        // an angle that only enters gravity or Coriolis terms) or an overflow is an `Err` at
-        // the one index past the pivots, never an `Ok` with NaN or ∞.
-        quote! {
-            for v in [#(#outs),*].iter() {
-                if !v.is_finite() {
-                    return Err(Singular {
-                        pivot: DOF,
-                        value: *v,
-                        condition_estimate: f64::INFINITY,
-                    });
-                }
+        quote!(pivot: DOF)
+    } else {
+        return TokenStream::new();
+    };
+    quote! {
+        for v in [#(#outs),*].iter() {
+            if !v.is_finite() {
+                return Err(Singular {
+                    #at,
+                    value: *v,
+                    condition_estimate: f64::INFINITY,
+                });
             }
         }
-    } else {
-        TokenStream::new()
     }
 }
 
