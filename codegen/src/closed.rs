@@ -336,6 +336,7 @@ fn items(
     joint_names: &[String],
     act_names: &[String],
 ) -> TokenStream {
+    let real = crate::emit::real();
     let nx_lit = Literal::usize_unsuffixed(plan.nx());
     let n_lit = Literal::usize_unsuffixed(plan.dof());
     let indep: Vec<Literal> = plan
@@ -376,10 +377,10 @@ fn items(
         #spring_names
         /// The spec's home configuration (every tree joint at zero, where the spec's geometry
         /// closes the loops in its declared branch): a guess for `forward_kinematics` near home.
-        pub const HOME: [f64; NX] = [0.0; NX];
+        pub const HOME: [#real; NX] = [0.0; NX];
         /// The largest move of each independent coordinate per stage of `forward_kinematics`
         /// (rad, or m: a fraction of the mechanism's size).
-        const STEP: [f64; DOF] = [#(#step),*];
+        const STEP: [#real; DOF] = [#(#step),*];
         /// The dependent revolute joints: assembly keeps each within ±π of its guess.
         const WRAP: [bool; NX] = [#(#wrap),*];
         #params
@@ -427,6 +428,7 @@ fn runtime_params(
 
 /// `actuator_mass_matrix`, the name every actuator-space module has: `mass_matrix` itself.
 fn actuator_mass_matrix(layout: &Layout) -> TokenStream {
+    let real = crate::emit::real();
     let (p_arg, p_call) = if layout.any() {
         (quote!(, p: &Params), quote!(, p))
     } else {
@@ -437,7 +439,7 @@ fn actuator_mass_matrix(layout: &Layout) -> TokenStream {
         /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
         #[allow(clippy::all)]
         #[inline(always)]
-        pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
+        pub fn actuator_mass_matrix(x: &[#real; NX] #p_arg) -> Result<[[#real; DOF]; DOF], Singular> {
             mass_matrix(x #p_call)
         }
     }

@@ -47,11 +47,12 @@ impl Part {
         }
     }
     fn ty(self) -> TokenStream {
+        let real = real();
         match self {
-            Part::Vector => quote!([f64; DOF]),
-            Part::Matrix => quote!([[f64; DOF]; DOF]),
-            Part::Coords(_) => quote!([f64; NX]),
-            Part::Scalar => quote!(f64),
+            Part::Vector => quote!([#real; DOF]),
+            Part::Matrix => quote!([[#real; DOF]; DOF]),
+            Part::Coords(_) => quote!([#real; NX]),
+            Part::Scalar => quote!(#real),
         }
     }
 }
@@ -106,22 +107,48 @@ fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
     }
 }
 
+/// The scalar type of the module being generated: `f64`, or `f32` when the generation runs in
+/// single precision ([`crate::Float::F32`]). Every type, constant path (`f64::INFINITY`,
+/// `core::f64::consts::PI`) and method path (`f64::abs`) the generator writes names it.
+pub(crate) fn real() -> Ident {
+    Ident::new(
+        if crate::scalar::single() {
+            "f32"
+        } else {
+            "f64"
+        },
+        Span::call_site(),
+    )
+}
+
+/// `text` (a doc or header line naming the scalar type) with the word `f64` replaced by
+/// [`real`]'s name.
+pub(crate) fn real_text(text: &str) -> String {
+    if crate::scalar::single() {
+        text.replace("f64", "f32")
+    } else {
+        text.to_string()
+    }
+}
+
 /// A call of the math backend's `f` (`sin_cos`, `sqrt`, `atan2`) on the argument tokens `x`.
+/// In `f32` these are `libm::{sincosf, sqrtf, atan2f}`, `f32::…` and `runtime::math::*_f32`.
 pub(crate) fn math_call(cfg: &Config, f: &str, x: TokenStream) -> TokenStream {
-    let f = Ident::new(f, Span::call_site());
+    let single = crate::scalar::single();
     match &cfg.math {
         MathBackend::Libm => {
-            let f = if f == "sin_cos" {
-                format_ident!("sincos")
-            } else {
-                f
-            };
+            let f = if f == "sin_cos" { "sincos" } else { f };
+            let f = format_ident!("{}{}", f, if single { "f" } else { "" });
             quote!(libm::#f(#x))
         }
-        MathBackend::Std => quote!(f64::#f(#x)),
+        MathBackend::Std => {
+            let (real, f) = (real(), Ident::new(f, Span::call_site()));
+            quote!(#real::#f(#x))
+        }
         MathBackend::Runtime(path) => {
             let path: syn::Path =
                 syn::parse_str(path).unwrap_or_else(|_| syn::parse_quote!(runtime));
+            let f = format_ident!("{}{}", f, if single { "_f32" } else { "" });
             quote!(#path::math::#f(#x))
         }
     }
@@ -159,6 +186,7 @@ fn step_tokens(g: &Graph, cfg: &Config, f: &Function<'_>, step: &Step) -> TokenS
 
 /// A guard's test: `Err(Singular)` at its site (parallel) or pivot (trees) when it fails.
 fn check_tokens(g: &Graph, f: &Function<'_>, node: ExprId) -> TokenStream {
+    let real = real();
     let s = &f.schedule;
     let Node::Guard {
         value,
@@ -199,7 +227,7 @@ fn check_tokens(g: &Graph, f: &Function<'_>, node: ExprId) -> TokenStream {
                 return Err(Singular {
                     #at,
                     value: #v,
-                    condition_estimate: if a > 0.0 { #sc / a } else { f64::INFINITY },
+                    condition_estimate: if a > 0.0 { #sc / a } else { #real::INFINITY },
                 });
             }
         }
@@ -209,7 +237,7 @@ fn check_tokens(g: &Graph, f: &Function<'_>, node: ExprId) -> TokenStream {
                 return Err(Singular {
                     #at,
                     value: #v,
-                    condition_estimate: if #v > 0.0 { #sc / #v } else { f64::INFINITY },
+                    condition_estimate: if #v > 0.0 { #sc / #v } else { #real::INFINITY },
                 });
             }
         }
@@ -218,6 +246,7 @@ fn check_tokens(g: &Graph, f: &Function<'_>, node: ExprId) -> TokenStream {
 
 /// `let x = …;` of one operation (empty for a node that is none).
 fn let_tokens(g: &Graph, cfg: &Config, s: &Schedule, name: usize, node: ExprId) -> TokenStream {
+    let real = real();
     let x = var(name);
     let e = match g.node(node) {
         Node::Add(a, b) => {
@@ -248,7 +277,7 @@ fn let_tokens(g: &Graph, cfg: &Config, s: &Schedule, name: usize, node: ExprId) 
         Node::Select(a, b, x, y) => {
             let (a, b) = (operand(g, s, a), operand(g, s, b));
             let (x, y) = (operand(g, s, x), operand(g, s, y));
-            quote!(if f64::abs(#a) > f64::abs(#b) { #x } else { #y })
+            quote!(if #real::abs(#a) > #real::abs(#b) { #x } else { #y })
         }
         _ => return TokenStream::new(),
     };
@@ -257,6 +286,7 @@ fn let_tokens(g: &Graph, cfg: &Config, s: &Schedule, name: usize, node: ExprId) 
 
 /// Parallel modules: a NaN or infinite input is an error, not a NaN result.
 fn input_checks(f: &Function<'_>) -> Vec<TokenStream> {
+    let real = real();
     if f.sites {
         f.args
             .iter()
@@ -268,7 +298,7 @@ fn input_checks(f: &Function<'_>) -> Vec<TokenStream> {
                             return Err(Singular {
                                 site: Site::Input,
                                 value: *v,
-                                condition_estimate: f64::INFINITY,
+                                condition_estimate: #real::INFINITY,
                             });
                         }
                     }
@@ -285,6 +315,7 @@ fn input_checks(f: &Function<'_>) -> Vec<TokenStream> {
 /// `forward_dynamics` (whose pivots a `q̇`, a `τ` or an angle that only enters gravity or
 /// Coriolis terms passes) the index one past the pivots.
 fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
+    let real = real();
     let at = if f.sites {
         quote!(site: Site::Input)
     } else if matches!(f.shape, Shape::FallibleVector) {
@@ -298,7 +329,7 @@ fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
                 return Err(Singular {
                     #at,
                     value: *v,
-                    condition_estimate: f64::INFINITY,
+                    condition_estimate: #real::INFINITY,
                 });
             }
         }
@@ -450,6 +481,7 @@ fn site_tokens(site: runtime::scalar::Site) -> TokenStream {
 
 /// The tokens of one function.
 pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
+    let real = real();
     let name = Ident::new(f.name, Span::call_site());
     let args: Vec<TokenStream> = f
         .args
@@ -464,13 +496,13 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
                 quote!(DOF)
             };
             let a = Ident::new(a.name(), Span::call_site());
-            quote!(#a: &[f64; #len])
+            quote!(#a: &[#real; #len])
         })
         .collect();
     let ret = match &f.shape {
-        Shape::Vector => quote!([f64; DOF]),
-        Shape::Matrix => quote!([[f64; DOF]; DOF]),
-        Shape::FallibleVector => quote!(Result<[f64; DOF], Singular>),
+        Shape::Vector => quote!([#real; DOF]),
+        Shape::Matrix => quote!([[#real; DOF]; DOF]),
+        Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
         Shape::Fallible(parts) => {
             let tys: Vec<TokenStream> = parts.iter().map(|p| p.ty()).collect();
             if tys.len() == 1 {
@@ -516,62 +548,17 @@ pub(crate) fn render(header: &[String], tokens: TokenStream) -> String {
         Err(e) => panic!("internal error: generated tokens do not parse: {e}"),
     };
     let mut out = String::new();
-    for h in header {
+    for (i, h) in header.iter().enumerate() {
         out.push_str("// ");
-        out.push_str(h);
+        out.push_str(&real_text(h));
         out.push('\n');
+        if i == 0 && crate::scalar::single() {
+            // The precision is named right after the first line.
+            out.push_str("// Scalar: f32 (single precision; the guards' thresholds and Newton's tolerance rescaled to it).\n");
+        }
     }
     out.push('\n');
     out.push_str(&prettyplease::unparse(&file));
-    out
-}
-
-/// The `f32` version of a generated module's text: the identifier `f64` becomes `f32`
-/// (types, `f64::INFINITY`, `f64::abs`, `core::f64::consts`) and the math calls become their
-/// single-precision forms (`libm::sincosf`, `sqrtf`, `atan2f`; `runtime::math::*_f32`). The
-/// thresholds were already chosen for `f32` while generating. Identifiers only: no literal is
-/// touched (every constant the generator writes is within `f32`'s range or rounds in it).
-pub fn to_f32(code: &str) -> String {
-    let mut out = String::with_capacity(code.len() + 128);
-    // The header names the precision right after its first line.
-    let code = match code.split_once('\n') {
-        Some((first, rest)) if first.starts_with("// @generated") => {
-            out.push_str(first);
-            out.push_str("\n// Scalar: f32 (single precision; the guards' thresholds and Newton's tolerance rescaled to it).\n");
-            rest
-        }
-        _ => code,
-    };
-    let b = code.as_bytes();
-    let mut i = 0;
-    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
-    while i < b.len() {
-        if ident(b[i]) && (i == 0 || !ident(b[i - 1])) {
-            let start = i;
-            while i < b.len() && ident(b[i]) {
-                i += 1;
-            }
-            let word = &code[start..i];
-            let prev = code[..start].trim_end();
-            let called = code[i..].starts_with('(');
-            let math = prev.ends_with("libm::") || prev.ends_with("math::");
-            let w = match word {
-                "f64" => "f32",
-                "sincos" if called && prev.ends_with("libm::") => "sincosf",
-                "sqrt" if called && prev.ends_with("libm::") => "sqrtf",
-                "atan2" if called && prev.ends_with("libm::") => "atan2f",
-                "sin_cos" if called && math => "sin_cos_f32",
-                "sqrt" if called && math => "sqrt_f32",
-                "atan2" if called && math => "atan2_f32",
-                w => w,
-            };
-            out.push_str(w);
-        } else {
-            let c = code[i..].chars().next().unwrap_or(' ');
-            out.push(c);
-            i += c.len_utf8();
-        }
-    }
     out
 }
 

@@ -42,16 +42,17 @@ pub fn template(cfg: &crate::Config) -> TokenStream {
 
 /// `INDEX_SYMMETRY_TOLERANCE`, `INDEX_DEFINITENESS_TOLERANCE` and `INDEX_MAX_SWEEPS`.
 fn constants() -> TokenStream {
+    let real = crate::emit::real();
     let sym_tol = Literal::f64_unsuffixed(SYMMETRY_TOLERANCE);
     let def_tol = Literal::f64_unsuffixed(DEFINITENESS_TOLERANCE);
     let sweeps = Literal::usize_unsuffixed(MAX_SWEEPS);
     quote! {
         /// Largest accepted asymmetry `|m_ij − m_ji|` of [`inertia_indices`]' input, relative to
         /// its largest entry.
-        pub const INDEX_SYMMETRY_TOLERANCE: f64 = #sym_tol;
+        pub const INDEX_SYMMETRY_TOLERANCE: #real = #sym_tol;
         /// Positive definiteness in [`inertia_indices`]: pivot `k` of `LDLᵀ` must exceed this
         /// times the diagonal entry it came from.
-        pub const INDEX_DEFINITENESS_TOLERANCE: f64 = #def_tol;
+        pub const INDEX_DEFINITENESS_TOLERANCE: #real = #def_tol;
         /// Cyclic Jacobi sweeps at most in [`inertia_indices`].
         pub const INDEX_MAX_SWEEPS: usize = #sweeps;
     }
@@ -59,6 +60,8 @@ fn constants() -> TokenStream {
 
 /// The result `InertiaIndices` and the error `IndexError`.
 fn types() -> TokenStream {
+    let real = crate::emit::real();
+    let real_doc = crate::emit::real_text(" An index overflowed the `f64` range.");
     quote! {
         /// Dynamic performance indices of an inertia matrix `M` whose coordinates are the task
         /// coordinates (`Λ = M`, efforts `τ = M ẍ` at rest with gravity compensated; units are
@@ -66,31 +69,31 @@ fn types() -> TokenStream {
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct InertiaIndices {
             /// Eigenvalues `λ` of `M`, ascending.
-            pub eigenvalues: [f64; DOF],
+            pub eigenvalues: [#real; DOF],
             /// `axes[k]`: the unit eigenvector of `eigenvalues[k]` (largest-magnitude entry
             /// positive), a principal axis of Asada's generalized inertia ellipsoid
             /// `{v : vᵀ M v = 1}` with semi-axis `1/√λ_k`.
-            pub axes: [[f64; DOF]; DOF],
+            pub axes: [[#real; DOF]; DOF],
             /// Asada: `λ_min / λ_max`.
-            pub gie_ratio: f64,
+            pub gie_ratio: #real,
             /// Condition number `λ_max / λ_min`.
-            pub condition: f64,
+            pub condition: #real,
             /// Ma & Angeles, first normalization: `σ = tr M / n`.
-            pub dci_trace_sigma: f64,
+            pub dci_trace_sigma: #real,
             /// `ψ = ½ ‖M − σ1‖²_F` (Frobenius weights: 1 on the diagonal, 2 off it, over the
             /// upper triangle), units of `M` squared.
-            pub dci_trace_psi: f64,
+            pub dci_trace_psi: #real,
             /// Ma & Angeles, second normalization: `σ = tr(M²) / tr M`.
-            pub dci_dimensionless_sigma: f64,
+            pub dci_dimensionless_sigma: #real,
             /// `ψ = ½ ‖(M − σ1)/σ‖²_F` (Frobenius weights), dimensionless.
-            pub dci_dimensionless_psi: f64,
+            pub dci_dimensionless_psi: #real,
             /// Yoshikawa's dynamic manipulability measure `√det(M⁻¹M⁻ᵀ) = 1/det M`.
-            pub manipulability: f64,
+            pub manipulability: #real,
             /// Semi-axes of Yoshikawa's ellipsoid `{M⁻¹τ : ‖τ‖ ≤ 1}`: `1/λ`, ascending.
-            pub acceleration_radii: [f64; DOF],
+            pub acceleration_radii: [#real; DOF],
             /// Khatib & Burdick's isotropic acceleration for `|τ_i| ≤ 1`:
             /// `min_i 1/‖row i of M‖₂`.
-            pub isotropic_acceleration: f64,
+            pub isotropic_acceleration: #real,
         }
 
         /// Why [`inertia_indices`] could not compute the indices.
@@ -115,11 +118,11 @@ fn types() -> TokenStream {
                 /// The pivot.
                 pivot: usize,
                 /// Its value.
-                value: f64,
+                value: #real,
             },
             /// The Jacobi iteration did not converge in [`INDEX_MAX_SWEEPS`] sweeps.
             NoConvergence,
-            /// An index overflowed the `f64` range.
+            #[doc = #real_doc]
             Overflow,
         }
     }
@@ -127,6 +130,7 @@ fn types() -> TokenStream {
 
 /// `inertia_indices`: one straight function whose body is the steps below, in order.
 fn inertia_indices(cfg: &crate::Config) -> TokenStream {
+    let real = crate::emit::real();
     let input = input_checks();
     let ldlt = ldlt();
     let jacobi = jacobi_sweeps(cfg);
@@ -141,7 +145,7 @@ fn inertia_indices(cfg: &crate::Config) -> TokenStream {
         /// isotropic acceleration of the symmetric positive definite `m` (e.g. `mass_matrix`,
         /// or `actuator_mass_matrix` of a parallel mechanism). No allocation, no panic.
         #[allow(clippy::all)]
-        pub fn inertia_indices(m: &[[f64; DOF]; DOF]) -> Result<InertiaIndices, IndexError> {
+        pub fn inertia_indices(m: &[[#real; DOF]; DOF]) -> Result<InertiaIndices, IndexError> {
             #input
             #ldlt
             #jacobi
@@ -156,8 +160,9 @@ fn inertia_indices(cfg: &crate::Config) -> TokenStream {
 /// Statements: the largest entry `scale` (every entry finite, not all zero), the symmetry test
 /// and the symmetrized `a`, kept as `s`.
 fn input_checks() -> TokenStream {
+    let real = crate::emit::real();
     quote! {
-        let mut scale: f64 = 0.0;
+        let mut scale: #real = 0.0;
         for i in 0..DOF {
             for j in 0..DOF {
                 let v = m[i][j];
@@ -325,6 +330,7 @@ fn sorted_eigenpairs() -> TokenStream {
 
 /// Statements: Ma & Angeles' `σ` and `ψ` in both normalizations.
 fn conditioning_indices() -> TokenStream {
+    let real = crate::emit::real();
     quote! {
         // Ma & Angeles, both normalizations, Frobenius weights.
         let mut tr = 0.0;
@@ -336,7 +342,7 @@ fn conditioning_indices() -> TokenStream {
                 tr2 += x * x;
             }
         }
-        let sigma1 = tr / (DOF as f64);
+        let sigma1 = tr / (DOF as #real);
         let sigma2 = scale * (tr2 / (tr / scale));
         let mut psi1 = 0.0;
         let mut psi2 = 0.0;
@@ -355,6 +361,7 @@ fn conditioning_indices() -> TokenStream {
 
 /// Statements: Yoshikawa's acceleration radii and Khatib & Burdick's isotropic acceleration.
 fn acceleration_indices(cfg: &crate::Config) -> TokenStream {
+    let real = crate::emit::real();
     let sqrt_row = crate::emit::math_call(cfg, "sqrt", quote!(r2));
     quote! {
         // Yoshikawa (J = 1): radii 1/λ; Khatib & Burdick: min 1/‖row‖.
@@ -362,7 +369,7 @@ fn acceleration_indices(cfg: &crate::Config) -> TokenStream {
         for k in 0..DOF {
             acceleration_radii[k] = 1.0 / eigenvalues[DOF - 1 - k];
         }
-        let mut isotropic_acceleration = f64::INFINITY;
+        let mut isotropic_acceleration = #real::INFINITY;
         for i in 0..DOF {
             let mut r2 = 0.0;
             for j in 0..DOF {

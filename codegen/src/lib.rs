@@ -154,18 +154,12 @@ pub fn generate(
             spec::Mechanism::Closed(model) => closed::generate(model, scene, cfg),
         })
     }));
-    let mut out = match generated {
-        Ok(out) => out?,
+    match generated {
+        Ok(out) => out,
         Err(_) => {
-            return Err(
-                "internal error: the generator panicked on this spec (please report it)".into(),
-            );
+            Err("internal error: the generator panicked on this spec (please report it)".into())
         }
-    };
-    if single {
-        out.code = emit::to_f32(&out.code);
     }
-    Ok(out)
 }
 
 /// The generator version written into every header.

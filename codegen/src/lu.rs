@@ -106,6 +106,7 @@ fn abs(v: &Ident) -> TokenStream {
 
 /// The emitted function.
 pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
+    let real = crate::emit::real();
     let n = s.n;
     let k_rhs = match s.rhs {
         Rhs::Vector => 1,
@@ -120,8 +121,8 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
     let tr = s.transpose;
     load_locals(s, k_rhs, &mut st);
     column_norms(n, &mut st);
-    st.push(quote!(let pn: f64 = 0.0;));
-    st.push(quote!(let pd: f64 = 1.0;));
+    st.push(quote!(let pn: #real = 0.0;));
+    st.push(quote!(let pd: #real = 1.0;));
     for k in 0..n {
         elimination_step(s, k, k_rhs, &tol2, &mut st);
     }
@@ -219,14 +220,15 @@ fn pivot_swaps(n: usize, k: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStr
 
 /// The pivot's test against the column-scaled tolerance, `Err(Actuation(k))` when it fails.
 fn pivot_test(s: &LuSolve<'_>, k: usize, tol2: &Literal, st: &mut Vec<TokenStream>) {
+    let real = crate::emit::real();
     let kk = m(k, k);
     let kl = Literal::usize_unsuffixed(k);
     let nk = format_ident!("n{}", k);
     let sqrt_n = (s.sqrt)(quote!(s));
     st.push(quote! {
         let best = if #kk < 0.0 { -#kk } else { #kk };
-        if !(best > 0.0 && best < f64::INFINITY) {
-            return Err(Singular { site: Site::Actuation(#kl), value: #kk, condition_estimate: f64::INFINITY });
+        if !(best > 0.0 && best < #real::INFINITY) {
+            return Err(Singular { site: Site::Actuation(#kl), value: #kk, condition_estimate: #real::INFINITY });
         }
         let b2 = #kk * #kk;
         let lhs = b2 * pd;
@@ -239,7 +241,7 @@ fn pivot_test(s: &LuSolve<'_>, k: usize, tol2: &Literal, st: &mut Vec<TokenStrea
             return Err(Singular {
                 site: Site::Actuation(#kl),
                 value: if n > 0.0 { #kk / n } else { #kk },
-                condition_estimate: if c >= 0.0 { c } else { f64::INFINITY },
+                condition_estimate: if c >= 0.0 { c } else { #real::INFINITY },
             });
         }
     });
@@ -285,16 +287,17 @@ fn back_substitution(n: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStream>
 
 /// The function of one right-hand side: `b: &[f64; DOF]`, solution `[f64; DOF]`.
 fn vector_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStream {
+    let real = crate::emit::real();
     let out = (0..n).map(|i| x(i, 0));
     quote! {
         #[doc = #doc]
         #[allow(clippy::all, unused_variables)]
-        fn #name(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+        fn #name(a: &[[#real; DOF]; DOF], b: &[#real; DOF]) -> Result<[#real; DOF], Singular> {
             #(#st)*
             let out = [#(#out),*];
             for v in out.iter() {
                 if !v.is_finite() {
-                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
+                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: #real::INFINITY });
                 }
             }
             Ok(out)
@@ -304,6 +307,7 @@ fn vector_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStre
 
 /// The function of the identity's columns: the inverse, `[[f64; DOF]; DOF]`.
 fn identity_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStream {
+    let real = crate::emit::real();
     let rows = (0..n).map(|i| {
         let row = (0..n).map(|c| x(i, c));
         quote!([#(#row),*])
@@ -311,12 +315,12 @@ fn identity_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenSt
     quote! {
         #[doc = #doc]
         #[allow(clippy::all, unused_variables)]
-        fn #name(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+        fn #name(a: &[[#real; DOF]; DOF]) -> Result<[[#real; DOF]; DOF], Singular> {
             #(#st)*
             let out = [#(#rows),*];
             for v in out.iter().flatten() {
                 if !v.is_finite() {
-                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: f64::INFINITY });
+                    return Err(Singular { site: Site::Input, value: *v, condition_estimate: #real::INFINITY });
                 }
             }
             Ok(out)

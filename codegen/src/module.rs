@@ -48,6 +48,10 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
 /// The `Singular` and `NoConvergence` types of a platform or closed-loop module (each kind has
 /// its own `Site`); `site`, `value` and `residual` document what the kind's fields hold.
 pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStream {
+    let real = crate::emit::real();
+    let real_doc = crate::emit::real_text(
+        " Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).",
+    );
     let (site, value, residual) = (
         format!(" {site}"),
         format!(" {value}"),
@@ -60,9 +64,9 @@ pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStrea
             #[doc = #site]
             pub site: Site,
             #[doc = #value]
-            pub value: f64,
-            /// Condition-number estimate of the matrix involved (`f64::INFINITY` if unknown).
-            pub condition_estimate: f64,
+            pub value: #real,
+            #[doc = #real_doc]
+            pub condition_estimate: #real,
         }
 
         /// Forward kinematics did not converge.
@@ -71,7 +75,7 @@ pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStrea
             /// Newton iterations made.
             pub iterations: usize,
             #[doc = #residual]
-            pub residual: f64,
+            pub residual: #real,
         }
     }
 }

@@ -443,6 +443,7 @@ fn items(
     cfg: &Config,
     want: &dyn Fn(&str) -> bool,
 ) -> TokenStream {
+    let real = crate::emit::real();
     let names: Vec<&str> = model
         .legs
         .iter()
@@ -472,7 +473,7 @@ fn items(
         /// The spec's home configuration `x` (its legs in their declared branches): a guess for
         /// `forward_kinematics` near home.
         #[allow(clippy::excessive_precision)]
-        pub const HOME: [f64; NX] = [#(#home),*];
+        pub const HOME: [#real; NX] = [#(#home),*];
         #params_items
         #items
     }

@@ -131,6 +131,7 @@ pub(crate) fn params_items(
     bodies: &[crate::spec::RuntimeBody],
     frame: &dyn Fn(usize) -> String,
 ) -> TokenStream {
+    let real = crate::emit::real();
     let (mut fields, mut default, mut fill) = match &payload {
         Some((on, m, c, i)) => payload_params(on, *m, c, i),
         None => (quote!(), quote!(), quote!()),
@@ -150,7 +151,7 @@ pub(crate) fn params_items(
             let doc = format!(" {doc}, per {}.", per.1);
             fields.extend(quote! {
                 #[doc = #doc]
-                pub #ident: [f64; #len],
+                pub #ident: [#real; #len],
             });
             default.extend(quote!(#ident: [#(#vals),*],));
             fill.extend(quote! {
@@ -203,7 +204,7 @@ pub(crate) fn params_items(
                 #default
             };
             /// The flat layout the generated functions read.
-            pub fn to_array(&self) -> [f64; NP] {
+            pub fn to_array(&self) -> [#real; NP] {
                 let mut a = [0.0; NP];
                 #fill
                 a
@@ -230,6 +231,7 @@ pub(crate) fn payload_params(
     proc_macro2::TokenStream,
     proc_macro2::TokenStream,
 ) {
+    let real = crate::emit::real();
     use quote::quote;
     let doc_m = format!(" Payload mass (kg), rigidly attached to {on}.");
     let doc_c = format!(" Payload mass centre in {on}'s frame (m).");
@@ -246,11 +248,11 @@ pub(crate) fn payload_params(
     (
         quote! {
             #[doc = #doc_m]
-            pub payload_mass: f64,
+            pub payload_mass: #real,
             #[doc = #doc_c]
-            pub payload_com: [f64; 3],
+            pub payload_com: [#real; 3],
             #[doc = #doc_i]
-            pub payload_inertia: [[f64; 3]; 3],
+            pub payload_inertia: [[#real; 3]; 3],
         },
         quote! {
             payload_mass: #m,
@@ -287,6 +289,7 @@ pub(crate) fn body_params(
     proc_macro2::TokenStream,
     proc_macro2::TokenStream,
 ) {
+    let real = crate::emit::real();
     use proc_macro2::Literal;
     use quote::quote;
     if bodies.is_empty() {
@@ -336,13 +339,13 @@ pub(crate) fn body_params(
         },
         quote! {
             /// Mass of each body of [`RUNTIME_BODY_NAMES`] (kg).
-            pub body_mass: [f64; NB],
+            pub body_mass: [#real; NB],
             /// Mass centre of each body of [`RUNTIME_BODY_NAMES`] (m), in the frame of the
             /// model body it is part of (listed there).
-            pub body_com: [[f64; 3]; NB],
+            pub body_com: [[#real; 3]; NB],
             /// Inertia of each body of [`RUNTIME_BODY_NAMES`] about its mass centre (kg·m²,
             /// symmetric), in the axes of the model body it is part of.
-            pub body_inertia: [[[f64; 3]; 3]; NB],
+            pub body_inertia: [[[#real; 3]; 3]; NB],
         },
         quote! {
             body_mass: [#(#mass),*],

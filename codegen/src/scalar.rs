@@ -31,9 +31,14 @@ pub(crate) fn with_precision<T>(single: bool, f: impl FnOnce() -> T) -> T {
     out
 }
 
+/// The current generation targets `f32`.
+pub(crate) fn single() -> bool {
+    SINGLE.with(|c| c.get())
+}
+
 /// The threshold for the current target of a test whose `f64` threshold is `t`.
 pub(crate) fn tolerance(t: f64) -> f64 {
-    if SINGLE.with(|c| c.get()) {
+    if single() {
         runtime::scalar::f32_tolerance(t)
     } else {
         t

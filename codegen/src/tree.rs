@@ -107,6 +107,7 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
 /// The `Params` struct of a module with run-time parameters: fields named for the user, its
 /// `DEFAULT` (the values the spec gives), and `to_array` in [`dynamics::param_index`]'s layout.
 fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::TokenStream {
+    let real = crate::emit::real();
     use proc_macro2::Literal;
     use quote::quote;
     let n = model.dof();
@@ -149,11 +150,11 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
         pub struct Params {
             #payload_fields
             /// Viscous friction per joint (N·m·s/rad or N·s/m).
-            pub damping: [f64; DOF],
+            pub damping: [#real; DOF],
             /// Coulomb friction level per joint (N·m or N), regularized as in the spec docs.
-            pub friction: [f64; DOF],
+            pub friction: [#real; DOF],
             /// Reflected rotor inertia per joint (kg·m² or kg).
-            pub armature: [f64; DOF],
+            pub armature: [#real; DOF],
             #body_fields
         }
         impl Params {
@@ -166,7 +167,7 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
                 #body_default
             };
             /// The flat layout the generated functions read.
-            pub fn to_array(&self) -> [f64; NP] {
+            pub fn to_array(&self) -> [#real; NP] {
                 let mut a = [0.0; NP];
                 #payload_fill
                 let mut i = 0;
@@ -377,6 +378,10 @@ fn items(
     functions: &[Function<'_>],
     extra: TokenStream,
 ) -> TokenStream {
+    let real = crate::emit::real();
+    let real_doc = crate::emit::real_text(
+        " of the mass matrix (`f64::INFINITY` when the pivot is not positive).",
+    );
     let dof_lit = Literal::usize_unsuffixed(dof);
     let names = joint_names.iter();
     let needs_singular = functions
@@ -388,7 +393,7 @@ fn items(
             /// (or an input is NaN). `value` is the pivot that was not above its tolerance
             /// (`1e-12` times the diagonal entry it came from); `condition_estimate` is that
             /// diagonal entry divided by the pivot, a lower bound of the 2-norm condition number
-            /// of the mass matrix (`f64::INFINITY` when the pivot is not positive).
+            #[doc = #real_doc]
             /// `pivot == DOF` is no pivot: the pivots passed but an input was not finite or the
             /// result overflowed (`value` is the first non-finite entry of the result).
             #[derive(Clone, Copy, Debug, PartialEq)]
@@ -396,9 +401,9 @@ fn items(
                 /// Index (joint) of the failed pivot; `DOF` for a non-finite input or result.
                 pub pivot: usize,
                 /// The pivot's value (the non-finite entry when `pivot == DOF`).
-                pub value: f64,
+                pub value: #real,
                 /// Lower bound of the mass matrix's 2-norm condition number.
-                pub condition_estimate: f64,
+                pub condition_estimate: #real,
             }
         }
     });

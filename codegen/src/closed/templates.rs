@@ -75,15 +75,16 @@ fn error_types(springs: bool) -> TokenStream {
 /// `inverse_kinematics` and `actuator_rates`: the actuated joints are the independent
 /// coordinates.
 fn actuator_functions() -> TokenStream {
+    let real = crate::emit::real();
     quote! {
         /// The independent coordinates of `x` (rad or m, `ACTUATOR_NAMES` order).
         #[allow(clippy::all)]
-        pub fn inverse_kinematics(x: &[f64; NX]) -> Result<[f64; DOF], Singular> {
+        pub fn inverse_kinematics(x: &[#real; NX]) -> Result<[#real; DOF], Singular> {
             let mut q = [0.0; DOF];
             for k in 0..DOF {
                 let v = x[INDEPENDENT[k]];
                 if !v.is_finite() {
-                    return Err(Singular { site: Site::Input, value: v, condition_estimate: f64::INFINITY });
+                    return Err(Singular { site: Site::Input, value: v, condition_estimate: #real::INFINITY });
                 }
                 q[k] = v;
             }
@@ -95,11 +96,11 @@ fn actuator_functions() -> TokenStream {
         /// coordinate or speed;
         /// whether `x` closes the loops is not needed here (`joint_rates` checks it).
         #[allow(clippy::all)]
-        pub fn actuator_rates(x: &[f64; NX], u: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+        pub fn actuator_rates(x: &[#real; NX], u: &[#real; DOF]) -> Result<[#real; DOF], Singular> {
             inverse_kinematics(x)?;
             for k in 0..DOF {
                 if !u[k].is_finite() {
-                    return Err(Singular { site: Site::Input, value: u[k], condition_estimate: f64::INFINITY });
+                    return Err(Singular { site: Site::Input, value: u[k], condition_estimate: #real::INFINITY });
                 }
             }
             Ok(*u)
@@ -110,6 +111,7 @@ fn actuator_functions() -> TokenStream {
 /// `forward_kinematics`: the independent coordinates moved to `q` in stages, each assembled by
 /// `newton_assembly`, else one solve from the guess.
 fn forward_kinematics() -> TokenStream {
+    let real = crate::emit::real();
     let max_stages = Literal::usize_unsuffixed(noc::FK_MAX_STAGES);
     let max_stages_f = Literal::f64_unsuffixed(noc::FK_MAX_STAGES as f64);
     quote! {
@@ -127,8 +129,8 @@ fn forward_kinematics() -> TokenStream {
         /// (kept unless it raises the residual); each dependent angle stays within ±π of its
         /// guess.
         #[allow(clippy::all)]
-        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
-            let mut need: f64 = 1.0;
+        pub fn forward_kinematics(q: &[#real; DOF], guess: &[#real; NX]) -> Result<[#real; NX], NoConvergence> {
+            let mut need: #real = 1.0;
             for k in 0..DOF {
                 let d = q[k] - guess[INDEPENDENT[k]];
                 let a = (if d < 0.0 { -d } else { d }) / STEP[k];
@@ -139,14 +141,14 @@ fn forward_kinematics() -> TokenStream {
             if need > 1.0 {
                 let stages = if need < #max_stages_f {
                     let n = need as usize;
-                    if (n as f64) < need { n + 1 } else { n }
+                    if (n as #real) < need { n + 1 } else { n }
                 } else {
                     #max_stages
                 };
                 let mut x = *guess;
                 let mut followed = true;
                 for s in 1..=stages {
-                    let t = s as f64 / stages as f64;
+                    let t = s as #real / stages as #real;
                     let mut qs = *q;
                     if s < stages {
                         for k in 0..DOF {
@@ -175,6 +177,7 @@ fn forward_kinematics() -> TokenStream {
 /// equations', every equation's, and the stall acceptance of single precision) and iteration
 /// limit.
 fn newton_assembly() -> TokenStream {
+    let real = crate::emit::real();
     let tol = crate::scalar::tolerance;
     let fk_tol = Literal::f64_unsuffixed(tol(noc::FK_TOLERANCE));
     // In single precision the loop equations' rounding floor can sit above the rescaled 1e-12
@@ -191,17 +194,17 @@ fn newton_assembly() -> TokenStream {
     quote! {
         /// One Newton solve of `forward_kinematics` from `guess`.
         #[allow(clippy::all)]
-        fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
+        fn newton_assembly(q: &[#real; DOF], guess: &[#real; NX]) -> Result<[#real; NX], NoConvergence> {
             // A dependent angle moved to within ±π of its guess (the same configuration): a
             // long Newton step can land turns away, where f32 (and f64) keep fewer digits.
-            let wrap = |x: &mut [f64; NX]| {
-                let t = 2.0 * core::f64::consts::PI;
+            let wrap = |x: &mut [#real; NX]| {
+                let t = 2.0 * core::#real::consts::PI;
                 for i in 0..NX {
                     let d = x[i] - guess[i];
                     let ad = if d < 0.0 { -d } else { d };
-                    if WRAP[i] && ad > core::f64::consts::PI && ad < 1e9 {
+                    if WRAP[i] && ad > core::#real::consts::PI && ad < 1e9 {
                         let k = d / t + 0.5;
-                        let mut n = k as i64 as f64;
+                        let mut n = k as i64 as #real;
                         if n > k {
                             n -= 1.0;
                         }
@@ -213,9 +216,9 @@ fn newton_assembly() -> TokenStream {
             for k in 0..DOF {
                 x[INDEPENDENT[k]] = q[k];
             }
-            let abs = |v: f64| if v < 0.0 { -v } else { v };
+            let abs = |v: #real| if v < 0.0 { -v } else { v };
             let Ok((mut dx, mut r, mut full)) = newton_step(&x) else {
-                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
+                return Err(NoConvergence { iterations: 0, residual: #real::INFINITY });
             };
             for it in 0..#fk_max {
                 if abs(r) <= #fk_tol {

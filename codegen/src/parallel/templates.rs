@@ -141,6 +141,7 @@ fn inverse_dynamics(
     p_arg: &TokenStream,
     p_pass: &TokenStream,
 ) -> TokenStream {
+    let real = crate::emit::real();
     let lu_solve_t = lu_fn(
         cfg,
         plan,
@@ -153,7 +154,7 @@ fn inverse_dynamics(
     /// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
     /// the platform motion `(x, u, ud)`; `Err` at a leg or parallel singularity.
     #[inline]
-    pub fn inverse_dynamics(x: &[f64; NX], u: &[f64; DOF], ud: &[f64; DOF] #p_arg) -> Result<[f64; DOF], Singular> {
+    pub fn inverse_dynamics(x: &[#real; NX], u: &[#real; DOF], ud: &[#real; DOF] #p_arg) -> Result<[#real; DOF], Singular> {
         let (a, f) = id_parts(x, u, ud #p_pass)?;
         lu_solve_t(&a, &f)
     }
@@ -170,6 +171,7 @@ fn actuator_mass_matrix(
     p_arg: &TokenStream,
     p_pass: &TokenStream,
 ) -> TokenStream {
+    let real = crate::emit::real();
     let lu_inverse = lu_fn(
         cfg,
         plan,
@@ -183,7 +185,7 @@ fn actuator_mass_matrix(
 
     /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
     #[allow(clippy::all)]
-    pub fn actuator_mass_matrix(x: &[f64; NX] #p_arg) -> Result<[[f64; DOF]; DOF], Singular> {
+    pub fn actuator_mass_matrix(x: &[#real; NX] #p_arg) -> Result<[[#real; DOF]; DOF], Singular> {
         let (a, i) = inertia_parts(x #p_pass)?;
         let ai = lu_inverse(&a)?;
         // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
@@ -205,7 +207,7 @@ fn actuator_mass_matrix(
                     s += ai[k][r] * b[k][c];
                 }
                 if !s.is_finite() {
-                    return Err(Singular { site: Site::Input, value: s, condition_estimate: f64::INFINITY });
+                    return Err(Singular { site: Site::Input, value: s, condition_estimate: #real::INFINITY });
                 }
                 out[r][c] = s;
                 out[c][r] = s;
@@ -251,11 +253,12 @@ fn retract_template(
     sin_cos: TokenStream,
     sqrt_n: TokenStream,
 ) -> TokenStream {
+    let real = crate::emit::real();
     if planar {
         return quote! {
             /// `x` moved by `du` (the point's displacement, m).
             #[allow(clippy::all)]
-            fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+            fn retract(x: &[#real; NX], du: &[#real; DOF]) -> [#real; NX] {
                 let mut out = *x;
                 for i in 0..NX {
                     out[i] += du[i];
@@ -267,7 +270,7 @@ fn retract_template(
     quote! {
         /// `x` moved by the small motion `du` (rotation vector, then translation; base frame).
         #[allow(clippy::all)]
-        fn retract(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+        fn retract(x: &[#real; NX], du: &[#real; DOF]) -> [#real; NX] {
             let a2 = du[0] * du[0] + du[1] * du[1] + du[2] * du[2];
             let a = #sqrt_a;
             let (s, c) = #sin_cos;
@@ -296,21 +299,22 @@ fn retract_template(
 
 /// `fk_residual`: Newton's residual of `forward_kinematics`, with `A(x)`.
 fn fk_residual() -> TokenStream {
+    let real = crate::emit::real();
     quote! {
         /// The residual `q − q(x)` (angles wrapped to (−π, π]: `q`'s revolute entries are already
         /// in [−π, π], as `q(x)`'s are), its max norm, and `A(x)`.
         #[allow(clippy::all)]
-        fn fk_residual(q: &[f64; DOF], x: &[f64; NX]) -> Option<([f64; DOF], f64, [[f64; DOF]; DOF])> {
+        fn fk_residual(q: &[#real; DOF], x: &[#real; NX]) -> Option<([#real; DOF], #real, [[#real; DOF]; DOF])> {
             let (qx, a) = fk_parts(x).ok()?;
             let mut r = [0.0; DOF];
-            let mut m: f64 = 0.0;
+            let mut m: #real = 0.0;
             for i in 0..DOF {
                 let mut d = q[i] - qx[i];
                 if REVOLUTE[i] {
-                    let t = 2.0 * core::f64::consts::PI;
-                    if d > core::f64::consts::PI {
+                    let t = 2.0 * core::#real::consts::PI;
+                    if d > core::#real::consts::PI {
                         d -= t;
-                    } else if d <= -core::f64::consts::PI {
+                    } else if d <= -core::#real::consts::PI {
                         d += t;
                     }
                 }
@@ -320,7 +324,7 @@ fn fk_residual() -> TokenStream {
                     m = ad;
                 }
             }
-            if m < f64::INFINITY { Some((r, m, a)) } else { None }
+            if m < #real::INFINITY { Some((r, m, a)) } else { None }
         }
     }
 }
@@ -328,6 +332,7 @@ fn fk_residual() -> TokenStream {
 /// `forward_kinematics`: Newton's method on `fk_residual`, its tolerance (scaled to the
 /// mechanism) and iteration limit in its docs.
 fn forward_kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
+    let real = crate::emit::real();
     let fk_tol = crate::scalar::tolerance(noc::FK_TOLERANCE);
     let fk_max = noc::FK_MAX_ITERATIONS;
     // Rounded to 13 significant digits, as the squared tolerance of the LU.
@@ -351,10 +356,10 @@ fn forward_kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
     quote! {
         #(#[doc = #fk_doc])*
         #[allow(clippy::all)]
-        pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoConvergence> {
+        pub fn forward_kinematics(q: &[#real; DOF], guess: &[#real; NX]) -> Result<[#real; NX], NoConvergence> {
             for v in q.iter().chain(guess.iter()) {
                 if !v.is_finite() {
-                    return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
+                    return Err(NoConvergence { iterations: 0, residual: #real::INFINITY });
                 }
             }
             // Revolute targets reduced to [−π, π] once (sin and cos reduce accurately).
@@ -370,7 +375,7 @@ fn forward_kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
             let tol = #fk_tol_lit;
             let mut x = retract(guess, &[0.0; DOF]);
             let Some(mut cur) = fk_residual(q, &x) else {
-                return Err(NoConvergence { iterations: 0, residual: f64::INFINITY });
+                return Err(NoConvergence { iterations: 0, residual: #real::INFINITY });
             };
             for it in 0..#fk_max_lit {
                 if cur.1 <= tol {
