@@ -148,11 +148,11 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         .map(|&j| joint_names[j].clone())
         .collect();
     let header = header(model, &plan, &layout, bodies, cfg, &act_names, &stats);
-    let items = items(model, &plan, params, &layout, &joint_names, &act_names);
+    let items = items(cfg, model, &plan, params, &layout, &joint_names, &act_names);
     // The names every actuator-space module has (parallel mechanisms): here the actuated
     // joints are the independent coordinates, so `A = 1`.
     let actuator_mass_matrix = if wanted("mass_matrix") {
-        actuator_mass_matrix(&layout)
+        templates::actuator_mass_matrix(cfg, &layout)
     } else {
         quote!()
     };
@@ -329,6 +329,7 @@ fn header(
 /// The items before the functions: the constants (names, `INDEPENDENT`, `HOME`, and the
 /// assembly's `STEP` and `WRAP`), the run-time parameters' items and the fixed templates.
 fn items(
+    cfg: &Config,
     model: &ClosedModel,
     plan: &Plan,
     params: Option<&RuntimeParams>,
@@ -360,7 +361,7 @@ fn items(
             })
         })
         .collect();
-    let items = templates(!plan.springs.is_empty());
+    let items = templates(cfg, !plan.springs.is_empty());
     let spring_names = spring_names(plan);
     let params = runtime_params(model, params, layout);
     quote! {
@@ -424,23 +425,4 @@ fn runtime_params(
         bodies,
         &|b| format!("tree body `{}`", model.tree.bodies[b].name),
     )
-}
-
-/// `actuator_mass_matrix`, the name every actuator-space module has: `mass_matrix` itself.
-fn actuator_mass_matrix(layout: &Layout) -> TokenStream {
-    let real = crate::emit::real();
-    let (p_arg, p_call) = if layout.any() {
-        (quote!(, p: &Params), quote!(, p))
-    } else {
-        (quote!(), quote!())
-    };
-    quote! {
-        /// The mass matrix in actuator space, `A⁻ᵀ I A⁻¹` (the lecture's eq. 68): the
-        /// actuated joints are the independent coordinates (`A = 1`), so it is `mass_matrix`.
-        #[allow(clippy::all)]
-        #[inline(always)]
-        pub fn actuator_mass_matrix(x: &[#real; NX] #p_arg) -> Result<[[#real; DOF]; DOF], Singular> {
-            mass_matrix(x #p_call)
-        }
-    }
 }

@@ -47,6 +47,7 @@ pub mod scalar;
 pub mod schedule;
 pub mod spec;
 pub mod sym;
+mod template;
 pub mod tree;
 
 use schedule::OpCount;

@@ -1,6 +1,6 @@
 //! Dynamic performance indices (`runtime::indices`, and the generated-code template
-//! `codegen::indices::template` through its committed `std` rendering,
-//! `tests/indices/template_std.rs`, kept current by `codegen/tests/indices_template.rs`).
+//! `codegen/templates/inertia_indices.rs`, compiled here as a module for three sizes with the
+//! stand-ins that generation replaces).
 //!
 //! Reference values never come from the code under test:
 //! * Ma & Angeles' DCI on the published check in docs/method.md
@@ -28,22 +28,26 @@ use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion};
 use tests::pkm::{model, random_state};
 
-/// The generated template for three sizes (the include is the committed `std` rendering).
-#[allow(dead_code)]
-mod g2 {
-    pub const DOF: usize = 2;
-    include!("indices/template_std.rs");
+/// The generated template for three sizes: the template file itself, with the stand-ins that
+/// generation replaces (the runtime's tolerances and sweep limit, std's `sqrt`).
+macro_rules! indices_template {
+    ($name:ident, $dof:literal) => {
+        #[allow(dead_code)]
+        mod $name {
+            pub const DOF: usize = $dof;
+            const SYMMETRY_TOLERANCE: f64 = runtime::indices::SYMMETRY_TOLERANCE;
+            const DEFINITENESS_TOLERANCE: f64 = runtime::indices::DEFINITENESS_TOLERANCE;
+            const MAX_SWEEPS: usize = codegen::indices::MAX_SWEEPS;
+            fn sqrt(x: f64) -> f64 {
+                x.sqrt()
+            }
+            include!("../../codegen/templates/inertia_indices.rs");
+        }
+    };
 }
-#[allow(dead_code)]
-mod g3 {
-    pub const DOF: usize = 3;
-    include!("indices/template_std.rs");
-}
-#[allow(dead_code)]
-mod g6 {
-    pub const DOF: usize = 6;
-    include!("indices/template_std.rs");
-}
+indices_template!(g2, 2);
+indices_template!(g3, 3);
+indices_template!(g6, 6);
 
 fn arr<const N: usize>(m: &DMatrix<f64>) -> [[f64; N]; N] {
     let mut a = [[0.0; N]; N];

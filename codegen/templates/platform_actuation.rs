@@ -1,0 +1,54 @@
+// Template: the actuator-space functions of a platform module, around its kernels
+// (`id_parts`, `inertia_parts`) and its LU solves of the actuation matrix `A`
+// (`lu_solve_t`, `lu_inverse`). Specialized by `codegen/src/template.rs`; compiled and tested
+// as a module by `tests/tests/templates.rs`.
+
+/// Actuator efforts `τ = A⁻ᵀ (I u̇ + C u − γ)` (N or N·m, gravity included) that produce
+/// the platform motion `(x, u, ud)`; `Err` at a leg or parallel singularity.
+#[inline]
+pub fn inverse_dynamics(
+    x: &[f64; NX],
+    u: &[f64; DOF],
+    ud: &[f64; DOF],
+    p: &Params,
+) -> Result<[f64; DOF], Singular> {
+    let (a, f) = id_parts(x, u, ud, p)?;
+    lu_solve_t(&a, &f)
+}
+
+/// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
+#[allow(clippy::all)]
+pub fn actuator_mass_matrix(x: &[f64; NX], p: &Params) -> Result<[[f64; DOF]; DOF], Singular> {
+    let (a, i) = inertia_parts(x, p)?;
+    let ai = lu_inverse(&a)?;
+    // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
+    let mut b = [[0.0; DOF]; DOF];
+    for r in 0..DOF {
+        for c in 0..DOF {
+            let mut s = 0.0;
+            for k in 0..DOF {
+                s += i[r][k] * ai[k][c];
+            }
+            b[r][c] = s;
+        }
+    }
+    let mut out = [[0.0; DOF]; DOF];
+    for r in 0..DOF {
+        for c in r..DOF {
+            let mut s = 0.0;
+            for k in 0..DOF {
+                s += ai[k][r] * b[k][c];
+            }
+            if !s.is_finite() {
+                return Err(Singular {
+                    site: Site::Input,
+                    value: s,
+                    condition_estimate: f64::INFINITY,
+                });
+            }
+            out[r][c] = s;
+            out[c][r] = s;
+        }
+    }
+    Ok(out)
+}

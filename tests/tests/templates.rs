@@ -1,0 +1,371 @@
+//! The fixed items of generated modules, `codegen/templates/*.rs`, compiled here as modules of
+//! their own: each template file is `include!`d into a module that defines, as a generated
+//! module does, the constants, error types and kernels it is written around, plus the
+//! stand-ins that generation replaces (tolerances, limits, `sqrt`/`sin_cos`/`atan2`). The
+//! kernels are small invented mechanisms whose answers are known in closed form, so every
+//! check compares against an independent value, not against the template itself.
+//! (`codegen/templates/inertia_indices.rs` is compiled the same way by `tests/indices.rs`.)
+
+#![allow(clippy::needless_range_loop)]
+
+use nalgebra::{DMatrix, DVector};
+
+fn sqrt(x: f64) -> f64 {
+    x.sqrt()
+}
+fn sin_cos(x: f64) -> (f64, f64) {
+    x.sin_cos()
+}
+fn atan2(y: f64, x: f64) -> f64 {
+    y.atan2(x)
+}
+
+/// Error types as every platform and closed-loop module defines them.
+macro_rules! error_types {
+    () => {
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        #[allow(dead_code)]
+        pub enum Site {
+            Actuation(usize),
+            Input,
+        }
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Singular {
+            pub site: Site,
+            pub value: f64,
+            pub condition_estimate: f64,
+        }
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        #[allow(dead_code)]
+        pub struct NoConvergence {
+            pub iterations: usize,
+            pub residual: f64,
+        }
+    };
+}
+
+/// `a x = b` by nalgebra's LU (the generated module has its straight-line LU).
+fn solve<const N: usize>(a: &[[f64; N]; N], b: &[f64; N]) -> Option<[f64; N]> {
+    let m = DMatrix::from_fn(N, N, |i, j| a[i][j]);
+    let x = m.lu().solve(&DVector::from_column_slice(b))?;
+    let mut out = [0.0; N];
+    out.copy_from_slice(x.as_slice());
+    Some(out)
+}
+
+/// `(q(x), A(x))` of a platform with `q(x)` given: `A = ∂q/∂du` by central differences
+/// through `retract` (the kernels of a generated module compute it exactly).
+fn parts<const NX: usize, const DOF: usize>(
+    x: &[f64; NX],
+    q: impl Fn(&[f64; NX]) -> [f64; DOF],
+    retract: impl Fn(&[f64; NX], &[f64; DOF]) -> [f64; NX],
+) -> ([f64; DOF], [[f64; DOF]; DOF]) {
+    let mut a = [[0.0; DOF]; DOF];
+    let h = 1e-7;
+    for j in 0..DOF {
+        let mut d = [0.0; DOF];
+        d[j] = h;
+        let qp = q(&retract(x, &d));
+        d[j] = -h;
+        let qm = q(&retract(x, &d));
+        for i in 0..DOF {
+            a[i][j] = (qp[i] - qm[i]) / (2.0 * h);
+        }
+    }
+    (q(x), a)
+}
+
+/// A 6-DOF platform in pose coordinates `(p, quaternion)` whose "actuators" read the position
+/// and twice the quaternion's vector part (sign of `w` positive).
+mod pose {
+    use super::{atan2, sin_cos, sqrt};
+    error_types!();
+    pub const NX: usize = 7;
+    pub const DOF: usize = 6;
+    const REVOLUTE: [bool; DOF] = [false, false, false, true, true, true];
+    const QUATERNION: usize = 3;
+    const HAS_POSITION: bool = true;
+    const FK_TOLERANCE: f64 = 1e-12;
+    const FK_MAX_ITERATIONS: usize = 50;
+
+    pub fn q_of(x: &[f64; NX]) -> [f64; DOF] {
+        let s = if x[3] < 0.0 { -2.0 } else { 2.0 };
+        [x[0], x[1], x[2], s * x[4], s * x[5], s * x[6]]
+    }
+    fn fk_parts(x: &[f64; NX]) -> Result<([f64; DOF], [[f64; DOF]; DOF]), Singular> {
+        Ok(super::parts(x, q_of, retract))
+    }
+    fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+        super::solve(a, b).ok_or(Singular {
+            site: Site::Actuation(0),
+            value: 0.0,
+            condition_estimate: f64::INFINITY,
+        })
+    }
+    include!("../../codegen/templates/platform_retract_quaternion.rs");
+    include!("../../codegen/templates/platform_newton.rs");
+    pub fn retract_pub(x: &[f64; NX], du: &[f64; DOF]) -> [f64; NX] {
+        retract(x, du)
+    }
+}
+
+/// A planar point `(x, y)` whose two actuators read a bent image of it; the first is an
+/// angle, compared modulo 2π.
+mod planar {
+    use super::{atan2, sin_cos};
+    error_types!();
+    pub const NX: usize = 2;
+    pub const DOF: usize = 2;
+    const REVOLUTE: [bool; DOF] = [true, false];
+    const FK_TOLERANCE: f64 = 1e-12;
+    const FK_MAX_ITERATIONS: usize = 50;
+
+    pub fn q_of(x: &[f64; NX]) -> [f64; DOF] {
+        let a = x[0] + 0.1 * x[1] * x[1];
+        // Wrapped to (−π, π], as a kernel's angles are.
+        [a.sin().atan2(a.cos()), x[1] + 0.1 * x[0] * x[0]]
+    }
+    fn fk_parts(x: &[f64; NX]) -> Result<([f64; DOF], [[f64; DOF]; DOF]), Singular> {
+        Ok(super::parts(x, q_of, retract))
+    }
+    fn lu_solve(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+        super::solve(a, b).ok_or(Singular {
+            site: Site::Actuation(0),
+            value: 0.0,
+            condition_estimate: f64::INFINITY,
+        })
+    }
+    include!("../../codegen/templates/platform_retract_planar.rs");
+    include!("../../codegen/templates/platform_newton.rs");
+}
+
+/// The actuator-space wrappers of a platform: kernels with a known `A` and `I`.
+mod actuation {
+    error_types!();
+    pub const NX: usize = 3;
+    pub const DOF: usize = 3;
+    pub struct Params {
+        pub scale: f64,
+    }
+    pub fn a_of(x: &[f64; NX]) -> [[f64; DOF]; DOF] {
+        [
+            [2.0 + x[0], 0.3, -0.1],
+            [0.2, 1.5, 0.4 * x[1]],
+            [-0.3, 0.1, 1.0 + x[2] * x[2]],
+        ]
+    }
+    pub fn i_of(x: &[f64; NX], p: &Params) -> [[f64; DOF]; DOF] {
+        let c = 0.1 * x[0];
+        [
+            [p.scale * 3.0, c, 0.2],
+            [c, p.scale * 2.0, -0.1],
+            [0.2, -0.1, p.scale * 1.5],
+        ]
+    }
+    pub fn f_of(u: &[f64; DOF], ud: &[f64; DOF]) -> [f64; DOF] {
+        [ud[0] + u[1], ud[1] - 2.0 * u[0], ud[2] + 0.5]
+    }
+    fn id_parts(
+        x: &[f64; NX],
+        u: &[f64; DOF],
+        ud: &[f64; DOF],
+        _p: &Params,
+    ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
+        Ok((a_of(x), f_of(u, ud)))
+    }
+    type Matrix = [[f64; DOF]; DOF];
+    fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
+        Ok((a_of(x), i_of(x, p)))
+    }
+    fn fail() -> Singular {
+        Singular {
+            site: Site::Actuation(0),
+            value: 0.0,
+            condition_estimate: f64::INFINITY,
+        }
+    }
+    fn lu_solve_t(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+        let mut t = [[0.0; DOF]; DOF];
+        for i in 0..DOF {
+            for j in 0..DOF {
+                t[i][j] = a[j][i];
+            }
+        }
+        super::solve(&t, b).ok_or_else(fail)
+    }
+    fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+        let mut inv = [[0.0; DOF]; DOF];
+        for c in 0..DOF {
+            let mut e = [0.0; DOF];
+            e[c] = 1.0;
+            let x = super::solve(a, &e).ok_or_else(fail)?;
+            for r in 0..DOF {
+                inv[r][c] = x[r];
+            }
+        }
+        Ok(inv)
+    }
+    include!("../../codegen/templates/platform_actuation.rs");
+}
+
+/// A one-loop mechanism in joint coordinates `x = (θ, φ)`: `θ` independent, `φ` dependent
+/// through `sin φ = ½ sin θ` (so `φ = asin(½ sin θ)` on the home branch).
+mod closed {
+    error_types!();
+    pub const NX: usize = 2;
+    pub const DOF: usize = 1;
+    pub const INDEPENDENT: [usize; DOF] = [0];
+    const STEP: [f64; DOF] = [0.2];
+    const WRAP: [bool; NX] = [false, true];
+    const FK_MAX_STAGES: usize = 64;
+    const FK_MAX_STAGES_REAL: f64 = 64.0;
+    const FK_MAX_ITERATIONS: usize = 50;
+    const FK_TOLERANCE: f64 = 1e-12;
+    const FULL_TOLERANCE: f64 = 1e-9;
+    const STALL_TOLERANCE: f64 = 1e-12;
+    pub struct Params {
+        pub m: f64,
+    }
+    fn newton_step(x: &[f64; NX]) -> Result<([f64; NX], f64, f64), Singular> {
+        // A kernel checks its inputs first.
+        if !(x[0].is_finite() && x[1].is_finite()) {
+            return Err(Singular {
+                site: Site::Input,
+                value: f64::NAN,
+                condition_estimate: f64::INFINITY,
+            });
+        }
+        let g = x[1].sin() - 0.5 * x[0].sin();
+        let d = x[1].cos();
+        if d.abs() < 1e-12 {
+            return Err(Singular {
+                site: Site::Actuation(0),
+                value: d,
+                condition_estimate: f64::INFINITY,
+            });
+        }
+        Ok(([0.0, -g / d], g, g))
+    }
+    fn mass_matrix(x: &[f64; NX], p: &Params) -> Result<[[f64; DOF]; DOF], Singular> {
+        Ok([[p.m * (1.0 + x[1] * x[1])]])
+    }
+    include!("../../codegen/templates/closed_actuation.rs");
+    include!("../../codegen/templates/closed_kinematics.rs");
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn pose_forward_kinematics_meets_its_targets() {
+    let home = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    // Targets: a pose built from a chosen rotation (axis, angle) and position; the actuators'
+    // values follow from the definition of `q_of`.
+    for (axis, angle, p) in [
+        ([0.0, 0.0, 1.0f64], 0.3f64, [0.1, -0.2, 0.3]),
+        ([1.0, 1.0, 0.0], -0.8, [0.0, 0.5, -0.1]),
+        ([0.3, -0.5, 0.8], 1.2, [1.0, 1.0, 1.0]),
+    ] {
+        let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let (s, c) = (0.5 * angle).sin_cos();
+        let want = [
+            p[0],
+            p[1],
+            p[2],
+            c,
+            s * axis[0] / n,
+            s * axis[1] / n,
+            s * axis[2] / n,
+        ];
+        let q = pose::q_of(&want);
+        let x = pose::forward_kinematics(&q, &home).expect("converges");
+        assert!(max_abs_diff(&x, &want) < 1e-9, "{x:?} vs {want:?}");
+        let unit = x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6];
+        assert!((unit - 1.0).abs() < 1e-14);
+    }
+    // Revolute targets count modulo 2π; non-finite inputs fail at once.
+    let q = [0.0, 0.0, 0.0, 0.2 + 2.0 * std::f64::consts::PI, 0.0, 0.0];
+    let x = pose::forward_kinematics(&q, &home).expect("converges");
+    assert!(max_abs_diff(&pose::q_of(&x), &[0.0, 0.0, 0.0, 0.2, 0.0, 0.0]) < 1e-10);
+    let bad = pose::forward_kinematics(&[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0], &home);
+    assert_eq!(bad.map_err(|e| e.iterations), Err(0));
+    // `retract` adds the translation and keeps the quaternion unit.
+    let r = pose::retract_pub(&home, &[0.0, 0.0, 0.2, 1.0, 2.0, 3.0]);
+    assert!(max_abs_diff(&r[..3], &[1.0, 2.0, 3.0]) < 1e-15);
+    assert!(max_abs_diff(&r[3..], &[0.1f64.cos(), 0.0, 0.0, 0.1f64.sin()]) < 1e-15);
+}
+
+#[test]
+fn planar_forward_kinematics_meets_its_targets() {
+    for want in [[0.3, -0.2], [-1.0, 0.7], [2.5, 0.1]] {
+        let q = planar::q_of(&want);
+        let x = planar::forward_kinematics(&q, &[0.0, 0.0]).expect("converges");
+        assert!(max_abs_diff(&planar::q_of(&x), &q) < 1e-11, "{x:?}");
+        assert!(max_abs_diff(&x, &want) < 1e-9, "{x:?} vs {want:?}");
+    }
+}
+
+#[test]
+fn platform_actuation_solves_with_a_transposed() {
+    use actuation::*;
+    let p = Params { scale: 1.3 };
+    let (x, u, ud) = ([0.2, -0.4, 0.7], [0.5, -1.0, 0.3], [1.0, 2.0, -0.5]);
+    let tau = inverse_dynamics(&x, &u, &ud, &p).expect("regular");
+    // Aᵀ τ = f, checked by multiplication.
+    let (a, f) = (a_of(&x), f_of(&u, &ud));
+    for j in 0..DOF {
+        let s: f64 = (0..DOF).map(|i| a[i][j] * tau[i]).sum();
+        assert!((s - f[j]).abs() < 1e-13);
+    }
+    // A⁻ᵀ I A⁻¹ by nalgebra's inverse.
+    let am = DMatrix::from_fn(DOF, DOF, |i, j| a[i][j]);
+    let im = DMatrix::from_fn(DOF, DOF, |i, j| i_of(&x, &p)[i][j]);
+    let ai = am.try_inverse().expect("invertible");
+    let want = ai.transpose() * im * &ai;
+    let got = actuator_mass_matrix(&x, &p).expect("regular");
+    for i in 0..DOF {
+        for j in 0..DOF {
+            assert!((got[i][j] - want[(i, j)]).abs() < 1e-13 * want.amax());
+            assert_eq!(got[i][j], got[j][i]);
+        }
+    }
+}
+
+#[test]
+fn closed_assembly_follows_the_branch() {
+    use closed::*;
+    let p = Params { m: 2.0 };
+    for theta in [0.1, 1.0, 2.5, -3.0] {
+        let x = forward_kinematics(&[theta], &[0.0, 0.0]).expect("assembles");
+        let phi = (0.5 * f64::sin(theta)).asin();
+        assert!((x[0] - theta).abs() == 0.0);
+        assert!(
+            (x[1] - phi).abs() < 1e-12,
+            "θ = {theta}: {x:?} vs φ = {phi}"
+        );
+    }
+    // The other branch (φ near π) stays on its own branch when guessed there.
+    let guess = [0.0, std::f64::consts::PI];
+    let x = forward_kinematics(&[0.5], &guess).expect("assembles");
+    assert!((x[1] - (std::f64::consts::PI - (0.5 * 0.5f64.sin()).asin())).abs() < 1e-12);
+    // The actuator-space functions.
+    assert_eq!(inverse_kinematics(&[0.4, 0.1]), Ok([0.4]));
+    assert_eq!(
+        inverse_kinematics(&[f64::INFINITY, 0.1]).map_err(|e| e.site),
+        Err(Site::Input)
+    );
+    assert_eq!(actuator_rates(&[0.4, 0.1], &[3.0]), Ok([3.0]));
+    assert_eq!(
+        actuator_rates(&[0.4, 0.1], &[f64::NAN]).map_err(|e| e.site),
+        Err(Site::Input)
+    );
+    assert_eq!(actuator_mass_matrix(&[0.4, 0.5], &p), Ok([[2.0 * 1.25]]));
+    assert_eq!(
+        forward_kinematics(&[f64::NAN], &[0.0, 0.0]).map_err(|e| e.iterations),
+        Err(0)
+    );
+}
