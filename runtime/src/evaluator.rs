@@ -24,6 +24,9 @@ pub trait Evaluator {
     /// Speed rates `u̇` under the actuator efforts `tau` (N or N·m, one per speed).
     fn forward_dynamics(&self, x: &[f64], u: &[f64], tau: &[f64]) -> Result<Vec<f64>, String>;
 
+    /// Actuator efforts (N or N·m, one per speed) for the speed rates `ud`.
+    fn inverse_dynamics(&self, x: &[f64], u: &[f64], ud: &[f64]) -> Result<Vec<f64>, String>;
+
     /// `x ⊕ d`: the positions moved by `d`, given in speed coordinates (a tree adds, a platform
     /// retracts onto its manifold, closed loops move their independent coordinates and
     /// reassemble).
@@ -55,6 +58,12 @@ impl Evaluator for Model {
             .map(|v| v.iter().copied().collect())
             .map_err(|e| format!("{e:?}"))
     }
+    fn inverse_dynamics(&self, x: &[f64], u: &[f64], ud: &[f64]) -> Result<Vec<f64>, String> {
+        Ok(crate::noc::inverse_dynamics(self, x, u, ud)
+            .iter()
+            .copied()
+            .collect())
+    }
     fn advance(&self, x: &[f64], d: &[f64]) -> Result<Vec<f64>, String> {
         Ok(x.iter().zip(d).map(|(a, b)| a + b).collect())
     }
@@ -73,6 +82,9 @@ impl Evaluator for parallel::Plan {
     fn forward_dynamics(&self, x: &[f64], u: &[f64], tau: &[f64]) -> Result<Vec<f64>, String> {
         parallel::noc::forward_dynamics(self, x, u, tau).map_err(|e| format!("{e}"))
     }
+    fn inverse_dynamics(&self, x: &[f64], u: &[f64], ud: &[f64]) -> Result<Vec<f64>, String> {
+        parallel::noc::inverse_dynamics(self, x, u, ud).map_err(|e| format!("{e}"))
+    }
     fn advance(&self, x: &[f64], d: &[f64]) -> Result<Vec<f64>, String> {
         Ok(parallel::noc::retract(self.motion, x, d))
     }
@@ -89,6 +101,9 @@ impl Evaluator for closed::Plan {
     }
     fn forward_dynamics(&self, x: &[f64], u: &[f64], tau: &[f64]) -> Result<Vec<f64>, String> {
         closed::noc::forward_dynamics(self, x, u, tau).map_err(|e| format!("{e}"))
+    }
+    fn inverse_dynamics(&self, x: &[f64], u: &[f64], ud: &[f64]) -> Result<Vec<f64>, String> {
+        closed::noc::inverse_dynamics(self, x, u, ud).map_err(|e| format!("{e}"))
     }
     fn advance(&self, x: &[f64], d: &[f64]) -> Result<Vec<f64>, String> {
         let xi: Vec<f64> = self

@@ -565,13 +565,15 @@ pub enum Space {
     Platform,
 }
 
-/// A parallel mechanism's indices could not be computed.
+/// A mechanism's indices could not be computed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EvalError {
     /// The runtime failed: a singular or unreachable pose, or a bad input.
     Singular(crate::scalar::Singular),
     /// The inertia matrix failed its checks.
     Index(IndexError),
+    /// Closed loops do not assemble on the home branch at the given coordinates.
+    Unassembled,
 }
 
 impl fmt::Display for EvalError {
@@ -579,6 +581,7 @@ impl fmt::Display for EvalError {
         match self {
             EvalError::Singular(s) => write!(f, "{s}"),
             EvalError::Index(e) => write!(f, "{e}"),
+            EvalError::Unassembled => write!(f, "the loops do not assemble on the home branch"),
         }
     }
 }

@@ -14,6 +14,8 @@
 //!   manipulability, Khatib & Burdick's isotropic acceleration.
 //! * [`simulate`] (feature `alloc`): fixed-step RK4 and symplectic Euler of any of the above
 //!   with no actuation, and its energy drift.
+//! * [`workspace`] (feature `alloc`): what the workspace tools ask of any kind of mechanism
+//!   (coordinates, home, the inertia the indices use), behind one trait.
 //! * [`rnea`] (feature `alloc`): recursive Newton–Euler and composite-rigid-body algorithms in
 //!   spatial (6-D) algebra, written from their own equations: the independent second route.
 #![no_std]
@@ -53,3 +55,5 @@ pub mod parallel;
 pub mod rnea;
 #[cfg(feature = "alloc")]
 pub mod simulate;
+#[cfg(feature = "alloc")]
+pub mod workspace;

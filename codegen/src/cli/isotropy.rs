@@ -27,8 +27,7 @@ use clap::{Args, ValueEnum};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use runtime::indices::{Normalization, Weights};
-use runtime::model::JointKind;
-use runtime::parallel::PlatformMotion;
+use runtime::workspace::Speed;
 
 use super::design::Design;
 use super::map::fmt_g;
@@ -105,25 +104,13 @@ struct Problem<'a> {
     norm: Normalization,
 }
 
-/// The coordinates at the search parameters `p` (offsets from home).
-fn coordinates(target: &Target, p: &[f64]) -> Vec<f64> {
-    match target {
-        // Trees: p are the joint positions; closed loops: p moves the independent joints from
-        // home, where they are zero.
-        Target::Tree(_) | Target::Closed { .. } => p.to_vec(),
-        Target::Parallel { model, .. } => {
-            runtime::parallel::noc::retract(model.motion, &model.home_x(), p)
-        }
-    }
-}
-
 impl Problem<'_> {
     /// The design value, the coordinates and the inertia at `p` (`None` where the spec is
     /// refused or the point fails).
     fn point(&self, p: &[f64]) -> Option<(Option<f64>, Vec<f64>, DMatrix<f64>)> {
         match self.design {
             None => {
-                let x = coordinates(self.target, p);
+                let x = self.target.mechanism.displaced(p);
                 let m = self.target.matrix(&x).ok()?;
                 Some((None, x, m))
             }
@@ -131,7 +118,7 @@ impl Problem<'_> {
                 let (last, coords) = p.split_last()?;
                 let value = mid + last;
                 let target = design.target(value).ok()?;
-                let x = coordinates(&target, coords);
+                let x = target.mechanism.displaced(coords);
                 let m = target.matrix(&x).ok()?;
                 Some((Some(value), x, m))
             }
@@ -329,51 +316,17 @@ fn load_design(args: &IsotropyArgs) -> Result<Option<Design>, ExitCode> {
 
 /// The search box's half-widths and the coordinates' names (without the design variable).
 fn search_box(target: &Target, args: &IsotropyArgs) -> (Vec<f64>, Vec<String>) {
-    match target {
-        Target::Tree(model) => (
-            model
-                .joints
-                .iter()
-                .map(|j| {
-                    if j.kind == JointKind::Revolute {
-                        std::f64::consts::PI
-                    } else {
-                        args.range
-                    }
-                })
-                .collect(),
-            model.joints.iter().map(|j| j.name.clone()).collect(),
-        ),
-        Target::Closed { model, plan } => (
-            plan.independent
-                .iter()
-                .map(|&j| {
-                    if model.tree.joints[j].kind == JointKind::Revolute {
-                        std::f64::consts::PI
-                    } else {
-                        args.range
-                    }
-                })
-                .collect(),
-            plan.independent
-                .iter()
-                .map(|&j| model.tree.joints[j].name.clone())
-                .collect(),
-        ),
-        Target::Parallel { model, .. } => {
-            let (half, names): (Vec<f64>, Vec<&str>) = match model.motion {
-                PlatformMotion::Pose => (
-                    [[args.angle_range; 3], [args.range; 3]].concat(),
-                    vec!["px", "py", "pz", "qw", "qx", "qy", "qz"],
-                ),
-                PlatformMotion::Orientation { .. } => {
-                    (vec![args.angle_range; 3], vec!["qw", "qx", "qy", "qz"])
-                }
-                PlatformMotion::PlanarPoint { .. } => (vec![args.range; 2], vec!["px", "py"]),
-            };
-            (half, names.into_iter().map(String::from).collect())
-        }
-    }
+    let half = target
+        .mechanism
+        .speeds()
+        .iter()
+        .map(|s| match s {
+            Speed::Joint { revolute: true } => std::f64::consts::PI,
+            Speed::Joint { revolute: false } | Speed::Translation => args.range,
+            Speed::Rotation => args.angle_range,
+        })
+        .collect();
+    (half, target.mechanism.coordinate_names())
 }
 
 fn normalization(arg: NormArg) -> Normalization {
@@ -538,12 +491,13 @@ impl Report<'_> {
             (Some(d), Some(v)) => d.target(v).ok(),
             _ => None,
         };
-        let q = match redesigned.as_ref().unwrap_or(self.target) {
-            Target::Parallel { plan, .. } => runtime::parallel::noc::inverse_kinematics(plan, &m.x)
-                .map(|q| q.iter().map(|v| fixed6(*v)).collect::<Vec<_>>().join(", "))
-                .unwrap_or_else(|_| "-".into()),
-            Target::Tree(_) | Target::Closed { .. } => coords.clone(),
-        };
+        let q = redesigned
+            .as_ref()
+            .unwrap_or(self.target)
+            .mechanism
+            .actuated(&m.x)
+            .map(|q| q.iter().map(|v| fixed6(*v)).collect::<Vec<_>>().join(", "))
+            .unwrap_or_else(|_| "-".into());
         let design_cell = m
             .design
             .map(|v| format!(" {} |", fixed6(v)))

@@ -16,8 +16,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use rayon::prelude::*;
-use runtime::model::JointKind;
-use runtime::parallel::PlatformMotion;
+use runtime::workspace::Axis;
 
 use super::{Failure, IndexKind, SpaceArg, Target, parse_range, progress, quat_axis, quat_mul};
 
@@ -69,39 +68,22 @@ pub struct MapArgs {
     pub threads: Option<usize>,
 }
 
-/// One axis of the slice.
-#[derive(Clone, Debug)]
-pub enum Axis {
-    /// Platform position coordinate `x[index]`, home value `home`.
-    Position {
-        /// `px` …
-        name: String,
-        /// Index into `x`.
-        index: usize,
-        /// Its home value (m).
-        home: f64,
-    },
-    /// Rotation about base axis `axis` (0, 1, 2).
-    Rotation {
-        /// `rx` …
-        name: String,
-        /// 0 = x, 1 = y, 2 = z.
-        axis: usize,
-    },
-    /// Tree joint `index`.
-    Joint {
-        /// Joint name.
-        name: String,
-        /// Index into `q`.
-        index: usize,
-        /// Revolute?
-        revolute: bool,
-    },
+/// An axis's words and defaults (the axes themselves come from the runtime,
+/// [`runtime::workspace::Workspace::axes`]).
+pub trait AxisText {
+    /// Name as in the CSV header (with its unit).
+    fn label(&self) -> String;
+    /// Name with its unit for the plot (`px [m]`).
+    fn plot_label(&self) -> String;
+    /// Default range.
+    fn default_range(&self) -> (f64, f64);
+    /// The value shown for the grid value `v` (absolute position for position axes).
+    fn shown(&self, v: f64) -> f64;
 }
 
-impl Axis {
+impl AxisText for Axis {
     /// Name as in the CSV header (with its unit).
-    pub fn label(&self) -> String {
+    fn label(&self) -> String {
         match self {
             Axis::Position { name, .. } => format!("{name}_m"),
             Axis::Rotation { name, .. } => format!("{name}_rad"),
@@ -111,7 +93,7 @@ impl Axis {
         }
     }
     /// Name with its unit for the plot (`px [m]`).
-    pub fn plot_label(&self) -> String {
+    fn plot_label(&self) -> String {
         match self {
             Axis::Position { name, .. } => format!("{name} [m]"),
             Axis::Rotation { name, .. } => format!("{name} [rad] (rotation about the base axis)"),
@@ -130,7 +112,7 @@ impl Axis {
         }
     }
     /// The value shown for the grid value `v` (absolute position for position axes).
-    pub fn shown(&self, v: f64) -> f64 {
+    fn shown(&self, v: f64) -> f64 {
         match self {
             Axis::Position { home, .. } => home + v,
             _ => v,
@@ -140,47 +122,7 @@ impl Axis {
 
 /// The axes a mechanism offers, by name.
 pub fn resolve_axes(target: &Target, spec: Option<&str>) -> Result<[Axis; 2], String> {
-    let offered: Vec<Axis> = match target {
-        Target::Parallel { model, .. } => {
-            let home = model.home_x();
-            let pos = |i: usize| Axis::Position {
-                name: ["px", "py", "pz"][i].into(),
-                index: i,
-                home: home[i],
-            };
-            let rot = |i: usize| Axis::Rotation {
-                name: ["rx", "ry", "rz"][i].into(),
-                axis: i,
-            };
-            match model.motion {
-                PlatformMotion::Pose => {
-                    vec![pos(0), pos(1), pos(2), rot(0), rot(1), rot(2)]
-                }
-                PlatformMotion::Orientation { .. } => vec![rot(0), rot(1), rot(2)],
-                PlatformMotion::PlanarPoint { .. } => vec![pos(0), pos(1)],
-            }
-        }
-        Target::Tree(model) => model
-            .joints
-            .iter()
-            .enumerate()
-            .map(|(i, j)| Axis::Joint {
-                name: j.name.clone(),
-                index: i,
-                revolute: j.kind == JointKind::Revolute,
-            })
-            .collect(),
-        Target::Closed { model, plan } => plan
-            .independent
-            .iter()
-            .enumerate()
-            .map(|(k, &j)| Axis::Joint {
-                name: model.tree.joints[j].name.clone(),
-                index: k,
-                revolute: model.tree.joints[j].kind == JointKind::Revolute,
-            })
-            .collect(),
-    };
+    let offered: Vec<Axis> = target.mechanism.axes();
     let name_of = |a: &Axis| match a {
         Axis::Position { name, .. } | Axis::Rotation { name, .. } | Axis::Joint { name, .. } => {
             name.clone()
@@ -195,7 +137,7 @@ pub fn resolve_axes(target: &Target, spec: Option<&str>) -> Result<[Axis; 2], St
         if let Some(k) = w
             .strip_prefix('q')
             .and_then(|d| d.parse::<usize>().ok())
-            .filter(|_| matches!(target, Target::Tree(_)))
+            .filter(|_| target.mechanism.every_joint())
             .filter(|k| *k < offered.len())
         {
             return Ok(offered[k].clone());
@@ -229,14 +171,7 @@ pub fn resolve_axes(target: &Target, spec: Option<&str>) -> Result<[Axis; 2], St
 /// The coordinates `x` at the grid values `(u, v)` of the two axes.
 pub fn point(target: &Target, axes: &[Axis; 2], base: &[f64], u: f64, v: f64) -> Vec<f64> {
     let mut x = base.to_vec();
-    let qi = match target {
-        Target::Parallel { model, .. } => match model.motion {
-            PlatformMotion::Pose => Some(3),
-            PlatformMotion::Orientation { .. } => Some(0),
-            PlatformMotion::PlanarPoint { .. } => None,
-        },
-        Target::Tree(_) | Target::Closed { .. } => None,
-    };
+    let qi = target.mechanism.quaternion();
     // Rotations compose from the left in the order given: R_a(u) · R_b(v) · R_home.
     let mut rot = [1.0, 0.0, 0.0, 0.0];
     for (axis, val) in axes.iter().zip([u, v]) {
@@ -256,36 +191,23 @@ pub fn point(target: &Target, axes: &[Axis; 2], base: &[f64], u: f64, v: f64) ->
 
 /// The base coordinates of the slice (home, or `--at` for a tree).
 fn base_point(target: &Target, at: Option<&str>) -> Result<Vec<f64>, String> {
-    match target {
-        Target::Parallel { model, .. } => {
-            if at.is_some() {
-                return Err("--at applies to trees only".into());
-            }
-            Ok(model.home_x())
-        }
-        Target::Closed { plan, .. } => {
-            if at.is_some() {
-                return Err("--at applies to trees only".into());
-            }
-            Ok(vec![0.0; plan.dof()])
-        }
-        Target::Tree(model) => match at {
-            None => Ok(vec![0.0; model.dof()]),
-            Some(s) => {
-                let v: Result<Vec<f64>, _> =
-                    s.split(',').map(|t| t.trim().parse::<f64>()).collect();
-                let v = v.map_err(|_| format!("--at `{s}`: not a list of numbers"))?;
-                if v.len() != model.dof() || v.iter().any(|x| !x.is_finite()) {
-                    return Err(format!(
-                        "--at needs {} finite joint values, got {}",
-                        model.dof(),
-                        v.len()
-                    ));
-                }
-                Ok(v)
-            }
-        },
+    let Some(s) = at else {
+        return Ok(target.mechanism.home());
+    };
+    if !target.mechanism.every_joint() {
+        return Err("--at applies to trees only".into());
     }
+    let dof = target.dof();
+    let v: Result<Vec<f64>, _> = s.split(',').map(|t| t.trim().parse::<f64>()).collect();
+    let v = v.map_err(|_| format!("--at `{s}`: not a list of numbers"))?;
+    if v.len() != dof || v.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "--at needs {} finite joint values, got {}",
+            dof,
+            v.len()
+        ));
+    }
+    Ok(v)
 }
 
 fn parse_steps(s: &str) -> Result<(usize, usize), String> {

@@ -1,10 +1,12 @@
 //! The workspace tools of the CLI (`docs/indices.md`): `map` and `isotropy`.
 //!
-//! Both evaluate the mechanism with the runtime, not with generated code:
+//! Both evaluate the mechanism with the runtime, not with generated code, through one
+//! `Box<dyn` [`runtime::workspace::Workspace`]`>` (no match on the kind here):
 //! * trees: the joint-space inertia `H(q)` by the CRBA ([`runtime::rnea::mass_matrix`]);
 //! * parallel mechanisms: [`runtime::parallel::noc::actuator_mass_matrix`] (`A⁻ᵀ I A⁻¹`,
 //!   actuator space, the default) or [`runtime::parallel::noc::mass_matrix`] (`I`, platform
-//!   speeds), through [`runtime::indices::parallel_indices`]. Where the runtime returns
+//!   speeds), through [`runtime::indices::parallel_indices`];
+//! * closed loops: the inertia of the independent joints, assembled on the home branch. Where the runtime returns
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
 pub mod design;
@@ -17,10 +19,9 @@ use std::process::ExitCode;
 
 use clap::ValueEnum;
 use codegen::spec::Mechanism;
-use runtime::indices::{self, EvalError, IndexError, InertiaIndices, Space};
-use runtime::model::{JointKind, Model};
-use runtime::parallel::{ParallelModel, Plan, PlatformMotion};
+use runtime::indices::{EvalError, IndexError, InertiaIndices, Space};
 use runtime::scalar::Site;
+use runtime::workspace::{Loops, Platform, Workspace};
 
 /// Which index to map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -121,27 +122,38 @@ impl Failure {
     }
 }
 
-/// A mechanism ready to evaluate.
-pub enum Target {
-    /// A tree: `x = q`.
-    Tree(Model),
-    /// A parallel mechanism: `x` its platform coordinates.
-    Parallel {
-        /// The model.
-        model: Box<ParallelModel>,
-        /// The runtime's plan.
-        plan: Box<Plan>,
-        /// Actuator or platform space.
-        space: Space,
-    },
-    /// Closed loops in joint coordinates: `x` the independent (actuated) joint positions; the
-    /// others follow by assembly from home (the home branch).
-    Closed {
-        /// The model.
-        model: Box<runtime::closed::ClosedModel>,
-        /// The runtime's plan.
-        plan: Box<runtime::closed::Plan>,
-    },
+/// A mechanism ready to evaluate, whatever its kind, and where its indices are taken.
+pub struct Target {
+    /// The mechanism: `x` a tree's joint positions, a platform's coordinates, or closed loops'
+    /// independent (actuated) joint positions, the others following by assembly from home (the
+    /// home branch); see [`runtime::workspace`].
+    pub mechanism: Box<dyn Workspace + Send + Sync>,
+    /// Actuator or platform space (platforms only).
+    pub space: Space,
+}
+
+/// The runtime's evaluator of a loaded mechanism: the one place the CLI meets the kind, to
+/// construct it. The error is the runtime's refusal of the model, rendered for `name`.
+pub fn workspace(
+    name: &str,
+    mechanism: Mechanism,
+) -> Result<Box<dyn Workspace + Send + Sync>, String> {
+    let refused = |e: String| format!("error: {name}: {e}\n");
+    Ok(match mechanism {
+        Mechanism::Tree(model) => Box::new(model),
+        Mechanism::Parallel(model) => Box::new(Platform::new(model).map_err(refused)?),
+        Mechanism::Closed(model) => Box::new(Loops::new(model).map_err(refused)?),
+    })
+}
+
+/// The failure of a point, from the runtime's error.
+fn failure(e: EvalError) -> Failure {
+    match e {
+        EvalError::Singular(s) if matches!(s.site, Site::Reach(_)) => Failure::Unreachable,
+        EvalError::Singular(s) => Failure::Singular(s.site),
+        EvalError::Index(i) => Failure::Invalid(i),
+        EvalError::Unassembled => Failure::Unreachable,
+    }
 }
 
 /// A spec file's name (as given) and text. On failure the error is printed and the exit code
@@ -183,183 +195,41 @@ impl Target {
         } else {
             warnings.render()
         };
-        let target = match mechanism {
-            Mechanism::Tree(model) => Target::Tree(model),
-            Mechanism::Parallel(model) => {
-                let plan = Plan::new(&model).map_err(|e| format!("error: {name}: {e}\n"))?;
-                Target::Parallel {
-                    model: Box::new(model),
-                    plan: Box::new(plan),
-                    space: match space {
-                        SpaceArg::Actuator => Space::Actuator,
-                        SpaceArg::Platform => Space::Platform,
-                    },
-                }
-            }
-            Mechanism::Closed(model) => {
-                let plan = runtime::closed::Plan::new(&model)
-                    .map_err(|e| format!("error: {name}: {e}\n"))?;
-                Target::Closed {
-                    model: Box::new(model),
-                    plan: Box::new(plan),
-                }
-            }
+        let target = Target {
+            mechanism: workspace(name, mechanism)?,
+            space: match space {
+                SpaceArg::Actuator => Space::Actuator,
+                SpaceArg::Platform => Space::Platform,
+            },
         };
         Ok((target, warnings))
     }
 
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
-        match self {
-            Target::Tree(m) => m.dof(),
-            Target::Parallel { model, .. } => model.dof(),
-            Target::Closed { model, .. } => model.dof(),
-        }
+        self.mechanism.dof()
     }
 
     /// The mechanism's name.
     pub fn name(&self) -> &str {
-        match self {
-            Target::Tree(m) => &m.name,
-            Target::Parallel { model, .. } => &model.name,
-            Target::Closed { model, .. } => &model.name,
-        }
+        self.mechanism.name()
     }
 
-    /// The indices at the coordinates `x` (joint positions of a tree, platform coordinates of a
-    /// parallel mechanism).
+    /// The indices at the coordinates `x`.
     pub fn indices(&self, x: &[f64]) -> Result<InertiaIndices, Failure> {
-        match self {
-            Target::Tree(model) => indices::tree_indices(model, x).map_err(Failure::Invalid),
-            Target::Parallel { plan, space, .. } => indices::parallel_indices(plan, x, *space)
-                .map_err(|e| match e {
-                    EvalError::Singular(s) if matches!(s.site, Site::Reach(_)) => {
-                        Failure::Unreachable
-                    }
-                    EvalError::Singular(s) => Failure::Singular(s.site),
-                    EvalError::Index(i) => Failure::Invalid(i),
-                }),
-            Target::Closed { .. } => {
-                let m = self.matrix(x)?;
-                indices::inertia_indices(&m).map_err(Failure::Invalid)
-            }
-        }
+        self.mechanism.indices(x, self.space).map_err(failure)
     }
 
     /// The matrix `Λ` the indices use at `x` (the joint-space, actuator-space or platform
     /// inertia), symmetrized and checked (`runtime::indices::validate_spd`).
     pub fn matrix(&self, x: &[f64]) -> Result<nalgebra::DMatrix<f64>, Failure> {
-        use runtime::parallel::noc;
-        let singular = |s: runtime::scalar::Singular| match s.site {
-            Site::Reach(_) => Failure::Unreachable,
-            site => Failure::Singular(site),
-        };
-        let m = match self {
-            Target::Tree(model) => {
-                if x.len() != model.dof() || x.iter().any(|v| !v.is_finite()) {
-                    return Err(Failure::Invalid(IndexError::NotFinite { row: 0, col: 0 }));
-                }
-                runtime::rnea::mass_matrix(model, x)
-            }
-            Target::Parallel { plan, space, .. } => {
-                let rows = match space {
-                    Space::Actuator => noc::actuator_mass_matrix(plan, x),
-                    Space::Platform => noc::mass_matrix(plan, x),
-                }
-                .map_err(singular)?;
-                indices::from_rows(&rows).map_err(Failure::Invalid)?
-            }
-            Target::Closed { plan, .. } => {
-                use runtime::closed::noc as cnoc;
-                if x.len() != plan.dof() || x.iter().any(|v| !v.is_finite()) {
-                    return Err(Failure::Invalid(IndexError::NotFinite { row: 0, col: 0 }));
-                }
-                // Assemble on the home branch; no convergence = not reachable on it.
-                let full = cnoc::forward_kinematics(plan, x, &vec![0.0; plan.nx()])
-                    .map_err(|_| Failure::Unreachable)?;
-                let rows = cnoc::mass_matrix(plan, &full).map_err(singular)?;
-                indices::from_rows(&rows).map_err(Failure::Invalid)?
-            }
-        };
-        indices::validate_spd(&m).map_err(Failure::Invalid)
+        self.mechanism.inertia(x, self.space).map_err(failure)
     }
 
     /// Which matrix the indices use, and its unit (for the messages).
     pub fn matrix_words(&self) -> (String, String, String) {
-        match self {
-            Target::Closed { model, plan } => {
-                let rev: Vec<bool> = plan
-                    .independent
-                    .iter()
-                    .map(|&j| model.tree.joints[j].kind == JointKind::Revolute)
-                    .collect();
-                let (unit, acc) = if rev.iter().all(|r| *r) {
-                    ("kg m^2", "rad/s^2 per N m")
-                } else if rev.iter().all(|r| !*r) {
-                    ("kg", "m/s^2 per N")
-                } else {
-                    ("mixed", "mixed")
-                };
-                (
-                    "inertia S^T M S of the actuated (independent) joints, closed loops assembled on the home branch".into(),
-                    unit.into(),
-                    acc.into(),
-                )
-            }
-            Target::Tree(model) => {
-                let all_r = model.joints.iter().all(|j| j.kind == JointKind::Revolute);
-                let all_p = model.joints.iter().all(|j| j.kind == JointKind::Prismatic);
-                let (unit, acc) = if all_r {
-                    ("kg m^2", "rad/s^2 per N m")
-                } else if all_p {
-                    ("kg", "m/s^2 per N")
-                } else {
-                    ("kg m^2 | kg m | kg (mixed joints)", "mixed")
-                };
-                (
-                    "joint-space inertia H(q) (CRBA), task = joint coordinates (J = 1)".into(),
-                    unit.into(),
-                    acc.into(),
-                )
-            }
-            Target::Parallel { model, space, .. } => {
-                let revolute = model
-                    .legs
-                    .iter()
-                    .map(|l| l.joints[l.actuated].kind == JointKind::Revolute)
-                    .collect::<Vec<_>>();
-                match space {
-                    Space::Actuator => {
-                        let (unit, acc) = if revolute.iter().all(|r| *r) {
-                            ("kg m^2", "rad/s^2 per N m")
-                        } else if revolute.iter().all(|r| !*r) {
-                            ("kg", "m/s^2 per N")
-                        } else {
-                            ("mixed", "mixed")
-                        };
-                        (
-                            "actuator-space inertia A^-T I A^-1 (actuator_mass_matrix), task = actuated joint coordinates".into(),
-                            unit.into(),
-                            acc.into(),
-                        )
-                    }
-                    Space::Platform => {
-                        let (unit, acc) = match model.motion {
-                            PlatformMotion::Orientation { .. } => {
-                                ("kg m^2", "rad/s^2 per unit effort")
-                            }
-                            PlatformMotion::PlanarPoint { .. } => ("kg", "m/s^2 per unit effort"),
-                            PlatformMotion::Pose => ("kg m^2 | kg m | kg (mixed)", "mixed"),
-                        };
-                        (
-                            "generalized inertia I in platform speeds u (mass_matrix), efforts tau = A^-T I u'".into(),
-                            unit.into(),
-                            acc.into(),
-                        )
-                    }
-                }
-            }
-        }
+        let w = self.mechanism.inertia_words(self.space);
+        (w.matrix.into(), w.unit.into(), w.acceleration.into())
     }
 }
 

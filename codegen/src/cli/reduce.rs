@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use codegen::spec::Mechanism;
+use runtime::workspace::Workspace;
 
 use super::Rng;
 
@@ -56,9 +57,14 @@ fn time_generated(name: &str, src: &str, m: &Mechanism, states: &[State]) -> Opt
         .iter()
         .map(|(a, b, c)| format!("({}, {}, {})", lit(a), lit(b), lit(c)))
         .collect();
+    // The generated functions' signatures differ: a tree's inverse dynamics cannot fail, a
+    // platform's and closed loops' return a `Result` (a match on the generated API, not on
+    // how the runtime evaluates the kind).
     let call = match m {
         Mechanism::Tree(_) => "m::inverse_dynamics(a, b, c)[0]",
-        _ => "m::inverse_dynamics(a, b, c).map_or(0.0, |t| t[0])",
+        Mechanism::Parallel(_) | Mechanism::Closed(_) => {
+            "m::inverse_dynamics(a, b, c).map_or(0.0, |t| t[0])"
+        }
     };
     let main = format!(
         "#![allow(warnings)]\nmod m {{ include!(\"module.rs\"); }}\n\
@@ -138,81 +144,30 @@ impl Level {
 /// One evaluation state.
 type State = (Vec<f64>, Vec<f64>, Vec<f64>);
 
-fn efforts(m: &Mechanism, s: &State) -> Option<Vec<f64>> {
+fn efforts(m: &dyn Workspace, s: &State) -> Option<Vec<f64>> {
     let (x, u, ud) = s;
-    match m {
-        Mechanism::Tree(model) => Some(
-            runtime::noc::inverse_dynamics(model, x, u, ud)
-                .iter()
-                .copied()
-                .collect(),
-        ),
-        Mechanism::Parallel(model) => {
-            let plan = runtime::parallel::Plan::new(model).ok()?;
-            runtime::parallel::noc::inverse_dynamics(&plan, x, u, ud).ok()
-        }
-        Mechanism::Closed(model) => {
-            let plan = runtime::closed::Plan::new(model).ok()?;
-            runtime::closed::noc::inverse_dynamics(&plan, x, u, ud).ok()
-        }
-    }
+    m.inverse_dynamics(x, u, ud).ok()
 }
 
-fn states(m: &Mechanism, n: usize, rng: &mut Rng) -> Vec<State> {
+/// Up to `n` random regular states: positions at random offsets from home (within
+/// [`Workspace::sample_widths`]; closed loops reassembled, a draw that does not assemble
+/// dropped), random speeds and speed rates in `±1`.
+fn states(m: &dyn Workspace, n: usize, rng: &mut Rng) -> Vec<State> {
+    let (home, widths) = (m.home_state(), m.sample_widths());
+    let d = m.dof();
     let mut out = Vec::new();
     let mut tries = 0;
     while out.len() < n && tries < 100 * n {
         tries += 1;
-        let s: State = match m {
-            Mechanism::Tree(model) => {
-                let d = model.dof();
-                (
-                    (0..d).map(|_| rng.uniform(-3.0, 3.0)).collect(),
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                )
-            }
-            Mechanism::Parallel(model) => {
-                let d = model.dof();
-                let (angle, reach) = match model.motion {
-                    runtime::parallel::PlatformMotion::Pose => (0.1, 0.02 * model.size()),
-                    runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
-                    runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
-                };
-                let planar = matches!(
-                    model.motion,
-                    runtime::parallel::PlatformMotion::PlanarPoint { .. }
-                );
-                let du: Vec<f64> = (0..d)
-                    .map(|i| {
-                        let r = if i < 3 && !planar { angle } else { reach };
-                        rng.uniform(-r, r)
-                    })
-                    .collect();
-                (
-                    runtime::parallel::noc::retract(model.motion, &model.home_x(), &du),
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                )
-            }
-            Mechanism::Closed(model) => {
-                let Ok(plan) = runtime::closed::Plan::new(model) else {
-                    return out;
-                };
-                let d = plan.dof();
-                let xi: Vec<f64> = (0..d).map(|_| rng.uniform(-0.5, 0.5)).collect();
-                let Ok(x) =
-                    runtime::closed::noc::forward_kinematics(&plan, &xi, &vec![0.0; plan.nx()])
-                else {
-                    continue;
-                };
-                (
-                    x,
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                    (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                )
-            }
+        let offset: Vec<f64> = widths.iter().map(|w| rng.uniform(-w, *w)).collect();
+        let Ok(x) = m.advance(&home, &offset) else {
+            continue;
         };
+        let s: State = (
+            x,
+            (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+            (0..d).map(|_| rng.uniform(-1.0, 1.0)).collect(),
+        );
         if efforts(m, &s).is_some_and(|t| t.iter().all(|v| v.is_finite())) {
             out.push(s);
         }
@@ -221,7 +176,7 @@ fn states(m: &Mechanism, n: usize, rng: &mut Rng) -> Vec<State> {
 }
 
 /// Worst and RMS relative error of `m`'s efforts against `reference` over `states`.
-fn errors(m: &Mechanism, states: &[State], reference: &[Vec<f64>]) -> Option<(f64, f64)> {
+fn errors(m: &dyn Workspace, states: &[State], reference: &[Vec<f64>]) -> Option<(f64, f64)> {
     let mut worst: f64 = 0.0;
     let mut sum = 0.0;
     for (s, r) in states.iter().zip(reference) {
@@ -248,16 +203,29 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
         Ok(r) => r,
         Err(code) => return code,
     };
-    let groups = groups(&full, &bodies);
+    // A model the runtime refuses has no regular state either.
+    let evaluator = super::workspace(&name, full.clone()).ok();
+    let groups = evaluator
+        .as_ref()
+        .map(|e| e.body_groups(&bodies))
+        .unwrap_or_default();
     let mut rng = Rng::new(args.seed);
-    let samples = states(&full, args.samples, &mut rng);
+    let samples = evaluator
+        .as_ref()
+        .map(|e| states(e.as_ref(), args.samples, &mut rng))
+        .unwrap_or_default();
     if samples.is_empty() {
         eprintln!("error: {name}: no regular state found to compare on");
         return ExitCode::from(2);
     }
     let reference: Vec<Vec<f64>> = samples
         .iter()
-        .map(|s| efforts(&full, s).unwrap_or_default())
+        .map(|s| {
+            evaluator
+                .as_ref()
+                .and_then(|e| efforts(e.as_ref(), s))
+                .unwrap_or_default()
+        })
         .collect();
     let search = Search {
         args,
@@ -320,29 +288,6 @@ fn load_full(name: &str, source: &str) -> Result<(Mechanism, Vec<String>), ExitC
     Ok((full, bodies))
 }
 
-/// Groups of bodies reduced together: a parallel mechanism's k-th body of every leg (the
-/// legs are alike); one body otherwise. The platform stays.
-fn groups(full: &Mechanism, bodies: &[String]) -> Vec<Vec<String>> {
-    match full {
-        Mechanism::Parallel(model) => {
-            let longest = model.legs.iter().map(|l| l.bodies.len()).max().unwrap_or(0);
-            (0..longest)
-                .map(|k| {
-                    model
-                        .legs
-                        .iter()
-                        .filter_map(|l| l.bodies.get(k))
-                        .map(|b| b.name.clone())
-                        .filter(|n| bodies.contains(n))
-                        .collect::<Vec<_>>()
-                })
-                .filter(|g| !g.is_empty())
-                .collect()
-        }
-        _ => bodies.iter().map(|b| vec![b.clone()]).collect(),
-    }
-}
-
 /// The greedy search's fixed data: the spec, the full model and the states compared on.
 struct Search<'a> {
     args: &'a ReduceArgs,
@@ -369,7 +314,8 @@ impl Search<'_> {
     fn evaluate(&self, level: &Level) -> Option<(usize, f64, f64)> {
         let src = format!("{}{}", self.source, level.scene());
         let (m, _) = codegen::spec::load_mechanism(self.name, &src).ok()?;
-        let (worst, rms) = errors(&m, self.samples, self.reference)?;
+        let m = super::workspace(self.name, m).ok()?;
+        let (worst, rms) = errors(m.as_ref(), self.samples, self.reference)?;
         Some((self.flops(level)?, worst, rms))
     }
 

@@ -8,7 +8,7 @@
 //! model; `parallel` lowers a parallel mechanism with the same machinery and splits it into
 //! legs. The format reference is `docs/spec.md`.
 //!
-//! This is the only module that knows TOML, XML or serde.
+//! This is the only module that knows TOML or XML.
 
 mod angle;
 mod closed;

@@ -1,5 +1,5 @@
 // The bundled mechanisms by kind: the one list that the firmware proofs share
-// (`tests/tests/no_alloc.rs`, `tests/no-panic`, `tools/code_size.py`). It is `include!`d, so it
+// (`tests/tests/no_alloc.rs`, `tests/no-panic`, `cargo xtask code-size`). It is `include!`d, so it
 // holds a single macro and nothing else.
 //
 // To add a mechanism, add its module name to the line of its kind. `tests/tests/no_alloc.rs`

@@ -6,7 +6,7 @@
 //!   codegen unit, `panic = "unwind"`). `main` calls every wrapper on opaque inputs
 //!   (`black_box`), so nothing is removed as dead code and nothing is constant-folded.
 //! - Without it, the same wrappers are the entry points whose reachable machine code
-//!   `tools/code_size.py` measures.
+//!   `cargo xtask code-size` measures.
 //!
 //! The scalar type and the module root are the two aliases below; an `f32` build of the
 //! mechanisms only has to change them.
