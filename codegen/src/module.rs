@@ -34,15 +34,18 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
         .map(|f| emit::function(plan.graph, cfg, f));
     let after = &plan.after;
     let indices = crate::indices::template(cfg);
-    emit::render(
-        &plan.header,
-        quote! {
-            #items
-            #(#fns)*
-            #after
-            #indices
-        },
-    )
+    let mut module = quote! {
+        #items
+        #(#fns)*
+        #after
+        #indices
+    };
+    if let Some(runtime) = &cfg.implement {
+        // The header's first line names the mechanism: "… from mechanism `name` — …".
+        let name = plan.header[0].split('`').nth(1).unwrap_or_default();
+        module.extend(crate::implement::items(&module, runtime, name));
+    }
+    emit::render(&plan.header, module)
 }
 
 /// The `Singular` and `NoConvergence` types of a platform or closed-loop module (each kind has
