@@ -2,7 +2,9 @@
 """Bytes of machine code per generated function, for firmware flash budgets.
 
 Builds `tests/no-panic` (one `#[inline(never)]` wrapper per generated function of every bundled
-mechanism, `tests_no_panic::<module>::<function>`) with the workspace's `firmware` profile (fat
+mechanism: a generic function per method of `runtime::Dynamics`, one instance per module,
+`tests_no_panic::<function>::<mechanisms::<module>::Module, NX, DOF>` in v0 symbol mangling,
+which this script turns on so that the instances have distinct names) with the workspace's `firmware` profile (fat
 LTO, one codegen unit, `panic = "abort"`) at each optimization level, disassembles it and, for
 every wrapper, adds up the sizes of all functions reachable from it through direct calls and
 jumps. Shared helpers (LU, kinematics kernels) count in every function that calls them; the
@@ -41,6 +43,8 @@ def build(level, target_dir):
         "--config", (f'profile.firmware.opt-level="{level}"' if level in ("s", "z")
                       else f"profile.firmware.opt-level={level}"),
         "--config", 'profile.firmware.panic="abort"',
+        # v0 mangling names each instance of a generic wrapper with its module.
+        "--config", 'build.rustflags=["-Csymbol-mangling-version=v0"]',
     ]
     env = dict(os.environ, CARGO_TARGET_DIR=target_dir)
     start = time.monotonic()
@@ -110,12 +114,15 @@ def reach(root, edges, funcs):
 def measure(binary):
     starts, funcs = symbols(binary)
     edges = call_graph(binary, starts, funcs)
-    wrapper = re.compile(rf"^{CRATE}::(\w+)::(\w+)$")
+    # `tests_no_panic::<function>::<mechanisms::<module>::Module, NX, DOF>` (v0 demangled;
+    # crate disambiguators, if shown, skipped).
+    wrapper = re.compile(rf"^{CRATE}(?:\[\w+\])?::(\w+)::<mechanisms(?:\[\w+\])?::"
+                         r"(?:f32::)?(\w+)::Module, [^>]*>$")
     sizes, per_mech, math, panics = {}, collections.defaultdict(set), set(), {}
     for s in starts:
         name = funcs[s][0]
         m = wrapper.match(name)
-        if not m or m.group(2) == "run":
+        if not m or m.group(1) == "run":
             continue
         own = 0
         seen, sites = reach(s, edges, funcs)
@@ -125,8 +132,8 @@ def measure(binary):
                 math.add(f)
             else:
                 own += size
-                per_mech[m.group(1)].add(f)
-        key = (m.group(1), m.group(2))
+                per_mech[m.group(2)].add(f)
+        key = (m.group(2), m.group(1))
         sizes[key] = own
         if sites:
             panics[key] = sorted(sites)
