@@ -18,6 +18,7 @@ fn main() {
             .unwrap_or_else(|e| panic!("{e}"))
             .math(codegen::MathBackend::Runtime("runtime".into()))
             .float(float)
+            .implement("runtime")
             .out_dir(&dir);
         b.compile().unwrap_or_else(|e| panic!("\n{e}"));
         if float == codegen::Float::F32 {

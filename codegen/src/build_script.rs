@@ -114,6 +114,15 @@ impl Builder {
         self
     }
 
+    /// Also implement the runtime's `Dynamics` trait in every module (`Config::implement`):
+    /// `runtime` is the path of the nocdyn runtime crate as the including crate names it (e.g.
+    /// `"runtime"`). Each module then holds `pub struct Module` and
+    /// `impl <runtime>::Dynamics<NX, DOF> for Module`, forwarding to its free functions.
+    pub fn implement(&mut self, runtime: impl Into<String>) -> &mut Self {
+        self.config.implement = Some(runtime.into());
+        self
+    }
+
     /// Apply the joints' friction (`damping`, `friction`; URDF `<dynamics>`) in every spec, as
     /// `[scene] friction = true` does.
     pub fn friction(&mut self, on: bool) -> &mut Self {

@@ -158,6 +158,7 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     };
     let code = module::render(
         &ModulePlan {
+            name: &model.name,
             header,
             items,
             graph: &k.graph,

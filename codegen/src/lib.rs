@@ -37,6 +37,7 @@ pub mod closed;
 pub mod diag;
 pub mod dynamics;
 pub mod emit;
+mod implement;
 pub mod indices;
 mod lu;
 pub mod macro_support;
@@ -87,6 +88,11 @@ pub struct Config {
     pub float: Float,
     /// Scene switches on top of the spec's `[scene]` (friction, rotor inertia).
     pub scene: spec::SceneOverrides,
+    /// `Some(path)`: the module also holds `pub struct Module` and implements
+    /// `<path>::Dynamics<NX, DOF>` for it, where `path` names the nocdyn runtime crate (e.g.
+    /// `"runtime"`), so that code over modules of every kind is written once (see
+    /// `runtime::Dynamics`). `None` (default): free functions only.
+    pub implement: Option<String>,
 }
 
 impl Default for Config {
@@ -95,6 +101,7 @@ impl Default for Config {
             math: MathBackend::Libm,
             float: Float::F64,
             scene: spec::SceneOverrides::default(),
+            implement: None,
         }
     }
 }
@@ -148,6 +155,9 @@ pub fn generate(
     cfg: &Config,
 ) -> Result<Generated, String> {
     let single = cfg.float == Float::F32;
+    if cfg.implement.is_some() {
+        implement::check(mechanism, scene)?;
+    }
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || match mechanism {
             spec::Mechanism::Tree(model) => Ok(tree::generate(model, scene, cfg)),

@@ -175,6 +175,7 @@ fn main() -> ExitCode {
                 rotor_inertia: cli.rotor_inertia,
                 snap: cli.snap,
             },
+            implement: None,
         },
     ) {
         Ok(o) => o,

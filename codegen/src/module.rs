@@ -13,6 +13,8 @@ use crate::sym::Graph;
 
 /// A generated module before it is written.
 pub(crate) struct ModulePlan<'g> {
+    /// The mechanism's name (the spec's).
+    pub name: &'g str,
     /// The header comment, one line an entry (without `// `).
     pub header: Vec<String>,
     /// The items before the functions.
@@ -34,15 +36,16 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
         .map(|f| emit::function(plan.graph, cfg, f));
     let after = &plan.after;
     let indices = crate::indices::template(cfg);
-    emit::render(
-        &plan.header,
-        quote! {
-            #items
-            #(#fns)*
-            #after
-            #indices
-        },
-    )
+    let mut module = quote! {
+        #items
+        #(#fns)*
+        #after
+        #indices
+    };
+    if let Some(runtime) = &cfg.implement {
+        module.extend(crate::implement::items(&module, runtime, plan.name));
+    }
+    emit::render(&plan.header, module)
 }
 
 /// The `Singular` and `NoConvergence` types of a platform or closed-loop module (each kind has

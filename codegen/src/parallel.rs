@@ -199,6 +199,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     let items = items(model, &plan, params, &layout, cfg, &want);
     let code = module::render(
         &ModulePlan {
+            name: &model.name,
             header,
             items,
             graph: &k.graph,

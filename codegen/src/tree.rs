@@ -210,6 +210,7 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
     let items = items(n, &joint_names, &functions, extra);
     let code = module::render(
         &ModulePlan {
+            name: &model.name,
             header,
             items,
             graph: &g,

@@ -73,6 +73,7 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
         math: math.clone(),
         float,
         scene: Default::default(),
+        implement: None,
     };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))

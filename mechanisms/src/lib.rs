@@ -1,9 +1,14 @@
 //! The generated dynamics of nocdyn's bundled mechanisms: one module per spec in `specs/`, each
-//! with `DOF`, `JOINT_NAMES`, `mass_matrix`, `coriolis`, `gravity`, `inverse_dynamics` and
-//! `forward_dynamics` (see the generated headers for op counts).
+//! with its constants and free functions (trees: `DOF`, `JOINT_NAMES`, `mass_matrix`,
+//! `coriolis`, `gravity`, `inverse_dynamics`, `forward_dynamics`; parallel platforms and closed
+//! loops: `NX`, `DOF`, `HOME`, kinematics and dynamics; see the generated headers for op
+//! counts), and a unit struct `Module` that implements [`Dynamics`] by calling them, so that
+//! code over every kind of module is written once.
 //!
 //! `#![no_std]`, no `alloc`: trigonometry comes from `runtime::math` (std with the `std`
 //! feature, `libm` otherwise).
 #![no_std]
+
+pub use runtime::Dynamics;
 
 include!(concat!(env!("OUT_DIR"), "/mechanisms.rs"));

@@ -26,6 +26,9 @@ extern crate alloc;
 extern crate std;
 
 pub mod math;
+pub mod module;
+
+pub use module::Dynamics;
 
 // The shared floor every mechanism kind stands on.
 #[cfg(feature = "alloc")]

@@ -3,10 +3,12 @@
 //! (`allocation_counter`, which counts only the calling thread's allocations inside
 //! `measure`), and the count must be zero. Inputs are prepared before the measured region.
 //!
-//! The mechanisms come from the shared list `tests/no-panic/src/list.rs`; `list_matches_specs`
-//! fails when a spec in `mechanisms/specs/` is missing from it or filed under the wrong kind.
+//! The mechanisms come from the shared list `tests/no-panic/src/list.rs`, and one generic
+//! function measures each through its `runtime::Dynamics` implementation; `list_matches_specs`
+//! fails when a spec in `mechanisms/specs/` is missing from the list.
 
 use allocation_counter::measure;
+use mechanisms::Dynamics;
 use std::hint::black_box;
 
 /// The generated code's scalar (an `f32` build changes this and `root`).
@@ -40,148 +42,119 @@ struct Outcome {
     allocations: u64,
 }
 
-macro_rules! tree {
-    ($($m:ident),* $(,)?) => {
-        fn trees() -> Vec<Outcome> {
-            let mut out = Vec::new();
-            $(
-                out.push({
-                    use root::$m as g;
-                    const N: usize = g::DOF;
-                    let mut rng = tests::rng(0xa110c ^ N as u64);
-                    let mut states = vec![([0.0 as F; N], [0.0 as F; N], [0.0 as F; N])];
-                    for _ in 0..STATES {
-                        let (q, qd, qdd) = tests::random_state(&mut rng, N);
-                        states.push((arr(&q), arr(&qd), arr(&qdd)));
-                    }
-                    let (mut calls, mut ok, mut fallible) = (0, 0, 0);
-                    let info = measure(|| {
-                        for (q, qd, qdd) in &states {
-                            let (q, qd, qdd) = (black_box(q), black_box(qd), black_box(qdd));
-                            black_box(g::mass_matrix(q));
-                            black_box(g::coriolis(q, qd));
-                            black_box(g::gravity(q));
-                            let tau = black_box(g::inverse_dynamics(q, qd, qdd));
-                            ok += usize::from(black_box(g::forward_dynamics(q, qd, &tau)).is_ok());
-                            calls += 5;
-                            fallible += 1;
-                        }
-                    });
-                    Outcome { name: stringify!($m), calls, ok, fallible, allocations: info.count_total }
-                });
-            )*
-            out
+/// One state `(x, u, ud)` of a module, in its coordinates.
+type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Home and `STATES` random states of the bundled mechanism `name`, from the runtime's model of
+/// its kind (the one place that knows the kinds: the states are data, the harness is generic).
+fn states(name: &str) -> Vec<State> {
+    use runtime::parallel::PlatformMotion;
+    let mut states = Vec::new();
+    match kind(name) {
+        Kind::Tree => {
+            let mut rng = tests::rng(0xa110c ^ dof(name) as u64);
+            let n = dof(name);
+            states.push((vec![0.0; n], vec![0.0; n], vec![0.0; n]));
+            for _ in 0..STATES {
+                states.push(tests::random_state(&mut rng, n));
+            }
         }
-    };
+        Kind::Parallel => {
+            let model = tests::pkm::model(name);
+            let plan = runtime::parallel::noc::Plan::new(&model).expect("plan");
+            let home = tests::pkm::home_x(&model);
+            let (angle, reach) = match model.motion {
+                PlatformMotion::Pose => (0.1, 0.02 * model.size()),
+                PlatformMotion::Orientation { .. } => (0.3, 0.0),
+                PlatformMotion::PlanarPoint { .. } => (0.0, 0.03),
+            };
+            let n = plan.dof();
+            let mut rng = tests::rng(0xa110c ^ n as u64);
+            states.push((home.clone(), vec![0.0; n], vec![0.0; n]));
+            for _ in 0..STATES {
+                states.push(tests::pkm::random_state(
+                    &plan, &home, &mut rng, angle, reach,
+                ));
+            }
+        }
+        Kind::Closed => {
+            let model = tests::closed::model(name);
+            let plan = runtime::closed::noc::Plan::new(&model).expect("plan");
+            let (n, nx) = (plan.dof(), plan.nx());
+            let mut rng = tests::rng(0xa110c ^ n as u64);
+            states.push((vec![0.0; nx], vec![0.0; n], vec![0.0; n]));
+            for _ in 0..STATES {
+                states.push(tests::closed::random_state(&plan, &mut rng, 0.3));
+            }
+        }
+    }
+    states
 }
 
-macro_rules! parallel {
-    ($($m:ident),* $(,)?) => {
-        fn parallels() -> Vec<Outcome> {
-            use runtime::parallel::PlatformMotion;
-            use runtime::parallel::noc::Plan;
-            let mut out = Vec::new();
-            $(
-                out.push({
-                    use root::$m as g;
-                    const N: usize = g::DOF;
-                    const NX: usize = g::NX;
-                    let model = tests::pkm::model(stringify!($m));
-                    let plan = Plan::new(&model).expect("plan");
-                    let home = tests::pkm::home_x(&model);
-                    let (angle, reach) = match model.motion {
-                        PlatformMotion::Pose => (0.1, 0.02 * model.size()),
-                        PlatformMotion::Orientation { .. } => (0.3, 0.0),
-                        PlatformMotion::PlanarPoint { .. } => (0.0, 0.03),
-                    };
-                    let mut rng = tests::rng(0xa110c ^ N as u64);
-                    let mut states = vec![(arr::<NX>(&home), [0.0 as F; N], [0.0 as F; N])];
-                    for _ in 0..STATES {
-                        let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, angle, reach);
-                        states.push((arr(&x), arr(&u), arr(&ud)));
-                    }
-                    let guess: [F; NX] = arr(&home);
-                    let (mut calls, mut ok, mut fallible) = (0, 0, 0);
-                    let info = measure(|| {
-                        for (x, u, ud) in &states {
-                            let (x, u, ud) = (black_box(x), black_box(u), black_box(ud));
-                            let q = black_box(g::inverse_kinematics(x));
-                            ok += usize::from(q.is_ok());
-                            ok += usize::from(black_box(g::actuator_rates(x, u)).is_ok());
-                            let tau = black_box(g::inverse_dynamics(x, u, ud));
-                            ok += usize::from(tau.is_ok());
-                            ok += usize::from(black_box(g::mass_matrix(x)).is_ok());
-                            ok += usize::from(black_box(g::actuator_mass_matrix(x)).is_ok());
-                            let tau = tau.unwrap_or([0.0; N]);
-                            ok += usize::from(black_box(g::forward_dynamics(x, u, &tau)).is_ok());
-                            let q = q.unwrap_or([0.0; N]);
-                            ok += usize::from(black_box(g::forward_kinematics(&q, &guess)).is_ok());
-                            calls += 7;
-                            fallible += 7;
-                        }
-                    });
-                    Outcome { name: stringify!($m), calls, ok, fallible, allocations: info.count_total }
-                });
-            )*
-            out
+/// Calls every method of module `m` on every state in `states` under the allocation counter.
+fn measure_module<M, const NX: usize, const N: usize>(
+    name: &'static str,
+    m: &M,
+    states: &[State],
+) -> Outcome
+where
+    M: Dynamics<NX, N, Scalar = F>,
+{
+    let states: Vec<([F; NX], [F; N], [F; N])> = states
+        .iter()
+        .map(|(x, u, ud)| (arr(x), arr(u), arr(ud)))
+        .collect();
+    let guess = M::HOME;
+    let (mut calls, mut ok, mut fallible) = (0, 0, 0);
+    let info = measure(|| {
+        for (x, u, ud) in &states {
+            let (m, x, u, ud) = (black_box(m), black_box(x), black_box(u), black_box(ud));
+            let q = black_box(m.inverse_kinematics(x));
+            ok += usize::from(q.is_ok());
+            let q = q.unwrap_or([0.0; N]);
+            ok += usize::from(black_box(m.forward_kinematics(&q, &guess)).is_ok());
+            ok += usize::from(black_box(m.actuator_rates(x, u)).is_ok());
+            let tau = black_box(m.inverse_dynamics(x, u, ud));
+            ok += usize::from(tau.is_ok());
+            ok += usize::from(black_box(m.mass_matrix(x)).is_ok());
+            ok += usize::from(black_box(m.actuator_mass_matrix(x)).is_ok());
+            let tau = tau.unwrap_or([0.0; N]);
+            ok += usize::from(black_box(m.forward_dynamics(x, u, &tau)).is_ok());
+            calls += 7;
+            fallible += 7;
+            if let Some(r) = black_box(m.joint_rates(x, u)) {
+                ok += usize::from(r.is_ok());
+                calls += 1;
+                fallible += 1;
+            }
+            calls += usize::from(black_box(m.coriolis(x, u)).is_some());
+            calls += usize::from(black_box(m.gravity(x)).is_some());
         }
-    };
+    });
+    Outcome {
+        name,
+        calls,
+        ok,
+        fallible,
+        allocations: info.count_total,
+    }
 }
 
-macro_rules! closed {
+macro_rules! measure_all {
     ($($m:ident),* $(,)?) => {
-        fn closed_loops() -> Vec<Outcome> {
-            use runtime::closed::noc::Plan;
-            let mut out = Vec::new();
-            $(
-                out.push({
-                    use root::$m as g;
-                    const N: usize = g::DOF;
-                    const NX: usize = g::NX;
-                    let model = tests::closed::model(stringify!($m));
-                    let plan = Plan::new(&model).expect("plan");
-                    let mut rng = tests::rng(0xa110c ^ N as u64);
-                    let mut states = vec![([0.0 as F; NX], [0.0 as F; N], [0.0 as F; N])];
-                    for _ in 0..STATES {
-                        let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, 0.3);
-                        states.push((arr(&x), arr(&u), arr(&ud)));
-                    }
-                    let guess = [0.0 as F; NX];
-                    let (mut calls, mut ok, mut fallible) = (0, 0, 0);
-                    let info = measure(|| {
-                        for (x, u, ud) in &states {
-                            let (x, u, ud) = (black_box(x), black_box(u), black_box(ud));
-                            let q = black_box(g::inverse_kinematics(x));
-                            ok += usize::from(q.is_ok());
-                            let q = q.unwrap_or([0.0; N]);
-                            ok += usize::from(black_box(g::forward_kinematics(&q, &guess)).is_ok());
-                            ok += usize::from(black_box(g::joint_rates(x, u)).is_ok());
-                            let tau = black_box(g::inverse_dynamics(x, u, ud));
-                            ok += usize::from(tau.is_ok());
-                            ok += usize::from(black_box(g::mass_matrix(x)).is_ok());
-                            let tau = tau.unwrap_or([0.0; N]);
-                            ok += usize::from(black_box(g::forward_dynamics(x, u, &tau)).is_ok());
-                            calls += 6;
-                            fallible += 6;
-                        }
-                    });
-                    Outcome { name: stringify!($m), calls, ok, fallible, allocations: info.count_total }
-                });
-            )*
-            out
+        /// Every bundled module, measured.
+        fn measure_all() -> Vec<Outcome> {
+            vec![$(measure_module(stringify!($m), &root::$m::Module, &states(stringify!($m)))),*]
         }
+        /// Every bundled module's name.
+        const NAMES: &[&str] = &[$(stringify!($m)),*];
     };
 }
-
-for_each_mechanism!(tree, parallel, closed);
+for_each_mechanism!(measure_all);
 
 #[test]
 fn no_generated_function_allocates() {
-    let all: Vec<Outcome> = trees()
-        .into_iter()
-        .chain(parallels())
-        .chain(closed_loops())
-        .collect();
+    let all = measure_all();
     let mut calls = 0;
     for o in &all {
         println!(
@@ -207,68 +180,64 @@ fn counter_counts() {
     assert_eq!(info.count_total, 2);
 }
 
-macro_rules! tree_names {
-    ($($m:ident),* $(,)?) => {
-        const TREE_NAMES: &[&str] = &[$(stringify!($m)),*];
-    };
+/// The kinds of module (for the states only).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Tree,
+    Parallel,
+    Closed,
 }
-macro_rules! parallel_names {
-    ($($m:ident),* $(,)?) => {
-        const PARALLEL_NAMES: &[&str] = &[$(stringify!($m)),*];
-    };
-}
-macro_rules! closed_names {
-    ($($m:ident),* $(,)?) => {
-        const CLOSED_NAMES: &[&str] = &[$(stringify!($m)),*];
-    };
-}
-for_each_mechanism!(tree_names, parallel_names, closed_names);
 
-/// The shared list holds every bundled spec, under its kind.
+/// The spec of bundled module `name` (a URDF whose stem is also a TOML spec's is `<stem>_urdf`).
+fn spec_path(name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs");
+    ["toml", "urdf"]
+        .iter()
+        .map(|e| dir.join(format!("{name}.{e}")))
+        .find(|p| p.exists())
+        .unwrap_or_else(|| dir.join(format!("{}.urdf", name.trim_end_matches("_urdf"))))
+}
+
+/// The loaded mechanism of bundled module `name`.
+fn mechanism(name: &str) -> codegen::spec::Mechanism {
+    let path = spec_path(name);
+    let src = std::fs::read_to_string(&path).expect("spec readable");
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((m, _)) => m,
+        Err(d) => panic!("{d}"),
+    }
+}
+
+fn kind(name: &str) -> Kind {
+    #[allow(unreachable_patterns)]
+    match mechanism(name) {
+        codegen::spec::Mechanism::Tree(_) => Kind::Tree,
+        codegen::spec::Mechanism::Parallel(_) => Kind::Parallel,
+        codegen::spec::Mechanism::Closed(_) => Kind::Closed,
+        _ => panic!("{name}: a new kind of mechanism; give it states in `states`"),
+    }
+}
+
+fn dof(name: &str) -> usize {
+    match mechanism(name) {
+        codegen::spec::Mechanism::Tree(m) => m.dof(),
+        _ => unreachable!("trees only"),
+    }
+}
+
+/// The shared list holds every bundled spec.
 #[test]
 fn list_matches_specs() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs");
     let mut builder = codegen::build_script::Builder::new();
     builder.specs_in(&dir).expect("specs dir");
-    let (mut trees, mut parallel, mut closed, mut other) = (vec![], vec![], vec![], vec![]);
-    for name in builder.module_names() {
-        let path = ["toml", "urdf"]
-            .iter()
-            .map(|e| dir.join(format!("{name}.{e}")))
-            .find(|p| p.exists())
-            .unwrap_or_else(|| dir.join(format!("{}.urdf", name.trim_end_matches("_urdf"))));
-        let src = std::fs::read_to_string(&path).expect("spec readable");
-        #[allow(unreachable_patterns)]
-        match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
-            Ok((codegen::spec::Mechanism::Tree(_), _)) => trees.push(name),
-            Ok((codegen::spec::Mechanism::Parallel(_), _)) => parallel.push(name),
-            Ok((codegen::spec::Mechanism::Closed(_), _)) => closed.push(name),
-            Ok(_) => other.push(name),
-            Err(d) => panic!("{d}"),
-        }
+    let mut specs = builder.module_names();
+    specs.sort();
+    let mut listed: Vec<String> = NAMES.iter().map(|s| s.to_string()).collect();
+    listed.sort();
+    assert_eq!(listed, specs, "add it to tests/no-panic/src/list.rs");
+    // Every listed module loads as a kind the harness knows.
+    for name in NAMES {
+        kind(name);
     }
-    let sorted = |v: &[&str]| {
-        let mut v: Vec<String> = v.iter().map(|s| s.to_string()).collect();
-        v.sort();
-        v
-    };
-    trees.sort();
-    parallel.sort();
-    closed.sort();
-    let hint = "add it to tests/no-panic/src/list.rs";
-    assert_eq!(sorted(TREE_NAMES), trees, "tree mechanisms: {hint}");
-    assert_eq!(
-        sorted(PARALLEL_NAMES),
-        parallel,
-        "parallel mechanisms: {hint}"
-    );
-    assert_eq!(
-        sorted(CLOSED_NAMES),
-        closed,
-        "closed-loop mechanisms: {hint}"
-    );
-    assert!(
-        other.is_empty(),
-        "{other:?}: a new kind of mechanism; give it a macro in tests/no-panic/src/list.rs and its harnesses"
-    );
 }

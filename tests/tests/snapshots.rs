@@ -52,3 +52,28 @@ fn f32_modules() {
         insta::assert_snapshot!(format!("f32_{spec}"), code);
     }
 }
+
+/// `Config::implement`: a tree, a parallel and a closed-loop module with the `Dynamics` impl.
+/// The option only appends (`Module` and its impl) to the default module, byte for byte; the
+/// appended text is the snapshot, a contract of its own.
+#[test]
+fn implement_modules() {
+    for spec in ["planar_2r.toml", "planar_five_bar.toml", "four_bar.toml"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../mechanisms/specs")
+            .join(spec);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let cfg = Config {
+            implement: Some("runtime".into()),
+            ..Config::default()
+        };
+        let with = compile(spec, &src, &cfg)
+            .unwrap_or_else(|d| panic!("{d}"))
+            .code;
+        let without = compile(spec, &src, &Config::default()).unwrap().code;
+        let tail = with
+            .strip_prefix(&without)
+            .unwrap_or_else(|| panic!("{spec}: `implement` changed the module before its impl"));
+        insta::assert_snapshot!(format!("implement_{spec}"), tail);
+    }
+}

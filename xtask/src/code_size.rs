@@ -2,7 +2,8 @@
 //! budgets (writes `docs/code-size.md`).
 //!
 //! Builds `tests/no-panic` (one `#[inline(never)]` wrapper per generated function of every
-//! bundled mechanism, `tests_no_panic::<module>::<function>`) with the workspace's `firmware`
+//! bundled mechanism: a generic function per method of `runtime::Dynamics`, one instance per
+//! module, told apart by v0 symbol mangling, which this task turns on) with the workspace's `firmware`
 //! profile (fat LTO, one codegen unit, `panic = "abort"`) at each optimization level,
 //! disassembles it and, for every wrapper, adds up the sizes of all functions reachable from it
 //! through direct calls and jumps. Shared helpers (LU, kinematics kernels) count in every
@@ -61,10 +62,26 @@ fn is_panic(name: &str) -> bool {
     .any(|p| name.contains(p))
 }
 
-/// `(module, function)` of a wrapper `tests_no_panic::<module>::<function>`.
+/// `(module, function)` of a wrapper, an instance of the generic
+/// `tests_no_panic::<function>::<mechanisms::<module>::Module, NX, DOF>` (v0 mangling,
+/// demangled; crate disambiguators `[…]`, if shown, skipped; `f32::` modules named as theirs).
 fn wrapper(name: &str) -> Option<(String, String)> {
-    let rest = name.strip_prefix(CRATE)?.strip_prefix("::")?;
-    let (m, f) = rest.split_once("::")?;
+    let skip_hash = |s: &str| -> Option<String> {
+        let s = s
+            .strip_prefix('[')
+            .map_or(Some(s), |r| r.split_once(']').map(|(_, t)| t))?;
+        Some(s.to_string())
+    };
+    let rest = skip_hash(name.strip_prefix(CRATE)?)?;
+    let rest = rest.strip_prefix("::")?;
+    let (f, rest) = rest.split_once("::<mechanisms")?;
+    let rest = skip_hash(rest)?;
+    let rest = rest.strip_prefix("::")?;
+    let rest = rest.strip_prefix("f32::").unwrap_or(rest);
+    let (m, rest) = rest.split_once("::Module, ")?;
+    if !rest.ends_with('>') || rest.contains('<') {
+        return None;
+    }
     let word = |s: &str| !s.is_empty() && s.chars().all(|c| c.is_alphanumeric() || c == '_');
     (word(m) && word(f)).then(|| (m.to_string(), f.to_string()))
 }
@@ -109,6 +126,9 @@ fn build(
             &opt,
             "--config",
             "profile.firmware.panic=\"abort\"",
+            // v0 mangling names each instance of a generic wrapper with its module.
+            "--config",
+            "build.rustflags=[\"-Csymbol-mangling-version=v0\"]",
         ])
         .env("CARGO_TARGET_DIR", target_dir)
         .current_dir(root)
@@ -503,4 +523,25 @@ pub fn run(root: &Path, args: &CodeSizeArgs) -> Result<ExitCode, Error> {
     } else {
         ExitCode::from(1)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrapper;
+
+    #[test]
+    fn wrapper_names() {
+        let w = |s: &str| wrapper(s).map(|(m, f)| format!("{m}/{f}"));
+        assert_eq!(
+            w("tests_no_panic::inverse_dynamics::<mechanisms::puma560::Module, 6, 6>").as_deref(),
+            Some("puma560/inverse_dynamics")
+        );
+        assert_eq!(
+            w("tests_no_panic[1a2b]::mass_matrix::<mechanisms[9f]::f32::agile_eye::Module, 4, 3>")
+                .as_deref(),
+            Some("agile_eye/mass_matrix")
+        );
+        assert_eq!(w("tests_no_panic::run"), None);
+        assert_eq!(w("core::panicking::panic"), None);
+    }
 }

@@ -194,6 +194,7 @@ impl Args {
             math,
             float,
             scene: Default::default(),
+            implement: None,
         })
     }
 }

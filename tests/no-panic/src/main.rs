@@ -1,5 +1,6 @@
 //! Wraps every generated function of every bundled mechanism (the list is `list.rs`) in a
-//! function of the same name in a module of the same name, `tests_no_panic::<module>::<fn>`.
+//! function of the same name, generic over the module's `runtime::Dynamics` implementation:
+//! `tests_no_panic::<fn>::<mechanisms::<module>::Module, NX, DOF>`, one instance per module.
 //!
 //! - With the `prove` feature each wrapper carries `#[no_panic]`: the linker fails, naming the
 //!   wrapper, unless LLVM removed every panic path from the fully inlined call (fat LTO, one
@@ -16,6 +17,7 @@ type F = f64;
 /// Where the generated modules live.
 use mechanisms as root;
 
+use mechanisms::Dynamics;
 use std::hint::black_box;
 
 include!("list.rs");
@@ -32,246 +34,158 @@ fn inputs<const N: usize>(seed: &mut u64, scale: F) -> [F; N] {
     black_box(out)
 }
 
-macro_rules! tree {
+// One wrapper per method of `runtime::Dynamics`, generic over the module: each module's
+// instance (`mass_matrix::<planar_2r::Module, 2, 2>`, …) is a function of its own, inlined into
+// nothing (`#[inline(never)]`) and, with `prove`, guarded by its own `#[no_panic]`, so the proof
+// covers every generated function of every module one by one (the trait's methods forward to the
+// free functions, and a tree's identities are covered with them). A method the module's kind
+// does not have (`joint_rates`, `coriolis`, `gravity`: `None`) is proved too, trivially.
+
+/// `M` with the generated code's scalar.
+pub trait Module<const NX: usize, const N: usize>: Dynamics<NX, N, Scalar = F> {}
+impl<M: Dynamics<NX, N, Scalar = F>, const NX: usize, const N: usize> Module<NX, N> for M {}
+
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn inverse_kinematics<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+) -> Result<[F; N], M::Singular> {
+    m.inverse_kinematics(x)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn forward_kinematics<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    q: &[F; N],
+    guess: &[F; NX],
+) -> Result<[F; NX], M::NoConvergence> {
+    m.forward_kinematics(q, guess)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn actuator_rates<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+) -> Result<[F; N], M::Singular> {
+    m.actuator_rates(x, u)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn inverse_dynamics<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+    ud: &[F; N],
+) -> Result<[F; N], M::Singular> {
+    m.inverse_dynamics(x, u, ud)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn mass_matrix<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+) -> Result<[[F; N]; N], M::Singular> {
+    m.mass_matrix(x)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn actuator_mass_matrix<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+) -> Result<[[F; N]; N], M::Singular> {
+    m.actuator_mass_matrix(x)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn forward_dynamics<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+    tau: &[F; N],
+) -> Result<[F; N], M::Singular> {
+    m.forward_dynamics(x, u, tau)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn joint_rates<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+) -> Option<Result<[F; NX], M::Singular>> {
+    m.joint_rates(x, u)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn coriolis<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+) -> Option<[F; N]> {
+    m.coriolis(x, u)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn gravity<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+) -> Option<[F; N]> {
+    m.gravity(x)
+}
+
+/// Calls every wrapper of module `m` once, at opaque, arbitrary inputs near its home (errors
+/// are values too); returns a checksum.
+fn run<M: Module<NX, N>, const NX: usize, const N: usize>(m: &M, seed: &mut u64) -> F {
+    let m = black_box(m);
+    let first = |r: Result<F, M::Singular>| match r {
+        Ok(v) => v,
+        Err(e) => {
+            black_box(e);
+            0.0
+        }
+    };
+    let mut x = inputs::<NX>(seed, 0.1);
+    for (x, h) in x.iter_mut().zip(M::HOME) {
+        *x += h;
+    }
+    let u = inputs::<N>(seed, 1.0);
+    let ud = inputs::<N>(seed, 1.0);
+    let mut s = 0.0;
+    let q = inverse_kinematics(m, &x);
+    s += first(q.map(|v| v[0]));
+    let q = q.unwrap_or(inputs::<N>(seed, 0.1));
+    let x = match forward_kinematics(m, &q, &x) {
+        Ok(x) => x,
+        Err(e) => {
+            black_box(e);
+            x
+        }
+    };
+    s += first(actuator_rates(m, &x, &u).map(|v| v[0]));
+    let tau = inverse_dynamics(m, &x, &u, &ud);
+    s += first(tau.map(|v| v[0]));
+    s += first(mass_matrix(m, &x).map(|a| a[N - 1][0]));
+    s += first(actuator_mass_matrix(m, &x).map(|a| a[0][0]));
+    let tau = tau.unwrap_or(ud);
+    s += first(forward_dynamics(m, &x, &u, &tau).map(|v| v[0] - ud[0]));
+    if let Some(r) = joint_rates(m, &x, &u) {
+        s += first(r.map(|v| v[0]));
+    }
+    s += coriolis(m, &x, &u).map_or(0.0, |v| v[0]);
+    s += gravity(m, &x).map_or(0.0, |v| v[0]);
+    s
+}
+
+macro_rules! mechanisms {
     ($($m:ident),* $(,)?) => {
-        $(
-            pub mod $m {
-                use super::F;
-                use super::root::$m as g;
-                const N: usize = g::DOF;
-
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn mass_matrix(q: &[F; N]) -> [[F; N]; N] {
-                    g::mass_matrix(q)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn coriolis(q: &[F; N], qd: &[F; N]) -> [F; N] {
-                    g::coriolis(q, qd)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn gravity(q: &[F; N]) -> [F; N] {
-                    g::gravity(q)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn inverse_dynamics(q: &[F; N], qd: &[F; N], qdd: &[F; N]) -> [F; N] {
-                    g::inverse_dynamics(q, qd, qdd)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn forward_dynamics(
-                    q: &[F; N],
-                    qd: &[F; N],
-                    tau: &[F; N],
-                ) -> Result<[F; N], g::Singular> {
-                    g::forward_dynamics(q, qd, tau)
-                }
-
-                /// Calls every wrapper once; returns a checksum.
-                pub fn run(seed: &mut u64) -> F {
-                    let q = super::inputs::<N>(seed, 3.0);
-                    let qd = super::inputs::<N>(seed, 1.0);
-                    let qdd = super::inputs::<N>(seed, 1.0);
-                    let mut s = mass_matrix(&q)[N - 1][0];
-                    s += coriolis(&q, &qd)[0];
-                    s += gravity(&q)[0];
-                    let tau = inverse_dynamics(&q, &qd, &qdd);
-                    s += match forward_dynamics(&q, &qd, &tau) {
-                        Ok(a) => a[0] - qdd[0],
-                        Err(e) => e.value,
-                    };
-                    s
-                }
-            }
-        )*
-        /// Every tree mechanism's `run`, with its name.
-        pub const TREES: &[(&str, fn(&mut u64) -> F)] = &[$((stringify!($m), $m::run)),*];
+        /// Every mechanism's `run`, with its name.
+        pub const MECHANISMS: &[(&str, fn(&mut u64) -> F)] =
+            &[$((stringify!($m), |seed| run(&root::$m::Module, seed))),*];
     };
 }
 
-macro_rules! parallel {
-    ($($m:ident),* $(,)?) => {
-        $(
-            pub mod $m {
-                use super::F;
-                use super::root::$m as g;
-                const N: usize = g::DOF;
-                const NX: usize = g::NX;
-
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn inverse_kinematics(x: &[F; NX]) -> Result<[F; N], g::Singular> {
-                    g::inverse_kinematics(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn actuator_rates(x: &[F; NX], u: &[F; N]) -> Result<[F; N], g::Singular> {
-                    g::actuator_rates(x, u)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn inverse_dynamics(
-                    x: &[F; NX],
-                    u: &[F; N],
-                    ud: &[F; N],
-                ) -> Result<[F; N], g::Singular> {
-                    g::inverse_dynamics(x, u, ud)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn mass_matrix(x: &[F; NX]) -> Result<[[F; N]; N], g::Singular> {
-                    g::mass_matrix(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn actuator_mass_matrix(x: &[F; NX]) -> Result<[[F; N]; N], g::Singular> {
-                    g::actuator_mass_matrix(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn forward_dynamics(
-                    x: &[F; NX],
-                    u: &[F; N],
-                    tau: &[F; N],
-                ) -> Result<[F; N], g::Singular> {
-                    g::forward_dynamics(x, u, tau)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn forward_kinematics(
-                    q: &[F; N],
-                    guess: &[F; NX],
-                ) -> Result<[F; NX], g::NoConvergence> {
-                    g::forward_kinematics(q, guess)
-                }
-
-                /// Calls every wrapper once (at opaque, arbitrary inputs: errors are values
-                /// too); returns a checksum.
-                pub fn run(seed: &mut u64) -> F {
-                    let pick = |r: Result<F, g::Singular>| match r {
-                        Ok(v) => v,
-                        Err(e) => e.value,
-                    };
-                    let x = super::inputs::<NX>(seed, 0.1);
-                    let u = super::inputs::<N>(seed, 1.0);
-                    let ud = super::inputs::<N>(seed, 1.0);
-                    let q = super::inputs::<N>(seed, 0.1);
-                    let mut s = pick(inverse_kinematics(&x).map(|v| v[0]));
-                    s += pick(actuator_rates(&x, &u).map(|v| v[0]));
-                    s += pick(inverse_dynamics(&x, &u, &ud).map(|v| v[0]));
-                    s += pick(mass_matrix(&x).map(|m| m[0][0]));
-                    s += pick(actuator_mass_matrix(&x).map(|m| m[0][0]));
-                    s += pick(forward_dynamics(&x, &u, &ud).map(|v| v[0]));
-                    s += match forward_kinematics(&q, &x) {
-                        Ok(xf) => xf[0],
-                        Err(e) => e.residual,
-                    };
-                    s
-                }
-            }
-        )*
-        /// Every parallel mechanism's `run`, with its name.
-        pub const PARALLEL: &[(&str, fn(&mut u64) -> F)] = &[$((stringify!($m), $m::run)),*];
-    };
-}
-
-macro_rules! closed {
-    ($($m:ident),* $(,)?) => {
-        $(
-            pub mod $m {
-                use super::F;
-                use super::root::$m as g;
-                const N: usize = g::DOF;
-                const NX: usize = g::NX;
-
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn inverse_kinematics(x: &[F; NX]) -> Result<[F; N], g::Singular> {
-                    g::inverse_kinematics(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn forward_kinematics(
-                    q: &[F; N],
-                    guess: &[F; NX],
-                ) -> Result<[F; NX], g::NoConvergence> {
-                    g::forward_kinematics(q, guess)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn joint_rates(x: &[F; NX], u: &[F; N]) -> Result<[F; NX], g::Singular> {
-                    g::joint_rates(x, u)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn actuator_rates(x: &[F; NX], u: &[F; N]) -> Result<[F; N], g::Singular> {
-                    g::actuator_rates(x, u)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn actuator_mass_matrix(x: &[F; NX]) -> Result<[[F; N]; N], g::Singular> {
-                    g::actuator_mass_matrix(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn inverse_dynamics(
-                    x: &[F; NX],
-                    u: &[F; N],
-                    ud: &[F; N],
-                ) -> Result<[F; N], g::Singular> {
-                    g::inverse_dynamics(x, u, ud)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn mass_matrix(x: &[F; NX]) -> Result<[[F; N]; N], g::Singular> {
-                    g::mass_matrix(x)
-                }
-                #[cfg_attr(feature = "prove", no_panic::no_panic)]
-                #[inline(never)]
-                pub fn forward_dynamics(
-                    x: &[F; NX],
-                    u: &[F; N],
-                    tau: &[F; N],
-                ) -> Result<[F; N], g::Singular> {
-                    g::forward_dynamics(x, u, tau)
-                }
-
-                /// Calls every wrapper once; returns a checksum.
-                pub fn run(seed: &mut u64) -> F {
-                    let pick = |r: Result<F, g::Singular>| match r {
-                        Ok(v) => v,
-                        Err(e) => e.value,
-                    };
-                    let x = super::inputs::<NX>(seed, 0.1);
-                    let u = super::inputs::<N>(seed, 1.0);
-                    let ud = super::inputs::<N>(seed, 1.0);
-                    let mut s = pick(inverse_kinematics(&x).map(|v| v[0]));
-                    let x = match forward_kinematics(&[0.0; N], &x) {
-                        Ok(x) => x,
-                        Err(e) => {
-                            s += e.residual;
-                            x
-                        }
-                    };
-                    s += pick(joint_rates(&x, &u).map(|v| v[0]));
-                    s += pick(actuator_rates(&x, &u).map(|v| v[0]));
-                    s += pick(actuator_mass_matrix(&x).map(|m| m[0][0]));
-                    s += pick(inverse_dynamics(&x, &u, &ud).map(|v| v[0]));
-                    s += pick(mass_matrix(&x).map(|m| m[0][0]));
-                    s += pick(forward_dynamics(&x, &u, &ud).map(|v| v[0]));
-                    s
-                }
-            }
-        )*
-        /// Every closed-loop mechanism's `run`, with its name.
-        pub const CLOSED: &[(&str, fn(&mut u64) -> F)] = &[$((stringify!($m), $m::run)),*];
-    };
-}
-
-for_each_mechanism!(tree, parallel, closed);
+for_each_mechanism!(mechanisms);
 
 /// A function that can panic (index out of bounds): `--features canary` must fail to link.
 #[cfg(feature = "canary")]
@@ -285,7 +199,7 @@ fn main() {
     let mut seed = black_box(0x9e37_79b9_7f4a_7c15_u64);
     #[cfg(feature = "canary")]
     println!("canary: {}", canary(&black_box([1.0; 4]), black_box(7)));
-    for (name, run) in TREES.iter().chain(PARALLEL).chain(CLOSED) {
+    for (name, run) in MECHANISMS {
         let s = run(&mut seed);
         println!("{name}: checksum {s:e}");
     }

@@ -1,0 +1,329 @@
+//! `Config::implement`: a generated module that also implements the runtime's
+//! `Dynamics<NX, DOF>` trait (`runtime/src/module.rs`), so that code over generated modules
+//! (firmware, the test harnesses) is written once, generically, whatever the module's kind.
+//!
+//! The module gets a struct `Module` (a unit struct, or `Module(pub Params)` when it has
+//! run-time parameters) and `impl <path>::Dynamics<NX, DOF> for Module`, each method a call of
+//! the module's free function of the same name. The impl is read off the module's own items
+//! (which public functions it has, whether each returns a `Result` and takes `&Params`), so it
+//! follows the kinds' templates without a second copy of their rules; [`check`] refuses, before
+//! generating, a scene that leaves out a function the trait needs.
+//!
+//! The scalar type is the generation's ([`crate::emit::real`]).
+
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::quote;
+
+use crate::spec::{Kind, Mechanism, Scene};
+
+/// The functions every implementing module must have (a tree has identities for the rest).
+const NEEDED: [&str; 4] = [
+    "mass_matrix",
+    "inverse_dynamics",
+    "forward_dynamics",
+    "actuator_mass_matrix",
+];
+
+/// `Err` when `scene` leaves out a function the trait needs (with `implement` set).
+pub(crate) fn check(mechanism: &Mechanism, scene: &Scene) -> Result<(), String> {
+    let kind = match mechanism {
+        Mechanism::Tree(_) => Kind::Tree,
+        Mechanism::Parallel(_) => Kind::Parallel,
+        Mechanism::Closed(_) => Kind::Closed,
+    };
+    let missing: Vec<&str> = NEEDED
+        .into_iter()
+        // A tree's `actuator_mass_matrix` is its `mass_matrix`; closed loops emit it with
+        // `mass_matrix`.
+        .filter(|f| !(*f == "actuator_mass_matrix" && kind != Kind::Parallel))
+        .filter(|f| !scene.functions.wants(kind, f))
+        .collect();
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "`implement` (the `Dynamics` trait) needs {}, which `[scene] functions` leaves out",
+            missing
+                .iter()
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    }
+}
+
+/// One public function of the module, as the impl calls it.
+struct Callee {
+    /// Returns `Result<…>` (else the impl wraps it in `Ok`).
+    fallible: bool,
+    /// Takes `p: &Params` last.
+    params: bool,
+}
+
+/// What the impl needs to know of the module's items.
+struct Items {
+    fns: Vec<(String, Callee)>,
+    consts: Vec<String>,
+    types: Vec<String>,
+}
+
+impl Items {
+    fn read(module: &TokenStream) -> Items {
+        let file: syn::File = match syn::parse2(module.clone()) {
+            Ok(f) => f,
+            Err(e) => panic!("internal error: generated tokens do not parse: {e}"),
+        };
+        let mut items = Items {
+            fns: Vec::new(),
+            consts: Vec::new(),
+            types: Vec::new(),
+        };
+        let public = |v: &syn::Visibility| matches!(v, syn::Visibility::Public(_));
+        for item in &file.items {
+            match item {
+                syn::Item::Fn(f) if public(&f.vis) => {
+                    let fallible = match &f.sig.output {
+                        syn::ReturnType::Type(_, t) => last_ident(t) == Some("Result".into()),
+                        syn::ReturnType::Default => false,
+                    };
+                    let params = f.sig.inputs.iter().last().is_some_and(|a| match a {
+                        syn::FnArg::Typed(t) => last_ident(&t.ty) == Some("Params".into()),
+                        syn::FnArg::Receiver(_) => false,
+                    });
+                    items
+                        .fns
+                        .push((f.sig.ident.to_string(), Callee { fallible, params }));
+                }
+                syn::Item::Const(c) if public(&c.vis) => items.consts.push(c.ident.to_string()),
+                syn::Item::Struct(s) if public(&s.vis) => items.types.push(s.ident.to_string()),
+                _ => {}
+            }
+        }
+        items
+    }
+
+    fn function(&self, name: &str) -> Option<&Callee> {
+        self.fns.iter().find(|(n, _)| n == name).map(|(_, c)| c)
+    }
+}
+
+/// The last identifier of a type path, through references (`&Params` → `Params`,
+/// `Result<…>` → `Result`).
+fn last_ident(ty: &syn::Type) -> Option<String> {
+    match ty {
+        syn::Type::Reference(r) => last_ident(&r.elem),
+        syn::Type::Path(p) => p.path.segments.last().map(|s| s.ident.to_string()),
+        _ => None,
+    }
+}
+
+/// The struct `Module` and its `impl <runtime>::Dynamics<NX, DOF>`, for the module whose items
+/// (everything but the header) are `module`; `name` is the spec's mechanism name.
+pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> TokenStream {
+    let real = crate::emit::real();
+    let items = Items::read(module);
+    let runtime: syn::Path = match syn::parse_str(runtime_path) {
+        Ok(p) => p,
+        Err(e) => panic!("internal error: `implement` is not a path ({runtime_path:?}): {e}"),
+    };
+    let has_const = |c: &str| items.consts.iter().any(|n| n == c);
+    let has_type = |t: &str| items.types.iter().any(|n| n == t);
+    // A tree: `x = q`, no `NX`, no `HOME`.
+    let tree = !has_const("NX");
+    let nx = if tree { quote!(DOF) } else { quote!(NX) };
+    let home = if has_const("HOME") {
+        quote!(HOME)
+    } else {
+        quote!([0.0; DOF])
+    };
+    let no_convergence = if has_type("NoConvergence") {
+        quote!(NoConvergence)
+    } else {
+        quote!(core::convert::Infallible)
+    };
+    let params = has_type("Params");
+    let doc = format!(
+        " This module as an implementation of `{runtime_path}::Dynamics`: each method calls"
+    );
+    let (module_struct, p) = if params {
+        (
+            quote! {
+                #[doc = #doc]
+                /// the free function of the same name, with these run-time parameters where it
+                /// takes them.
+                #[derive(Clone, Copy, Debug, PartialEq)]
+                pub struct Module(pub Params);
+            },
+            quote!(&self.0),
+        )
+    } else {
+        (
+            quote! {
+                #[doc = #doc]
+                /// the free function of the same name.
+                #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+                pub struct Module;
+            },
+            quote!(),
+        )
+    };
+    // The call of free function `f` with `args` (and the parameters), as a `Result`.
+    let call = |f: &str, args: TokenStream| -> Option<TokenStream> {
+        let c = items.function(f)?;
+        let id = Ident::new(f, Span::call_site());
+        let args = if c.params { quote!(#args, #p) } else { args };
+        Some(if c.fallible {
+            quote!(#id(#args))
+        } else {
+            quote!(Ok(#id(#args)))
+        })
+    };
+    let need = |f: &str, args: TokenStream| -> TokenStream {
+        match call(f, args) {
+            Some(t) => t,
+            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
+        }
+    };
+    // A tree's identities where it has no function.
+    let or_tree = |f: &str, args: TokenStream, identity: TokenStream| -> TokenStream {
+        match call(f, args) {
+            Some(t) => t,
+            None if tree => identity,
+            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
+        }
+    };
+    let inverse_kinematics = or_tree("inverse_kinematics", quote!(x), quote!(Ok(*x)));
+    let forward_kinematics = or_tree(
+        "forward_kinematics",
+        quote!(q, guess),
+        quote!(let _ = guess; Ok(*q)),
+    );
+    let actuator_rates = or_tree("actuator_rates", quote!(x, u), quote!(let _ = x; Ok(*u)));
+    let inverse_dynamics = need("inverse_dynamics", quote!(x, u, ud));
+    let mass_matrix = need("mass_matrix", quote!(x));
+    let actuator_mass_matrix = or_tree("actuator_mass_matrix", quote!(x), mass_matrix.clone());
+    let forward_dynamics = need("forward_dynamics", quote!(x, u, tau));
+    // The functions of some kinds only: `Some` where the module has them.
+    let optional = |f: &str, args: TokenStream, sig: TokenStream| -> TokenStream {
+        match items.function(f) {
+            None => quote!(),
+            Some(c) => {
+                let id = Ident::new(f, Span::call_site());
+                let args = if c.params { quote!(#args, #p) } else { args };
+                quote! {
+                    #sig {
+                        Some(#id(#args))
+                    }
+                }
+            }
+        }
+    };
+    let joint_rates = optional(
+        "joint_rates",
+        quote!(x, u),
+        quote! {
+            fn joint_rates(&self, x: &[#real; #nx], u: &[#real; DOF])
+                -> Option<Result<[#real; #nx], Singular>>
+        },
+    );
+    let coriolis = optional(
+        "coriolis",
+        quote!(x, u),
+        quote! {
+            fn coriolis(&self, x: &[#real; #nx], u: &[#real; DOF]) -> Option<[#real; DOF]>
+        },
+    );
+    let gravity = optional(
+        "gravity",
+        quote!(x),
+        quote! {
+            fn gravity(&self, x: &[#real; #nx]) -> Option<[#real; DOF]>
+        },
+    );
+    quote! {
+        #module_struct
+        impl #runtime::Dynamics<#nx, DOF> for Module {
+            type Scalar = #real;
+            type Singular = Singular;
+            type NoConvergence = #no_convergence;
+            const NAME: &'static str = #name;
+            const HOME: [#real; #nx] = #home;
+            fn inverse_kinematics(&self, x: &[#real; #nx]) -> Result<[#real; DOF], Singular> {
+                #inverse_kinematics
+            }
+            fn forward_kinematics(
+                &self,
+                q: &[#real; DOF],
+                guess: &[#real; #nx],
+            ) -> Result<[#real; #nx], #no_convergence> {
+                #forward_kinematics
+            }
+            fn actuator_rates(&self, x: &[#real; #nx], u: &[#real; DOF]) -> Result<[#real; DOF], Singular> {
+                #actuator_rates
+            }
+            fn inverse_dynamics(
+                &self,
+                x: &[#real; #nx],
+                u: &[#real; DOF],
+                ud: &[#real; DOF],
+            ) -> Result<[#real; DOF], Singular> {
+                #inverse_dynamics
+            }
+            fn mass_matrix(&self, x: &[#real; #nx]) -> Result<[[#real; DOF]; DOF], Singular> {
+                #mass_matrix
+            }
+            fn actuator_mass_matrix(&self, x: &[#real; #nx]) -> Result<[[#real; DOF]; DOF], Singular> {
+                #actuator_mass_matrix
+            }
+            fn forward_dynamics(
+                &self,
+                x: &[#real; #nx],
+                u: &[#real; DOF],
+                tau: &[#real; DOF],
+            ) -> Result<[#real; DOF], Singular> {
+                #forward_dynamics
+            }
+            #joint_rates
+            #coriolis
+            #gravity
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    const SPEC: &str = r#"
+[mechanism]
+name = "pendulum"
+[[body]]
+name = "rod"
+mass = 1.0
+com = [0.5, 0.0, 0.0]
+[[joint]]
+name = "j1"
+kind = "revolute"
+parent = "base"
+child = "rod"
+axis = [0.0, 1.0, 0.0]
+"#;
+
+    fn compile(scene: &str) -> Result<String, String> {
+        let cfg = crate::Config {
+            implement: Some("runtime".into()),
+            ..crate::Config::default()
+        };
+        crate::compile("p.toml", &format!("{SPEC}{scene}"), &cfg)
+            .map(|g| g.code)
+            .map_err(|d| d.to_string())
+    }
+
+    #[test]
+    fn a_scene_without_the_traits_functions_is_refused() {
+        let err = compile("[scene]\nfunctions = [\"inverse_dynamics\"]\n").unwrap_err();
+        assert!(err.contains("`mass_matrix`, `forward_dynamics`"), "{err}");
+        assert!(!err.contains("actuator_mass_matrix"), "{err}");
+        let code = compile("").expect("the default scene has every function");
+        assert!(code.contains("impl runtime::Dynamics<DOF, DOF> for Module"));
+        assert!(code.contains("const NAME: &'static str = \"pendulum\";"));
+    }
+}

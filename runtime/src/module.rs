@@ -1,0 +1,125 @@
+//! [`Dynamics`]: the one interface of every generated module, whatever its kind, so that code
+//! over generated modules (firmware, test harnesses) is written once, as generic functions.
+//!
+//! `no_std`, no `alloc`: this file is all that generated code needs from this crate besides
+//! `math`. A module implements the trait when it is generated with
+//! `codegen::Config::implement` set (the path of this crate): it then holds a struct
+//! `Module` (a unit struct, or `Module(pub Params)` with run-time parameters) and
+//! `impl Dynamics<NX, DOF> for Module`, whose methods forward to the module's free functions.
+
+/// The dynamics of one generated module, in its own coordinates.
+///
+/// `NX` is the number of position coordinates `x`, `DOF` the number of degrees of freedom:
+/// of speeds `u`, of actuators (positions `q`, efforts `tau`). What they are depends on the
+/// module's kind, as its own docs state:
+///
+/// | kind | `x` (`NX`) | `u`, `ud` (`DOF`) | `q`, `tau` (`DOF`) |
+/// |---|---|---|---|
+/// | tree | the joint positions `q` (`NX = DOF`) | joint rates `q̇`, accelerations `q̈` | the joints: `q = x`, efforts `τ` |
+/// | parallel platform | the platform's pose: `[px, py, pz, qw, qx, qy, qz]` (`Pose`), a unit quaternion (`Orientation`) or `[px, py]` (`PlanarPoint`) | the platform's twist `[ω; v]`, `ω` or `[vx, vy]`, and its rate | the actuated joints' positions and efforts, in `ACTUATOR_NAMES` order |
+/// | closed loops in joint coordinates | every spanning-tree joint's position (`JOINT_NAMES` order), closing the loops | the rates of the independent coordinates `x[INDEPENDENT[k]]`, and their rates | the independent (actuated) joints: `q = x[INDEPENDENT]`, their efforts |
+///
+/// Positions in rad or m, speeds in rad/s or m/s, efforts in N·m or N (SI throughout).
+///
+/// Every method is a call of the free function of the same name (with the module's `Params`
+/// last when it has run-time parameters); where a tree has no such function the method is the
+/// identity the table states (`inverse_kinematics`, `forward_kinematics`, `actuator_rates`), or
+/// `mass_matrix` for `actuator_mass_matrix`. The errors are the module's own types, unchanged:
+/// `Singular` (where and how a configuration failed) and `NoConvergence` (forward kinematics'
+/// iterations and residual); a tree's forward kinematics cannot fail
+/// (`NoConvergence = core::convert::Infallible`), and its only fallible function is
+/// `forward_dynamics`.
+///
+/// The functions that only some kinds generate are the provided methods returning `Option`:
+/// `None` from a module that does not have the function (another kind, or left out by the
+/// spec's `[scene] functions`).
+pub trait Dynamics<const NX: usize, const DOF: usize> {
+    /// The scalar of the generated code (`f64`, or `f32`).
+    type Scalar: Copy;
+    /// The module's error of a singular configuration or a non-finite input.
+    type Singular: Copy + core::fmt::Debug;
+    /// The module's error of forward kinematics that did not converge.
+    type NoConvergence: Copy + core::fmt::Debug;
+
+    /// The spec's mechanism name.
+    const NAME: &'static str;
+    /// The spec's home configuration `x`: a guess for [`Dynamics::forward_kinematics`] near
+    /// home (all zeros for a tree).
+    const HOME: [Self::Scalar; NX];
+
+    /// The actuated joints' positions `q(x)` (a tree: `x`).
+    fn inverse_kinematics(
+        &self,
+        x: &[Self::Scalar; NX],
+    ) -> Result<[Self::Scalar; DOF], Self::Singular>;
+
+    /// The configuration `x` whose actuated joints are at `q`, on the branch of `guess` (pass
+    /// the last configuration, or `HOME`); a tree: `q`.
+    fn forward_kinematics(
+        &self,
+        q: &[Self::Scalar; DOF],
+        guess: &[Self::Scalar; NX],
+    ) -> Result<[Self::Scalar; NX], Self::NoConvergence>;
+
+    /// The actuated joints' rates `q̇ = A u` (a tree, and closed loops: `u`).
+    fn actuator_rates(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+    ) -> Result<[Self::Scalar; DOF], Self::Singular>;
+
+    /// The actuator efforts `tau` that produce the motion `(x, u, ud)`, gravity included.
+    fn inverse_dynamics(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+        ud: &[Self::Scalar; DOF],
+    ) -> Result<[Self::Scalar; DOF], Self::Singular>;
+
+    /// The generalized inertia `I(x)` of the speeds `u` (a tree's is infallible).
+    fn mass_matrix(
+        &self,
+        x: &[Self::Scalar; NX],
+    ) -> Result<[[Self::Scalar; DOF]; DOF], Self::Singular>;
+
+    /// The inertia in actuator space `A⁻ᵀ I A⁻¹` (a tree, and closed loops: `mass_matrix`).
+    fn actuator_mass_matrix(
+        &self,
+        x: &[Self::Scalar; NX],
+    ) -> Result<[[Self::Scalar; DOF]; DOF], Self::Singular>;
+
+    /// The speed rates `ud` that the actuator efforts `tau` produce at `(x, u)`.
+    fn forward_dynamics(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+        tau: &[Self::Scalar; DOF],
+    ) -> Result<[Self::Scalar; DOF], Self::Singular>;
+
+    /// Closed loops: every joint's rate `ẋ = S u` (`joint_rates`). `None` elsewhere.
+    fn joint_rates(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+    ) -> Option<Result<[Self::Scalar; NX], Self::Singular>> {
+        let _ = (x, u);
+        None
+    }
+
+    /// Trees: the velocity-dependent efforts `C(q, q̇) q̇` (`coriolis`). `None` elsewhere.
+    fn coriolis(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+    ) -> Option<[Self::Scalar; DOF]> {
+        let _ = (x, u);
+        None
+    }
+
+    /// Trees: the efforts that hold the mechanism still against gravity (`gravity`). `None`
+    /// elsewhere.
+    fn gravity(&self, x: &[Self::Scalar; NX]) -> Option<[Self::Scalar; DOF]> {
+        let _ = x;
+        None
+    }
+}
