@@ -142,56 +142,14 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
         quote!(core::convert::Infallible)
     };
     let params = has_type("Params");
-    let doc = format!(
-        " This module as an implementation of `{runtime_path}::Dynamics`: each method calls"
-    );
-    let (module_struct, p) = if params {
-        (
-            quote! {
-                #[doc = #doc]
-                /// the free function of the same name, with these run-time parameters where it
-                /// takes them.
-                #[derive(Clone, Copy, Debug, PartialEq)]
-                pub struct Module(pub Params);
-            },
-            quote!(&self.0),
-        )
-    } else {
-        (
-            quote! {
-                #[doc = #doc]
-                /// the free function of the same name.
-                #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-                pub struct Module;
-            },
-            quote!(),
-        )
+    let (module_struct, p) = module_struct(runtime_path, params);
+    let calls = Calls {
+        items: &items,
+        tree,
+        p: &p,
     };
-    // The call of free function `f` with `args` (and the parameters), as a `Result`.
-    let call = |f: &str, args: TokenStream| -> Option<TokenStream> {
-        let c = items.function(f)?;
-        let id = Ident::new(f, Span::call_site());
-        let args = if c.params { quote!(#args, #p) } else { args };
-        Some(if c.fallible {
-            quote!(#id(#args))
-        } else {
-            quote!(Ok(#id(#args)))
-        })
-    };
-    let need = |f: &str, args: TokenStream| -> TokenStream {
-        match call(f, args) {
-            Some(t) => t,
-            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
-        }
-    };
-    // A tree's identities where it has no function.
-    let or_tree = |f: &str, args: TokenStream, identity: TokenStream| -> TokenStream {
-        match call(f, args) {
-            Some(t) => t,
-            None if tree => identity,
-            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
-        }
-    };
+    let or_tree = |f, args, identity| calls.or_tree(f, args, identity);
+    let need = |f, args| calls.need(f, args);
     let inverse_kinematics = or_tree("inverse_kinematics", quote!(x), quote!(Ok(*x)));
     let forward_kinematics = or_tree(
         "forward_kinematics",
@@ -204,20 +162,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
     let actuator_mass_matrix = or_tree("actuator_mass_matrix", quote!(x), mass_matrix.clone());
     let forward_dynamics = need("forward_dynamics", quote!(x, u, tau));
     // The functions of some kinds only: `Some` where the module has them.
-    let optional = |f: &str, args: TokenStream, sig: TokenStream| -> TokenStream {
-        match items.function(f) {
-            None => quote!(),
-            Some(c) => {
-                let id = Ident::new(f, Span::call_site());
-                let args = if c.params { quote!(#args, #p) } else { args };
-                quote! {
-                    #sig {
-                        Some(#id(#args))
-                    }
-                }
-            }
-        }
-    };
+    let optional = |f, args, sig| calls.optional(f, args, sig);
     let joint_rates = optional(
         "joint_rates",
         quote!(x, u),
@@ -286,6 +231,93 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             #joint_rates
             #coriolis
             #gravity
+        }
+    }
+}
+
+/// `pub struct Module` (holding the run-time parameters when the module has them) and what a
+/// method passes for them.
+fn module_struct(runtime_path: &str, params: bool) -> (TokenStream, TokenStream) {
+    let doc = format!(
+        " This module as an implementation of `{runtime_path}::Dynamics`: each method calls"
+    );
+    if params {
+        (
+            quote! {
+                #[doc = #doc]
+                /// the free function of the same name, with these run-time parameters where it
+                /// takes them.
+                #[derive(Clone, Copy, Debug, PartialEq)]
+                pub struct Module(pub Params);
+            },
+            quote!(&self.0),
+        )
+    } else {
+        (
+            quote! {
+                #[doc = #doc]
+                /// the free function of the same name.
+                #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+                pub struct Module;
+            },
+            quote!(),
+        )
+    }
+}
+
+/// The methods' bodies: calls of the module's free functions.
+struct Calls<'a> {
+    items: &'a Items,
+    /// A tree (`x = q`): identities where it has no function.
+    tree: bool,
+    /// What a method passes for the run-time parameters.
+    p: &'a TokenStream,
+}
+
+impl Calls<'_> {
+    /// The call of free function `f` with `args` (and the parameters), as a `Result`.
+    fn call(&self, f: &str, args: TokenStream) -> Option<TokenStream> {
+        let c = self.items.function(f)?;
+        let id = Ident::new(f, Span::call_site());
+        let p = self.p;
+        let args = if c.params { quote!(#args, #p) } else { args };
+        Some(if c.fallible {
+            quote!(#id(#args))
+        } else {
+            quote!(Ok(#id(#args)))
+        })
+    }
+
+    /// [`Calls::call`] of a function every module has.
+    fn need(&self, f: &str, args: TokenStream) -> TokenStream {
+        match self.call(f, args) {
+            Some(t) => t,
+            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
+        }
+    }
+
+    /// [`Calls::call`], or for a tree without `f`, `identity`.
+    fn or_tree(&self, f: &str, args: TokenStream, identity: TokenStream) -> TokenStream {
+        match self.call(f, args) {
+            Some(t) => t,
+            None if self.tree => identity,
+            None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
+        }
+    }
+
+    /// The method `sig` returning `Some(f(args))` where the module has `f`, else nothing (the
+    /// trait's default, `None`).
+    fn optional(&self, f: &str, args: TokenStream, sig: TokenStream) -> TokenStream {
+        let Some(c) = self.items.function(f) else {
+            return quote!();
+        };
+        let id = Ident::new(f, Span::call_site());
+        let p = self.p;
+        let args = if c.params { quote!(#args, #p) } else { args };
+        quote! {
+            #sig {
+                Some(#id(#args))
+            }
         }
     }
 }

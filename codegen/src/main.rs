@@ -56,9 +56,14 @@ struct Cli {
     /// Where sin/cos and sqrt come from.
     #[arg(long, value_enum, default_value = "libm")]
     math: Math,
-    /// Crate path of the runtime for `--math runtime`.
+    /// Crate path of the runtime for `--math runtime` and `--implement`.
     #[arg(long, default_value = "runtime", value_name = "PATH")]
     runtime_path: String,
+    /// Also emit `pub struct Module` implementing the runtime's `Dynamics` trait
+    /// (`<runtime-path>::Dynamics`: the same methods for every kind of mechanism, for code
+    /// written once over many modules).
+    #[arg(long)]
+    implement: bool,
     /// Scalar type of the generated code (`f32`: single precision, thresholds rescaled).
     #[arg(long, value_enum, default_value = "f64")]
     float: FloatArg,
@@ -156,6 +161,15 @@ fn main() -> ExitCode {
             }
         };
     }
+    if (cli.implement || matches!(cli.math, Math::Runtime))
+        && syn::parse_str::<syn::Path>(&cli.runtime_path).is_err()
+    {
+        eprintln!(
+            "error: --runtime-path {:?} is not a Rust path (e.g. `runtime` or `::nocdyn_runtime`)",
+            cli.runtime_path
+        );
+        return ExitCode::from(2);
+    }
     let math = match cli.math {
         Math::Libm => MathBackend::Libm,
         Math::Std => MathBackend::Std,
@@ -175,7 +189,7 @@ fn main() -> ExitCode {
                 rotor_inertia: cli.rotor_inertia,
                 snap: cli.snap,
             },
-            implement: None,
+            implement: cli.implement.then(|| cli.runtime_path.clone()),
         },
     ) {
         Ok(o) => o,
