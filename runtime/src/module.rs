@@ -37,9 +37,9 @@ pub trait Dynamics<const NX: usize, const DOF: usize> {
     /// The scalar of the generated code (`f64`, or `f32`).
     type Scalar: Copy;
     /// The module's error of a singular configuration or a non-finite input.
-    type Singular: Copy + core::fmt::Debug;
+    type Singular: Copy + core::fmt::Debug + PartialEq;
     /// The module's error of forward kinematics that did not converge.
-    type NoConvergence: Copy + core::fmt::Debug;
+    type NoConvergence: Copy + core::fmt::Debug + PartialEq;
 
     /// The spec's mechanism name.
     const NAME: &'static str;

@@ -6,11 +6,14 @@
 //! pose by the generated forward kinematics (Newton), warm-started from the previous tick.
 //!
 //! In `f32` this estimate, not the arithmetic, sets the rounding floor: Newton stops as soon as
-//! the leg-length residual is within the rescaled tolerance `4.9e-6·(1 + max|q|)` (about 1e-5 m
-//! here), and returns a warm start that is already that close unchanged. Along the demo
+//! the leg-length residual is within the rescaled tolerance (`FK_TOLERANCE` rescaled to `f32`,
+//! times the longest leg: a few µm here), and returns a warm start that is already that close
+//! unchanged. Along the demo
 //! reference the `f32` estimate is off by a few µm and µrad (the example prints it), where half
 //! an `f32` ulp of the pose is 6e-8 m. (A guess moved on by `h·u` makes it worse: every guess
 //! passes the test, and the estimate drifts by dead reckoning up to the tolerance.)
+
+use runtime::Dynamics;
 
 use crate::{Gains, Real, raised_cosine};
 
@@ -20,70 +23,37 @@ pub const N: usize = mechanisms::gough_stewart::DOF;
 pub const NX: usize = mechanisms::gough_stewart::NX;
 
 /// A scalar with a generated Gough–Stewart module: `f32` (`mechanisms::f32::gough_stewart`) or
-/// `f64` (`mechanisms::gough_stewart`).
+/// `f64` (`mechanisms::gough_stewart`), reached through the module's implementation of
+/// `runtime::Dynamics` (the same methods every generated module has).
 pub trait Scalar: Real {
-    /// The module's `Singular` (a leg or parallel singularity, an unreachable pose).
-    type Singular: Copy + core::fmt::Debug + PartialEq;
-    /// The module's `NoConvergence` (forward kinematics).
-    type NoConvergence: Copy + core::fmt::Debug + PartialEq;
-    /// The generated forward kinematics: the pose whose leg lengths are `q`, by Newton from
-    /// `guess`.
-    fn forward_kinematics(
-        q: &[Self; N],
-        guess: &[Self; NX],
-    ) -> Result<[Self; NX], Self::NoConvergence>;
-    /// The generated inverse dynamics: leg forces (N) for the pose `x`, twist `u` and twist
-    /// rate `ud`.
-    fn inverse_dynamics(
-        x: &[Self; NX],
-        u: &[Self; N],
-        ud: &[Self; N],
-    ) -> Result<[Self; N], Self::Singular>;
+    /// The module in this precision.
+    type Module: Dynamics<NX, N, Scalar = Self>;
+    /// Its value (a unit struct).
+    const MODULE: Self::Module;
 }
 
 impl Scalar for f64 {
-    type Singular = mechanisms::gough_stewart::Singular;
-    type NoConvergence = mechanisms::gough_stewart::NoConvergence;
-    fn forward_kinematics(
-        q: &[f64; N],
-        guess: &[f64; NX],
-    ) -> Result<[f64; NX], Self::NoConvergence> {
-        mechanisms::gough_stewart::forward_kinematics(q, guess)
-    }
-    fn inverse_dynamics(
-        x: &[f64; NX],
-        u: &[f64; N],
-        ud: &[f64; N],
-    ) -> Result<[f64; N], Self::Singular> {
-        mechanisms::gough_stewart::inverse_dynamics(x, u, ud)
-    }
+    type Module = mechanisms::gough_stewart::Module;
+    const MODULE: Self::Module = mechanisms::gough_stewart::Module;
 }
 
 impl Scalar for f32 {
-    type Singular = mechanisms::f32::gough_stewart::Singular;
-    type NoConvergence = mechanisms::f32::gough_stewart::NoConvergence;
-    fn forward_kinematics(
-        q: &[f32; N],
-        guess: &[f32; NX],
-    ) -> Result<[f32; NX], Self::NoConvergence> {
-        mechanisms::f32::gough_stewart::forward_kinematics(q, guess)
-    }
-    fn inverse_dynamics(
-        x: &[f32; NX],
-        u: &[f32; N],
-        ud: &[f32; N],
-    ) -> Result<[f32; N], Self::Singular> {
-        mechanisms::f32::gough_stewart::inverse_dynamics(x, u, ud)
-    }
+    type Module = mechanisms::f32::gough_stewart::Module;
+    const MODULE: Self::Module = mechanisms::f32::gough_stewart::Module;
 }
+
+/// The module's `Singular` (a leg or parallel singularity, an unreachable pose).
+pub type Singular<S> = <<S as Scalar>::Module as Dynamics<NX, N>>::Singular;
+/// The module's `NoConvergence` (forward kinematics).
+pub type NoConvergence<S> = <<S as Scalar>::Module as Dynamics<NX, N>>::NoConvergence;
 
 /// Why a control tick failed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Fault<S: Scalar> {
     /// A leg or parallel singularity (from the generated inverse dynamics).
-    Singular(S::Singular),
+    Singular(Singular<S>),
     /// Forward kinematics did not converge from the previous estimate.
-    NoConvergence(S::NoConvergence),
+    NoConvergence(NoConvergence<S>),
 }
 
 /// The home pose of `mechanisms/specs/gough_stewart.toml` (`[platform] home`): 1 m above the
@@ -215,7 +185,9 @@ impl<S: Scalar> Controller<S> {
     /// `τ = ID(x, u, u̇_d + kd (u_d − u) + kp [δθ; δp])` (N; one generated call: the platform's
     /// Newton–Euler equations, the legs' dynamics and the `A⁻ᵀ` mapping to actuator forces).
     pub fn step(&mut self, t: S, q: &[S; N], u: &[S; N]) -> Result<[S; N], Fault<S>> {
-        let x = S::forward_kinematics(q, &self.estimate).map_err(Fault::NoConvergence)?;
+        let x = S::MODULE
+            .forward_kinematics(q, &self.estimate)
+            .map_err(Fault::NoConvergence)?;
         self.estimate = x;
         let (x_d, u_d, ud_d) = self.reference.at(t);
         let e = pose_error(&x_d, &x);
@@ -223,6 +195,8 @@ impl<S: Scalar> Controller<S> {
         for i in 0..N {
             a[i] = ud_d[i] + self.gains.kd * (u_d[i] - u[i]) + self.gains.kp * e[i];
         }
-        S::inverse_dynamics(&x, u, &a).map_err(Fault::Singular)
+        S::MODULE
+            .inverse_dynamics(&x, u, &a)
+            .map_err(Fault::Singular)
     }
 }
