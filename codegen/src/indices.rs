@@ -15,7 +15,7 @@
 //! Jacobi rotations (entries below 1e-17 of their diagonal pair are set to zero; at most
 //! `INDEX_MAX_SWEEPS` sweeps), `sqrt` from the configured math
 //! backend. Bad input gives `Err(IndexError)`, never NaN. The items are the real Rust file
-//! `codegen/templates/inertia_indices.rs`, specialized by [`crate::template`].
+//! `codegen/templates/inertia_indices.rs`, specialized by `template::Specialize`.
 
 use proc_macro2::{Literal, TokenStream};
 

@@ -4,7 +4,7 @@
 //! use and its words, inverse kinematics to the actuated joints.
 //!
 //! The tools' coordinates `x`: a tree's joint positions `q`; a platform's coordinates (as
-//! [`parallel::noc`]); closed loops' independent (actuated) joint positions, the others following
+//! [`crate::parallel::noc`]); closed loops' independent (actuated) joint positions, the others following
 //! by assembly from home (the home branch). They differ from the state of [`Evaluator`] only for
 //! closed loops, whose state holds every joint position.
 //!
