@@ -16,7 +16,7 @@ use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
 use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
-use crate::schedule::{Kernel, OpCount, schedule};
+use crate::schedule::{Kernel, OpCount};
 use crate::spec::{Kind, RuntimeBody, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
@@ -179,32 +179,17 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
 /// The DAG kernels as the module's scheduled functions, in emission order (all of them; the
 /// caller keeps those the scene selects).
 fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>> {
-    let g = &k.graph;
     let n = plan.dof();
     let nx = plan.nx();
     let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
-    // The functions of the masses read the run-time parameters.
-    let with_p = |mut args: Vec<Arg>| {
-        if layout.any() {
-            args.push(Arg::P);
-        }
-        args
-    };
-    let make = |name: &'static str,
-                doc: Vec<String>,
-                args: Vec<Arg>,
-                kernel: &Kernel,
-                shape: Shape,
-                public: bool| Function {
-        name,
-        doc,
-        args,
-        schedule: schedule(g, kernel),
-        outputs: kernel.outputs.clone(),
-        shape,
+    let fns = module::Functions {
+        graph: &k.graph,
         dof: n,
-        public,
-        sites: true,
+        params: layout.any(),
+    };
+    let with_p = |args| fns.with_p(args);
+    let make = |name, doc, args, kernel: &Kernel, shape, public| {
+        fns.make(name, doc, args, kernel, shape, public)
     };
     let coords = "`x`: every tree joint's position (rad or m, `JOINT_NAMES` order), closing the loops (see `forward_kinematics`); `u`: the rates of the independent coordinates (`x[INDEPENDENT[k]]`)";
     vec![

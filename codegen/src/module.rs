@@ -8,8 +8,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use crate::Config;
-use crate::emit::{self, Function};
-use crate::sym::Graph;
+use crate::emit::{self, Function, Shape};
+use crate::schedule::{Kernel, schedule};
+use crate::sym::{Arg, Graph};
 
 /// A generated module before it is written.
 pub(crate) struct ModulePlan<'g> {
@@ -79,6 +80,51 @@ pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStrea
             pub iterations: usize,
             #[doc = #residual]
             pub residual: #real,
+        }
+    }
+}
+
+/// The scheduled functions of a platform or closed-loop module, built alike: each reports
+/// `Site`s, and the functions of the masses take the run-time parameters when the module has
+/// them.
+pub(crate) struct Functions<'g> {
+    /// The DAG the kernels are nodes of.
+    pub graph: &'g Graph,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// The module has run-time parameters.
+    pub params: bool,
+}
+
+impl Functions<'_> {
+    /// `args`, then `p` when the module has run-time parameters.
+    pub fn with_p(&self, mut args: Vec<Arg>) -> Vec<Arg> {
+        if self.params {
+            args.push(Arg::P);
+        }
+        args
+    }
+
+    /// The function `name` of `kernel`, scheduled.
+    pub fn make(
+        &self,
+        name: &'static str,
+        doc: Vec<String>,
+        args: Vec<Arg>,
+        kernel: &Kernel,
+        shape: Shape,
+        public: bool,
+    ) -> Function<'static> {
+        Function {
+            name,
+            doc,
+            args,
+            schedule: schedule(self.graph, kernel),
+            outputs: kernel.outputs.clone(),
+            shape,
+            dof: self.dof,
+            public,
+            sites: true,
         }
     }
 }

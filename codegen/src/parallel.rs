@@ -20,7 +20,7 @@ use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
-use crate::schedule::{Kernel, OpCount, schedule};
+use crate::schedule::{Kernel, OpCount};
 use crate::spec::{Kind, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION};
@@ -241,32 +241,17 @@ fn functions(
     layout: &Layout,
     want: &dyn Fn(&str) -> bool,
 ) -> Vec<Function<'static>> {
-    let g = &k.graph;
     let n = plan.dof();
     let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
     let coords = coordinates_doc(&plan.motion);
-    // The functions of the masses read the run-time payload.
-    let with_p = |mut args: Vec<Arg>| {
-        if layout.any() {
-            args.push(Arg::P);
-        }
-        args
-    };
-    let make = |name: &'static str,
-                doc: Vec<String>,
-                args: Vec<Arg>,
-                kernel: &Kernel,
-                shape: Shape,
-                public: bool| Function {
-        name,
-        doc,
-        args,
-        schedule: schedule(g, kernel),
-        outputs: kernel.outputs.clone(),
-        shape,
+    let fns = module::Functions {
+        graph: &k.graph,
         dof: n,
-        public,
-        sites: true,
+        params: layout.any(),
+    };
+    let with_p = |args| fns.with_p(args);
+    let make = |name, doc, args, kernel: &Kernel, shape, public| {
+        fns.make(name, doc, args, kernel, shape, public)
     };
     let functions = [
         make(
