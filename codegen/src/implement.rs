@@ -26,11 +26,7 @@ const NEEDED: [&str; 4] = [
 
 /// `Err` when `scene` leaves out a function the trait needs (with `implement` set).
 pub(crate) fn check(mechanism: &Mechanism, scene: &Scene) -> Result<(), String> {
-    let kind = match mechanism {
-        Mechanism::Tree(_) => Kind::Tree,
-        Mechanism::Parallel(_) => Kind::Parallel,
-        Mechanism::Closed(_) => Kind::Closed,
-    };
+    let kind = mechanism.kind();
     let missing: Vec<&str> = NEEDED
         .into_iter()
         // A tree's `actuator_mass_matrix` is its `mass_matrix`; closed loops emit it with
