@@ -12,6 +12,8 @@
 
 #![allow(clippy::redundant_guards, clippy::collapsible_if)] // float guards read clearer than float patterns
 
+pub mod derivative;
+
 use indexmap::IndexSet;
 use rustc_hash::FxBuildHasher;
 
