@@ -59,6 +59,8 @@
 //! * `inverse`: [`inverse_dynamics`], the recursion that evaluates `Tᵀ(M ṫ + W M t − w^G)`;
 //! * `composite`: [`mass_matrix`], `TᵀMT` by composite bodies;
 //! * `forward`: [`forward_dynamics`] by an `Lᵀ D L` factorization;
+//! * `derivatives`: [`inverse_dynamics_derivatives`] and [`forward_dynamics_derivatives`],
+//!   by differentiating the inverse-dynamics DAG and solving with forward dynamics' factors;
 //! * `drives`: joint friction and rotor inertia;
 //! * `runtime_params`: the run-time parameter layout ([`param_index`]) and the run-time bodies'
 //!   inertial parameters.
@@ -66,6 +68,7 @@
 mod algebra;
 mod choice;
 mod composite;
+mod derivatives;
 mod drives;
 mod flops;
 mod forward;
@@ -78,6 +81,7 @@ mod runtime_params;
 use crate::sym::ExprId;
 
 pub use composite::mass_matrix;
+pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives};
 pub use drives::{add_drive_efforts, friction_effort};
 pub use forward::{PIVOT_TOLERANCE, forward_dynamics};
 pub use inverse::{Terms, inverse_dynamics};

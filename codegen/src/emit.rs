@@ -20,8 +20,12 @@ pub enum Shape {
     Matrix,
     /// `Result<[f64; DOF], Singular>`.
     FallibleVector,
-    /// `Result<…, Singular>` of one part or a tuple of parts, in output order.
+    /// `Result<…, Singular>` of one part or a tuple of parts, in output order. In a tree
+    /// module every output (the [`Part::Hidden`] ones first) is checked for finiteness, as in
+    /// [`Shape::FallibleVector`].
     Fallible(Vec<Part>),
+    /// A tuple of parts, in output order (no [`Part::Hidden`]).
+    Tuple(Vec<Part>),
 }
 
 /// One part of a [`Shape::Fallible`] result.
@@ -35,6 +39,9 @@ pub enum Part {
     Coords(usize),
     /// `f64`.
     Scalar,
+    /// This many outputs that are checked for finiteness but not returned (a tree's
+    /// `forward_dynamics_derivatives`: its `q̈`, so that it fails where `forward_dynamics` does).
+    Hidden(usize),
 }
 
 impl Part {
@@ -42,7 +49,7 @@ impl Part {
         match self {
             Part::Vector => dof,
             Part::Matrix => dof * dof,
-            Part::Coords(n) => n,
+            Part::Coords(n) | Part::Hidden(n) => n,
             Part::Scalar => 1,
         }
     }
@@ -53,6 +60,7 @@ impl Part {
             Part::Matrix => quote!([[#real; DOF]; DOF]),
             Part::Coords(_) => quote!([#real; NX]),
             Part::Scalar => quote!(#real),
+            Part::Hidden(_) => quote!(()),
         }
     }
 }
@@ -318,7 +326,7 @@ fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
     let real = real();
     let at = if f.sites {
         quote!(site: Site::Input)
-    } else if matches!(f.shape, Shape::FallibleVector) {
+    } else if matches!(f.shape, Shape::FallibleVector | Shape::Fallible(_)) {
         quote!(pivot: DOF)
     } else {
         return TokenStream::new();
@@ -346,12 +354,16 @@ fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
             let rows: Vec<TokenStream> = outs.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
             quote!([#(#rows),*])
         }
-        Shape::Fallible(ref parts) => fallible_tokens(parts, f.dof, outs),
+        Shape::Fallible(ref parts) => {
+            let v = parts_tokens(parts, f.dof, outs);
+            quote!(Ok(#v))
+        }
+        Shape::Tuple(ref parts) => parts_tokens(parts, f.dof, outs),
     }
 }
 
-/// `Ok` of one part or a tuple of parts, in output order.
-fn fallible_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
+/// One part or a tuple of parts, in output order ([`Part::Hidden`] ones left out).
+fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
     let mut rest = outs;
     let mut items = Vec::new();
     for p in parts {
@@ -360,6 +372,7 @@ fn fallible_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStrea
         items.push(match p {
             Part::Vector | Part::Coords(_) => quote!([#(#now),*]),
             Part::Scalar => quote!(#(#now)*),
+            Part::Hidden(_) => continue,
             Part::Matrix => {
                 let rows: Vec<TokenStream> =
                     now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
@@ -368,9 +381,9 @@ fn fallible_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStrea
         });
     }
     if items.len() == 1 {
-        quote!(Ok(#(#items)*))
+        quote!(#(#items)*)
     } else {
-        quote!(Ok((#(#items),*)))
+        quote!((#(#items),*))
     }
 }
 
@@ -504,13 +517,10 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
         Shape::Matrix => quote!([[#real; DOF]; DOF]),
         Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
         Shape::Fallible(parts) => {
-            let tys: Vec<TokenStream> = parts.iter().map(|p| p.ty()).collect();
-            if tys.len() == 1 {
-                quote!(Result<#(#tys)*, Singular>)
-            } else {
-                quote!(Result<(#(#tys),*), Singular>)
-            }
+            let t = parts_type(parts);
+            quote!(Result<#t, Singular>)
         }
+        Shape::Tuple(parts) => parts_type(parts),
     };
     let docs = f.doc.iter().map(|d| {
         let d = format!(" {d}");
@@ -537,6 +547,20 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
         #vis fn #name(#(#args),*) -> #ret {
             #body
         }
+    }
+}
+
+/// The type of one part or a tuple of parts ([`Part::Hidden`] ones left out).
+fn parts_type(parts: &[Part]) -> TokenStream {
+    let tys: Vec<TokenStream> = parts
+        .iter()
+        .filter(|p| !matches!(p, Part::Hidden(_)))
+        .map(|p| p.ty())
+        .collect();
+    if tys.len() == 1 {
+        quote!(#(#tys)*)
+    } else {
+        quote!((#(#tys),*))
     }
 }
 

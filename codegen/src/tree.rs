@@ -7,7 +7,7 @@ use quote::quote;
 use runtime::model::Model;
 
 use crate::dynamics::{self, Terms, Tree};
-use crate::emit::{self, Function, Shape};
+use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount, schedule};
 use crate::spec::{self, Kind, Scene};
@@ -35,6 +35,11 @@ pub struct Symbolic {
     pub forward_dynamics_guards: Vec<sym::ExprId>,
     /// Joint friction `δ(q̇)`, when some joint's drive has friction (`[scene] friction`).
     pub friction: Option<Vec<sym::ExprId>>,
+    /// `∂τ/∂q` then `∂τ/∂q̇` of `inverse_dynamics`, each row-major.
+    pub inverse_dynamics_derivatives: Vec<sym::ExprId>,
+    /// `q̈` (checked, not returned), then `∂q̈/∂q`, `∂q̈/∂q̇` and `I⁻¹ = ∂q̈/∂τ`, each
+    /// row-major; under `forward_dynamics_guards`.
+    pub forward_dynamics_derivatives: Vec<sym::ExprId>,
 }
 
 /// Build the symbolic dynamics of a validated model.
@@ -91,6 +96,21 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
                 },
             )
         });
+    // Built last, so that the nodes (and the emitted text) of the functions above stay as
+    // they were without them.
+    let inverse_dynamics_derivatives =
+        dynamics::inverse_dynamics_derivatives(&mut g, &inverse_dynamics);
+    let forward_dynamics_derivatives = dynamics::forward_dynamics_derivatives(
+        &mut g,
+        &tree,
+        &inverse_dynamics_derivatives,
+        &forward_dynamics,
+    );
+    debug_assert_eq!(
+        g.take_guards(),
+        forward_dynamics_guards,
+        "the derivatives test what forward dynamics tests"
+    );
     Symbolic {
         graph: g,
         dof: tree.dof(),
@@ -101,6 +121,8 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         forward_dynamics,
         forward_dynamics_guards,
         friction,
+        inverse_dynamics_derivatives,
+        forward_dynamics_derivatives,
     }
 }
 
@@ -244,7 +266,10 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
         forward_dynamics: fd,
         forward_dynamics_guards: fd_guards,
         friction,
+        inverse_dynamics_derivatives: idd,
+        forward_dynamics_derivatives: fdd,
     } = parts;
+    let n = fd.len();
     let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
     let mut specs: Vec<Spec> = vec![
         (
@@ -301,8 +326,38 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
                     .into(),
             ],
             vec![Arg::Q, Arg::Qd, Arg::Tau],
-            Kernel::new(fd, fd_guards),
+            Kernel::new(fd, fd_guards.clone()),
             Shape::FallibleVector,
+        ),
+        (
+            "inverse_dynamics_derivatives",
+            vec![
+                "Derivatives of `inverse_dynamics`: `(∂τ/∂q, ∂τ/∂q̇)`, element `[i][j] = \
+                 ∂τ_i/∂x_j`, exact (symbolic differentiation of the same expressions, friction \
+                 and rotor inertia included). `∂τ/∂q̈` is `mass_matrix`."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd, Arg::Qdd],
+            k(idd),
+            Shape::Tuple(vec![Part::Matrix, Part::Matrix]),
+        ),
+        (
+            "forward_dynamics_derivatives",
+            vec![
+                "Derivatives of `forward_dynamics`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹ = ∂q̈/∂τ)`, element \
+                 `[i][j] = ∂q̈_i/∂x_j`, with `∂q̈/∂x = −I⁻¹ ∂τ/∂x` at `q̈ = forward_dynamics(q, \
+                 q̇, τ)`. The same factorization, pivots and errors as `forward_dynamics` (and \
+                 `Err` with `pivot == DOF` when a derivative overflows)."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd, Arg::Tau],
+            Kernel::new(fdd, fd_guards),
+            Shape::Fallible(vec![
+                Part::Hidden(n),
+                Part::Matrix,
+                Part::Matrix,
+                Part::Matrix,
+            ]),
         ),
     ];
     if let Some(friction) = friction {
@@ -387,7 +442,7 @@ fn items(
     let names = joint_names.iter();
     let needs_singular = functions
         .iter()
-        .any(|f| matches!(f.shape, Shape::FallibleVector));
+        .any(|f| matches!(f.shape, Shape::FallibleVector | Shape::Fallible(_)));
     let singular = needs_singular.then(|| {
         quote! {
             /// A failed pivot of the mass-matrix factorization: the configuration is singular

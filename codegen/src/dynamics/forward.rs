@@ -31,7 +31,22 @@ pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
             g.sub(t, bias[i])
         })
         .collect();
-    let mut h = m.clone();
+    let f = factor(g, &m);
+    solve(g, &f, &f.inv_d, rhs)
+}
+
+/// The `Lᵀ D L` factorization of a mass matrix, eliminated from the tips.
+pub(super) struct Factor {
+    /// `1/d` of the pivots `d`, each a guard.
+    pub inv_d: Vec<ExprId>,
+    /// `L` (unit lower triangular, the unit diagonal implied), row-major.
+    pub l: Vec<Vec<ExprId>>,
+}
+
+/// Factor `m` with checked pivots (each asked for as a guard, in the order eliminated).
+pub(super) fn factor(g: &mut Graph, m: &[Vec<ExprId>]) -> Factor {
+    let n = m.len();
+    let mut h = m.to_vec();
     let mut inv_d = vec![g.zero(); n];
     let mut l = vec![vec![g.zero(); n]; n];
     for k in (0..n).rev() {
@@ -55,8 +70,14 @@ pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
             l[k][i] = a;
         }
     }
-    // Lᵀ y = b (from the last row up), z = D⁻¹ y, L x = z (from the first row down).
-    let mut y = rhs;
+    Factor { inv_d, l }
+}
+
+/// `Lᵀ y = b` (from the last row up), `z = s ∘ y`, `L x = z` (from the first row down): with
+/// `s = 1/d` the solution of `m x = b`, with `s = −1/d` its negative.
+pub(super) fn solve(g: &mut Graph, f: &Factor, s: &[ExprId], b: Vec<ExprId>) -> Vec<ExprId> {
+    let (n, l) = (b.len(), &f.l);
+    let mut y = b;
     for k in (0..n).rev() {
         for j in (k + 1)..n {
             if !g.is_const(l[j][k], 0.0) {
@@ -65,7 +86,7 @@ pub fn forward_dynamics(g: &mut Graph, tree: &Tree) -> Vec<ExprId> {
             }
         }
     }
-    let mut x: Vec<ExprId> = (0..n).map(|k| g.mul(y[k], inv_d[k])).collect();
+    let mut x: Vec<ExprId> = (0..n).map(|k| g.mul(y[k], s[k])).collect();
     for k in 0..n {
         for i in 0..k {
             if !g.is_const(l[k][i], 0.0) {

@@ -19,6 +19,10 @@ pub enum Function {
     ForwardDynamics,
     /// `friction`: the joints' friction efforts (trees with `[scene] friction`).
     Friction,
+    /// `inverse_dynamics_derivatives`: `(∂τ/∂q, ∂τ/∂q̇)` (trees).
+    InverseDynamicsDerivatives,
+    /// `forward_dynamics_derivatives`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹)` (trees).
+    ForwardDynamicsDerivatives,
     /// `joint_rates`: every tree joint's rate (closed loops).
     JointRates,
     /// `actuator_rates`: `q̇ = A u`.
@@ -33,13 +37,15 @@ pub enum Function {
 
 impl Function {
     /// Every function, in the order of the enum.
-    pub const ALL: [Function; 11] = [
+    pub const ALL: [Function; 13] = [
         Function::MassMatrix,
         Function::Coriolis,
         Function::Gravity,
         Function::InverseDynamics,
         Function::ForwardDynamics,
         Function::Friction,
+        Function::InverseDynamicsDerivatives,
+        Function::ForwardDynamicsDerivatives,
         Function::JointRates,
         Function::ActuatorRates,
         Function::ActuatorMassMatrix,
@@ -56,6 +62,8 @@ impl Function {
             Function::InverseDynamics => "inverse_dynamics",
             Function::ForwardDynamics => "forward_dynamics",
             Function::Friction => "friction",
+            Function::InverseDynamicsDerivatives => "inverse_dynamics_derivatives",
+            Function::ForwardDynamicsDerivatives => "forward_dynamics_derivatives",
             Function::JointRates => "joint_rates",
             Function::ActuatorRates => "actuator_rates",
             Function::ActuatorMassMatrix => "actuator_mass_matrix",
@@ -100,6 +108,8 @@ impl Kind {
                 Gravity,
                 InverseDynamics,
                 ForwardDynamics,
+                InverseDynamicsDerivatives,
+                ForwardDynamicsDerivatives,
                 Friction,
             ],
             Kind::Parallel => &[
