@@ -25,7 +25,12 @@ macro_rules! export {
                         Ok(a) => a[0],
                         Err(e) => e.value,
                     };
-                    m[0][0] + c[0] + gr[0] + t[0] + a
+                    let (dq, _) = g::inverse_dynamics_derivatives(q, qd, x);
+                    let d = match g::forward_dynamics_derivatives(q, qd, x) {
+                        Ok((_, _, minv)) => minv[0][0],
+                        Err(e) => e.value,
+                    };
+                    m[0][0] + c[0] + gr[0] + t[0] + a + dq[0][0] + d
                 }
             }
         )*
