@@ -122,7 +122,9 @@ fn stats_prints_the_table_to_stderr_beside_the_module() {
             "coriolis",
             "gravity",
             "inverse_dynamics",
-            "forward_dynamics"
+            "forward_dynamics",
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives"
         ]
     );
     assert!(!t.contains("pub fn"), "--stats printed code");
