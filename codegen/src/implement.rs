@@ -181,6 +181,32 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             fn gravity(&self, x: &[#real; #nx]) -> Option<[#real; DOF]>
         },
     );
+    let id_derivatives = optional(
+        "inverse_dynamics_derivatives",
+        quote!(x, u, ud),
+        quote! {
+            #[allow(clippy::type_complexity)]
+            fn inverse_dynamics_derivatives(
+                &self,
+                x: &[#real; #nx],
+                u: &[#real; DOF],
+                ud: &[#real; DOF],
+            ) -> Option<([[#real; DOF]; DOF], [[#real; DOF]; DOF])>
+        },
+    );
+    let fd_derivatives = optional(
+        "forward_dynamics_derivatives",
+        quote!(x, u, tau),
+        quote! {
+            #[allow(clippy::type_complexity)]
+            fn forward_dynamics_derivatives(
+                &self,
+                x: &[#real; #nx],
+                u: &[#real; DOF],
+                tau: &[#real; DOF],
+            ) -> Option<Result<([[#real; DOF]; DOF], [[#real; DOF]; DOF], [[#real; DOF]; DOF]), Singular>>
+        },
+    );
     quote! {
         #module_struct
         impl #runtime::Dynamics<#nx, DOF> for Module {
@@ -227,6 +253,8 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             #joint_rates
             #coriolis
             #gravity
+            #id_derivatives
+            #fd_derivatives
         }
     }
 }

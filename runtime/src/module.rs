@@ -122,4 +122,39 @@ pub trait Dynamics<const NX: usize, const DOF: usize> {
         let _ = x;
         None
     }
+
+    /// Trees: `(∂τ/∂q, ∂τ/∂q̇)` of `inverse_dynamics`, element `[i][j] = ∂τ_i/∂x_j`
+    /// (`inverse_dynamics_derivatives`). `None` elsewhere (for now).
+    #[allow(clippy::type_complexity)]
+    fn inverse_dynamics_derivatives(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+        ud: &[Self::Scalar; DOF],
+    ) -> Option<([[Self::Scalar; DOF]; DOF], [[Self::Scalar; DOF]; DOF])> {
+        let _ = (x, u, ud);
+        None
+    }
+
+    /// Trees: `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of `forward_dynamics`, with its pivots and errors
+    /// (`forward_dynamics_derivatives`). `None` elsewhere (for now).
+    #[allow(clippy::type_complexity)]
+    fn forward_dynamics_derivatives(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+        tau: &[Self::Scalar; DOF],
+    ) -> Option<
+        Result<
+            (
+                [[Self::Scalar; DOF]; DOF],
+                [[Self::Scalar; DOF]; DOF],
+                [[Self::Scalar; DOF]; DOF],
+            ),
+            Self::Singular,
+        >,
+    > {
+        let _ = (x, u, tau);
+        None
+    }
 }

@@ -31,6 +31,14 @@ fn tree_agrees() {
         );
         assert_eq!(m.coriolis(&q, &qd), Some(g::coriolis(&q, &qd)));
         assert_eq!(m.gravity(&q), Some(g::gravity(&q)));
+        assert_eq!(
+            m.inverse_dynamics_derivatives(&q, &qd, &qdd),
+            Some(g::inverse_dynamics_derivatives(&q, &qd, &qdd))
+        );
+        assert_eq!(
+            m.forward_dynamics_derivatives(&q, &qd, &tau),
+            Some(g::forward_dynamics_derivatives(&q, &qd, &tau))
+        );
         // The identities of a tree: x = q, u = q̇.
         assert_eq!(m.inverse_kinematics(&q), Ok(q));
         assert_eq!(m.forward_kinematics(&q, &qd), Ok(q));

@@ -39,7 +39,8 @@ fn inputs<const N: usize>(seed: &mut u64, scale: F) -> [F; N] {
 // nothing (`#[inline(never)]`) and, with `prove`, guarded by its own `#[no_panic]`, so the proof
 // covers every generated function of every module one by one (the trait's methods forward to the
 // free functions, and a tree's identities are covered with them). A method the module's kind
-// does not have (`joint_rates`, `coriolis`, `gravity`: `None`) is proved too, trivially.
+// does not have (`joint_rates`, `coriolis`, `gravity`, the derivatives: `None`) is proved too,
+// trivially.
 
 /// `M` with the generated code's scalar.
 pub trait Module<const NX: usize, const N: usize>: Dynamics<NX, N, Scalar = F> {}
@@ -134,6 +135,29 @@ pub fn gravity<M: Module<NX, N>, const NX: usize, const N: usize>(
     m.gravity(x)
 }
 
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+#[allow(clippy::type_complexity)]
+pub fn inverse_dynamics_derivatives<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+    ud: &[F; N],
+) -> Option<([[F; N]; N], [[F; N]; N])> {
+    m.inverse_dynamics_derivatives(x, u, ud)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+#[allow(clippy::type_complexity)]
+pub fn forward_dynamics_derivatives<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+    tau: &[F; N],
+) -> Option<Result<([[F; N]; N], [[F; N]; N], [[F; N]; N]), M::Singular>> {
+    m.forward_dynamics_derivatives(x, u, tau)
+}
+
 /// Calls every wrapper of module `m` once, at opaque, arbitrary inputs near its home (errors
 /// are values too); returns a checksum.
 fn run<M: Module<NX, N>, const NX: usize, const N: usize>(m: &M, seed: &mut u64) -> F {
@@ -174,6 +198,10 @@ fn run<M: Module<NX, N>, const NX: usize, const N: usize>(m: &M, seed: &mut u64)
     }
     s += coriolis(m, &x, &u).map_or(0.0, |v| v[0]);
     s += gravity(m, &x).map_or(0.0, |v| v[0]);
+    s += inverse_dynamics_derivatives(m, &x, &u, &ud).map_or(0.0, |(a, b)| a[0][0] + b[N - 1][0]);
+    if let Some(r) = forward_dynamics_derivatives(m, &x, &u, &tau) {
+        s += first(r.map(|(a, b, c)| a[0][0] + b[0][N - 1] + c[N - 1][N - 1]));
+    }
     s
 }
 
