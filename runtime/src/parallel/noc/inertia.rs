@@ -47,7 +47,7 @@ pub fn payload_inertia<R: Real>(
     let n = plan.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
-    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+    if plan.motion.translates() {
         for (i, row) in out.iter_mut().enumerate() {
             row[i] = payload.mass;
         }
@@ -150,7 +150,8 @@ pub fn generalized_inertia_with<R: Real>(
                 }
             }
         } else {
-            // Orientation (u = ω) or planar point (u = in-plane velocity): I += Λ's block.
+            // Orientation (u = ω), planar point (u = in-plane velocity) or translation (u = v):
+            // I += Λ's block.
             for i in 0..n {
                 for j in 0..n {
                     out[i][j] = out[i][j] + lam[i][j];
@@ -158,7 +159,7 @@ pub fn generalized_inertia_with<R: Real>(
             }
         }
     }
-    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+    if plan.motion.translates() {
         let (mass, _, _) = plan.platform;
         for i in 0..n {
             out[i][i] = out[i][i] + R::c(mass);

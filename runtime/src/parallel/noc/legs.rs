@@ -445,6 +445,7 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                 }
                 PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
                 PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
+                PlatformMotion::Translation { .. } => vec![g[0], g[1], g[2]],
             }
         })
         .collect()
