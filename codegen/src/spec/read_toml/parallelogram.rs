@@ -185,7 +185,7 @@ impl Reader<'_> {
         })
     }
 
-    /// Expands the parallelograms into `spec` (see the module docs), after the checks that
+    /// Expands the parallelograms into `spec` (see the module docs), with the checks that
     /// need the home placement: equal widths, equal transverse moments of the rods, the rod
     /// length against the home distance of `E` and `P`, a revolute joint moving the parent
     /// (whose axis the short sides follow), and a translational platform.
@@ -199,25 +199,24 @@ impl Reader<'_> {
         }
     }
 
+    /// The checks, each reported at its key; the expansion goes ahead after those whose
+    /// values it does not need (so that the legs' checks do not echo them), with the rod
+    /// placed at the home distance of `E` and `P`.
     fn expand(
         &mut self,
         spec: &Spec,
         pg: &ParallelogramSpec,
     ) -> Option<(BodySpec, [JointSpec; 2])> {
         let key = |k: &str| format!("{}.{k}", pg.path);
-        let Some(ps) = spec
-            .platform
-            .as_ref()
-            .filter(|p| p.coordinates == Some(Coordinates::Translation))
-        else {
+        let ps = spec.platform.as_ref()?;
+        if ps.coordinates != Some(Coordinates::Translation) {
             self.err(
                 "a parallelogram needs a translational platform",
                 &pg.path,
                 pg.span.clone(),
             )
-            .hint = Some("write [platform] with coordinates = \"translation\" (a Delta robot): the rods' short sides stay parallel only while the platform does not turn".into());
-            return None;
-        };
+            .hint = Some("write [platform] coordinates = \"translation\" (a Delta robot): the rods' short sides stay parallel only while the platform does not turn".into());
+        }
         let w = pg.elbow_width.max(pg.platform_width).max(pg.length);
         if (pg.elbow_width - pg.platform_width).abs() > TOLERANCE * w {
             self.err(
@@ -230,7 +229,6 @@ impl Reader<'_> {
                 pg.platform_width_span.clone(),
             )
             .hint = Some("the two rods form a parallelogram only when the elbow's and the platform's ball pairs are the same distance apart; make the widths equal".into());
-            return None;
         }
         let i = pg.rod_inertia;
         let off = i[0][1].abs() + i[0][2].abs() + i[1][2].abs();
@@ -242,7 +240,6 @@ impl Reader<'_> {
                 pg.rod_inertia_span.clone(),
             )
             .hint = Some("the rods' spin about their own axis is an idle freedom of their ball joints, so the model holds only for rods whose transverse moments are equal (x is the rod axis)".into());
-            return None;
         }
         let (parent_pose, axis) = self.motor(spec, pg)?;
         let e = parent_pose.apply(&pg.elbow);
@@ -260,6 +257,8 @@ impl Reader<'_> {
                 pg.length_span.clone(),
             )
             .hint = Some("place the upper arm and the platform's home so that the parallelogram closes: |P − E| = length (elbow in the parent's frame, platform_point in the platform frame at platform.home)".into());
+        }
+        if dist == 0.0 {
             return None;
         }
         // Rod direction and motor axis in the parent's frame.
@@ -278,7 +277,7 @@ impl Reader<'_> {
             return None;
         }
         let n = [n[0] / nn, n[1] / nn, n[2] / nn];
-        Some(self.equivalent(pg, a, n, d))
+        Some(self.equivalent(pg, a, n, d, dist))
     }
 
     /// The parent's pose at home (base frame) and the axis of the revolute joint that moves it
@@ -326,6 +325,7 @@ impl Reader<'_> {
         a: Vec3,
         n: Vec3,
         d: Vec3,
+        l: f64,
     ) -> (BodySpec, [JointSpec; 2]) {
         let rods = format!("{}_rods", pg.name);
         let it = 2.0 * pg.rod_inertia[1][1];
@@ -378,7 +378,6 @@ impl Reader<'_> {
         u.placement = Placement::Origin(at(pg.elbow));
         u.axes = vec![axis(a), axis(n)];
         let mut s = joint(pg.name.clone(), Kind::Spherical, rods, pg.child.clone());
-        let l = pg.length;
         s.placement = Placement::Origin(at([l * d[0], l * d[1], l * d[2]]));
         s.child_origin = Some(at(pg.platform_point));
         s.child_origin_span = Some(pg.span.clone());
