@@ -5,6 +5,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::delta::delta_force;
 use super::legs::LegKin;
 use super::motion::leg_motion;
 use super::plan::Plan;
@@ -70,6 +71,14 @@ pub fn generalized_force_with<R: Real>(
             // t = S u, S = [0; 1₃]: every platform point moves with u.
             PlatformMotion::Translation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         };
+        if let (Some(dp), Some(dk), None) = (&lp.delta, &lk.delta, drives) {
+            // A translational platform's legs end at points moving with v: G = 1₃.
+            let y = delta_force(dp, dk, &lk.frame, v_end, a_end, cv(&g_world));
+            for i in 0..3 {
+                f[i] = f[i] + y[i];
+            }
+            continue;
+        }
         if let (Some(up), Some(uk), None) = (&lp.ups, &lk.ups, drives) {
             let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
             if let PlatformMotion::Translation { .. } = plan.motion {

@@ -5,6 +5,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::delta::delta_inertia;
 use super::force::generalized_force;
 use super::legs::LegKin;
 use super::plan::{LegPlan, Plan};
@@ -126,8 +127,9 @@ pub fn generalized_inertia_with<R: Real>(
                 (a != 0.0).then(|| R::c(a))
             }),
         };
-        let lam = match (&lp.ups, &lk.ups, drives) {
-            (Some(up), Some(uk), None) => ups_inertia(up, uk),
+        let lam = match (&lp.ups, &lk.ups, &lp.delta, &lk.delta, drives) {
+            (Some(up), Some(uk), _, _, None) => ups_inertia(up, uk),
+            (_, _, Some(dp), Some(dk), None) => delta_inertia(dp, dk, &lk.frame),
             _ => leg_end_inertia(lp, lk, &armature),
         };
         if pose {
