@@ -230,6 +230,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         PlatformMotion::PlanarPoint { .. } => {
             "`x = [px, py]` (the point where the legs meet, m, base frame); `u = [vx, vy]` (m/s)"
         }
+        PlatformMotion::Translation { .. } => {
+            "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"
+        }
     }
 }
 

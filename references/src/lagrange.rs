@@ -1048,6 +1048,11 @@ pub fn platform_pose(motion: PlatformMotion, x: &[f64]) -> Transform {
             rotation: quaternion_matrix([1.0, 0.0, 0.0, 0.0]),
             translation: [x[0], x[1], height],
         },
+        // The origin; the orientation stays fixed.
+        PlatformMotion::Translation { rotation } => Transform {
+            rotation,
+            translation: [x[0], x[1], x[2]],
+        },
     }
 }
 
@@ -1109,7 +1114,9 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
                 let axis = mat_vec(&lpose.rotation, &on_leg);
                 let centre = match model.motion {
                     PlatformMotion::Orientation { centre } => centre,
-                    PlatformMotion::Pose | PlatformMotion::PlanarPoint { .. } => plat.translation,
+                    PlatformMotion::Pose
+                    | PlatformMotion::PlanarPoint { .. }
+                    | PlatformMotion::Translation { .. } => plat.translation,
                 };
                 (
                     CJointKind::Revolute { axis },

@@ -131,6 +131,7 @@ macro_rules! bench_parallel {
                 runtime::parallel::PlatformMotion::Pose => (0.1, 0.02 * model.size()),
                 runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
                 runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+                runtime::parallel::PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
             };
             let (x, u, ud) =
                 tests::pkm::random_state(&plan, &home, &mut rng(N as u64), angle, reach);
@@ -200,6 +201,7 @@ macro_rules! bench_parallel {
 
 bench_parallel!(gough_stewart, gough_stewart);
 bench_parallel!(agile_eye, agile_eye);
+bench_parallel!(delta_rl5, delta_rl5);
 
 /// A bundled closed-loop mechanism in joint coordinates: generated vs the runtime evaluator
 /// (`runtime::closed::noc`) vs the independent Newton–Euler + Lagrange-multiplier route (dense
@@ -284,6 +286,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, five_bar_joints, spherical_five_bar
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, five_bar_joints, spherical_five_bar
 }
 criterion_main!(benches);

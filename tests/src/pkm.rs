@@ -7,12 +7,13 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 5] = [
+pub const PARALLEL: [&str; 6] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
     "agile_eye",
     "planar_five_bar",
+    "delta_rl5",
 ];
 
 /// The spec file of a bundled mechanism.
@@ -55,10 +56,7 @@ pub fn random_state(
     loop {
         let mut d = vec![0.0; n];
         for (i, v) in d.iter_mut().enumerate() {
-            let planar = matches!(
-                plan.motion,
-                runtime::parallel::PlatformMotion::PlanarPoint { .. }
-            );
+            let planar = plan.motion.translates();
             *v = if i < 3 && !planar { angle } else { reach } * rng.random_range(-1.0..1.0);
         }
         let x = noc::retract(plan.motion, home, &d);

@@ -300,6 +300,7 @@ fn parallel_guards_match_the_runtime_tests() {
         "sliding_hexapod",
         "rus_hexapod",
         "planar_five_bar",
+        "delta_rl5",
     ] {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();

@@ -334,6 +334,11 @@ fn rotated_parallel(m: &ParallelModel, r: Mat3) -> ParallelModel {
             centre: mat_vec(&r, &centre),
         };
     }
+    if let PlatformMotion::Translation { rotation } = m.motion {
+        out.motion = PlatformMotion::Translation {
+            rotation: runtime::model::mat_mul(&r, &rotation),
+        };
+    }
     out
 }
 
@@ -358,6 +363,7 @@ fn rotate_x(m: &ParallelModel, r: &Mat3, x: &[f64]) -> Vec<f64> {
             let p = mat_vec(r, &[x[0], x[1], 0.0]);
             vec![p[0], p[1]]
         }
+        PlatformMotion::Translation { .. } => mat_vec(r, &[x[0], x[1], x[2]]).to_vec(),
     }
 }
 
@@ -372,6 +378,7 @@ fn parallel_indices_are_invariant_under_a_rotation_of_the_whole_mechanism() {
         ("gough_stewart", 0.1, 0.05, false),
         ("agile_eye", 0.5, 0.0, false),
         ("planar_five_bar", 0.0, 0.05, true),
+        ("delta_rl5", 0.0, 0.05, false),
     ] {
         let m = model(name);
         let plan = Plan::new(&m).unwrap();

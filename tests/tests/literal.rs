@@ -25,6 +25,7 @@ fn amplitudes(m: &runtime::parallel::ParallelModel) -> (f64, f64) {
         PlatformMotion::Pose => (0.15, 0.03 * m.size()),
         PlatformMotion::Orientation { .. } => (0.4, 0.0),
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+        PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
     }
 }
 
@@ -97,6 +98,7 @@ fn literal_noc_agrees_with_drives_on_every_leg_joint() {
         for lp in &mut plan.legs {
             // A leg with drives takes the generic route (as `Plan::new` would choose).
             lp.ups = None;
+            lp.delta = None;
             for d in &mut lp.drives {
                 *d = Drive {
                     viscous: rng.random_range(0.0..20.0),

@@ -28,6 +28,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
         PlatformMotion::Pose => (0.15, 0.03 * m.size()),
         PlatformMotion::Orientation { .. } => (0.4, 0.0),
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+        PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
     }
 }
 
@@ -112,6 +113,7 @@ generated_vs_runtime!(sliding_hexapod);
 generated_vs_runtime!(rus_hexapod);
 generated_vs_runtime!(agile_eye);
 generated_vs_runtime!(planar_five_bar);
+generated_vs_runtime!(delta_rl5);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -179,6 +181,7 @@ power_balance!(power_balance_sliding_hexapod, sliding_hexapod);
 power_balance!(power_balance_rus_hexapod, rus_hexapod);
 power_balance!(power_balance_agile_eye, agile_eye);
 power_balance!(power_balance_planar_five_bar, planar_five_bar);
+power_balance!(power_balance_delta_rl5, delta_rl5);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]
@@ -244,6 +247,9 @@ macro_rules! against_lagrange {
                         vec![0.0, 0.0, 0.0, u[0], u[1], 0.0],
                         vec![0.0, 0.0, 0.0, ud[0], ud[1], 0.0],
                     ),
+                    // The Delta's parallelograms hold the platform's orientation; its own test
+                    // (tests/tests/delta.rs) gives the reference U joints to hold it.
+                    PlatformMotion::Translation { .. } => unreachable!("see tests/tests/delta.rs"),
                 };
                 let sol = lagrange::inverse_dynamics(&sys, &prescribed, &uu, &uud).unwrap();
                 let tau = g::inverse_dynamics(&arr(&x), &arr(&u), &arr(&ud)).unwrap();

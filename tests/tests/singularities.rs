@@ -89,6 +89,7 @@ fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
         PlatformMotion::Pose => vec![p[0], p[1], p[2], q[0], q[1], q[2], q[3]],
         PlatformMotion::Orientation { .. } => q.to_vec(),
         PlatformMotion::PlanarPoint { .. } => vec![p[0], p[1]],
+        PlatformMotion::Translation { .. } => p.to_vec(),
     }
 }
 
@@ -180,6 +181,7 @@ generated_routes!(agile_eye);
 generated_routes!(sliding_hexapod);
 generated_routes!(rus_hexapod);
 generated_routes!(planar_five_bar);
+generated_routes!(delta_rl5);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -188,6 +190,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "sliding_hexapod" => &sliding_hexapod::ROUTES,
         "rus_hexapod" => &rus_hexapod::ROUTES,
         "planar_five_bar" => &planar_five_bar::ROUTES,
+        "delta_rl5" => &delta_rl5::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }
@@ -489,6 +492,7 @@ fn reference_agrees_with_runtime_at_generic_states() {
         "sliding_hexapod",
         "rus_hexapod",
         "agile_eye",
+        "delta_rl5",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -685,6 +689,95 @@ fn planar_five_bar_boundary_singularity() {
     finish(&bad);
 }
 
+/// Delta (`delta_rl5`): leg 0's boundary, where its elbow circle touches the sphere of the rod
+/// length about its platform point `P₀` (the arm and the rod in one line, stretched): the two
+/// elbow branches meet and the leg Jacobian's scalar `d·(a × (E − O))` vanishes, a leg
+/// (type-I) singularity. The platform moves in leg 0's plane (y = 0) along the line from the
+/// motor axis `O₀` through `P₀` at home, `|P₀ − O₀| = l_arm + l_rod − δ` m (1e-1 … 1e-12 m,
+/// then 0).
+#[test]
+fn delta_stretched_leg_singularity() {
+    let m = model("delta_rl5");
+    let plan = plan(&m);
+    let (o, p0): ([f64; 3], [f64; 3]) = ([0.33, 0.0, 0.0], [0.125, 0.0, -1.0]);
+    let dir = [p0[0] - o[0], 0.0, p0[2] - o[2]];
+    let n = (dir[0] * dir[0] + dir[2] * dir[2]).sqrt();
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| {
+            let r = 0.42 + 1.055 - d;
+            Point {
+                delta: d,
+                x: vec![o[0] + r * dir[0] / n - 0.125, 0.0, o[2] + r * dir[2] / n],
+            }
+        })
+        .collect();
+    let bad = walk_report(
+        "Delta, |P₀ − O₀| = 1.475 m − δ (leg 0 stretched)",
+        &plan,
+        &walk,
+        &states(3, 0xde),
+        Some(generated_id("delta_rl5")),
+        &[
+            |s| matches!(s, Site::Leg(0)),
+            |s| matches!(s, Site::Reach(0)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
+    );
+    finish(&bad);
+}
+
+/// Delta (`delta_rl5`): a parallel (type-II) singularity inside the workspace, where the three
+/// rod directions become coplanar (the rows `dᵀ/s` of `A` dependent) while every leg stays
+/// regular (`|d·(a × (E − O))| ≈ 0.24`, far from the leg test). Found on the line `y = 0.1 m`,
+/// `z = −0.6 m`: `x*` is where the runtime's `det A` changes sign between 1.0 and 1.04 m
+/// (bisection to rounding); the walk is `x = x* − δ` (1e-1 … 1e-12 m, then `x*`). (Off the
+/// symmetry plane `y = 0` on purpose: there the singular direction is `e_y` itself, `A`'s
+/// second column vanishes, and the unit-column scaling of the pivot test normalizes it back to
+/// a regular-looking matrix, so the test misses it; see the report of issue 20.)
+#[test]
+fn delta_parallel_singularity() {
+    let m = model("delta_rl5");
+    let plan = plan(&m);
+    let det = |x: f64| {
+        let a = noc::actuation(&plan, &[x, 0.1, -0.6]).unwrap();
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let (mut lo, mut hi) = (1.0, 1.04);
+    assert!(det(lo) * det(hi) < 0.0, "no sign change of det A");
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if det(mid) * det(lo) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let xs = lo;
+    println!("Delta: det A changes sign at x* = {xs} m (y = 0.1 m, z = -0.6 m)");
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![xs - d, 0.1, -0.6],
+        })
+        .collect();
+    let bad = walk_report(
+        "Delta, x = x* − δ (rods coplanar)",
+        &plan,
+        &walk,
+        &states(3, 0xd2),
+        Some(generated_id("delta_rl5")),
+        &[|s| matches!(s, Site::Actuation(_))],
+    );
+    finish(&bad);
+}
+
 /// A platform axis approaching the base axis of a *different* leg (`v₂ → u₃` by
 /// `R_z(30°)·R_y(−90° + δ)`, `v₁`, `v₃` generic) is *not* singular for the exact Agile-Eye
 /// geometry: the actuation matrix stays well conditioned (scaled pivot ratio → √3) and the
@@ -781,6 +874,7 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
         "sliding_hexapod",
         "rus_hexapod",
         "agile_eye",
+        "delta_rl5",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -889,8 +983,9 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
 /// which tests `value > 0` instead of `|value| > 0` before dividing.
 #[test]
 fn out_of_reach() {
-    let cases: [(&str, [f64; 3]); 3] = [
+    let cases: [(&str, [f64; 3]); 4] = [
         ("rus_hexapod", [0.0, 0.0, 10.0]),
+        ("delta_rl5", [3.0, 0.0, 0.0]),
         ("sliding_hexapod", [10.0, 0.0, 0.0]),
         ("sliding_hexapod", [0.0, -10.0, 2.0]),
     ];
@@ -902,8 +997,9 @@ fn out_of_reach() {
         for (xi, di) in x.iter_mut().zip(dir) {
             *xi += di * s;
         }
-        let z = vec![0.0; 6];
-        let u: Vec<f64> = (0..6).map(|i| 0.1 * i as f64).collect();
+        let n = plan.dof();
+        let z = vec![0.0; n];
+        let u: Vec<f64> = (0..n).map(|i| 0.1 * i as f64).collect();
         let outcomes: Vec<(&str, Outcome)> = vec![
             ("runtime", noc::inverse_dynamics(&plan, &x, &u, &z)),
             ("double-double", dd::inverse_dynamics_dd(&plan, &x, &u, &z)),

@@ -135,7 +135,7 @@ mod planar {
             condition_estimate: f64::INFINITY,
         })
     }
-    include!("../../codegen/templates/platform_retract_planar.rs");
+    include!("../../codegen/templates/platform_retract_sum.rs");
     include!("../../codegen/templates/platform_newton.rs");
 }
 

@@ -60,6 +60,9 @@ fn turn_parallel(m: &ParallelModel, t: &Transform) -> ParallelModel {
         PlatformMotion::Orientation { centre } => PlatformMotion::Orientation {
             centre: t.apply(&centre),
         },
+        PlatformMotion::Translation { rotation } => PlatformMotion::Translation {
+            rotation: runtime::model::mat_mul(&t.rotation, &rotation),
+        },
         other => other,
     };
     out
@@ -98,6 +101,7 @@ fn turn_state(motion: PlatformMotion, r: &Mat3, x: &[f64], u: &[f64]) -> (Vec<f6
             let v = rv(r, &[u[0], u[1], 0.0]);
             (vec![p[0], p[1]], vec![v[0], v[1]])
         }
+        PlatformMotion::Translation { .. } => (rv(r, x).to_vec(), rv(r, u).to_vec()),
     }
 }
 

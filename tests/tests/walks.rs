@@ -327,7 +327,8 @@ parallel_routes!(
     agile_eye,
     sliding_hexapod,
     rus_hexapod,
-    planar_five_bar
+    planar_five_bar,
+    delta_rl5
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -410,6 +411,9 @@ fn turned(m: &ParallelModel, axis: usize, deg: f64, dp: [f64; 3]) -> Vec<f64> {
             qmul(r, [home[0], home[1], home[2], home[3]]).to_vec()
         }
         PlatformMotion::PlanarPoint { .. } => vec![home[0] + dp[0], home[1] + dp[1]],
+        PlatformMotion::Translation { .. } => {
+            vec![home[0] + dp[0], home[1] + dp[1], home[2] + dp[2]]
+        }
     }
 }
 
@@ -422,6 +426,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "rus_hexapod",
         "agile_eye",
         "planar_five_bar",
+        "delta_rl5",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
@@ -477,6 +482,30 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                         at(
                             turned(&m, 0, 0.0, [dx * t, dy * t, 0.0]),
                             format!("{t} along ({dx}, {dy})"),
+                            &mut bad,
+                        );
+                    }
+                }
+            }
+            PlatformMotion::Translation { .. } => {
+                // Out of the workspace sideways and down (the legs stretched: leg
+                // singularities, then out of reach), and up toward the base (the rods level
+                // out: leg and parallel singularities).
+                let dirs = [
+                    [1.0, 0.0, 0.0],
+                    [-1.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                    [0.0, 0.0, -1.0],
+                    [0.0, 0.0, 1.0],
+                    [0.6, 0.0, 0.8],
+                    [-0.6, 0.0, 0.8],
+                ];
+                for d in dirs {
+                    for s in 0..=800 {
+                        let t = 1.2 * s as f64 / 800.0;
+                        at(
+                            turned(&m, 0, 0.0, [d[0] * t, d[1] * t, d[2] * t]),
+                            format!("{t} m along {d:?}"),
                             &mut bad,
                         );
                     }

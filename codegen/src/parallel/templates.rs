@@ -18,7 +18,7 @@ const ACTUATION: &str = include_str!("../../templates/platform_actuation.rs");
 /// `retract` of coordinates that hold a quaternion.
 const RETRACT_QUATERNION: &str = include_str!("../../templates/platform_retract_quaternion.rs");
 /// `retract` of a planar point.
-const RETRACT_PLANAR: &str = include_str!("../../templates/platform_retract_planar.rs");
+const RETRACT_SUM: &str = include_str!("../../templates/platform_retract_sum.rs");
 /// `fk_residual` and `forward_kinematics`.
 const NEWTON: &str = include_str!("../../templates/platform_newton.rs");
 
@@ -165,7 +165,7 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
     let (quaternion, has_position) = match plan.motion {
         PlatformMotion::Pose => (3usize, true),
         PlatformMotion::Orientation { .. } => (0usize, false),
-        PlatformMotion::PlanarPoint { .. } => (0usize, false),
+        PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -174,8 +174,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .constant("FK_MAX_ITERATIONS", Literal::usize_unsuffixed(fk_max))
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
-    let retract = if matches!(plan.motion, PlatformMotion::PlanarPoint { .. }) {
-        sp.items(RETRACT_PLANAR, &["retract"])
+    let retract = if plan.motion.translates() {
+        sp.items(RETRACT_SUM, &["retract"])
     } else {
         sp.items(RETRACT_QUATERNION, &["retract"])
     };

@@ -28,6 +28,10 @@ pub(crate) struct Spec {
     pub scene: SceneSpec,
     /// `[[spring]]` force elements (TOML only; closed loops in joint coordinates).
     pub springs: Vec<SpringSpec>,
+    /// `[[parallelogram]]` elements (TOML only; translational platforms), already expanded
+    /// into `bodies` and `joints` (their equivalent rod, a U at the elbow and an S at the
+    /// platform); their names, for the mobility count.
+    pub parallelograms: Vec<String>,
 }
 
 /// A `[[spring]]` entry: a linear spring-damper between a point of `body_a` and one of
@@ -179,6 +183,8 @@ pub(crate) enum Coordinates {
     Orientation,
     /// Two DOF: a point moving in a plane `z = const` (a planar five-bar).
     Planar,
+    /// Three DOF: the platform's position, its orientation fixed (a Delta robot).
+    Translation,
 }
 
 /// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`

@@ -5,8 +5,8 @@
 //! By concept: [`syntax`] reports the parser's own errors; [`keys`] holds the key tables and
 //! the unknown-key check every table runs first; [`values`] reads the typed values (strings,
 //! numbers, angles, vectors, names, inertias); then one file per part of the spec —
-//! [`mechanism`] (the `[mechanism]` table), [`platform`], [`scene`], [`bodies`], [`joints`] and
-//! [`springs`]. The walk itself ([`Reader::spec`]) is here.
+//! [`mechanism`] (the `[mechanism]` table), [`platform`], [`scene`], [`bodies`], [`joints`],
+//! [`springs`] and [`parallelogram`]. The walk itself ([`Reader::spec`]) is here.
 
 use std::ops::Range;
 
@@ -20,6 +20,7 @@ mod bodies;
 mod joints;
 mod keys;
 mod mechanism;
+mod parallelogram;
 mod platform;
 mod scene;
 mod springs;
@@ -65,7 +66,8 @@ fn key_span(t: &DeTable<'_>, k: &str) -> Option<Range<usize>> {
 
 impl Reader<'_> {
     /// The whole file: `[mechanism]`, `[platform]`, `[scene]` (whose `gravity` overrides the
-    /// mechanism's), then `[[body]]`, `[[joint]]` and `[[spring]]`, in that order.
+    /// mechanism's), then `[[body]]`, `[[joint]]`, `[[spring]]` and `[[parallelogram]]` (expanded
+    /// into bodies and joints), in that order.
     fn spec(&mut self, root: &DeTable<'_>) -> Spec {
         self.unknown_keys(root, TOP_KEYS, "");
         let (name, mut gravity, anchor) = self.mechanism(root);
@@ -94,7 +96,12 @@ impl Reader<'_> {
             .into_iter()
             .filter_map(|(i, t, span)| self.spring(i, t, span))
             .collect();
-        Spec {
+        let parallelograms: Vec<_> = self
+            .entries(root, "parallelogram")
+            .into_iter()
+            .filter_map(|(i, t, span)| self.parallelogram(i, t, span))
+            .collect();
+        let mut spec = Spec {
             name,
             gravity,
             bodies,
@@ -104,7 +111,10 @@ impl Reader<'_> {
             platform,
             scene,
             springs,
-        }
+            parallelograms: Vec::new(),
+        };
+        self.expand_parallelograms(&mut spec, parallelograms);
+        spec
     }
 
     /// The tables of an array of tables `[[what]]`, with index and span.

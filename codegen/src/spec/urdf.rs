@@ -71,6 +71,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         platform: None,
         scene: Default::default(),
         springs: Vec::new(),
+        parallelograms: Vec::new(),
     })
 }
 

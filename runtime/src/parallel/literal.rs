@@ -77,6 +77,7 @@ fn end_map(motion: PlatformMotion, lk: &LegKin<f64>) -> DMatrix<f64> {
         }
         PlatformMotion::Orientation { .. } => DMatrix::identity(3, 3),
         PlatformMotion::PlanarPoint { .. } => DMatrix::identity(3, 2),
+        PlatformMotion::Translation { .. } => DMatrix::identity(3, 3),
     }
 }
 
@@ -94,6 +95,7 @@ fn end_motion(motion: PlatformMotion, lk: &LegKin<f64>, u: &[f64], ud: &[f64]) -
         }
         PlatformMotion::Orientation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         PlatformMotion::PlanarPoint { .. } => ([u[0], u[1], 0.0], [ud[0], ud[1], 0.0]),
+        PlatformMotion::Translation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
     }
 }
 
@@ -183,6 +185,14 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             t[(6 * b + 3, 0)] = 1.0;
             t[(6 * b + 4, 1)] = 1.0;
             put_body(&mut m, &mut gravity, b, Matrix3::zeros(), mass, g_world);
+        }
+        PlatformMotion::Translation { .. } => {
+            // T_P = S = [0; 1₃]: ω = 0 and every point moves with u, so Ṫ u = 0.
+            t.view_mut((6 * b + 3, 0), (3, 3))
+                .copy_from(&Matrix3::identity());
+            let rot = m3(&pl.rot);
+            let inertia = rot * m3(&inertia) * rot.transpose();
+            put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
         }
         PlatformMotion::Pose | PlatformMotion::Orientation { .. } => {
             let rot = m3(&pl.rot);

@@ -5,7 +5,9 @@
 //! # The model
 //! * The platform's independent coordinates are its pose ([`PlatformMotion::Pose`]:
 //!   `x = [px, py, pz, qw, qx, qy, qz]`, `u = [ω; v]`) or its orientation about a fixed centre
-//!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`). Base-frame components;
+//!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`), or its position with
+//!   the orientation fixed ([`PlatformMotion::Translation`]: `x = [px, py, pz]`, `u = v`; a Delta
+//!   robot). Base-frame components;
 //!   `v` is the velocity of the platform frame's origin.
 //! * Leg `J` is a serial chain of one-DOF joints (U joints arrive expanded into two revolutes with
 //!   a massless body between them) whose last body meets the platform in a spherical joint (pose)
@@ -49,6 +51,14 @@ pub enum PlatformMotion {
         /// The plane's height `z` (base frame, m).
         height: f64,
     },
+    /// Three DOF: the platform translates, its orientation fixed at `rotation` (its home
+    /// rotation, platform → base), as a Delta robot's. `x = [px, py, pz]`: the platform frame's
+    /// origin (m); `u = v` (m/s); the platform twist is `t = S u` with `S = [0; 1₃]`, `ω = 0`
+    /// (docs/method.md, "nocdyn's formulation").
+    Translation {
+        /// The platform's fixed rotation (platform → base).
+        rotation: crate::model::Mat3,
+    },
 }
 
 impl PlatformMotion {
@@ -58,6 +68,7 @@ impl PlatformMotion {
             PlatformMotion::Pose => 7,
             PlatformMotion::Orientation { .. } => 4,
             PlatformMotion::PlanarPoint { .. } => 2,
+            PlatformMotion::Translation { .. } => 3,
         }
     }
     /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
@@ -66,7 +77,16 @@ impl PlatformMotion {
             PlatformMotion::Pose => 6,
             PlatformMotion::Orientation { .. } => 3,
             PlatformMotion::PlanarPoint { .. } => 2,
+            PlatformMotion::Translation { .. } => 3,
         }
+    }
+    /// Whether the platform only translates (`PlanarPoint`, `Translation`): `u` is the
+    /// velocity of its origin, `ω = 0`, and `x ⊕ δu` is a sum.
+    pub fn translates(&self) -> bool {
+        matches!(
+            self,
+            PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. }
+        )
     }
 }
 
@@ -191,6 +211,7 @@ impl ParallelModel {
             PlatformMotion::PlanarPoint { .. } => {
                 alloc::vec![self.home.translation[0], self.home.translation[1]]
             }
+            PlatformMotion::Translation { .. } => self.home.translation.to_vec(),
         }
     }
 
@@ -303,6 +324,14 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
         (PlatformMotion::Pose, LegEnd::Spherical { .. }, [P, R, R]) if meet(1, 2) => LegKind::Pus,
         (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, R]) if meet(1, 2) => LegKind::Rus,
         (PlatformMotion::Pose, LegEnd::Spherical { .. }, [_, _, _]) => LegKind::Generic,
+        // A translational platform (a Delta): the crank, the U at the elbow and the rod of the
+        // parallelogram's equivalent (docs/spec.md, "Parallelograms") to the S at the platform.
+        (PlatformMotion::Translation { .. }, LegEnd::Spherical { .. }, [R, R, R]) if meet(1, 2) => {
+            LegKind::Rus
+        }
+        (PlatformMotion::Translation { .. }, LegEnd::Spherical { .. }, [_, _, _]) => {
+            LegKind::Generic
+        }
         (PlatformMotion::Orientation { centre }, LegEnd::Revolute { .. }, [R, R]) => {
             for (k, (e, p)) in ax.iter().enumerate() {
                 let off = cross(&sub(&centre, p), e);
@@ -334,6 +363,11 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
         (PlatformMotion::Pose, LegEnd::Revolute { .. }, _) => {
             return Err(format!(
                 "leg {name}: a 6-DOF platform needs legs that end in a spherical joint"
+            ));
+        }
+        (PlatformMotion::Translation { .. }, LegEnd::Revolute { .. }, _) => {
+            return Err(format!(
+                "leg {name}: a translational platform needs legs that end in a spherical joint"
             ));
         }
         (PlatformMotion::Orientation { .. }, LegEnd::Spherical { .. }, _) => {

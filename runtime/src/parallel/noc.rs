@@ -34,6 +34,9 @@
 //! One concept per file, in the order of an evaluation; this module re-exports their items.
 //! * `plan.rs`: [`Plan`] and [`LegPlan`], the constant data prepared once.
 //! * `ups.rs`: the closed-form UPS leg ([`UpsPlan`], [`UpsKin`], `ups_force`).
+//! * `delta.rs`: the closed-form Delta leg ([`DeltaPlan`], [`DeltaKin`], `delta_force`): a RUS
+//!   leg of a translational platform whose rod (a parallelogram's equivalent) has no spin
+//!   inertia, with the scalar leg Jacobian `s = d·(e₀ × (E − O))`.
 //! * `pose.rs`: step 1, the platform's pose ([`Platform`]).
 //! * `subproblems.rs`: the Paden–Kahan subproblems of step 2.
 //! * `legs.rs`: steps 2–3, [`leg_kinematics`] ([`LegKin`]) and [`kinematics`] of every leg;
@@ -57,6 +60,7 @@
 
 mod api;
 mod assembly;
+mod delta;
 mod dynamics;
 mod force;
 mod generic_leg;
@@ -77,6 +81,7 @@ pub use api::{
     inverse_dynamics, inverse_kinematics, leg_joint_positions, mass_matrix, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
+pub use delta::{DeltaKin, DeltaPlan};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
 pub use force::{generalized_force, generalized_force_with, payload_force};
 pub use generic_leg::{GENERIC_IK_ITERATIONS, GENERIC_IK_TOLERANCE};

@@ -61,6 +61,7 @@ impl Workspace for Platform {
             PlatformMotion::Pose => &["px", "py", "pz", "qw", "qx", "qy", "qz"],
             PlatformMotion::Orientation { .. } => &["qw", "qx", "qy", "qz"],
             PlatformMotion::PlanarPoint { .. } => &["px", "py"],
+            PlatformMotion::Translation { .. } => &["px", "py", "pz"],
         };
         names.iter().map(|n| String::from(*n)).collect()
     }
@@ -69,6 +70,7 @@ impl Workspace for Platform {
             PlatformMotion::Pose => [[Speed::Rotation; 3], [Speed::Translation; 3]].concat(),
             PlatformMotion::Orientation { .. } => vec![Speed::Rotation; 3],
             PlatformMotion::PlanarPoint { .. } => vec![Speed::Translation; 2],
+            PlatformMotion::Translation { .. } => vec![Speed::Translation; 3],
         }
     }
     fn displaced(&self, p: &[f64]) -> Vec<f64> {
@@ -89,13 +91,14 @@ impl Workspace for Platform {
             PlatformMotion::Pose => vec![pos(0), pos(1), pos(2), rot(0), rot(1), rot(2)],
             PlatformMotion::Orientation { .. } => vec![rot(0), rot(1), rot(2)],
             PlatformMotion::PlanarPoint { .. } => vec![pos(0), pos(1)],
+            PlatformMotion::Translation { .. } => vec![pos(0), pos(1), pos(2)],
         }
     }
     fn quaternion(&self) -> Option<usize> {
         match self.model.motion {
             PlatformMotion::Pose => Some(3),
             PlatformMotion::Orientation { .. } => Some(0),
-            PlatformMotion::PlanarPoint { .. } => None,
+            PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => None,
         }
     }
     fn inertia(&self, x: &[f64], space: Space) -> Result<DMatrix<f64>, EvalError> {
@@ -123,7 +126,9 @@ impl Workspace for Platform {
             Space::Platform => {
                 let (unit, acceleration) = match self.model.motion {
                     PlatformMotion::Orientation { .. } => ("kg m^2", "rad/s^2 per unit effort"),
-                    PlatformMotion::PlanarPoint { .. } => ("kg", "m/s^2 per unit effort"),
+                    PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => {
+                        ("kg", "m/s^2 per unit effort")
+                    }
                     PlatformMotion::Pose => ("kg m^2 | kg m | kg (mixed)", "mixed"),
                 };
                 InertiaWords {
@@ -142,8 +147,9 @@ impl Workspace for Platform {
             PlatformMotion::Pose => (0.1, 0.02 * self.model.size()),
             PlatformMotion::Orientation { .. } => (0.3, 0.0),
             PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
+            PlatformMotion::Translation { .. } => (0.0, 0.02 * self.model.size()),
         };
-        let planar = matches!(self.model.motion, PlatformMotion::PlanarPoint { .. });
+        let planar = self.model.motion.translates();
         (0..self.model.dof())
             .map(|i| if i < 3 && !planar { angle } else { reach })
             .collect()

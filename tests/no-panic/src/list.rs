@@ -30,6 +30,7 @@ macro_rules! for_each_mechanism {
             rus_hexapod,
             agile_eye,
             planar_five_bar,
+            delta_rl5,
             // Closed loops in joint coordinates.
             four_bar,
             five_bar_joints,

@@ -84,7 +84,8 @@ export_parallel!(
     sliding_hexapod,
     rus_hexapod,
     agile_eye,
-    planar_five_bar
+    planar_five_bar,
+    delta_rl5
 );
 
 macro_rules! export_closed {

@@ -134,6 +134,7 @@ fn check_closing_joint(
             Coordinates::Pose => (Kind::Spherical, "pose"),
             Coordinates::Orientation => (Kind::Revolute, "orientation"),
             Coordinates::Planar => (Kind::Revolute, "planar"),
+            Coordinates::Translation => (Kind::Spherical, "translation"),
         };
         if j.kind != want {
             diags.push(
@@ -145,7 +146,7 @@ fn check_closing_joint(
                 ))
                 .with_key(format!("{}.kind", j.key))
                 .with_span(j.kind_span.clone())
-                .with_hint("the joints into the platform close the legs' loops: spherical joints for a 6-DOF (pose) platform, revolute joints with axes through the centre for an orientation platform; attach bodies rigidly to the platform with fixed joints from the platform instead"),
+                .with_hint("the joints into the platform close the legs' loops: spherical joints for a 6-DOF (pose) or translational platform (a Delta's [[parallelogram]] brings its own), revolute joints with axes through the centre for an orientation platform; attach bodies rigidly to the platform with fixed joints from the platform instead"),
             );
         }
     }

@@ -31,7 +31,7 @@ const SUPPORTED_POSE: &[&[JointKind]] = &[
     ],
 ];
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
-pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point)";
+pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point); for coordinates = \"translation\" a revolute crank with a [[parallelogram]] (a Delta leg), or the legs of \"pose\"";
 
 /// The lowered tree with what the leg steps need: its topology, the build (model and
 /// bookkeeping), and the spec joints into the platform, one per leg in declared order.
@@ -280,7 +280,7 @@ fn check_leg_type(
     let (spec, model) = (tree.spec, &tree.built.model);
     let kinds: Vec<JointKind> = path.iter().map(|&k| model.joints[k].kind).collect();
     let supported = match motion {
-        Coordinates::Pose => SUPPORTED_POSE,
+        Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
     };
     if !supported.contains(&kinds.as_slice()) {

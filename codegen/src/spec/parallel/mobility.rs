@@ -20,9 +20,14 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Pose => (6i64, 6i64, "spatial, λ = 6"),
         Coordinates::Orientation => (3, 3, "spherical, λ = 3"),
         Coordinates::Planar => (3, 2, "planar, λ = 3"),
+        Coordinates::Translation => (6, 3, "spatial, λ = 6"),
     };
-    let n = spec.bodies.len() as i64 + 1;
-    let j = spec.joints.len() as i64;
+    // A parallelogram is counted as what it is, two rods with a ball joint at each end
+    // (2 bodies, 4 S joints), not as its expansion (the equivalent rod, a U and an S: 1 body,
+    // 2 joints, 5 freedoms); each rod's spin about its own axis is idle and does not count.
+    let pgs = spec.parallelograms.len() as i64;
+    let n = spec.bodies.len() as i64 + 1 + pgs;
+    let j = spec.joints.len() as i64 + 2 * pgs;
     let f: i64 = spec
         .joints
         .iter()
@@ -32,16 +37,18 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
             Kind::Spherical => 3,
             Kind::Fixed => 0,
         })
-        .sum();
+        .sum::<i64>()
+        + 7 * pgs;
     // A planar point platform's spin about the plane normal is idle (the point has no
     // orientation), so it does not count; a "platform" that the legs meet at different points
     // is a link whose spin they determine.
-    let idle = i64::from(coords == Coordinates::Planar && apart(spec, ps).is_none());
+    let idle = i64::from(coords == Coordinates::Planar && apart(spec, ps).is_none()) + 2 * pgs;
     let m = lambda * (n - j - 1) + f - idle;
     let coords_word = match coords {
         Coordinates::Pose => "pose",
         Coordinates::Orientation => "orientation",
         Coordinates::Planar => "planar",
+        Coordinates::Translation => "translation",
     };
     if m != dof {
         diags.push(
@@ -56,6 +63,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
                     Coordinates::Pose => ": each leg of a 6-DOF platform has six joint freedoms (UPS, PUS, RUS)",
                     Coordinates::Orientation => ": each leg of a spherical mechanism is R-R-R",
                     Coordinates::Planar => ": each leg of a planar five-bar is R-R, joined at the point by a revolute",
+                    Coordinates::Translation => ": each leg of a Delta is a revolute crank carrying a [[parallelogram]] (two ball–ball rods, their idle spins not counted)",
                 }
             )),
         );

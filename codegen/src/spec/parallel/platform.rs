@@ -31,7 +31,7 @@ pub(super) fn check_platform(
     diags: &mut Diagnostics,
 ) -> Option<usize> {
     match ps.coordinates {
-        Some(Coordinates::Pose) if ps.centre.is_some() => {
+        Some(Coordinates::Pose | Coordinates::Translation) if ps.centre.is_some() => {
             diags.push(
                 Diagnostic::error("`centre` is only for coordinates = \"orientation\"")
                     .with_key("platform.centre")
@@ -194,6 +194,9 @@ pub(super) fn assemble(
         Coordinates::Orientation => PlatformMotion::Orientation { centre },
         Coordinates::Planar => PlatformMotion::PlanarPoint {
             height: ps.home.translation[2],
+        },
+        Coordinates::Translation => PlatformMotion::Translation {
+            rotation: ps.home.rotation,
         },
     };
     let parts: Vec<MassProps> = parts

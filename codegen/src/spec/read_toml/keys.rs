@@ -6,7 +6,28 @@ use toml::de::DeTable;
 use super::Reader;
 use crate::spec::suggest_hint;
 
-pub(super) const TOP_KEYS: &[&str] = &["mechanism", "platform", "scene", "body", "joint", "spring"];
+pub(super) const TOP_KEYS: &[&str] = &[
+    "mechanism",
+    "platform",
+    "scene",
+    "body",
+    "joint",
+    "spring",
+    "parallelogram",
+];
+pub(super) const PARALLELOGRAM_KEYS: &[&str] = &[
+    "name",
+    "parent",
+    "child",
+    "elbow",
+    "platform_point",
+    "length",
+    "elbow_width",
+    "platform_width",
+    "rod_mass",
+    "rod_com",
+    "rod_inertia",
+];
 pub(super) const SPRING_KEYS: &[&str] = &[
     "name",
     "body_a",

@@ -66,20 +66,21 @@ impl Reader<'_> {
         Some(p)
     }
 
-    /// `platform.coordinates`: `"pose"`, `"orientation"` or `"planar"`.
+    /// `platform.coordinates`: `"pose"`, `"orientation"`, `"planar"` or `"translation"`.
     fn coordinates(&mut self, c: &Val<'_>) -> Option<Coordinates> {
         let s = self.string(c, "platform.coordinates")?;
         match s.as_str() {
             "pose" => Some(Coordinates::Pose),
             "orientation" => Some(Coordinates::Orientation),
             "planar" => Some(Coordinates::Planar),
+            "translation" => Some(Coordinates::Translation),
             other => {
                 let hint = suggest_hint(
                     &other.to_ascii_lowercase(),
-                    &["pose", "orientation", "planar"],
+                    &["pose", "orientation", "planar", "translation"],
                 )
                 .unwrap_or_else(|| {
-                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF) or \"planar\" (a point in a plane, 2 DOF)".into()
+                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF) or \"translation\" (position, orientation fixed, 3 DOF)".into()
                 });
                 self.err(
                     format!("unknown platform coordinates {other:?}"),

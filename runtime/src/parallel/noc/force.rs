@@ -5,6 +5,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::delta::delta_force;
 use super::legs::LegKin;
 use super::motion::leg_motion;
 use super::plan::Plan;
@@ -43,8 +44,9 @@ pub fn generalized_force_with<R: Real>(
     let dof = plan.dof();
     let mut f: Vec<R> = vec![R::c(0.0); dof];
     let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
-    let planar = matches!(plan.motion, PlatformMotion::PlanarPoint { .. });
-    // Platform angular velocity and acceleration (a planar point does not turn).
+    let planar = plan.motion.translates();
+    // Platform angular velocity and acceleration (a planar point or a translational platform
+    // does not turn).
     let (w, wd) = if planar {
         (zero3::<R>(), zero3::<R>())
     } else {
@@ -66,9 +68,25 @@ pub fn generalized_force_with<R: Real>(
                 let z = R::c(0.0);
                 ([u[0], u[1], z], [ud[0], ud[1], z])
             }
+            // t = S u, S = [0; 1₃]: every platform point moves with u.
+            PlatformMotion::Translation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         };
+        if let (Some(dp), Some(dk), None) = (&lp.delta, &lk.delta, drives) {
+            // A translational platform's legs end at points moving with v: G = 1₃.
+            let y = delta_force(dp, dk, &lk.frame, v_end, a_end, cv(&g_world));
+            for i in 0..3 {
+                f[i] = f[i] + y[i];
+            }
+            continue;
+        }
         if let (Some(up), Some(uk), None) = (&lp.ups, &lk.ups, drives) {
             let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
+            if let PlatformMotion::Translation { .. } = plan.motion {
+                for i in 0..3 {
+                    f[i] = f[i] + y[i];
+                }
+                continue;
+            }
             let m = cross(lk.arm, y);
             for i in 0..3 {
                 f[i] = f[i] + m[i];
@@ -123,7 +141,7 @@ pub fn generalized_force_with<R: Real>(
                     f[3 + i] = f[3 + i] + y[i];
                 }
             }
-            PlatformMotion::Orientation { .. } => {
+            PlatformMotion::Orientation { .. } | PlatformMotion::Translation { .. } => {
                 for i in 0..3 {
                     f[i] = f[i] + y[i];
                 }
@@ -137,9 +155,10 @@ pub fn generalized_force_with<R: Real>(
     }
     // The platform.
     if planar {
-        // A point mass at P.
+        // A point mass at P (planar), or a body that only translates: Newton's m (a − g), the
+        // same for every point, so its mass centre and inertia do not enter.
         let (mass, _, _) = plan.platform;
-        for i in 0..2 {
+        for i in 0..dof {
             f[i] = f[i] + R::c(mass) * (ud[i] - R::c(g_world[i]));
         }
         return f;
@@ -148,7 +167,7 @@ pub fn generalized_force_with<R: Real>(
     let r = mv(&pl.rot, cv::<R>(&com));
     let (a0,) = match plan.motion {
         PlatformMotion::Pose => ([ud[3], ud[4], ud[5]],),
-        PlatformMotion::Orientation { .. } | PlatformMotion::PlanarPoint { .. } => (zero3::<R>(),),
+        _ => (zero3::<R>(),),
     };
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(R::c(mass), sub(a, cv(&g_world)));
@@ -178,8 +197,8 @@ pub fn payload_force<R: Real>(
     let n = plan.dof();
     let mut f = vec![R::c(0.0); n];
     let g: V<R> = cv(&if gravity { plan.gravity } else { [0.0; 3] });
-    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
-        for i in 0..2 {
+    if plan.motion.translates() {
+        for i in 0..n {
             f[i] = payload.mass * (ud[i] - g[i]);
         }
         return f;

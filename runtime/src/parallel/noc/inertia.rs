@@ -5,6 +5,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::delta::delta_inertia;
 use super::force::generalized_force;
 use super::legs::LegKin;
 use super::plan::{LegPlan, Plan};
@@ -47,7 +48,7 @@ pub fn payload_inertia<R: Real>(
     let n = plan.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
-    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+    if plan.motion.translates() {
         for (i, row) in out.iter_mut().enumerate() {
             row[i] = payload.mass;
         }
@@ -126,8 +127,9 @@ pub fn generalized_inertia_with<R: Real>(
                 (a != 0.0).then(|| R::c(a))
             }),
         };
-        let lam = match (&lp.ups, &lk.ups, drives) {
-            (Some(up), Some(uk), None) => ups_inertia(up, uk),
+        let lam = match (&lp.ups, &lk.ups, &lp.delta, &lk.delta, drives) {
+            (Some(up), Some(uk), _, _, None) => ups_inertia(up, uk),
+            (_, _, Some(dp), Some(dk), None) => delta_inertia(dp, dk, &lk.frame),
             _ => leg_end_inertia(lp, lk, &armature),
         };
         if pose {
@@ -150,7 +152,8 @@ pub fn generalized_inertia_with<R: Real>(
                 }
             }
         } else {
-            // Orientation (u = ω) or planar point (u = in-plane velocity): I += Λ's block.
+            // Orientation (u = ω), planar point (u = in-plane velocity) or translation (u = v):
+            // I += Λ's block.
             for i in 0..n {
                 for j in 0..n {
                     out[i][j] = out[i][j] + lam[i][j];
@@ -158,7 +161,7 @@ pub fn generalized_inertia_with<R: Real>(
             }
         }
     }
-    if let PlatformMotion::PlanarPoint { .. } = plan.motion {
+    if plan.motion.translates() {
         let (mass, _, _) = plan.platform;
         for i in 0..n {
             out[i][i] = out[i][i] + R::c(mass);

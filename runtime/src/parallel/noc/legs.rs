@@ -9,6 +9,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::LEG_TOLERANCE;
+use super::delta::{DeltaKin, delta_kin};
 use super::generic_leg::generic_ik;
 use super::plan::{LegPlan, Plan, sub3};
 use super::pose::{Platform, platform};
@@ -51,6 +52,8 @@ pub struct LegKin<R> {
     pub arm: V<R>,
     /// The closed-form UPS leg's frame (when [`LegPlan::ups`] is set).
     pub ups: Option<UpsKin<R>>,
+    /// The closed-form Delta leg's configuration (when [`LegPlan::delta`] is set).
+    pub delta: Option<DeltaKin<R>>,
 }
 
 /// Inverse kinematics, pose and Jacobian of leg `k` for the platform pose `pl`. Each test is
@@ -77,6 +80,10 @@ pub fn leg_kinematics<R: Real>(
         _ => add(mv(&chain.g, cv(&lp.end_home)), chain.t),
     };
     let jinv = jacobian_inverse(lp, k, &chain.e, &chain.o, end, jacobian)?;
+    let delta = match (&lp.delta, q[0]) {
+        (Some(dp), JointPos::R(s, c)) => Some(delta_kin(dp, k, (s, c), target, jacobian)?),
+        _ => None,
+    };
     Ok(LegKin {
         q,
         e: chain.e,
@@ -88,6 +95,7 @@ pub fn leg_kinematics<R: Real>(
         frame: fr,
         arm,
         ups,
+        delta,
     })
 }
 
@@ -236,7 +244,10 @@ fn rus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<
     // The rod direction in the crank's home frame.
     let qv = mtv(&r0, sub(target, u));
     let p = sub3(&lp.end_home, &lp.u_centre);
-    let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
+    // A Delta leg's U angles serve only the positions (its closed form does not use them, and
+    // its own test covers the leg): unchecked.
+    let check = lp.delta.is_none();
+    let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, check)?;
     q.push(JointPos::R(s0, c0));
     q.push(JointPos::R(a.0, a.1));
     q.push(JointPos::R(b.0, b.1));
@@ -372,7 +383,7 @@ fn jacobian_inverse<R: Real>(
     let r2 = cross(cols[0], cols[1]);
     let det = dot(cols[0], r0);
     let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
-    let det = if jacobian && lp.ups.is_none() {
+    let det = if jacobian && lp.ups.is_none() && lp.delta.is_none() {
         R::check(
             det,
             R::c(R::tolerance(LEG_TOLERANCE)) * hn,
@@ -434,9 +445,11 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
         .map(|(lp, lk)| {
             // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a; for a
             // closed-form UPS leg the prismatic rate is ±ρ̇ = ±s·v_end.
-            let g = match &lk.ups {
-                Some(uk) => scale(R::c(lp.sigma_first), uk.s),
-                None => mv(&lk.frame, lk.jinv[lp.actuated]),
+            // a Delta leg's crank rate is q̇ = (d/s)·v_end.
+            let g = match (&lk.ups, &lk.delta) {
+                (Some(uk), _) => scale(R::c(lp.sigma_first), uk.s),
+                (None, Some(dk)) => mv(&lk.frame, scale(dk.inv_s, dk.d)),
+                (None, None) => mv(&lk.frame, lk.jinv[lp.actuated]),
             };
             match plan.motion {
                 PlatformMotion::Pose => {
@@ -445,6 +458,7 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                 }
                 PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
                 PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
+                PlatformMotion::Translation { .. } => vec![g[0], g[1], g[2]],
             }
         })
         .collect()

@@ -7,6 +7,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::api::inverse_dynamics;
+use super::delta::{DeltaPlan, delta_plan};
 use super::subproblems::rus_crank;
 use super::ups::{UpsPlan, ups_plan};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
@@ -51,6 +52,9 @@ pub struct LegPlan {
     /// The closed form of a UPS leg (see [`UpsPlan`]); `None` for other legs, or a UPS leg
     /// whose geometry it does not cover (those take the generic route).
     pub ups: Option<UpsPlan>,
+    /// The closed form of a Delta leg (see [`DeltaPlan`]): a RUS leg of a translational
+    /// platform whose rod has no spin inertia; `None` otherwise.
+    pub delta: Option<DeltaPlan>,
 }
 
 /// The constant data of a whole mechanism: what the evaluators need, prepared once.
@@ -172,6 +176,7 @@ impl Plan {
                 sigma_u: 1.0,
                 sigma_first: 1.0,
                 ups: None,
+                delta: None,
             };
             match kind {
                 LegKind::Ups => {
@@ -204,6 +209,11 @@ impl Plan {
                         }
                     }
                     plan.sigma_first = best.1;
+                    if kind == LegKind::Rus
+                        && matches!(model.motion, PlatformMotion::Translation { .. })
+                    {
+                        plan.delta = delta_plan(&plan);
+                    }
                 }
                 LegKind::SphericalRr => {
                     plan.sigma_u = sign(dot3(&end_home, &k));

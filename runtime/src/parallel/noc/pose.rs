@@ -2,7 +2,7 @@
 //! normalized on the fly, and its origin).
 
 use super::plan::Plan;
-use crate::algebra::{M, V, cv, ident};
+use crate::algebra::{M, V, cm, cv, ident};
 use crate::parallel::PlatformMotion;
 use crate::scalar::{Real, Singular, Site};
 
@@ -15,7 +15,8 @@ pub struct Platform<R> {
     pub origin: V<R>,
 }
 
-/// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`); the quaternion need not
+/// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`, `Translation`: `p` with
+/// the fixed rotation); the quaternion need not
 /// be unit (it is normalized), but it must not be zero (`Err(Site::Platform)`).
 pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> {
     let (origin, q) = match plan.motion {
@@ -25,6 +26,12 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             return Ok(Platform {
                 rot: ident(),
                 origin: [x[0], x[1], R::c(height)],
+            });
+        }
+        PlatformMotion::Translation { rotation } => {
+            return Ok(Platform {
+                rot: cm(&rotation),
+                origin: [x[0], x[1], x[2]],
             });
         }
     };

@@ -1,0 +1,159 @@
+//! The Delta robot (`mechanisms/specs/delta_rl5.toml`: a translational platform, three legs of a
+//! revolute crank and a parallelogram) against two independent routes:
+//! - the same machine in joint coordinates (`tests/data/delta_rl5_joints.toml`, 3-RUU: each
+//!   parallelogram one rod of twice the mass and transverse inertia with no spin inertia, a U at
+//!   the elbow and at the platform), evaluated by the closed-loop route
+//!   (`runtime::closed::noc`: its own loop equations, Newton assembly and `Φ_d` solves);
+//! - Newton–Euler of every body with the joint reactions and efforts as Lagrange multipliers
+//!   (`references::lagrange`), the platform's S joints replaced by the U joints of the 3-RUU, so
+//!   that the reactions can hold the platform's orientation.
+//!
+//! Errors are relative, `‖a − b‖∞ / ‖b‖∞`.
+
+use runtime::closed::noc as cnoc;
+use runtime::parallel::literal;
+use runtime::parallel::noc::{self, Plan};
+use tests::pkm::{model, random_state, rel};
+
+/// Random regular states per check.
+const STATES: usize = 500;
+
+fn joints_model() -> runtime::closed::ClosedModel {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/delta_rl5_joints.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("not a closed-loop mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+fn mat_vec(a: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
+    a.iter()
+        .map(|r| r.iter().zip(v).map(|(x, y)| x * y).sum())
+        .collect()
+}
+
+/// The platform form and the joint-coordinate form agree at corresponding states: `q` by the
+/// platform's inverse kinematics, the joint coordinates `x_J` by the closed route's assembly
+/// from `q`, `q̇ = A v`, `q̈ = A a + Ȧ v` (`Ȧ v` the actuated rows of the literal route's
+/// `L̇ u`, kinematics only). Inverse dynamics, actuator-space inertia `A⁻ᵀ I A⁻¹` against the
+/// closed route's `I`, and forward dynamics (`q̈` of the closed route against `A u̇ + Ȧ v`).
+#[test]
+fn delta_in_joint_coordinates_matches_the_platform_form() {
+    let pm = model("delta_rl5");
+    let pplan = Plan::new(&pm).unwrap();
+    let jm = joints_model();
+    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let home = pm.home_x();
+    let mut rng = tests::rng(0xde17a);
+    let mut worst = [0.0f64; 3];
+    for _ in 0..STATES {
+        let (p, v, a) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
+        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
+        let t = literal::terms(&pplan, &p, &v).unwrap();
+        let amat: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
+            .collect();
+        let bias: Vec<f64> = pplan
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
+            .collect();
+        let qd = mat_vec(&amat, &v);
+        let qdd: Vec<f64> = mat_vec(&amat, &a)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        // Inverse dynamics.
+        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
+        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
+        worst[0] = worst[0].max(rel(&tp, &tj));
+        // Actuator-space inertia.
+        let mp = noc::actuator_mass_matrix(&pplan, &p).unwrap();
+        let mj = cnoc::mass_matrix(&jplan, &x).unwrap();
+        worst[1] = worst[1].max(rel(&mp.concat(), &mj.concat()));
+        // Forward dynamics under the same efforts.
+        let tau: Vec<f64> = tp
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 10.0 * (i as f64 - 1.0))
+            .collect();
+        let ap = noc::forward_dynamics(&pplan, &p, &v, &tau).unwrap();
+        let qdd_p: Vec<f64> = mat_vec(&amat, &ap)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        let qdd_j = cnoc::forward_dynamics(&jplan, &x, &qd, &tau).unwrap();
+        worst[2] = worst[2].max(rel(&qdd_p, &qdd_j));
+    }
+    println!(
+        "delta_rl5: platform form vs joint coordinates over {STATES} states, worst relative error (∞-norm): ID {:.1e}, A⁻ᵀIA⁻¹ vs I_J {:.1e}, FD {:.1e}",
+        worst[0], worst[1], worst[2]
+    );
+    for w in worst {
+        assert!(w <= 1e-12, "{worst:?}");
+    }
+}
+
+/// The generated inverse dynamics against Newton–Euler with Lagrange multipliers, the platform's
+/// orientation held by U joints at the rods' platform ends (axes `n = a × d` on the rod, the
+/// motor axis `a` on the platform), its motion prescribed as `ω = 0`, `v`.
+#[test]
+fn delta_against_lagrange_multipliers() {
+    use mechanisms::delta_rl5 as g;
+    use references::lagrange::{self, CJointKind, Prescribed};
+    let m = model("delta_rl5");
+    let plan = Plan::new(&m).unwrap();
+    let home = m.home_x();
+    let mut rng = tests::rng(0x1a9de);
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let (x, u, ud) = random_state(&plan, &home, &mut rng, 0.0, 0.05 * m.size());
+        let leg_q = noc::leg_joint_positions(&plan, &x).unwrap();
+        let mut sys = lagrange::from_parallel(&m, &leg_q, &x);
+        assert!(lagrange::closure_residual(&sys) < 1e-12 * m.size());
+        let platform = sys.bodies.len() - 1;
+        let (_, legs) = noc::kinematics(&plan, &x).unwrap();
+        let ends: Vec<usize> = (0..sys.joints.len())
+            .filter(|&j| sys.joints[j].child == platform)
+            .collect();
+        for (&j, lk) in ends.iter().zip(&legs) {
+            let f = |v: [f64; 3]| runtime::model::mat_vec(&lk.frame, &v);
+            let a = f(lk.e[0]);
+            let d = f([
+                lk.end[0] - lk.o[1][0],
+                lk.end[1] - lk.o[1][1],
+                lk.end[2] - lk.o[1][2],
+            ]);
+            let n = [
+                a[1] * d[2] - a[2] * d[1],
+                a[2] * d[0] - a[0] * d[2],
+                a[0] * d[1] - a[1] * d[0],
+            ];
+            let nn = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            sys.joints[j].kind = CJointKind::Universal {
+                axis_parent: [n[0] / nn, n[1] / nn, n[2] / nn],
+                axis_child: a,
+            };
+        }
+        let prescribed = Prescribed::Pose {
+            body: platform,
+            point: [x[0], x[1], x[2]],
+        };
+        let uu = [0.0, 0.0, 0.0, u[0], u[1], u[2]];
+        let uud = [0.0, 0.0, 0.0, ud[0], ud[1], ud[2]];
+        let sol = lagrange::inverse_dynamics(&sys, &prescribed, &uu, &uud).unwrap();
+        let xa: [f64; 3] = x.clone().try_into().unwrap();
+        let tau = g::inverse_dynamics(&xa, &[u[0], u[1], u[2]], &[ud[0], ud[1], ud[2]]).unwrap();
+        worst = worst.max(rel(&tau, &sol.efforts));
+    }
+    println!(
+        "delta_rl5: generated vs Lagrange multipliers (3-RUU), worst relative error (∞-norm): {worst:.1e}"
+    );
+    assert!(worst <= 1e-10, "{worst:e}");
+}
