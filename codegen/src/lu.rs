@@ -11,13 +11,17 @@
 //! - at step `k` each lower row `i` is swapped into row `k` by selects when `|m_ik| > |m_kk|`,
 //!   so row `k` ends with the largest entry of the column (the pivot a search would choose, the
 //!   first one on ties) without a data-dependent branch;
-//! - the tolerance test is that of the matrix with its columns scaled to unit 2-norm (scaling
-//!   the columns changes neither the pivots chosen nor, in exact arithmetic, the solution): the
-//!   scaled pivot `|p_k|/‖a_k‖` must exceed `tol` times the largest scaled pivot so far. It is
-//!   compared squared and cross-multiplied, `p_k² · d > tol² · n · ‖a_k‖²` with the largest so
-//!   far kept as the fraction `n / d`, so the test needs neither a square root nor a division;
+//! - the tolerance test is that of the matrix with each column scaled by the largest 2-norm of
+//!   its unit group (`PlatformMotion::unit_groups`: the speeds in rad/s, those in m/s), so the
+//!   test does not depend on the units, yet a column that shrinks against the others of its
+//!   unit (the platform moving along that speed with the actuators still) is a small pivot
+//!   (scaling changes neither the pivots chosen nor, in exact arithmetic, the solution): the
+//!   scaled pivot `|p_k|/g_k` (`g_k` the group's largest column norm) must exceed `tol` times
+//!   the larger of 1 and the largest scaled pivot so far. It is compared squared and
+//!   cross-multiplied, `p_k² · d > tol² · n · g_k²` with the largest so far kept as the
+//!   fraction `n / d` (starting at 1), so the test needs neither a square root nor a division;
 //!   those are spent only on the error path (the scaled pivot and the condition estimate
-//!   `max_j (|p_j|/‖a_j‖) / (|p_k|/‖a_k‖)` reported in `Singular`);
+//!   reported in `Singular`);
 //! - back substitution multiplies by the reciprocal pivots kept from the elimination;
 //! - `Aᵀ τ = f` factorizes `A`, not `Aᵀ`: its swaps and multipliers are kept, and the solve
 //!   runs `Uᵀ` forward, then `Lᵀ` and the swaps backward (LINPACK's `dgesl`). All three
@@ -52,6 +56,9 @@ pub(crate) struct LuSolve<'a> {
     pub rhs: Rhs,
     /// The squared pivot tolerance, `tol²`.
     pub tol2: f64,
+    /// The unit group of each column (`PlatformMotion::unit_groups`): a column's pivot is
+    /// scaled by the largest column norm of its group.
+    pub groups: &'a [usize],
     /// The square-root call of the chosen math backend, applied to the tokens given.
     pub sqrt: &'a dyn Fn(TokenStream) -> TokenStream,
 }
@@ -121,7 +128,10 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
     let tr = s.transpose;
     load_locals(s, k_rhs, &mut st);
     column_norms(n, &mut st);
-    st.push(quote!(let pn: #real = 0.0;));
+    group_norms(s, &mut st);
+    // The largest column of a group has unit norm once scaled: a pivot is compared with 1 as
+    // well as with the largest before it.
+    st.push(quote!(let pn: #real = 1.0;));
     st.push(quote!(let pd: #real = 1.0;));
     for k in 0..n {
         elimination_step(s, k, k_rhs, &tol2, &mut st);
@@ -176,6 +186,33 @@ fn column_norms(n: usize, st: &mut Vec<TokenStream>) {
     }
 }
 
+/// The column norm a pivot is scaled by: `g{j}`, the largest `n{i}` of column `j`'s unit group
+/// (by selects, NaN left out), the same for every column of a group.
+fn group_norms(s: &LuSolve<'_>, st: &mut Vec<TokenStream>) {
+    let group = |j: usize| s.groups.get(j).copied().unwrap_or(0);
+    for j in 0..s.n {
+        let gj = g(j);
+        let first = (0..s.n).find(|&i| group(i) == group(j)).unwrap_or(j);
+        if first < j {
+            let g_first = g(first);
+            st.push(quote!(let #gj = #g_first;));
+            continue;
+        }
+        let n0 = format_ident!("n{}", j);
+        st.push(quote!(let #gj = #n0;));
+        for i in j + 1..s.n {
+            if group(i) == group(j) {
+                let ni = format_ident!("n{}", i);
+                st.push(quote!(let #gj = if #ni > #gj { #ni } else { #gj };));
+            }
+        }
+    }
+}
+
+fn g(j: usize) -> Ident {
+    format_ident!("g{}", j)
+}
+
 /// Step `k` of the elimination: the conditional swaps, the pivot's test, its reciprocal and
 /// the elimination below it.
 fn elimination_step(
@@ -189,8 +226,8 @@ fn elimination_step(
     pivot_swaps(n, k, k_rhs, tr, st);
     pivot_test(s, k, tol2, st);
     if k + 1 < n {
-        let nk = format_ident!("n{}", k);
-        st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #nk) } else { (pn, pd) };));
+        let gk = g(k);
+        st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #gk) } else { (pn, pd) };));
     }
     let (kk, rk) = (m(k, k), format_ident!("r{}", k));
     st.push(quote!(let #rk = 1.0 / #kk;));
@@ -223,7 +260,7 @@ fn pivot_test(s: &LuSolve<'_>, k: usize, tol2: &Literal, st: &mut Vec<TokenStrea
     let real = crate::emit::real();
     let kk = m(k, k);
     let kl = Literal::usize_unsuffixed(k);
-    let nk = format_ident!("n{}", k);
+    let nk = g(k);
     let sqrt_n = (s.sqrt)(quote!(s));
     st.push(quote! {
         let best = if #kk < 0.0 { -#kk } else { #kk };

@@ -126,11 +126,15 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
 /// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: squared column
 /// norms, partial pivoting, `k` right-hand sides (`lu_solve` is `k = 1`, `lu_inverse` is
 /// `k = n`). The error paths (a square root and a division each) are not counted.
-pub fn lu_many_ops(n: usize, k: usize) -> OpCount {
+pub fn lu_many_ops(n: usize, k: usize, groups: &[usize]) -> OpCount {
     let mut c = OpCount::default();
-    // Squared column norms (for the scale-free pivot test).
+    // Squared column norms (for the scale-free pivot test), and each unit group's largest.
     c.mul += n * n;
     c.add += n * (n - 1);
+    let distinct = (0..n)
+        .filter(|&j| (0..j).all(|i| groups.get(i) != groups.get(j)))
+        .count();
+    c.cmp += n - distinct;
     for p in 0..n {
         let rows = n - p - 1;
         // The pivot's conditional swaps (one comparison per lower row); its square and the
@@ -151,14 +155,14 @@ pub fn lu_many_ops(n: usize, k: usize) -> OpCount {
 }
 
 /// Operation count of `lu_solve` (one right-hand side).
-pub fn lu_ops(n: usize) -> OpCount {
-    lu_many_ops(n, 1)
+pub fn lu_ops(n: usize, groups: &[usize]) -> OpCount {
+    lu_many_ops(n, 1, groups)
 }
 
 /// Operation count of `lu_inverse` followed by `A⁻ᵀ I A⁻¹` (`I A⁻¹` in full, then the upper
 /// triangle of `A⁻ᵀ (I A⁻¹)`).
-pub fn lu_inverse_ops(n: usize) -> OpCount {
-    let mut c = lu_many_ops(n, n);
+pub fn lu_inverse_ops(n: usize, groups: &[usize]) -> OpCount {
+    let mut c = lu_many_ops(n, n, groups);
     let tri = n * (n + 1) / 2;
     c.mul += n * n * n + tri * n;
     c.add += (n * n + tri) * (n - 1);
@@ -194,7 +198,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     })?;
     let n = plan.dof();
     let functions = functions(&k, &plan, &layout, &want);
-    let stats = stats(&functions, n, &want);
+    let stats = stats(&functions, n, plan.motion.unit_groups(), &want);
     let header = header(model, &plan, &layout, cfg, &stats);
     let items = items(model, &plan, params, &layout, cfg, &want);
     let code = module::render(
@@ -334,6 +338,7 @@ fn functions(
 fn stats(
     functions: &[Function<'_>],
     n: usize,
+    groups: &[usize],
     want: &dyn Fn(&str) -> bool,
 ) -> Vec<(String, OpCount)> {
     let ops = |name: &str| {
@@ -343,7 +348,7 @@ fn stats(
             .map(|f| f.schedule.ops)
             .unwrap_or_default()
     };
-    let lu = lu_ops(n);
+    let lu = lu_ops(n, groups);
     let stats: Vec<(String, OpCount)> = vec![
         ("inverse_kinematics".into(), ops("inverse_kinematics")),
         ("actuator_rates".into(), ops("actuator_rates")),
@@ -351,7 +356,7 @@ fn stats(
         ("mass_matrix".into(), ops("mass_matrix")),
         (
             "actuator_mass_matrix".into(),
-            plus(ops("inertia_parts"), lu_inverse_ops(n), 1),
+            plus(ops("inertia_parts"), lu_inverse_ops(n, groups), 1),
         ),
         ("forward_dynamics".into(), ops("forward_dynamics")),
         (

@@ -737,10 +737,24 @@ fn delta_stretched_leg_singularity() {
 /// a regular-looking matrix, so the test misses it; see the report of issue 20.)
 #[test]
 fn delta_parallel_singularity() {
+    delta_type_two(0.1);
+}
+
+/// The Delta's type-II singularity on its symmetry plane `y = 0`: there the uncontrollable
+/// direction is the `x` axis, so a column of `A` vanishes while the others stay. Scaling each
+/// column by its own norm made that `A` look regular (`Ok` with errors up to 6e-2 at 1e-11 m);
+/// the columns of one unit group are scaled together now (`PlatformMotion::unit_groups`).
+#[test]
+fn delta_parallel_singularity_on_its_symmetry_plane() {
+    delta_type_two(0.0);
+}
+
+/// A walk in `x` toward the Delta's type-II singularity at height `z = −0.6 m` and `y`.
+fn delta_type_two(y: f64) {
     let m = model("delta_rl5");
     let plan = plan(&m);
     let det = |x: f64| {
-        let a = noc::actuation(&plan, &[x, 0.1, -0.6]).unwrap();
+        let a = noc::actuation(&plan, &[x, y, -0.6]).unwrap();
         a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
             - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
             + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
@@ -759,12 +773,12 @@ fn delta_parallel_singularity() {
         }
     }
     let xs = lo;
-    println!("Delta: det A changes sign at x* = {xs} m (y = 0.1 m, z = -0.6 m)");
+    println!("Delta: det A changes sign at x* = {xs} m (y = {y} m, z = -0.6 m)");
     let walk: Vec<Point> = deltas()
         .into_iter()
         .map(|d| Point {
             delta: d,
-            x: vec![xs - d, 0.1, -0.6],
+            x: vec![xs - d, y, -0.6],
         })
         .collect();
     let bad = walk_report(

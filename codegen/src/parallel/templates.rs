@@ -36,7 +36,7 @@ pub(super) fn templates(
         cfg,
         plan,
         "lu_solve",
-        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with its columns scaled to unit 2-norm must exceed the tolerance times the\n largest so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of the largest scaled\n pivot to this one as the condition estimate.",
+        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with each column scaled by the largest 2-norm of its unit group (the speeds\n in rad/s, those in m/s) must exceed the tolerance times the larger of 1 and the largest\n pivot so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of that reference to\n this pivot as the condition estimate.",
         false,
         lu::Rhs::Vector,
     );
@@ -97,7 +97,7 @@ fn error_types() -> TokenStream {
         " Leg `k`'s Jacobian is singular: `|det J| ≤ {leg_tol:e} · ∏‖columns‖` (a leg, type-I, singularity)."
     );
     let act_doc = format!(
-        " Pivot `i` of the actuation matrix `A` (columns scaled to unit norm, partial pivoting) is `≤ {act_tol:e}` times the largest pivot: a parallel (type-II) singularity."
+        " Pivot `i` of the actuation matrix `A` (each column scaled by the largest norm of its unit group, partial pivoting) is `≤ {act_tol:e}` times the larger of 1 and the largest pivot: a parallel (type-II) singularity."
     );
     let errors = crate::module::error_types(
         "Which matrix, leg or pivot.",
@@ -149,6 +149,7 @@ fn lu_fn(
         transpose,
         rhs,
         tol2: act_tol2,
+        groups: plan.motion.unit_groups(),
         sqrt: &sqrt_call,
     })
 }

@@ -271,16 +271,26 @@ pub fn generalized_force(plan: &Plan, terms: &Terms, u: &[f64], ud: &[f64]) -> D
 }
 
 /// The LU factorization with partial pivoting (`nalgebra`) of the column-scaled actuation
-/// matrix `Â = A D⁻¹` (`D` the columns' largest magnitudes), or of `Âᵀ`; `Err(Actuation(i))`
-/// when the smallest pivot falls below [`ACTUATION_TOLERANCE`] times the largest (the threshold
-/// of [`super::noc::lu_solve`]). Returns the factorization and `D`.
+/// matrix `Â = A D⁻¹` (`D` the largest magnitude of each column's unit group,
+/// `PlatformMotion::unit_groups`), or of `Âᵀ`; `Err(Actuation(i))` when the smallest pivot
+/// falls below [`ACTUATION_TOLERANCE`] times the largest or 1 (the threshold of
+/// [`super::noc::lu_solve`]). Returns the factorization and `D`.
 type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 
-fn actuation_lu(a: &DMatrix<f64>, transpose: bool) -> Result<(Lu, DVector<f64>), Singular> {
-    let scale = DVector::from_iterator(
-        a.ncols(),
-        a.column_iter().map(|c| c.amax().max(f64::MIN_POSITIVE)),
-    );
+fn actuation_lu(
+    a: &DMatrix<f64>,
+    transpose: bool,
+    groups: &[usize],
+) -> Result<(Lu, DVector<f64>), Singular> {
+    // Each column scaled by the largest magnitude in its unit group.
+    let amax: alloc::vec::Vec<f64> = a.column_iter().map(|c| c.amax()).collect();
+    let group = |j: usize| groups.get(j).copied().unwrap_or(0);
+    let scale = DVector::from_fn(a.ncols(), |j, _| {
+        (0..a.ncols())
+            .filter(|&i| group(i) == group(j))
+            .map(|i| amax[i])
+            .fold(f64::MIN_POSITIVE, f64::max)
+    });
     let scaled = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / scale[j]);
     let lu = if transpose {
         scaled.transpose()
@@ -289,7 +299,8 @@ fn actuation_lu(a: &DMatrix<f64>, transpose: bool) -> Result<(Lu, DVector<f64>),
     }
     .lu();
     let d = lu.u().diagonal().map(f64::abs);
-    let (big, small) = (d.max(), d.min());
+    // The largest entry of a group is 1 once scaled: a pivot is compared with 1 as well.
+    let (big, small) = (d.max().max(1.0), d.min());
     if !(small > ACTUATION_TOLERANCE * big) {
         return Err(Singular {
             site: Site::Actuation(d.imin()),
@@ -311,8 +322,12 @@ const SINGULAR_A: Singular = Singular {
 };
 
 /// `τ = A⁻ᵀ f`: with `A = Â D`, `Aᵀ τ = f` is `Âᵀ τ = D⁻¹ f`.
-fn solve_transposed(a: &DMatrix<f64>, f: &DVector<f64>) -> Result<DVector<f64>, Singular> {
-    let (lu, scale) = actuation_lu(a, true)?;
+fn solve_transposed(
+    a: &DMatrix<f64>,
+    f: &DVector<f64>,
+    groups: &[usize],
+) -> Result<DVector<f64>, Singular> {
+    let (lu, scale) = actuation_lu(a, true, groups)?;
     lu.solve(&f.component_div(&scale)).ok_or(SINGULAR_A)
 }
 
@@ -332,7 +347,7 @@ pub fn inverse_dynamics(
     check_finite(&[ud])?;
     let terms = terms(plan, x, u)?;
     let f = generalized_force(plan, &terms, u, ud);
-    finite(solve_transposed(&terms.a, &f)?)
+    finite(solve_transposed(&terms.a, &f, plan.motion.unit_groups())?)
 }
 
 /// The generalized inertia `I = TᵀMT + Lᵀ I_a L` of the speeds `u` at `x`.
@@ -380,7 +395,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<DMatrix<f64>, Sing
     let n = plan.dof();
     let terms = terms(plan, x, &vec![0.0; n])?;
     let i = generalized_inertia(plan, &terms);
-    let (lu, scale) = actuation_lu(&terms.a, false)?;
+    let (lu, scale) = actuation_lu(&terms.a, false, plan.motion.unit_groups())?;
     // A⁻¹ = D⁻¹ Â⁻¹ (A = Â D).
     let ainv = lu.try_inverse().ok_or(SINGULAR_A)?;
     let ainv = DMatrix::from_fn(n, n, |r, c| ainv[(r, c)] / scale[r]);

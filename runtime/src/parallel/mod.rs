@@ -80,6 +80,18 @@ impl PlatformMotion {
             PlatformMotion::Translation { .. } => 3,
         }
     }
+    /// The unit group of each speed (`u`'s columns of the actuation matrix `A`): speeds of one
+    /// physical unit (rad/s, m/s) share a group. The pivot test of `A`'s LU scales the columns
+    /// of a group by the group's largest column norm, not each column by its own: a column
+    /// that shrinks against the others of its unit is a singularity (the platform moves along
+    /// that speed with the actuators still), which scaling it alone to unit norm would hide.
+    pub fn unit_groups(&self) -> &'static [usize] {
+        match self {
+            PlatformMotion::Pose => &[0, 0, 0, 1, 1, 1],
+            PlatformMotion::Orientation { .. } | PlatformMotion::Translation { .. } => &[0, 0, 0],
+            PlatformMotion::PlanarPoint { .. } => &[0, 0],
+        }
+    }
     /// Whether the platform only translates (`PlanarPoint`, `Translation`): `u` is the
     /// velocity of its origin, `ω = 0`, and `x ⊕ δu` is a sum.
     pub fn translates(&self) -> bool {

@@ -106,7 +106,8 @@ use crate::scalar::Real;
 /// singularity grows like `ε/h²` (measured on the five-bar's stretched leg): `1e-4` keeps it
 /// below about `1e-8`.
 pub const LEG_TOLERANCE: f64 = 1e-4;
-/// Actuation-matrix threshold: `A` (columns scaled to unit norm) is singular when a pivot of its
-/// partially pivoted LU is `≤ ACTUATION_TOLERANCE` times the largest pivot; the condition
-/// estimate is the ratio of the largest to the smallest pivot.
+/// Actuation-matrix threshold: `A` (each column scaled by the largest norm of its unit group,
+/// `PlatformMotion::unit_groups`) is singular when a pivot of its partially pivoted LU is
+/// `≤ ACTUATION_TOLERANCE` times the larger of 1 and the largest pivot; the condition estimate
+/// is the ratio of that reference to the pivot.
 pub const ACTUATION_TOLERANCE: f64 = 1e-8;

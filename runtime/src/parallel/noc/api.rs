@@ -75,7 +75,7 @@ pub fn inverse_dynamics(
     let (pl, legs) = kinematics(plan, x)?;
     let f = generalized_force(plan, &pl, &legs, u, ud, true);
     let a = actuation_matrix(plan, &legs);
-    solve_dyn(&a, &f, true)
+    solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
 /// The generalized force `I u̇ + C u − γ` of the speeds `u` (before the actuation map).
@@ -111,7 +111,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
     for j in 0..n {
         let mut e = vec![0.0; n];
         e[j] = 1.0;
-        let c = solve_dyn(&a, &e, false)?;
+        let c = solve_dyn(&a, &e, false, plan.motion.unit_groups())?;
         for r in 0..n {
             b[r][j] = (0..n).map(|k| i[r][k] * c[k]).sum();
         }
@@ -119,7 +119,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
     let mut out = vec![vec![0.0; n]; n];
     for j in 0..n {
         let col: Vec<f64> = (0..n).map(|r| b[r][j]).collect();
-        let c = solve_dyn(&a, &col, true)?;
+        let c = solve_dyn(&a, &col, true, plan.motion.unit_groups())?;
         for r in 0..n {
             out[r][j] = c[r];
         }

@@ -1,5 +1,6 @@
 //! The solves with the actuation matrix `A` of step 6 (`τ = A⁻ᵀ f`, `A⁻¹` in forward
-//! kinematics): [`lu_solve`], LU with partial pivoting of `A` with unit columns, checked against
+//! kinematics): [`lu_solve`], LU with partial pivoting of `A` with its columns scaled by unit
+//! group, checked against
 //! [`ACTUATION_TOLERANCE`], for fixed sizes and on row vectors.
 
 use alloc::vec::Vec;
@@ -8,25 +9,38 @@ use super::ACTUATION_TOLERANCE;
 use crate::scalar::{Singular, Site};
 use crate::solve::check_finite;
 
-/// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting of `a` with its columns
-/// scaled to unit 2-norm; a pivot `≤ ACTUATION_TOLERANCE` times the largest pivot (or a
-/// non-finite one) is reported as `Site::Actuation(pivot)` with the ratio of the largest to the
-/// smallest pivot as the condition estimate. Both solves factorize the same matrix, so they
+/// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting of `a` with each column
+/// scaled by the largest 2-norm of its unit group (`groups[j]`, `PlatformMotion::unit_groups`);
+/// a pivot `≤ ACTUATION_TOLERANCE` times the larger of 1 and the largest pivot (or a
+/// non-finite one) is reported as `Site::Actuation(pivot)` with the ratio of that reference to
+/// the pivot as the condition estimate. Both solves factorize the same matrix, so they
 /// give the same verdict at every `a` (LAPACK's `dgetrf` and `dgetrs`). Fixed-size, no
 /// allocation.
 pub fn lu_solve<const N: usize>(
     a: &[[f64; N]; N],
     b: &[f64; N],
     transpose: bool,
+    groups: &[usize],
 ) -> Result<[f64; N], Singular> {
     // m = a·S (column scaling S), factorized in place as P m = L U: the multipliers below the
     // diagonal, swapped with their rows.
     let mut m = *a;
+    let mut norm = [0.0; N];
+    for j in 0..N {
+        for row in m.iter() {
+            norm[j] += row[j] * row[j];
+        }
+    }
+    // Each column scaled by the largest norm of its unit group (`groups[j]`; all one group
+    // when `groups` is short).
+    let group = |j: usize| groups.get(j).copied().unwrap_or(0);
     let mut sc = [1.0; N];
     for j in 0..N {
-        let mut s = 0.0;
-        for row in m.iter() {
-            s += row[j] * row[j];
+        let mut s: f64 = 0.0;
+        for i in 0..N {
+            if group(i) == group(j) && norm[i] > s {
+                s = norm[i];
+            }
         }
         let s = crate::math::sqrt(s);
         if s > 0.0 {
@@ -37,7 +51,9 @@ pub fn lu_solve<const N: usize>(
         }
     }
     let mut piv = [0usize; N];
-    let mut pmax: f64 = 0.0;
+    // The largest column of a group has unit norm: a pivot is compared with 1 as well as with
+    // the largest before it.
+    let mut pmax: f64 = 1.0;
     for k in 0..N {
         let mut p = k;
         let mut best = if m[k][k] < 0.0 { -m[k][k] } else { m[k][k] };
@@ -128,7 +144,12 @@ pub fn lu_solve<const N: usize>(
 }
 
 /// `lu_solve` for the sizes the bundled platforms use, on row vectors.
-pub(super) fn solve_dyn(a: &[Vec<f64>], b: &[f64], transpose: bool) -> Result<Vec<f64>, Singular> {
+pub(super) fn solve_dyn(
+    a: &[Vec<f64>],
+    b: &[f64],
+    transpose: bool,
+    groups: &[usize],
+) -> Result<Vec<f64>, Singular> {
     macro_rules! fixed {
         ($n:literal) => {{
             let mut m = [[0.0; $n]; $n];
@@ -139,7 +160,7 @@ pub(super) fn solve_dyn(a: &[Vec<f64>], b: &[f64], transpose: bool) -> Result<Ve
                     m[i][j] = a[i][j];
                 }
             }
-            lu_solve(&m, &v, transpose).map(|x| x.to_vec())
+            lu_solve(&m, &v, transpose, groups).map(|x| x.to_vec())
         }};
     }
     match b.len() {
