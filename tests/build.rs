@@ -102,6 +102,11 @@ fn main() {
     generate(&out, "gs_point_legs", &p, |_| {});
     let p = with_scene(&out, gs, "gs_id_only", "functions = [\"inverse_dynamics\"]");
     generate(&out, "gs_id_only", &p, |_| {});
+    // The Delta in joint coordinates (the closed-loop route), for the bench against its
+    // platform form.
+    let joints = "data/delta_rl5_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(&out, "delta_joints", Path::new(joints), |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

@@ -283,9 +283,35 @@ fn config() -> Criterion {
         .sample_size(30)
 }
 
+/// The Delta's inverse dynamics in platform coordinates (inverse kinematics included) against
+/// the same robot in joint coordinates (the closed-loop route), both generated, at the same
+/// configuration (the platform's home; the joint form assembled at its crank angles) and
+/// rates (the platform velocity `u`; the cranks' rates it implies); the accelerations are
+/// arbitrary, the same numbers for both (the cost does not depend on them).
+fn delta_task_vs_joints(c: &mut Criterion) {
+    use mechanisms::delta_rl5 as task;
+    use tests::variants::delta_joints as joints;
+    let x = task::HOME;
+    let (u, ud) = ([0.3, -0.2, 0.1], [1.0, 0.5, -2.0]);
+    let q = task::inverse_kinematics(&x).expect("home in reach");
+    let qd = task::actuator_rates(&x, &u).expect("regular");
+    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
+    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
+    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
+    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
+    let mut g = c.benchmark_group("delta_rl5/inverse_dynamics_task_vs_joints");
+    g.bench_function("platform_coordinates", |b| {
+        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("joint_coordinates", |b| {
+        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, five_bar_joints, spherical_five_bar
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, five_bar_joints, spherical_five_bar
 }
 criterion_main!(benches);

@@ -92,3 +92,11 @@ pub mod iiwa_rounded {
 pub mod iiwa_snapped {
     include!(concat!(env!("OUT_DIR"), "/variants/iiwa_snapped/iiwa14.rs"));
 }
+/// The Delta of `mechanisms/specs/delta_rl5.toml` in joint coordinates (`tests/data/
+/// delta_rl5_joints.toml`, the closed-loop route), for the bench against its platform form.
+pub mod delta_joints {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/delta_joints/delta_rl5_joints.rs"
+    ));
+}
