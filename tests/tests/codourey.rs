@@ -168,17 +168,20 @@ fn codourey_errors_at_the_key() {
         "delta_rl5.toml",
         &with_scene(&src, "delta_model = \"codourey\"\nforearm_split = 1.5"),
     );
-    let d = bad.err().expect("a split of 1.5 is an error").to_string();
+    let Err(d) = bad else {
+        panic!("a split of 1.5 is an error")
+    };
+    let d = d.to_string();
     assert!(d.contains("scene.forearm_split"), "{d}");
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../mechanisms/specs/gough_stewart.toml");
     let gs = std::fs::read_to_string(path).unwrap();
-    let d = codegen::spec::load_mechanism(
+    let Err(d) = codegen::spec::load_mechanism(
         "gough_stewart.toml",
         &with_scene(&gs, "delta_model = \"codourey\""),
-    )
-    .err()
-    .expect("not a Delta: an error")
-    .to_string();
+    ) else {
+        panic!("not a Delta: an error")
+    };
+    let d = d.to_string();
     assert!(d.contains("scene.delta_model"), "{d}");
 }
