@@ -90,6 +90,12 @@ pub(crate) struct SceneSpec {
     /// The bodies `runtime_inertia` resolved to, with their inertial data as the spec gives it
     /// (filled by `apply_scene`, which then zeroes those bodies' constants).
     pub runtime_bodies: Vec<RuntimeBodySpec>,
+    /// `delta_model = "codourey"`: Codourey's simplified Delta (see `scene::codourey`); the
+    /// span of the value.
+    pub codourey: Option<Span>,
+    /// `forearm_split`: the fraction of each forearm pair's mass lumped at the elbow (the rest
+    /// on the platform), in [0, 1]; with the span of the value. Default 2/3.
+    pub forearm_split: Option<(f64, Span)>,
 }
 
 /// The value of `[scene] runtime_inertia`.
@@ -133,6 +139,8 @@ impl Default for SceneSpec {
             runtime_params_span: None,
             runtime_inertia: None,
             runtime_bodies: Vec::new(),
+            codourey: None,
+            forearm_split: None,
         }
     }
 }

@@ -73,6 +73,7 @@ pub(super) fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &m
 /// `[scene]`: point masses and massless bodies replace the bodies' inertial data before
 /// lowering (so everything downstream, fixed-joint merging included, sees the scene's model).
 pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
+    codourey(spec, diags);
     let scene = spec.scene.clone();
     let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
     let find = |n: &ir::Named, diags: &mut Diagnostics| -> Option<usize> {
@@ -191,6 +192,136 @@ pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
     for i in massless {
         spec.bodies[i].mass = 0.0;
         spec.bodies[i].inertia = [[0.0; 3]; 3];
+    }
+}
+
+/// Codourey's share of a forearm pair's mass lumped at its elbow (the rest on the platform).
+pub(crate) const CODOUREY_SPLIT: f64 = 2.0 / 3.0;
+
+/// `[scene] delta_model = "codourey"` (Codourey 1998, IJRR 17(12)): the simplified Delta, as
+/// a change of the bodies before everything else in the scene. For each `[[parallelogram]]`:
+/// - its equivalent rod (`<name>_rods`, twice `rod_mass`) becomes massless;
+/// - `forearm_split` (default 2/3) of that mass is a point mass at the elbow `E` on the parent
+///   (the upper arm), the rest a point mass at the platform frame's origin (the platform only
+///   translates, so where on it does not change the dynamics: its rotational inertia and the
+///   place of its mass centre never enter);
+/// - the parent's own mass becomes a thin uniform rod from the motor axis to `E`: mass centre at
+///   `l/2` (the spec's mass centre is *replaced*, so that `m l²/3` about the motor axis is a
+///   real rigid body: with the RL5's published 0.2463 m > l/2 = 0.21 m, keeping it would need a
+///   negative inertia about the mass centre), inertia `m l²/12` across the rod about it, none
+///   along it (`l` the distance of `E` from the motor axis).
+///
+/// Other bodies (elbow pins, the platform's own mass) stay as written. Errors, at the key: the
+/// level without a `[[parallelogram]]` on a translational platform, `forearm_split` without it.
+fn codourey(spec: &mut ir::Spec, diags: &mut Diagnostics) {
+    let Some(span) = spec.scene.codourey.clone() else {
+        if let Some((_, s)) = &spec.scene.forearm_split {
+            diags.push(
+                Diagnostic::error("`forearm_split` without `delta_model = \"codourey\"`")
+                    .with_key("scene.forearm_split")
+                    .with_span(s.clone())
+                    .with_hint("the split belongs to Codourey's simplified Delta: add delta_model = \"codourey\" to [scene], or remove forearm_split"),
+            );
+        }
+        return;
+    };
+    let platform = spec
+        .platform
+        .as_ref()
+        .filter(|p| p.coordinates == Some(ir::Coordinates::Translation))
+        .and_then(|p| p.body.clone());
+    let Some(platform) = platform.filter(|_| !spec.parallelograms.is_empty()) else {
+        diags.push(
+            Diagnostic::error("`delta_model = \"codourey\"` needs a Delta: [[parallelogram]] legs on a translational platform")
+                .with_key("scene.delta_model")
+                .with_span(span)
+                .with_hint("Codourey's simplified model lumps each parallelogram's rods at its elbow and the platform; this mechanism has none (write [platform] coordinates = \"translation\" and the legs as [[parallelogram]] entries, or remove delta_model)"),
+        );
+        return;
+    };
+    let split = spec
+        .scene
+        .forearm_split
+        .as_ref()
+        .map_or(CODOUREY_SPLIT, |s| s.0);
+    let body = |spec: &ir::Spec, n: &str| spec.bodies.iter().position(|b| b.name == n);
+    let mut rods_done: Vec<String> = Vec::new();
+    for pg in spec.parallelograms.clone() {
+        let elbow = spec.joints.iter().find(|j| j.name == format!("{pg}_elbow"));
+        let (Some(rods), Some(elbow), Some(plat)) = (
+            body(spec, &format!("{pg}_rods")),
+            elbow,
+            body(spec, &platform),
+        ) else {
+            continue; // the expansion failed: already reported
+        };
+        let arm_name = elbow.parent.clone();
+        let (Some(arm), ir::Placement::Origin(at), Some(a)) =
+            (body(spec, &arm_name), &elbow.placement, elbow.axes.first())
+        else {
+            continue;
+        };
+        let e = at.translation;
+        let a = a.v;
+        let Some(motor) = spec.joints.iter().find(|j| j.child == arm_name) else {
+            continue;
+        };
+        // A point of the motor axis in the arm's frame: the joint frame's origin, seen from the
+        // child frame (`offset⁻¹ · 0`).
+        let (_, offset) = lower::placement_frames(&motor.placement);
+        let (r, t) = (offset.rotation, offset.translation);
+        let o: runtime::model::Vec3 =
+            std::array::from_fn(|i| -(0..3).map(|k| r[k][i] * t[k]).sum::<f64>());
+        let eo = [e[0] - o[0], e[1] - o[1], e[2] - o[2]];
+        let along = eo[0] * a[0] + eo[1] * a[1] + eo[2] * a[2];
+        let foot = [
+            o[0] + along * a[0],
+            o[1] + along * a[1],
+            o[2] + along * a[2],
+        ];
+        let rod = [e[0] - foot[0], e[1] - foot[1], e[2] - foot[2]];
+        let l = geom::norm(&rod);
+        let m_rods = spec.bodies[rods].mass;
+        let point = |mass: f64, com: runtime::model::Vec3| geom::MassProps {
+            mass,
+            com,
+            inertia: [[0.0; 3]; 3],
+        };
+        // The upper arm: a thin rod (once per arm) plus the elbow's share.
+        let b = &spec.bodies[arm];
+        let mut arm_props = geom::MassProps {
+            mass: b.mass,
+            com: b.com,
+            inertia: b.inertia,
+        };
+        if !rods_done.contains(&arm_name) && l > 0.0 {
+            let d = rod.map(|x| x / l);
+            let k = b.mass * l * l / 12.0;
+            arm_props = geom::MassProps {
+                mass: b.mass,
+                com: std::array::from_fn(|i| 0.5 * (foot[i] + e[i])),
+                inertia: std::array::from_fn(|r| {
+                    std::array::from_fn(|c| k * (f64::from(u8::from(r == c)) - d[r] * d[c]))
+                }),
+            };
+            rods_done.push(arm_name.clone());
+        }
+        let arm_props = geom::MassProps::combine(&[arm_props, point(split * m_rods, e)]);
+        let b = &mut spec.bodies[arm];
+        (b.mass, b.com, b.inertia) = (arm_props.mass, arm_props.com, arm_props.inertia);
+        let p = &spec.bodies[plat];
+        let p_props = geom::MassProps::combine(&[
+            geom::MassProps {
+                mass: p.mass,
+                com: p.com,
+                inertia: p.inertia,
+            },
+            point((1.0 - split) * m_rods, [0.0; 3]),
+        ]);
+        let p = &mut spec.bodies[plat];
+        (p.mass, p.com, p.inertia) = (p_props.mass, p_props.com, p_props.inertia);
+        let r = &mut spec.bodies[rods];
+        (r.mass, r.com, r.inertia) = (0.0, [0.0; 3], [[0.0; 3]; 3]);
     }
 }
 

@@ -51,6 +51,8 @@ pub(super) const SCENE_KEYS: &[&str] = &[
     "snap",
     "parameters",
     "runtime_inertia",
+    "delta_model",
+    "forearm_split",
 ];
 pub(super) const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 pub(super) const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];

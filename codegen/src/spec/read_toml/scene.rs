@@ -52,6 +52,46 @@ impl Reader<'_> {
         if let Some(l) = get(t, "locked") {
             self.locked(l, scene);
         }
+        if let Some(v) = get(t, "delta_model") {
+            self.delta_model(v, scene);
+        }
+        if let Some(v) = get(t, "forearm_split") {
+            self.forearm_split(v, scene);
+        }
+    }
+
+    /// `scene.delta_model`: `"exact"` (the default) or `"codourey"`.
+    fn delta_model(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(x) = self.string(v, "scene.delta_model") else {
+            return;
+        };
+        match x.as_str() {
+            "exact" => {}
+            "codourey" => scene.codourey = Some(Some(v.span())),
+            _ => self.diags.push(
+                Diagnostic::error(format!("unknown Delta model {x:?}"))
+                    .with_key("scene.delta_model")
+                    .with_span(Some(v.span()))
+                    .with_hint("\"exact\" (the default: every rod as the spec gives it) or \"codourey\" (Codourey's simplified Delta: the forearms' mass lumped at the elbows and the platform, the upper arms thin rods)"),
+            ),
+        }
+    }
+
+    /// `scene.forearm_split`: a fraction in [0, 1].
+    fn forearm_split(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(x) = self.number(v, "scene.forearm_split") else {
+            return;
+        };
+        if (0.0..=1.0).contains(&x) {
+            scene.forearm_split = Some((x, Some(v.span())));
+        } else {
+            self.diags.push(
+                Diagnostic::error(format!("`forearm_split` = {x} is not in [0, 1]"))
+                    .with_key("scene.forearm_split")
+                    .with_span(Some(v.span()))
+                    .with_hint("the fraction of each forearm pair's mass lumped at the elbow (the rest goes to the platform); Codourey's is 2/3"),
+            );
+        }
     }
 
     /// `scene.coulomb_velocity`: a positive number.
