@@ -10,6 +10,16 @@
 //! on stderr, nothing written), 1 I/O error. A spec file literally named `map` or `isotropy`
 //! must be written `./map`.
 
+/// `print!`/`println!` to standard output that never panics: when the reader has gone
+/// (`codegen spec.toml | head`), the process ends quietly with exit code 0, as the output was
+/// only cut short by its reader; any other write error is reported, exit code 1.
+macro_rules! out {
+    ($($t:tt)*) => { $crate::write_stdout(format_args!($($t)*), false) };
+}
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::write_stdout(format_args!($($t)*), true) };
+}
+
 mod cli;
 
 use std::path::PathBuf;
@@ -213,9 +223,27 @@ fn main() -> ExitCode {
                 return ExitCode::from(1);
             }
         }
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     ExitCode::SUCCESS
+}
+
+/// Write `args` (and a newline) to standard output; see `out!`.
+fn write_stdout(args: std::fmt::Arguments<'_>, newline: bool) {
+    use std::io::Write;
+    let mut o = std::io::stdout().lock();
+    let written = o
+        .write_fmt(args)
+        .and_then(|()| if newline { o.write_all(b"\n") } else { Ok(()) })
+        .and_then(|()| o.flush());
+    match written {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(e) => {
+            eprintln!("error: writing to standard output: {e}");
+            std::process::exit(1);
+        }
+    }
 }
 
 #[cfg(test)]

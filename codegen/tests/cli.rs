@@ -633,3 +633,28 @@ fn an_endless_file_is_refused() {
         stderr(&o)
     );
 }
+
+/// A reader that stops early (`codegen spec.toml | head`) ends the run quietly: exit code 0,
+/// nothing on stderr (it was a panic, "failed printing to stdout: Broken pipe", exit 101).
+#[test]
+fn a_reader_that_stops_early_is_not_a_crash() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_codegen"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg(PUMA)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the codegen binary runs");
+    let mut first = [0u8; 64];
+    let mut out = child.stdout.take().expect("piped stdout");
+    out.read_exact(&mut first).expect("the module starts");
+    assert!(first.starts_with(b"// @generated"));
+    // The module (about 200 KB) is larger than a pipe's buffer: the writer meets the closed
+    // pipe.
+    drop(out);
+    let o = child.wait_with_output().expect("the run ends");
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    assert!(stderr(&o).is_empty(), "stderr: {}", stderr(&o));
+}

@@ -409,13 +409,13 @@ impl Report<'_> {
     /// The mechanism, the matrix, the search and the design.
     fn print_head(&self, matrix: &str, norm: Normalization, seconds: f64) {
         let (args, unit) = (self.args, self.unit);
-        println!(
+        outln!(
             "mechanism: {} ({} DOF)",
             self.target.name(),
             self.target.dof()
         );
-        println!("matrix: {matrix}; sigma in {unit}");
-        println!(
+        outln!("matrix: {matrix}; sigma in {unit}");
+        outln!(
             "search: {} random starts (seed {}), Levenberg-Marquardt on psi ({}), W = Frobenius (1 on the diagonal, 2 off it); {:.2} s",
             args.samples,
             args.seed,
@@ -426,7 +426,7 @@ impl Report<'_> {
             seconds
         );
         if let Some(d) = self.design {
-            println!(
+            outln!(
                 "design: {} in [{}, {}] (the spec has {}), searched with the coordinates",
                 d.name,
                 fmt_g(d.lo),
@@ -445,14 +445,14 @@ impl Report<'_> {
     ) -> Vec<&'m Minimum> {
         let args = self.args;
         if isotropic.is_empty() {
-            println!(
+            outln!(
                 "no isotropic point found (psi2 <= {:e}); the {} best local minima of psi:",
                 args.tolerance,
                 args.top.min(minima.len())
             );
             minima.iter().take(args.top).collect()
         } else {
-            println!(
+            outln!(
                 "{} dynamically isotropic point(s) (psi2 <= {:e}):",
                 isotropic.len(),
                 args.tolerance
@@ -468,12 +468,12 @@ impl Report<'_> {
             .design
             .map(|d| (format!(" {} |", d.name), "---:|"))
             .unwrap_or_default();
-        println!(
+        outln!(
             "| point |{} coordinates ({}) | actuated joints q | sigma [{unit}] | psi (tr/n) [({unit})^2] | psi2 |",
             design_head.0,
             coordinate_names.join(", ")
         );
-        println!("|---|{}---|---|---:|---:|---:|", design_head.1);
+        outln!("|---|{}---|---|---:|---:|---:|", design_head.1);
         for (k, m) in rows.iter().enumerate() {
             self.print_row(k, m);
         }
@@ -502,7 +502,7 @@ impl Report<'_> {
             .design
             .map(|v| format!(" {} |", fixed6(v)))
             .unwrap_or_default();
-        println!(
+        outln!(
             "| {} |{design_cell} ({coords}) | ({q}) | {} | {} | {} |",
             k + 1,
             fmt_g(m.sigma),

@@ -330,19 +330,19 @@ pub fn run(args: &MapArgs) -> ExitCode {
         eprintln!("error: cannot write {}: {e}", svg_path.display());
         return ExitCode::from(1);
     }
-    println!("mechanism: {} ({} DOF)", target.name(), target.dof());
-    println!("matrix: {matrix}; unit {unit}");
-    println!("index: {}", args.index.describe(&unit, &acc));
+    outln!("mechanism: {} ({} DOF)", target.name(), target.dof());
+    outln!("matrix: {matrix}; unit {unit}");
+    outln!("index: {}", args.index.describe(&unit, &acc));
     slice.print_grid();
     counts.print();
     let (nu, nv) = (slice.nu, slice.nv);
-    println!(
+    outln!(
         "time: {:.3} s ({:.2} us per point, {} threads)",
         elapsed.as_secs_f64(),
         elapsed.as_secs_f64() * 1e6 / (nu * nv) as f64,
         args.threads.unwrap_or_else(rayon::current_num_threads)
     );
-    println!("wrote {} and {}", csv_path.display(), svg_path.display());
+    outln!("wrote {} and {}", csv_path.display(), svg_path.display());
     ExitCode::SUCCESS
 }
 
@@ -408,7 +408,7 @@ impl Slice {
     /// The `grid:` line.
     fn print_grid(&self) {
         let (axes, ranges) = (&self.axes, &self.ranges);
-        println!(
+        outln!(
             "grid: {} x {} = {} points ({} in [{}, {}], {} in [{}, {}])",
             self.nu,
             self.nv,
@@ -506,18 +506,20 @@ impl Counts {
     /// The `range:` and `singular:` lines.
     fn print(&self) {
         if self.finite.is_empty() {
-            println!("range: no regular point");
+            outln!("range: no regular point");
         } else {
-            println!(
+            outln!(
                 "range: {} .. {} over {} regular points",
                 fmt_g(self.vmin),
                 fmt_g(self.vmax),
                 self.finite.len()
             );
         }
-        println!(
+        outln!(
             "singular: {}, unreachable: {}, invalid: {}",
-            self.singular, self.unreachable, self.invalid
+            self.singular,
+            self.unreachable,
+            self.invalid
         );
     }
 }

@@ -247,7 +247,7 @@ pub fn run(args: &ReduceArgs) -> ExitCode {
         cost = f;
     }
     pb.finish_and_clear();
-    println!(
+    outln!(
         "cheapest within tolerance: {} ({cost} flops)",
         current.describe()
     );
@@ -335,17 +335,17 @@ impl Search<'_> {
     fn print_head(&self, level: &Level, cost: usize) {
         let ns_head = if self.args.time { " ns per call |" } else { "" };
         let ns_rule = if self.args.time { "---:|" } else { "" };
-        println!(
+        outln!(
             "reduce: {} ({} states, tolerance {:e} on the worst relative actuator-effort error, inf-norm)",
             self.full.name(),
             self.samples.len(),
             self.args.tolerance
         );
-        println!(
+        outln!(
             "| fidelity | inverse dynamics flops |{ns_head} max relative error | RMS relative error | accepted |"
         );
-        println!("|---|---:|{ns_rule}---:|---:|---|");
-        println!(
+        outln!("|---|---:|{ns_rule}---:|---:|---|");
+        outln!(
             "| {} | {cost} |{} 0 | 0 | (reference) |",
             level.describe(),
             self.ns(level)
@@ -372,7 +372,7 @@ impl Search<'_> {
                     continue;
                 };
                 let ok = worst <= self.args.tolerance && f < cost;
-                println!(
+                outln!(
                     "| {} | {f} |{} {worst:.2e} | {rms:.2e} | {} |",
                     l.describe(),
                     self.ns(&l),
@@ -423,7 +423,7 @@ fn write_output(args: &ReduceArgs, source: &str, level: &Level) -> ExitCode {
                 return ExitCode::from(1);
             }
         }
-        None => print!("{out}"),
+        None => out!("{out}"),
     }
     ExitCode::SUCCESS
 }
