@@ -187,13 +187,9 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
         dof: n,
         params: layout.any(),
     };
-    let with_p = |args| fns.with_p(args);
-    let make = |name, doc, args, kernel: &Kernel, shape, public| {
-        fns.make(name, doc, args, kernel, shape, public)
-    };
     let coords = "`x`: every tree joint's position (rad or m, `JOINT_NAMES` order), closing the loops (see `forward_kinematics`); `u`: the rates of the independent coordinates (`x[INDEPENDENT[k]]`)";
     vec![
-        make(
+        fns.make(
             "joint_rates",
             vec![format!(
                 "All joint rates `ẋ = S u` (`ẋ_d = −Φ_d⁻¹ Φ_i u`). {coords}. `Err` when `x` does not close the loops (`Site::Closure`) or the independent coordinates do not determine the others (`Site::Constraint`)."
@@ -203,33 +199,33 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
             fallible(&[Part::Coords(nx)]),
             true,
         ),
-        make(
+        fns.make(
             "inverse_dynamics",
             vec![format!(
                 "Generalized forces of the independent coordinates, `f = Sᵀ τ_tree = I u̇ + C u − γ` (N or N·m, gravity included): the efforts of the actuated joints that produce the motion `(x, u, ud)`. {coords}."
             )],
-            with_p(vec![Arg::X, Arg::U, Arg::Ud]),
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Ud]),
             &k.inverse_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
-        make(
+        fns.make(
             "mass_matrix",
             vec!["Generalized inertia `I = Sᵀ M S` of the independent coordinates (symmetric positive definite away from singularities).".into()],
-            with_p(vec![Arg::X]),
+            fns.with_p(vec![Arg::X]),
             &k.mass_matrix,
             fallible(&[Part::Matrix]),
             true,
         ),
-        make(
+        fns.make(
             "forward_dynamics",
             vec!["Rates `u̇` of the independent speeds with `I u̇ = τ − (C u − γ)` for the actuator efforts `tau`; `Err` where the method fails or a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
-            with_p(vec![Arg::X, Arg::U, Arg::Tau]),
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Tau]),
             &k.forward_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
-        make(
+        fns.make(
             "newton_step",
             vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates, the signed largest scaled residual of the kept loop equations, and that of every loop equation and revolute-axis alignment.".into()],
             vec![Arg::X],

@@ -256,12 +256,8 @@ fn functions(
         dof: n,
         params: layout.any(),
     };
-    let with_p = |args| fns.with_p(args);
-    let make = |name, doc, args, kernel: &Kernel, shape, public| {
-        fns.make(name, doc, args, kernel, shape, public)
-    };
     let functions = [
-        make(
+        fns.make(
             "inverse_kinematics",
             vec![format!(
                 "Actuated joint positions `q(x)` (rad or m, in `ACTUATOR_NAMES` order) by closed-form leg inverse kinematics. {coords}. `Err` when a leg cannot reach the platform (`Site::Reach`) or is singular (`Site::Leg`)."
@@ -271,7 +267,7 @@ fn functions(
             fallible(&[Part::Vector]),
             true,
         ),
-        make(
+        fns.make(
             "actuator_rates",
             vec!["Actuator rates `q̇ = A u` (rad/s or m/s); `Err` at a leg singularity.".into()],
             vec![Arg::X, Arg::U],
@@ -279,39 +275,39 @@ fn functions(
             fallible(&[Part::Vector]),
             true,
         ),
-        make(
+        fns.make(
             "id_parts",
             vec!["Kernel of `inverse_dynamics`: the actuation matrix `A` and the generalized force `f = I u̇ + C u − γ`.".into()],
-            with_p(vec![Arg::X, Arg::U, Arg::Ud]),
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Ud]),
             &k.id_parts,
             fallible(&[Part::Matrix, Part::Vector]),
             false,
         ),
-        make(
+        fns.make(
             "mass_matrix",
             vec!["Generalized inertia `I = TᵀMT` of the speeds `u` (symmetric positive definite away from singularities; kg·m², kg·m, kg).".into()],
-            with_p(vec![Arg::X]),
+            fns.with_p(vec![Arg::X]),
             &k.mass_matrix,
             fallible(&[Part::Matrix]),
             true,
         ),
-        make(
+        fns.make(
             "inertia_parts",
             vec!["Kernel of `actuator_mass_matrix`: `A` and `I`.".into()],
-            with_p(vec![Arg::X]),
+            fns.with_p(vec![Arg::X]),
             &k.inertia_parts,
             fallible(&[Part::Matrix, Part::Matrix]),
             false,
         ),
-        make(
+        fns.make(
             "forward_dynamics",
             vec!["Speed rates `u̇` with `I u̇ = Aᵀ τ − (C u − γ)` for the actuator efforts `tau` (N or N·m); `Err` at a leg singularity or when a pivot of `I`'s `LDLᵀ` is not above `1e-12` times its diagonal entry.".into()],
-            with_p(vec![Arg::X, Arg::U, Arg::Tau]),
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Tau]),
             &k.forward_dynamics,
             fallible(&[Part::Vector]),
             true,
         ),
-        make(
+        fns.make(
             "fk_parts",
             vec!["Kernel of `forward_kinematics`: `q(x)` and `A(x)`.".into()],
             vec![Arg::X],
