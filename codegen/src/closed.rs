@@ -10,7 +10,8 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
-use runtime::scalar::Singular;
+use runtime::drive::DriveInputs;
+use runtime::scalar::{Real, Singular};
 
 use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
@@ -43,6 +44,12 @@ pub struct Kernels {
     /// that of every loop equation and axis alignment (on open configurations by design: no
     /// closure tests).
     pub newton_step: Kernel,
+    /// `−γ`: the efforts that hold the mechanism still against gravity and the springs.
+    pub gravity: Kernel,
+    /// `C u`: the velocity-dependent efforts.
+    pub coriolis: Kernel,
+    /// The joints' friction and the springs' damping; `None` without either.
+    pub friction: Option<Kernel>,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -90,6 +97,19 @@ fn build(
         payloads,
         drives: layout.drives().then(|| drive_inputs(plan.nx(), layout)),
     };
+    let zero = vec![Sx::c(0.0); d];
+    let still = noc::Extras {
+        payloads: extras.payloads.clone(),
+        drives: extras.drives.as_ref().map(DriveInputs::without_friction),
+    };
+    let run_time_friction = extras
+        .drives
+        .as_ref()
+        .is_some_and(|d| d.viscous.is_some() || d.coulomb.is_some());
+    let dissipation = (plan.has_friction() || run_time_friction).then(|| noc::Extras {
+        payloads: Vec::new(),
+        drives: extras.drives.as_ref().map(DriveInputs::friction_only),
+    });
     // Each function as the `f64` API evaluates it, from `x` (the shared configuration is built
     // once; the DAG shares it, and each kernel keeps the guards it asked for).
     let kernel = |f: &dyn Fn() -> Result<Vec<ExprId>, Singular>| {
@@ -118,6 +138,38 @@ fn build(
             newton.push(full.0);
             Ok(newton)
         })?,
+        // The split of the efforts, built last so that the nodes of the functions above stay
+        // as they were without it: `−γ` at rest; `C u` from a plan and drives without
+        // dissipation at `u̇ = 0` without gravity; the dissipation from a plan of it alone
+        // (`Plan::without_friction`, `Plan::friction_only`; springs count with gravity).
+        gravity: configured(&|c| {
+            ids(&noc::generalized_force_with(
+                plan, c, &zero, &zero, true, &extras,
+            ))
+        })?,
+        coriolis: configured(&|c| {
+            ids(&noc::generalized_force_with(
+                &plan.without_friction(),
+                c,
+                &u,
+                &zero,
+                false,
+                &still,
+            ))
+        })?,
+        friction: match dissipation {
+            Some(d) => Some(configured(&|c| {
+                ids(&noc::generalized_force_with(
+                    &plan.friction_only(),
+                    c,
+                    &u,
+                    &zero,
+                    true,
+                    &d,
+                ))
+            })?),
+            None => None,
+        },
     })
 }
 
@@ -188,7 +240,17 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
         params: layout.any(),
     };
     let coords = "`x`: every tree joint's position (rad or m, `JOINT_NAMES` order), closing the loops (see `forward_kinematics`); `u`: the rates of the independent coordinates (`x[INDEPENDENT[k]]`)";
-    vec![
+    let friction = k.friction.as_ref().map(|kernel| {
+        fns.make(
+            "friction",
+            vec!["Efforts of the dissipation at `(x, u)`: every joint's friction (viscous and regularized Coulomb, actuated and passive joints alike) and the springs' damping, mapped to the independent coordinates by `Sᵀ`.".into()],
+            fns.with_p(vec![Arg::X, Arg::U]),
+            kernel,
+            fallible(&[Part::Vector]),
+            true,
+        )
+    });
+    let mut functions = vec![
         fns.make(
             "joint_rates",
             vec![format!(
@@ -226,6 +288,24 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
             true,
         ),
         fns.make(
+            "gravity",
+            vec![format!(
+                "Efforts of the independent coordinates that hold the mechanism still against gravity and the springs at `x`, `−γ(x)`: `inverse_dynamics(x, 0, 0)`. {coords}."
+            )],
+            fns.with_p(vec![Arg::X]),
+            &k.gravity,
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        fns.make(
+            "coriolis",
+            vec!["Velocity-dependent efforts `C u` of the independent coordinates (Coriolis and centrifugal terms, the rotors' among them; no gravity, springs or friction). So `inverse_dynamics(x, u, ud) = I ud + coriolis(x, u) + gravity(x) (+ friction(x, u))` with `I = mass_matrix(x)`.".into()],
+            fns.with_p(vec![Arg::X, Arg::U]),
+            &k.coriolis,
+            fallible(&[Part::Vector]),
+            true,
+        ),
+        fns.make(
             "newton_step",
             vec!["Kernel of `forward_kinematics`: the Newton step of the dependent coordinates, the signed largest scaled residual of the kept loop equations, and that of every loop equation and revolute-axis alignment.".into()],
             vec![Arg::X],
@@ -233,7 +313,9 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
             fallible(&[Part::Coords(nx), Part::Scalar, Part::Scalar]),
             false,
         ),
-    ]
+    ];
+    functions.extend(friction);
+    functions
 }
 
 /// The operation counts of the header's table: each selectable function `wanted` keeps, then
@@ -250,7 +332,7 @@ fn stats(functions: &[Function<'_>], wanted: &dyn Fn(&str) -> bool) -> Vec<(Stri
         .selectable()
         .iter()
         .map(|f| f.name())
-        .filter(|n| wanted(n))
+        .filter(|n| wanted(n) && functions.iter().any(|f| f.name == *n))
         .map(|n| (n.to_string(), ops(n)))
         .collect();
     stats.push((

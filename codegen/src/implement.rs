@@ -167,18 +167,29 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
                 -> Option<Result<[#real; #nx], Singular>>
         },
     );
-    let coriolis = optional(
+    // The split of the efforts: `Result`s in every kind (a tree's are infallible: `Ok`).
+    let fallible = |f, args, sig| calls.optional_result(f, args, sig);
+    let coriolis = fallible(
         "coriolis",
         quote!(x, u),
         quote! {
-            fn coriolis(&self, x: &[#real; #nx], u: &[#real; DOF]) -> Option<[#real; DOF]>
+            fn coriolis(&self, x: &[#real; #nx], u: &[#real; DOF])
+                -> Option<Result<[#real; DOF], Singular>>
         },
     );
-    let gravity = optional(
+    let gravity = fallible(
         "gravity",
         quote!(x),
         quote! {
-            fn gravity(&self, x: &[#real; #nx]) -> Option<[#real; DOF]>
+            fn gravity(&self, x: &[#real; #nx]) -> Option<Result<[#real; DOF], Singular>>
+        },
+    );
+    let friction = fallible(
+        "friction",
+        quote!(x, u),
+        quote! {
+            fn friction(&self, x: &[#real; #nx], u: &[#real; DOF])
+                -> Option<Result<[#real; DOF], Singular>>
         },
     );
     let id_derivatives = optional(
@@ -253,6 +264,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             #joint_rates
             #coriolis
             #gravity
+            #friction
             #id_derivatives
             #fd_derivatives
         }
@@ -326,6 +338,27 @@ impl Calls<'_> {
             Some(t) => t,
             None if self.tree => identity,
             None => panic!("internal error: `implement` needs `{f}` (see implement::check)"),
+        }
+    }
+
+    /// [`Calls::optional`] for a method that returns `Option<Result<…>>`: an infallible `f`
+    /// is wrapped in `Ok`.
+    fn optional_result(&self, f: &str, args: TokenStream, sig: TokenStream) -> TokenStream {
+        let Some(c) = self.items.function(f) else {
+            return quote!();
+        };
+        let id = Ident::new(f, Span::call_site());
+        let p = self.p;
+        let args = if c.params { quote!(#args, #p) } else { args };
+        let call = if c.fallible {
+            quote!(#id(#args))
+        } else {
+            quote!(Ok(#id(#args)))
+        };
+        quote! {
+            #sig {
+                Some(#call)
+            }
         }
     }
 

@@ -9,6 +9,7 @@
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
+use runtime::drive::DriveInputs;
 use runtime::model::JointKind;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion};
@@ -48,6 +49,12 @@ pub struct Kernels {
     pub forward_dynamics: Kernel,
     /// `q(x)` then `A`.
     pub fk_parts: Kernel,
+    /// `A` then `−γ` (`gravity`).
+    pub gravity_parts: Kernel,
+    /// `A` then `C u` (`coriolis`).
+    pub coriolis_parts: Kernel,
+    /// `A` then the leg joints' friction mapped to `u` (`friction`); `None` without friction.
+    pub friction_parts: Option<Kernel>,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -111,6 +118,10 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let (fd, fd_guards) =
         guarded(|| noc::forward_dynamics_with(plan, &x, &u, &tau, &payloads, drives.as_ref()));
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
+    // The split of the efforts, built last so that the nodes of the functions above stay as
+    // they were without it.
+    let (fg, fc, ffr) = split(plan, &pl, &legs, &u, drives.as_ref(), &payloads);
+    let split_kernel = |f: Vec<Sx>| with_kin(cat(flat(&a), ids(&f)));
     Ok(Kernels {
         graph: Graph::new(),
         inverse_kinematics: Kernel::new(ids(&q), pos_guards),
@@ -120,7 +131,64 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         inertia_parts: with_kin(cat(flat(&a), flat(&i))),
         forward_dynamics: Kernel::new(ids(&fd?), fd_guards),
         fk_parts: with_kin(cat(ids(&q), flat(&a))),
+        gravity_parts: split_kernel(fg),
+        coriolis_parts: split_kernel(fc),
+        friction_parts: ffr.map(split_kernel),
     })
+}
+
+/// The generalized force split as the module's `gravity`, `coriolis` and `friction` take it
+/// (the friction's part only when a leg joint has friction): `−γ` at rest, `C u` from a plan
+/// and drives without friction at `u̇ = 0` and no gravity, and the friction from a plan of the
+/// friction alone ([`Plan::without_friction`], [`Plan::friction_only`]). The payloads enter
+/// the first two.
+fn split(
+    plan: &Plan,
+    pl: &noc::Platform<Sx>,
+    legs: &[noc::LegKin<Sx>],
+    u: &[Sx],
+    drives: Option<&DriveInputs<Sx>>,
+    payloads: &[runtime::payload::Payload<Sx>],
+) -> (Vec<Sx>, Vec<Sx>, Option<Vec<Sx>>) {
+    let n = plan.dof();
+    let zero = vec![Sx::c(0.0); n];
+    let with_payloads = |mut f: Vec<Sx>, u: &[Sx], gravity: bool| {
+        for p in payloads {
+            let fp = noc::payload_force(plan, pl, p, u, &zero, gravity);
+            for r in 0..n {
+                f[r] = f[r] + fp[r];
+            }
+        }
+        f
+    };
+    // At rest the drives do nothing: the plan's own (and its closed forms) serve.
+    let fg = noc::generalized_force_with(plan, pl, legs, &zero, &zero, true, None);
+    let fg = with_payloads(fg, &zero, true);
+    let still = drives.map(DriveInputs::without_friction);
+    let fc = noc::generalized_force_with(
+        &plan.without_friction(),
+        pl,
+        legs,
+        u,
+        &zero,
+        false,
+        still.as_ref(),
+    );
+    let fc = with_payloads(fc, u, false);
+    let run_time_friction = drives.is_some_and(|d| d.viscous.is_some() || d.coulomb.is_some());
+    let ffr = (plan.has_friction() || run_time_friction).then(|| {
+        let friction = drives.map(DriveInputs::friction_only);
+        noc::generalized_force_with(
+            &plan.friction_only(),
+            pl,
+            legs,
+            u,
+            &zero,
+            false,
+            friction.as_ref(),
+        )
+    });
+    (fg, fc, ffr)
 }
 
 /// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: squared column
@@ -200,7 +268,13 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     let functions = functions(&k, &plan, &layout, &want);
     let stats = stats(&functions, n, plan.motion.unit_groups(), &want);
     let header = header(model, &plan, &layout, cfg, &stats);
-    let items = items(model, &plan, params, &layout, cfg, &want);
+    // The wrappers of the kernels that are emitted.
+    let emitted = |name: &str| {
+        functions
+            .iter()
+            .any(|f| f.name.strip_suffix("_parts") == Some(name))
+    };
+    let items = items(model, &plan, params, &layout, cfg, &emitted);
     let code = module::render(
         &ModulePlan {
             name: &model.name,
@@ -284,6 +358,22 @@ fn functions(
             false,
         ),
         fns.make(
+            "gravity_parts",
+            vec!["Kernel of `gravity`: `A` and `−γ`, the generalized force at rest.".into()],
+            fns.with_p(vec![Arg::X]),
+            &k.gravity_parts,
+            fallible(&[Part::Matrix, Part::Vector]),
+            false,
+        ),
+        fns.make(
+            "coriolis_parts",
+            vec!["Kernel of `coriolis`: `A` and `C u`, the generalized force of the velocities alone.".into()],
+            fns.with_p(vec![Arg::X, Arg::U]),
+            &k.coriolis_parts,
+            fallible(&[Part::Matrix, Part::Vector]),
+            false,
+        ),
+        fns.make(
             "mass_matrix",
             vec!["Generalized inertia `I = TᵀMT` of the speeds `u` (symmetric positive definite away from singularities; kg·m², kg·m, kg).".into()],
             fns.with_p(vec![Arg::X]),
@@ -316,13 +406,27 @@ fn functions(
             false,
         ),
     ];
+    let friction = k.friction_parts.as_ref().map(|kernel| {
+        fns.make(
+            "friction_parts",
+            vec![
+                "Kernel of `friction`: `A` and the leg joints' friction as a generalized force."
+                    .into(),
+            ],
+            fns.with_p(vec![Arg::X, Arg::U]),
+            kernel,
+            fallible(&[Part::Matrix, Part::Vector]),
+            false,
+        )
+    });
     functions
         .into_iter()
+        .chain(friction)
         .filter(|f| {
             want(match f.name {
                 "id_parts" => "inverse_dynamics",
                 "inertia_parts" => "actuator_mass_matrix",
-                n => n,
+                n => n.strip_suffix("_parts").unwrap_or(n),
             })
         })
         .collect()
@@ -349,6 +453,8 @@ fn stats(
         ("inverse_kinematics".into(), ops("inverse_kinematics")),
         ("actuator_rates".into(), ops("actuator_rates")),
         ("inverse_dynamics".into(), plus(ops("id_parts"), lu, 1)),
+        ("gravity".into(), plus(ops("gravity_parts"), lu, 1)),
+        ("coriolis".into(), plus(ops("coriolis_parts"), lu, 1)),
         ("mass_matrix".into(), ops("mass_matrix")),
         (
             "actuator_mass_matrix".into(),
@@ -360,7 +466,15 @@ fn stats(
             plus(ops("fk_parts"), lu, 1),
         ),
     ];
-    stats.into_iter().filter(|(n, _)| want(n)).collect()
+    let friction = functions
+        .iter()
+        .any(|f| f.name == "friction_parts")
+        .then(|| ("friction".to_string(), plus(ops("friction_parts"), lu, 1)));
+    stats
+        .into_iter()
+        .chain(friction)
+        .filter(|(n, _)| want(n))
+        .collect()
 }
 
 /// The module's header comment: provenance, the mechanism, the math backend, the run-time

@@ -16,6 +16,32 @@ pub fn inverse_dynamics(
     lu_solve_t(&a, &f)
 }
 
+/// Actuator efforts `τ = A⁻ᵀ (−γ)` (N or N·m) that hold the platform still against gravity
+/// at `x`: `inverse_dynamics(x, 0, 0)`; `Err` at a leg or parallel singularity.
+#[inline]
+pub fn gravity(x: &[f64; NX], p: &Params) -> Result<[f64; DOF], Singular> {
+    let (a, f) = gravity_parts(x, p)?;
+    lu_solve_t(&a, &f)
+}
+
+/// Velocity-dependent actuator efforts `τ = A⁻ᵀ C u` (N or N·m): the Coriolis and centrifugal
+/// terms of the legs and the platform, the rotors' among them; no gravity, no friction. So
+/// `inverse_dynamics(x, u, ud) = M_q q̈ + coriolis(x, u) + gravity(x) (+ friction(x, u))` with
+/// `M_q = actuator_mass_matrix(x)` and `q̈ = A ud` (`actuator_rates(x, ud)`).
+#[inline]
+pub fn coriolis(x: &[f64; NX], u: &[f64; DOF], p: &Params) -> Result<[f64; DOF], Singular> {
+    let (a, f) = coriolis_parts(x, u, p)?;
+    lu_solve_t(&a, &f)
+}
+
+/// Actuator efforts `τ = A⁻ᵀ Σ J⁻ᵀ δ(θ̇)` (N or N·m) of the leg joints' friction (viscous
+/// and regularized Coulomb, actuated and passive joints alike) at `(x, u)`.
+#[inline]
+pub fn friction(x: &[f64; NX], u: &[f64; DOF], p: &Params) -> Result<[f64; DOF], Singular> {
+    let (a, f) = friction_parts(x, u, p)?;
+    lu_solve_t(&a, &f)
+}
+
 /// Inertia in actuator space `A⁻ᵀ I A⁻¹` (the lecture's eq. 68), symmetric.
 #[allow(clippy::all)]
 pub fn actuator_mass_matrix(x: &[f64; NX], p: &Params) -> Result<[[f64; DOF]; DOF], Singular> {

@@ -40,6 +40,47 @@ impl<R: Real> DriveInputs<R> {
     }
 }
 
+impl<R: Clone> DriveInputs<R> {
+    /// The rotor inertias alone: the drives of the velocity-dependent efforts (`coriolis`),
+    /// which leave out friction.
+    pub fn without_friction(&self) -> DriveInputs<R> {
+        DriveInputs {
+            viscous: None,
+            coulomb: None,
+            ..self.clone()
+        }
+    }
+    /// The friction alone (viscous and Coulomb): the drives of `friction`.
+    pub fn friction_only(&self) -> DriveInputs<R> {
+        DriveInputs {
+            armature: None,
+            ..self.clone()
+        }
+    }
+}
+
+impl crate::model::Drive {
+    /// This drive without its friction (viscous and Coulomb), its rotor inertia kept.
+    pub fn without_friction(&self) -> crate::model::Drive {
+        crate::model::Drive {
+            viscous: 0.0,
+            coulomb: 0.0,
+            ..*self
+        }
+    }
+    /// This drive's friction alone (no rotor inertia).
+    pub fn friction_only(&self) -> crate::model::Drive {
+        crate::model::Drive {
+            armature: 0.0,
+            ..*self
+        }
+    }
+    /// Whether the drive has friction (viscous or Coulomb).
+    pub fn has_friction(&self) -> bool {
+        self.viscous != 0.0 || self.coulomb != 0.0
+    }
+}
+
 /// [`Drive::effort`](crate::model::Drive::effort) over [`Real`]: `I_a q̈ + b q̇ + c q̇ / √(q̇² + v_s²)`
 /// (terms with zero coefficients are not formed).
 pub fn drive_effort<R: Real>(d: &crate::model::Drive, qd: R, qdd: R) -> R {

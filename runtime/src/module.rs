@@ -30,9 +30,12 @@
 /// (`NoConvergence = core::convert::Infallible`), and its only fallible function is
 /// `forward_dynamics`.
 ///
-/// The functions that only some kinds generate are the provided methods returning `Option`:
-/// `None` from a module that does not have the function (another kind, or left out by the
-/// spec's `[scene] functions`).
+/// The functions that some modules do not have are the provided methods returning `Option`:
+/// `None` from a module without the function (another kind, no friction, or left out by the
+/// spec's `[scene] functions`). Every kind has `gravity` and `coriolis` (and `friction` with
+/// friction), in its own efforts, so that
+/// `inverse_dynamics(x, u, ud) = actuator_mass_matrix(x) · q̈ + coriolis(x, u) + gravity(x)
+/// (+ friction(x, u))` with `q̈ = actuator_rates(x, ud)`.
 pub trait Dynamics<const NX: usize, const DOF: usize> {
     /// The scalar of the generated code (`f64`, or `f32`).
     type Scalar: Copy;
@@ -106,20 +109,38 @@ pub trait Dynamics<const NX: usize, const DOF: usize> {
         None
     }
 
-    /// Trees: the velocity-dependent efforts `C(q, q̇) q̇` (`coriolis`). `None` elsewhere.
+    /// The velocity-dependent actuator efforts (`coriolis`): `C(q, q̇) q̇` of a tree, `A⁻ᵀ C u`
+    /// of a platform, `C u` of closed loops; no gravity, no friction. `None` where the scene
+    /// leaves it out. A tree's cannot fail (`Ok`).
     fn coriolis(
         &self,
         x: &[Self::Scalar; NX],
         u: &[Self::Scalar; DOF],
-    ) -> Option<[Self::Scalar; DOF]> {
+    ) -> Option<Result<[Self::Scalar; DOF], Self::Singular>> {
         let _ = (x, u);
         None
     }
 
-    /// Trees: the efforts that hold the mechanism still against gravity (`gravity`). `None`
-    /// elsewhere.
-    fn gravity(&self, x: &[Self::Scalar; NX]) -> Option<[Self::Scalar; DOF]> {
+    /// The actuator efforts that hold the mechanism still against gravity (and a closed
+    /// loop's springs) at `x` (`gravity`): `inverse_dynamics(x, 0, 0)`. `None` where the scene
+    /// leaves it out. A tree's cannot fail (`Ok`).
+    fn gravity(
+        &self,
+        x: &[Self::Scalar; NX],
+    ) -> Option<Result<[Self::Scalar; DOF], Self::Singular>> {
         let _ = x;
+        None
+    }
+
+    /// The actuator efforts of the joints' friction (viscous and regularized Coulomb; a
+    /// closed loop's spring damping too) at `(x, u)` (`friction`). `None` where the mechanism
+    /// has no friction or the scene leaves it out. A tree's cannot fail (`Ok`).
+    fn friction(
+        &self,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+    ) -> Option<Result<[Self::Scalar; DOF], Self::Singular>> {
+        let _ = (x, u);
         None
     }
 

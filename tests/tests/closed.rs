@@ -201,6 +201,11 @@ macro_rules! generated_matches_runtime {
                 let mm = g::mass_matrix(&xa).unwrap();
                 let mr = noc::mass_matrix(&plan, &x).unwrap();
                 worst = worst.max(rel(&mm.concat(), &mr.concat()));
+                worst = worst.max(rel(&g::gravity(&xa).unwrap(), &noc::gravity(&plan, &x).unwrap()));
+                worst = worst.max(rel(
+                    &g::coriolis(&xa, &ua).unwrap(),
+                    &noc::coriolis(&plan, &x, &u).unwrap(),
+                ));
                 let rates = g::joint_rates(&xa, &ua).unwrap();
                 let rr = noc::joint_rates(&plan, &x, &u).unwrap();
                 worst = worst.max(rel(&rates, &rr));

@@ -29,8 +29,9 @@ fn tree_agrees() {
             m.forward_dynamics(&q, &qd, &qdd),
             g::forward_dynamics(&q, &qd, &qdd)
         );
-        assert_eq!(m.coriolis(&q, &qd), Some(g::coriolis(&q, &qd)));
-        assert_eq!(m.gravity(&q), Some(g::gravity(&q)));
+        assert_eq!(m.coriolis(&q, &qd), Some(Ok(g::coriolis(&q, &qd))));
+        assert_eq!(m.gravity(&q), Some(Ok(g::gravity(&q))));
+        assert_eq!(m.friction(&q, &qd), None);
         assert_eq!(
             m.inverse_dynamics_derivatives(&q, &qd, &qdd),
             Some(g::inverse_dynamics_derivatives(&q, &qd, &qdd))
@@ -83,7 +84,9 @@ fn parallel_agrees() {
             m.forward_dynamics(&x, &u, &ud),
             g::forward_dynamics(&x, &u, &ud)
         );
-        assert_eq!((m.coriolis(&x, &u), m.gravity(&x)), (None, None));
+        assert_eq!(m.coriolis(&x, &u), Some(g::coriolis(&x, &u)));
+        assert_eq!(m.gravity(&x), Some(g::gravity(&x)));
+        assert_eq!(m.friction(&x, &u), None);
         assert_eq!(m.joint_rates(&x, &u), None);
     }
     // An error is the module's own, unchanged (compared as text: it may hold a NaN).
@@ -122,7 +125,9 @@ fn closed_agrees() {
             m.forward_dynamics(&x, &u, &tau),
             g::forward_dynamics(&x, &u, &tau)
         );
-        assert_eq!((m.coriolis(&x, &u), m.gravity(&x)), (None, None));
+        assert_eq!(m.coriolis(&x, &u), Some(g::coriolis(&x, &u)));
+        assert_eq!(m.gravity(&x), Some(g::gravity(&x)));
+        assert_eq!(m.friction(&x, &u), None);
     }
     // An error is the module's own, unchanged: `x` that does not close the loops.
     let open = [0.3, 0.0, 0.0];

@@ -128,8 +128,14 @@ where
                 calls += 1;
                 fallible += 1;
             }
-            calls += usize::from(black_box(m.coriolis(x, u)).is_some());
-            calls += usize::from(black_box(m.gravity(x)).is_some());
+            for split in [m.coriolis(x, u), m.gravity(x), m.friction(x, u)]
+                .into_iter()
+                .flatten()
+            {
+                ok += usize::from(black_box(split).is_ok());
+                calls += 1;
+                fallible += 1;
+            }
             calls += usize::from(black_box(m.inverse_dynamics_derivatives(x, u, ud)).is_some());
             if let Some(r) = black_box(m.forward_dynamics_derivatives(x, u, &tau)) {
                 ok += usize::from(r.is_ok());

@@ -63,7 +63,16 @@ macro_rules! generated_vs_runtime {
                     rel(
                         &flat(&g::mass_matrix(&xa).unwrap()),
                         &noc::mass_matrix(&plan, &x).unwrap().concat(),
-                    ),
+                    )
+                    // The split of the efforts, against the runtime's.
+                    .max(rel(
+                        &g::gravity(&xa).unwrap(),
+                        &noc::gravity(&plan, &x).unwrap(),
+                    ))
+                    .max(rel(
+                        &g::coriolis(&xa, &ua).unwrap(),
+                        &noc::coriolis(&plan, &x, &u).unwrap(),
+                    )),
                     rel(
                         &flat(&g::actuator_mass_matrix(&xa).unwrap()),
                         &noc::actuator_mass_matrix(&plan, &x).unwrap().concat(),
@@ -91,7 +100,7 @@ macro_rules! generated_vs_runtime {
                 }
             }
             eprintln!(
-                "{}: worst relative errors (∞-norm) over {STATES} states: IK {:.1e}, rates {:.1e}, ID {:.1e}, I {:.1e}, A⁻ᵀIA⁻¹ {:.1e}, FD {:.1e}, round trips {:.1e}",
+                "{}: worst relative errors (∞-norm) over {STATES} states: IK {:.1e}, rates {:.1e}, ID {:.1e}, I (and gravity, coriolis) {:.1e}, A⁻ᵀIA⁻¹ {:.1e}, FD {:.1e}, round trips {:.1e}",
                 stringify!($name),
                 worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6]
             );

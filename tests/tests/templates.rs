@@ -173,6 +173,26 @@ mod actuation {
     ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
         Ok((a_of(x), f_of(u, ud)))
     }
+    fn gravity_parts(
+        x: &[f64; NX],
+        _p: &Params,
+    ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
+        Ok((a_of(x), f_of(&[0.0; DOF], &[0.0; DOF])))
+    }
+    fn coriolis_parts(
+        x: &[f64; NX],
+        u: &[f64; DOF],
+        _p: &Params,
+    ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
+        Ok((a_of(x), f_of(u, &[0.0; DOF])))
+    }
+    fn friction_parts(
+        x: &[f64; NX],
+        u: &[f64; DOF],
+        _p: &Params,
+    ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
+        Ok((a_of(x), [u[0], 0.0, -u[2]]))
+    }
     type Matrix = [[f64; DOF]; DOF];
     fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
         Ok((a_of(x), i_of(x, p)))
@@ -320,6 +340,20 @@ fn platform_actuation_solves_with_a_transposed() {
     for j in 0..DOF {
         let s: f64 = (0..DOF).map(|i| a[i][j] * tau[i]).sum();
         assert!((s - f[j]).abs() < 1e-13);
+    }
+    // The split wrappers solve Aᵀ τ = f of their kernels' forces.
+    let zero = [0.0; DOF];
+    let parts = [
+        (gravity(&x, &p), f_of(&zero, &zero)),
+        (coriolis(&x, &u, &p), f_of(&u, &zero)),
+        (friction(&x, &u, &p), [u[0], 0.0, -u[2]]),
+    ];
+    for (tau, f) in parts {
+        let tau = tau.expect("regular");
+        for j in 0..DOF {
+            let s: f64 = (0..DOF).map(|i| a[i][j] * tau[i]).sum();
+            assert!((s - f[j]).abs() < 1e-13);
+        }
     }
     // A⁻ᵀ I A⁻¹ by nalgebra's inverse.
     let am = DMatrix::from_fn(DOF, DOF, |i, j| a[i][j]);

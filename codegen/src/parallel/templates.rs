@@ -23,7 +23,8 @@ const RETRACT_SUM: &str = include_str!("../../templates/platform_retract_sum.rs"
 const NEWTON: &str = include_str!("../../templates/platform_newton.rs");
 
 /// The fixed items of every parallel module: error types, the LU of `A`, and the public
-/// functions that wrap the DAG kernels.
+/// functions that wrap the DAG kernels `want` says are emitted (by the name before `_parts`:
+/// `id`, `inertia`, `gravity`, `coriolis`, `friction`).
 pub(super) fn templates(
     cfg: &Config,
     plan: &Plan,
@@ -42,7 +43,11 @@ pub(super) fn templates(
     );
     // Wrappers of the kernels `[scene] functions` may leave out.
     let actuation = Specialize::new(cfg).params(params);
-    let id_wrapper = if want("inverse_dynamics") {
+    let split: Vec<&str> = ["gravity", "coriolis", "friction"]
+        .into_iter()
+        .filter(|f| want(f))
+        .collect();
+    let id_wrapper = if want("id") || !split.is_empty() {
         let lu_solve_t = lu_fn(
             cfg,
             plan,
@@ -51,12 +56,17 @@ pub(super) fn templates(
             true,
             lu::Rhs::Vector,
         );
-        let f = actuation.items(ACTUATION, &["inverse_dynamics"]);
-        quote!(#f #lu_solve_t)
+        let id = if want("id") {
+            actuation.items(ACTUATION, &["inverse_dynamics"])
+        } else {
+            quote!()
+        };
+        let split = actuation.items(ACTUATION, &split);
+        quote!(#id #split #lu_solve_t)
     } else {
         quote!()
     };
-    let amm_wrapper = if want("actuator_mass_matrix") {
+    let amm_wrapper = if want("inertia") {
         let lu_inverse = lu_fn(
             cfg,
             plan,

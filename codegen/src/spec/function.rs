@@ -118,8 +118,19 @@ impl Kind {
                 MassMatrix,
                 ActuatorMassMatrix,
                 ForwardDynamics,
+                Gravity,
+                Coriolis,
+                Friction,
             ],
-            Kind::Closed => &[JointRates, InverseDynamics, MassMatrix, ForwardDynamics],
+            Kind::Closed => &[
+                JointRates,
+                InverseDynamics,
+                MassMatrix,
+                ForwardDynamics,
+                Gravity,
+                Coriolis,
+                Friction,
+            ],
         }
     }
 

@@ -49,8 +49,8 @@ mod tree;
 mod twists;
 
 pub use api::{
-    constraint_condition, constraints, forward_dynamics, generalized_effort, inverse_dynamics,
-    joint_rates, mass_matrix, potential_energy,
+    constraint_condition, constraints, coriolis, forward_dynamics, friction, generalized_effort,
+    gravity, inverse_dynamics, joint_rates, mass_matrix, potential_energy,
 };
 pub use assembly::{closure_residual, forward_kinematics, newton_assembly, newton_step};
 pub use config::{Config, configuration};

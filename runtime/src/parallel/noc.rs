@@ -47,7 +47,8 @@
 //! * `inertia.rs`: [`generalized_inertia`] and [`payload_inertia`].
 //! * `lu.rs`: step 6's solves with `A`, [`lu_solve`].
 //! * `dynamics.rs`: forward dynamics over [`Real`], [`forward_dynamics_generic`].
-//! * `api.rs`: the `f64` functions, [`inverse_kinematics`] to [`potential_energy`].
+//! * `api.rs`: the `f64` functions, [`inverse_kinematics`] to [`potential_energy`], and the
+//!   split of the efforts: [`gravity`], [`coriolis`], [`friction`].
 //! * `assembly.rs`: forward kinematics by Newton's method, [`forward_kinematics`], and
 //!   [`retract`].
 
@@ -77,8 +78,9 @@ pub use crate::payload::Payload;
 pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, check_finite, solve_spd};
 
 pub use api::{
-    actuation, actuator_mass_matrix, actuator_rates, forward_dynamics, generalized_effort,
-    inverse_dynamics, inverse_kinematics, leg_joint_positions, mass_matrix, potential_energy,
+    actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics, friction,
+    generalized_effort, gravity, inverse_dynamics, inverse_kinematics, leg_joint_positions,
+    mass_matrix, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
 pub use delta::{DeltaKin, DeltaPlan};

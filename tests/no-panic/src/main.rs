@@ -39,7 +39,7 @@ fn inputs<const N: usize>(seed: &mut u64, scale: F) -> [F; N] {
 // nothing (`#[inline(never)]`) and, with `prove`, guarded by its own `#[no_panic]`, so the proof
 // covers every generated function of every module one by one (the trait's methods forward to the
 // free functions, and a tree's identities are covered with them). A method the module's kind
-// does not have (`joint_rates`, `coriolis`, `gravity`, the derivatives: `None`) is proved too,
+// does not have (`joint_rates`, `friction`, the derivatives: `None`) is proved too,
 // trivially.
 
 /// `M` with the generated code's scalar.
@@ -123,7 +123,7 @@ pub fn coriolis<M: Module<NX, N>, const NX: usize, const N: usize>(
     m: &M,
     x: &[F; NX],
     u: &[F; N],
-) -> Option<[F; N]> {
+) -> Option<Result<[F; N], M::Singular>> {
     m.coriolis(x, u)
 }
 #[cfg_attr(feature = "prove", no_panic::no_panic)]
@@ -131,8 +131,17 @@ pub fn coriolis<M: Module<NX, N>, const NX: usize, const N: usize>(
 pub fn gravity<M: Module<NX, N>, const NX: usize, const N: usize>(
     m: &M,
     x: &[F; NX],
-) -> Option<[F; N]> {
+) -> Option<Result<[F; N], M::Singular>> {
     m.gravity(x)
+}
+#[cfg_attr(feature = "prove", no_panic::no_panic)]
+#[inline(never)]
+pub fn friction<M: Module<NX, N>, const NX: usize, const N: usize>(
+    m: &M,
+    x: &[F; NX],
+    u: &[F; N],
+) -> Option<Result<[F; N], M::Singular>> {
+    m.friction(x, u)
 }
 
 #[cfg_attr(feature = "prove", no_panic::no_panic)]
@@ -196,8 +205,12 @@ fn run<M: Module<NX, N>, const NX: usize, const N: usize>(m: &M, seed: &mut u64)
     if let Some(r) = joint_rates(m, &x, &u) {
         s += first(r.map(|v| v[0]));
     }
-    s += coriolis(m, &x, &u).map_or(0.0, |v| v[0]);
-    s += gravity(m, &x).map_or(0.0, |v| v[0]);
+    for split in [coriolis(m, &x, &u), gravity(m, &x), friction(m, &x, &u)]
+        .into_iter()
+        .flatten()
+    {
+        s += first(split.map(|v| v[0]));
+    }
     s += inverse_dynamics_derivatives(m, &x, &u, &ud).map_or(0.0, |(a, b)| a[0][0] + b[N - 1][0]);
     if let Some(r) = forward_dynamics_derivatives(m, &x, &u, &tau) {
         s += first(r.map(|(a, b, c)| a[0][0] + b[0][N - 1] + c[N - 1][N - 1]));

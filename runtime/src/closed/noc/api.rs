@@ -3,6 +3,7 @@
 //! coordinates, the generalized inertia, forward dynamics, the condition of `Φ_d`, potential
 //! energy).
 
+use alloc::vec;
 use alloc::vec::Vec;
 
 use super::config::configuration;
@@ -65,6 +66,39 @@ pub fn generalized_effort(
     check_finite(&[x, u, ud])?;
     let c = configuration(plan, x, true)?;
     finite(generalized_force(plan, &c, u, ud, gravity))
+}
+
+/// Efforts of the independent coordinates that hold the mechanism still against gravity and
+/// the springs at `x` (`−γ`): `inverse_dynamics(x, 0, 0)`.
+pub fn gravity(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x])?;
+    let c = configuration(plan, x, true)?;
+    let z = vec![0.0; plan.dof()];
+    finite(generalized_force(plan, &c, &z, &z, true))
+}
+
+/// Velocity-dependent efforts `C u` (Coriolis and centrifugal terms, the rotor inertias'
+/// among them; no gravity, springs or friction).
+pub fn coriolis(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u])?;
+    let c = configuration(plan, x, true)?;
+    let z = vec![0.0; plan.dof()];
+    finite(generalized_force(
+        &plan.without_friction(),
+        &c,
+        u,
+        &z,
+        false,
+    ))
+}
+
+/// Efforts of the dissipation at `(x, u)`: every joint's friction (viscous and regularized
+/// Coulomb) and the springs' damping, mapped to the independent coordinates by `Sᵀ`.
+pub fn friction(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u])?;
+    let c = configuration(plan, x, true)?;
+    let z = vec![0.0; plan.dof()];
+    finite(generalized_force(&plan.friction_only(), &c, u, &z, true))
 }
 
 /// The kept loop equations at `(x, ẋ)` for integrators in redundant coordinates (all the tree's

@@ -169,6 +169,42 @@ impl Plan {
     pub fn nx(&self) -> usize {
         self.joints.len()
     }
+    /// This plan without its dissipation (the joints' viscous and Coulomb friction, the
+    /// springs' damping; the rotor inertias kept): its generalized force at `u̇ = 0` without
+    /// gravity is the velocity-dependent part `C u` alone (`coriolis`).
+    pub fn without_friction(&self) -> Plan {
+        let mut p = self.clone();
+        for j in &mut p.joints {
+            j.drive = j.drive.without_friction();
+        }
+        for s in &mut p.springs {
+            s.damping = 0.0;
+        }
+        p
+    }
+
+    /// The dissipation alone: massless bodies, no rotor inertia, no gravity, springs without
+    /// stiffness. Its generalized force at `(u, u̇ = 0)` with the applied forces on (springs
+    /// count with gravity) is the joints' friction and the springs' damping (`friction`).
+    pub fn friction_only(&self) -> Plan {
+        let mut p = self.clone();
+        p.gravity = [0.0; 3];
+        for j in &mut p.joints {
+            j.body = (0.0, j.body.1, [[0.0; 3]; 3]);
+            j.drive = j.drive.friction_only();
+        }
+        for s in &mut p.springs {
+            s.stiffness = 0.0;
+        }
+        p
+    }
+
+    /// Whether a joint has friction or a spring has damping.
+    pub fn has_friction(&self) -> bool {
+        self.joints.iter().any(|j| j.drive.has_friction())
+            || self.springs.iter().any(|s| s.damping != 0.0)
+    }
+
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.independent.len()

@@ -78,6 +78,39 @@ pub fn inverse_dynamics(
     solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
+/// Actuator efforts that hold the mechanism still against gravity at `x`: `A⁻ᵀ (−γ)`, equal
+/// to `inverse_dynamics(x, 0, 0)` (N or N·m).
+pub fn gravity(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let z = vec![0.0; plan.dof()];
+    let f = generalized_force(plan, &pl, &legs, &z, &z, true);
+    let a = actuation_matrix(plan, &legs);
+    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+}
+
+/// Velocity-dependent actuator efforts `A⁻ᵀ C u` (Coriolis and centrifugal terms, the rotor
+/// inertias' among them; no gravity, no friction).
+pub fn coriolis(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let z = vec![0.0; plan.dof()];
+    let f = generalized_force(&plan.without_friction(), &pl, &legs, u, &z, false);
+    let a = actuation_matrix(plan, &legs);
+    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+}
+
+/// Actuator efforts of the leg joints' friction (viscous and regularized Coulomb, actuated
+/// and passive joints) at `(x, u)`, mapped to the actuators: `A⁻ᵀ Σ J⁻ᵀ δ(θ̇)`.
+pub fn friction(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x, u])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let z = vec![0.0; plan.dof()];
+    let f = generalized_force(&plan.friction_only(), &pl, &legs, u, &z, false);
+    let a = actuation_matrix(plan, &legs);
+    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+}
+
 /// The generalized force `I u̇ + C u − γ` of the speeds `u` (before the actuation map).
 pub fn generalized_effort(
     plan: &Plan,

@@ -248,6 +248,48 @@ impl Plan {
         Ok(plan)
     }
 
+    /// This plan without the drives' friction (viscous and Coulomb; the rotor inertias
+    /// kept): its generalized force at `u̇ = 0` without gravity is the velocity-dependent part
+    /// `C u` alone (`coriolis`). A leg with drives takes the generic route already, so the
+    /// closed forms stay as they are.
+    pub fn without_friction(&self) -> Plan {
+        let mut p = self.clone();
+        for leg in &mut p.legs {
+            for d in &mut leg.drives {
+                *d = d.without_friction();
+            }
+        }
+        p
+    }
+
+    /// The drives' friction alone: massless legs and platform, no rotor inertia, no gravity,
+    /// and every leg on the generic route (the closed forms hold masses of their own). Its
+    /// generalized force at `(u, u̇ = 0)` is the friction's part (`friction`).
+    pub fn friction_only(&self) -> Plan {
+        let mut p = self.clone();
+        let none = [[0.0; 3]; 3];
+        p.gravity = [0.0; 3];
+        p.platform = (0.0, p.platform.1, none);
+        for leg in &mut p.legs {
+            leg.ups = None;
+            leg.delta = None;
+            for b in &mut leg.bodies {
+                *b = (0.0, b.1, none);
+            }
+            for d in &mut leg.drives {
+                *d = d.friction_only();
+            }
+        }
+        p
+    }
+
+    /// Whether a leg joint has friction (viscous or Coulomb).
+    pub fn has_friction(&self) -> bool {
+        self.legs
+            .iter()
+            .any(|l| l.drives.iter().any(|d| d.has_friction()))
+    }
+
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.motion.dof()
