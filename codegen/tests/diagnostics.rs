@@ -44,6 +44,28 @@ fn bad_urdf_specs() {
     });
 }
 
+/// XML that is not a URDF (MJCF, SDF, anything else) is named for what it is, at its root
+/// element, instead of failing as TOML.
+#[test]
+fn other_xml_formats() {
+    insta::glob!("data/bad", "*.xml", |path| {
+        insta::assert_snapshot!(render_bad(path));
+    });
+}
+
+/// A URDF is recognized by its `<robot>` root whatever the file is called.
+#[cfg(feature = "urdf")]
+#[test]
+fn a_urdf_under_another_name_is_read() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/puma560.urdf");
+    let source = std::fs::read_to_string(path).unwrap();
+    let (as_urdf, _) = codegen::spec::load_tree("puma560.urdf", &source).unwrap();
+    let (as_xml, _) = codegen::spec::load_tree("puma560.xml", &source)
+        .unwrap_or_else(|e| panic!("{}", e.render()));
+    assert_eq!(as_urdf, as_xml);
+}
+
 /// Loads `path`, which must be accepted with at least one warning, and renders the warnings.
 fn render_warnings(path: &Path) -> String {
     let name = path.file_name().unwrap().to_str().unwrap();

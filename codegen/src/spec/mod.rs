@@ -171,10 +171,19 @@ fn load_any(
     }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let mut d = Diagnostics::new(file_name, source);
-        let spec = if is_urdf(file_name) {
-            read_urdf(source, &mut d)
-        } else {
-            read_toml::read(source, &mut d)
+        let root = xml_root(source);
+        let spec = match root
+            .as_ref()
+            .map(|(name, span)| (name.as_str(), span.clone()))
+        {
+            _ if is_urdf(file_name) => read_urdf(source, &mut d),
+            // A URDF under another name (`robot.xml`).
+            Some(("robot", _)) => read_urdf(source, &mut d),
+            Some((other, span)) => {
+                d.push(other_xml(other, span));
+                None
+            }
+            None => read_toml::read(source, &mut d),
         };
         let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
             prepare(&mut s, overrides, &mut d);
@@ -302,6 +311,53 @@ fn finish(
             Err(diags)
         }
     }
+}
+
+/// The root element's name and span when `source` is XML (after an optional byte-order mark,
+/// XML declaration, processing instructions, comments and a DOCTYPE), `None` otherwise.
+fn xml_root(source: &str) -> Option<(String, std::ops::Range<usize>)> {
+    let mut at = source.strip_prefix('\u{feff}').map_or(0, |_| 3);
+    loop {
+        let rest = &source[at..];
+        let trimmed = rest.trim_start();
+        at += rest.len() - trimmed.len();
+        let skip = [("<?", "?>"), ("<!--", "-->"), ("<!", ">")]
+            .into_iter()
+            .find(|(open, _)| trimmed.starts_with(open));
+        match skip {
+            Some((_, close)) => at += trimmed.find(close)? + close.len(),
+            None => break,
+        }
+    }
+    let tag = source[at..].strip_prefix('<')?;
+    let len = tag
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == ':'))
+        .unwrap_or(tag.len());
+    (len > 0).then(|| (tag[..len].to_string(), at..at + 1 + len))
+}
+
+/// The error of an XML file that is not a URDF: MJCF and SDF by name, anything else by its
+/// root element.
+fn other_xml(root: &str, span: std::ops::Range<usize>) -> Diagnostic {
+    let (what, hint) = match root {
+        "mujoco" => (
+            format!(
+                "this is an MJCF file (MuJoCo's format, root element `<{root}>`), which nocdyn does not read"
+            ),
+            "write the mechanism as a TOML spec (docs/spec.md; a tree's bodies, hinge and slide joints and inertials map one to one, an `<equality connect>` onto a loop-closing joint with `child_origin`), or give a URDF of the same robot",
+        ),
+        "sdf" => (
+            format!(
+                "this is an SDF file (Gazebo's format, root element `<{root}>`), which nocdyn does not read"
+            ),
+            "give a URDF of the same robot (a robot description package usually has one), or write the mechanism as a TOML spec (docs/spec.md)",
+        ),
+        _ => (
+            format!("this is an XML file with root element `<{root}>`, not a URDF (`<robot>`)"),
+            "nocdyn reads TOML specs (docs/spec.md) and URDF files",
+        ),
+    };
+    Diagnostic::error(what).with_span(span).with_hint(hint)
 }
 
 fn is_urdf(file_name: &str) -> bool {

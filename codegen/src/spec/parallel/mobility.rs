@@ -77,9 +77,22 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
             ))
             .with_key("platform")
             .with_span(ps.span.clone())
-            .with_hint(format!(
-                "a parallel mechanism has one actuator per degree of freedom: mark exactly one revolute or prismatic joint in each of the {dof} legs with actuated = true"
-            )),
+            .with_hint({
+                // The legs are the chains that end in the platform.
+                let legs = spec
+                    .joints
+                    .iter()
+                    .filter(|j| Some(j.child.as_str()) == ps.body.as_deref())
+                    .count();
+                let each = if legs as i64 == dof {
+                    format!("in each of the {legs} legs")
+                } else {
+                    format!("in each leg ({legs} legs end in the platform; a platform with {dof} degrees of freedom needs {dof})")
+                };
+                format!(
+                    "a parallel mechanism has one actuator per degree of freedom: mark exactly one revolute or prismatic joint {each} with actuated = true"
+                )
+            }),
         );
     }
 }
