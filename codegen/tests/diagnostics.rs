@@ -321,3 +321,64 @@ fn examples_in_docs_load_without_warnings() {
         "no complete parallel example found in docs/spec.md"
     );
 }
+
+/// A loop that does not close at home is reported at its own loop-closing joint (not the
+/// first one), and the `child_origin` its hint offers closes it. Andrews' squeezer has three
+/// loop-closing joints; the third one is moved by 1 mm.
+#[test]
+fn an_open_loop_is_reported_at_its_joint_with_the_child_origin_that_closes_it() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../mechanisms/specs/andrews_squeezer.toml");
+    let good = std::fs::read_to_string(path).unwrap();
+    let (line, line_no) = good
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with("child_origin"))
+        .map(|(i, l)| (l, i + 1))
+        .nth(2)
+        .expect("three loop-closing joints");
+    assert_eq!(line, "child_origin = { xyz = [0.0, -0.035, 0.0] }");
+    let bad: String = good
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == line_no {
+                "child_origin = { xyz = [0.0, -0.036, 0.0] }".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let e = match codegen::spec::load_mechanism("squeezer.toml", &bad) {
+        Ok(_) => panic!("an open loop was accepted"),
+        Err(e) => e.render(),
+    };
+    assert!(
+        e.contains(&format!("squeezer.toml:{line_no}:")),
+        "not at line {line_no}:\n{e}"
+    );
+    let fix = e
+        .split("`child_origin = ")
+        .nth(1)
+        .and_then(|s| s.split("` closes").next())
+        .unwrap_or_else(|| panic!("no child_origin in the hint:\n{e}"));
+    let fixed: String = bad
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == line_no {
+                format!("child_origin = {fix}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    if let Err(e) = codegen::spec::load_mechanism("squeezer.toml", &fixed) {
+        panic!(
+            "the offered child_origin {fix} does not close the loop:\n{}",
+            e.render()
+        );
+    }
+}

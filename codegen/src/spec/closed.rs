@@ -287,12 +287,54 @@ fn check_spring_lengths(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnosti
     }
 }
 
+/// `{ xyz = […], rpy = […] }` of a transform (fixed-axis X-Y-Z angles, `R = Rz Ry Rx`), to 12
+/// significant digits; `rpy` left out when it is zero.
+fn xyz_rpy(t: &runtime::model::Transform) -> String {
+    let m = &t.rotation;
+    let rpy = [
+        m[2][1].atan2(m[2][2]),
+        (-m[2][0]).atan2(m[0][0].hypot(m[1][0])),
+        m[1][0].atan2(m[0][0]),
+    ];
+    let num = |v: f64| {
+        let v = if v.abs() < 1e-15 { 0.0 } else { v };
+        let s = format!("{v:.12e}").parse::<f64>().unwrap_or(v);
+        format!("{s:?}")
+    };
+    let list = |v: &[f64; 3]| format!("[{}, {}, {}]", num(v[0]), num(v[1]), num(v[2]));
+    if rpy.iter().all(|a| a.abs() < 1e-15) {
+        format!("{{ xyz = {} }}", list(&t.translation))
+    } else {
+        format!("{{ xyz = {}, rpy = {} }}", list(&t.translation), list(&rpy))
+    }
+}
+
 /// The loop analysis ([`Plan::new`]); `None` when it fails (reported).
 fn check_plan(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) -> Option<()> {
     if let Err(e) = Plan::new(closed) {
-        // Point at the first loop-closing joint (the loops are where the analysis failed).
-        let at = spec.joints.iter().find(|j| j.child_origin.is_some());
-        let mut d = Diagnostic::error(e).with_hint("the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)");
+        // A loop that does not close: point at its joint and say which `child_origin` closes
+        // it; otherwise at the first loop-closing joint (the loops are where the analysis
+        // failed).
+        let open = closed.open_cut().and_then(|(k, fix)| {
+            let name = &closed.cuts[k].name;
+            let j = spec.joints.iter().find(|j| &j.name == name)?;
+            Some((j, fix))
+        });
+        let hint = match open {
+            Some((j, fix)) => {
+                let now = j.child_origin.unwrap_or(runtime::model::Transform::IDENTITY);
+                let to = now.compose(&fix);
+                format!(
+                    "with every tree joint at zero, `child_origin = {}` closes this loop (if that is not the intended geometry, check the joint origins along the loop)",
+                    xyz_rpy(&to)
+                )
+            }
+            None => "the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)".to_string(),
+        };
+        let at = open
+            .map(|(j, _)| j)
+            .or_else(|| spec.joints.iter().find(|j| j.child_origin.is_some()));
+        let mut d = Diagnostic::error(e).with_hint(hint);
         if let Some(j) = at {
             d = d
                 .with_key(format!("{}.child_origin", j.key))

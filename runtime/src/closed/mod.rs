@@ -52,7 +52,7 @@ use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use crate::model::{Model, Transform, Vec3, mat_vec};
+use crate::model::{Mat3, Model, Transform, Vec3, mat_mul, mat_vec};
 
 pub mod noc;
 
@@ -226,6 +226,84 @@ impl ClosedModel {
         }
         Ok(())
     }
+}
+
+impl ClosedModel {
+    /// The first cut joint whose two frames do not meet at home (beyond the tolerance of
+    /// [`ClosedModel::validate`]), with the correction `D` that closes it: its frame on the
+    /// child side, `frame_child · D`, meets the parent side's (the origins for a spherical cut,
+    /// the whole frame for a revolute one). `None` when every loop closes.
+    pub fn open_cut(&self) -> Option<(usize, Transform)> {
+        let poses = home_poses(&self.tree);
+        let tol = HOME_TOLERANCE * self.size();
+        self.cuts.iter().enumerate().find_map(|(k, c)| {
+            let a = frame_at_home(&poses, c.parent, &c.frame_parent);
+            let b = frame_at_home(&poses, c.child, &c.frame_child);
+            let d = [
+                a.translation[0] - b.translation[0],
+                a.translation[1] - b.translation[1],
+                a.translation[2] - b.translation[2],
+            ];
+            let dist = libm::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            let bt = transpose(&b.rotation);
+            // A revolute cut's axes must coincide: the rotation (in the child-side frame) that
+            // turns the child side's axis onto the parent side's, about their common normal.
+            let turn = match c.kind {
+                CutKind::Revolute { axis } => {
+                    let (ea, eb) = (mat_vec(&a.rotation, &axis), mat_vec(&b.rotation, &axis));
+                    let e = [ea[0] - eb[0], ea[1] - eb[1], ea[2] - eb[2]];
+                    (!(libm::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) <= 1e-9))
+                        .then(|| align(&axis, &mat_vec(&bt, &ea)))
+                }
+                CutKind::Spherical => None,
+            };
+            if dist <= tol && turn.is_none() {
+                // The tests of `validate`.
+                return None;
+            }
+            let rotation = turn.unwrap_or(Transform::IDENTITY.rotation);
+            Some((
+                k,
+                Transform {
+                    rotation,
+                    translation: mat_vec(&bt, &d),
+                },
+            ))
+        })
+    }
+}
+
+/// The rotation about `u × v` that turns the unit `u` onto the unit `v` (a half turn about a
+/// perpendicular when they are opposite).
+fn align(u: &Vec3, v: &Vec3) -> Mat3 {
+    let k = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let ss = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+    let (k, f) = if ss > 1e-24 {
+        (k, (1.0 - c) / ss)
+    } else if c > 0.0 {
+        return Transform::IDENTITY.rotation;
+    } else {
+        // A half turn about a unit perpendicular p: R = 2 p pᵀ − 1.
+        let (p, _) = perpendiculars(u);
+        return core::array::from_fn(|i| {
+            core::array::from_fn(|j| 2.0 * p[i] * p[j] - if i == j { 1.0 } else { 0.0 })
+        });
+    };
+    // Rodrigues: R = 1 + [k]× + [k]×² (1 − c)/|k|².
+    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+    let kx2 = mat_mul(&kx, &kx);
+    core::array::from_fn(|i| {
+        core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 } + kx[i][j] + f * kx2[i][j])
+    })
+}
+
+fn transpose(m: &Mat3) -> Mat3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| m[j][i]))
 }
 
 /// Body poses of the tree at `x = 0` (base frame).
