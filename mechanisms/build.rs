@@ -15,7 +15,6 @@ fn main() {
         std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
         let mut b = codegen::build_script::Builder::new();
         b.specs_in("specs")
-            .unwrap_or_else(|e| panic!("{e}"))
             .math(codegen::MathBackend::Runtime("runtime".into()))
             .float(float)
             .implement("runtime")

@@ -12,8 +12,10 @@ fn generate(out: &Path, variant: &str, spec: &Path, setup: impl FnOnce(&mut Buil
     let dir = out.join("variants").join(variant);
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     let mut b = Builder::new();
+    // The variants' warnings are deliberate (massless wrists, snapped angles).
     b.spec(spec)
         .math(codegen::MathBackend::Runtime("runtime".into()))
+        .warnings(false)
         .out_dir(&dir);
     setup(&mut b);
     b.compile().unwrap_or_else(|e| panic!("\n{e}"));

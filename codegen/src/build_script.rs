@@ -3,18 +3,43 @@
 //!
 //! ```no_run
 //! // In build.rs, inside `fn main()`:
-//! codegen::build_script::Builder::new()
-//!     .spec("specs/arm.toml")
-//!     .compile()
-//!     .unwrap_or_else(|e| panic!("{e}"));
+//! codegen::build_script::Builder::new().spec("specs/arm.toml").compile().unwrap_or_else(|e| panic!("{e}"));
 //! // Then in src/lib.rs:
 //! // pub mod arm { include!(concat!(env!("OUT_DIR"), "/arm.rs")); }
 //! ```
+//!
+//! Every option is a builder method, and every method chains; errors (an unreadable spec or
+//! directory, an invalid spec) come from [`Builder::compile`]:
+//!
+//! ```no_run
+//! // build.rs
+//! fn main() {
+//!     codegen::build_script::Builder::new()
+//!         .spec("specs/arm.toml")            // .specs_in(dir) adds a whole directory
+//!         .float(codegen::Float::F32)        // default: Float::F64
+//!         .compile()                         // math: MathBackend::Libm unless .math(..) says otherwise
+//!         .unwrap_or_else(|e| panic!("{e}"));
+//! }
+//! ```
+//!
+//! ```no_run
+//! codegen::build_script::Builder::new()
+//!     .specs_in("specs")
+//!     .implement("runtime")
+//!     .compile()
+//!     .unwrap_or_else(|e| panic!("{e}"));
+//! ```
+//!
+//! The snippets of `README.md` and `docs/firmware.md` are these (`codegen/tests/doc_snippets.rs`
+//! checks that they stay so), so `cargo test` compiles them.
 //!
 //! Each spec `dir/<stem>.toml` (or `.urdf`) becomes `$OUT_DIR/<stem>.rs`; a URDF whose stem is
 //! also a TOML spec's becomes `<stem>_urdf.rs`. Files are written only when their content
 //! changed, and replaced atomically ([`write_if_changed`]); `cargo:rerun-if-changed` is printed
 //! for every spec.
+
+// The docs show a whole `build.rs`, `fn main` included, as users write it.
+#![allow(clippy::needless_doctest_main)]
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -53,6 +78,11 @@ pub struct Builder {
     specs: Vec<PathBuf>,
     out_dir: Option<PathBuf>,
     config: Config,
+    /// A directory of [`Builder::specs_in`] that could not be read: reported by
+    /// [`Builder::compile`], so that every builder method chains (path, kind, message).
+    unreadable: Option<(PathBuf, std::io::ErrorKind, String)>,
+    /// Print the specs' warnings as cargo warnings.
+    warnings: bool,
 }
 
 impl Default for Builder {
@@ -68,6 +98,8 @@ impl Builder {
             specs: Vec::new(),
             out_dir: None,
             config: Config::default(),
+            unreadable: None,
+            warnings: true,
         }
     }
 
@@ -77,23 +109,32 @@ impl Builder {
         self
     }
 
-    /// Add every `.toml` and `.urdf` file of a directory (sorted by name).
-    pub fn specs_in(&mut self, dir: impl AsRef<Path>) -> Result<&mut Self, Error> {
+    /// Add every `.toml` and `.urdf` file of a directory (sorted by name). A directory that
+    /// cannot be read makes [`Builder::compile`] fail with [`Error::Io`].
+    pub fn specs_in(&mut self, dir: impl AsRef<Path>) -> &mut Self {
         let dir = dir.as_ref();
-        let rd = std::fs::read_dir(dir).map_err(|e| Error::Io(dir.to_path_buf(), e))?;
-        let mut found: Vec<PathBuf> = rd
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                matches!(
-                    p.extension().and_then(|e| e.to_str()),
-                    Some("toml" | "urdf")
-                )
-            })
-            .collect();
-        found.sort();
-        self.specs.extend(found);
         println!("cargo:rerun-if-changed={}", dir.display());
-        Ok(self)
+        match std::fs::read_dir(dir) {
+            Ok(rd) => {
+                let mut found: Vec<PathBuf> = rd
+                    .filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| {
+                        matches!(
+                            p.extension().and_then(|e| e.to_str()),
+                            Some("toml" | "urdf")
+                        )
+                    })
+                    .collect();
+                found.sort();
+                self.specs.extend(found);
+            }
+            Err(e) => {
+                if self.unreadable.is_none() {
+                    self.unreadable = Some((dir.to_path_buf(), e.kind(), e.to_string()));
+                }
+            }
+        }
+        self
     }
 
     /// Output directory (default `$OUT_DIR`).
@@ -145,6 +186,13 @@ impl Builder {
         self
     }
 
+    /// Print each spec's warnings (e.g. `snap`'s changes, a joint that moves only massless
+    /// bodies) as `cargo:warning` lines; on by default.
+    pub fn warnings(&mut self, on: bool) -> &mut Self {
+        self.warnings = on;
+        self
+    }
+
     /// Module name of each spec (see the module docs), in the order added.
     pub fn module_names(&self) -> Vec<String> {
         self.specs
@@ -161,13 +209,27 @@ impl Builder {
                 .map(PathBuf::from)
                 .ok_or(Error::NoOutDir)?,
         };
+        if let Some((dir, kind, msg)) = &self.unreadable {
+            return Err(Error::Io(
+                dir.clone(),
+                std::io::Error::new(*kind, msg.clone()),
+            ));
+        }
         let mut written = Vec::new();
         for p in &self.specs {
             println!("cargo:rerun-if-changed={}", p.display());
             let bytes = read_spec(p).map_err(|e| Error::Io(p.clone(), e))?;
-            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("spec");
-            let src = crate::spec::source_text(name, bytes).map_err(Error::Spec)?;
-            let g = compile(name, &src, &self.config).map_err(Error::Spec)?;
+            // Diagnostics name the spec by its path as given (relative to the crate's root,
+            // where cargo runs build scripts), as cargo's own messages do.
+            let name = p.to_string_lossy();
+            let src = crate::spec::source_text(&name, bytes).map_err(Error::Spec)?;
+            let g = compile(&name, &src, &self.config).map_err(Error::Spec)?;
+            // Warnings (e.g. `snap`'s changes) reach the user as cargo warnings.
+            if self.warnings && !g.warnings.is_empty() {
+                for line in g.warnings.render().lines() {
+                    println!("cargo:warning={line}");
+                }
+            }
             let path = out.join(format!("{}.rs", module_name(p, &self.specs)));
             write_if_changed(&path, &g.code)?;
             written.push(path);
@@ -266,6 +328,35 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    /// Every method chains: an unreadable directory and an invalid spec are errors of
+    /// `compile`, and a spec's diagnostics name it by its path as given.
+    #[test]
+    fn errors_come_from_compile_and_name_the_path() {
+        let dir = scratch("errors");
+        let missing = dir.join("no-such-dir");
+        let err = Builder::new()
+            .specs_in(&missing)
+            .out_dir(&dir)
+            .compile()
+            .unwrap_err();
+        assert!(matches!(&err, Error::Io(p, _) if p == &missing), "{err}");
+        let specs = dir.join("specs");
+        std::fs::create_dir_all(&specs).unwrap();
+        std::fs::write(specs.join("arm.toml"), "[mechanism]\nname = 3\n").unwrap();
+        let err = Builder::new()
+            .specs_in(&specs)
+            .out_dir(&dir)
+            .compile()
+            .unwrap_err();
+        let shown = err.to_string();
+        let path = specs.join("arm.toml");
+        assert!(
+            shown.contains(&format!("{}:2:", path.display())),
+            "the diagnostic does not name {}:\n{shown}",
+            path.display()
+        );
     }
 
     #[test]

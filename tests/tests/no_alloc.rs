@@ -243,7 +243,7 @@ fn dof(name: &str) -> usize {
 fn list_matches_specs() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs");
     let mut builder = codegen::build_script::Builder::new();
-    builder.specs_in(&dir).expect("specs dir");
+    builder.specs_in(&dir);
     let mut specs = builder.module_names();
     specs.sort();
     let mut listed: Vec<String> = NAMES.iter().map(|s| s.to_string()).collect();

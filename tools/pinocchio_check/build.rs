@@ -1,6 +1,6 @@
 fn main() {
     let mut b = codegen::build_script::Builder::new();
-    b.specs_in("urdf").unwrap().math(codegen::MathBackend::Runtime("runtime".into()));
+    b.specs_in("urdf").math(codegen::MathBackend::Runtime("runtime".into()));
     b.compile().unwrap_or_else(|e| panic!("{e}"));
     let mut list = String::new();
     for m in b.module_names() {
