@@ -164,15 +164,13 @@ fn planar_3rrr_generated_task_and_joint_modules_agree() {
     assert!(worst <= 1e-12, "{worst:e}");
 }
 
+/// The actuator efforts of a route at `(x, u, u̇)`.
+type Efforts = dyn Fn(&Plan, &[f64], &[f64], &[f64]) -> Vec<f64>;
+
 /// Newton–Euler with Lagrange multipliers: the legs' revolutes about z, a spherical joint at each
 /// platform point (the three together hold the platform in its plane), the platform's motion
 /// prescribed as `t = S u` (`ω = (0, 0, u₂)`, the origin's velocity `(u₀, u₁, 0)`).
-fn against_lagrange(
-    m: &ParallelModel,
-    seed: u64,
-    states: usize,
-    efforts: &dyn Fn(&Plan, &[f64], &[f64], &[f64]) -> Vec<f64>,
-) -> f64 {
+fn against_lagrange(m: &ParallelModel, seed: u64, states: usize, efforts: &Efforts) -> f64 {
     use references::lagrange::{self, Prescribed};
     let plan = Plan::new(m).unwrap();
     let home = m.home_x();
@@ -226,6 +224,31 @@ fn planar_3rpr_and_3prr_against_lagrange_multipliers() {
             "{name}: runtime vs Lagrange multipliers over 100 states, worst relative error (∞-norm): {worst:.1e}"
         );
         assert!(worst <= 1e-10, "{name}: {worst:e}");
+    }
+}
+
+/// Either leg joint may be actuated: the 3-RRR at its elbows, the 3-RPR at its base revolutes
+/// and the 3-PRR at its rod revolutes (the models of the specs with the other joint of each leg
+/// actuated), the runtime against Lagrange multipliers.
+#[test]
+fn other_actuated_joints_against_lagrange_multipliers() {
+    for (mut m, seed) in [
+        (model("planar_3rrr"), 0x51),
+        (data_model("planar_3rpr"), 0x52),
+        (data_model("planar_3prr"), 0x53),
+    ] {
+        for leg in &mut m.legs {
+            leg.actuated = 1 - leg.actuated;
+            leg.actuated_name = leg.joints[leg.actuated].name.clone();
+        }
+        let worst = against_lagrange(&m, seed, 100, &|plan, x, u, ud| {
+            noc::inverse_dynamics(plan, x, u, ud).unwrap()
+        });
+        println!(
+            "{} actuated at its other leg joints: runtime vs Lagrange multipliers over 100 states, worst relative error (∞-norm): {worst:.1e}",
+            m.name
+        );
+        assert!(worst <= 1e-10, "{}: {worst:e}", m.name);
     }
 }
 
