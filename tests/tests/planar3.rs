@@ -252,6 +252,57 @@ fn other_actuated_joints_against_lagrange_multipliers() {
     }
 }
 
+/// `det A` at `x`.
+fn det_a(plan: &Plan, x: &[f64]) -> f64 {
+    let a = noc::actuation(plan, x).unwrap();
+    a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+}
+
+/// Forward kinematics (Newton on `q(x)` with `A`, `x ⊕ δu` a sum) recovers the platform pose
+/// from the actuated positions of its inverse kinematics, for the three leg kinds, from a guess
+/// 2 mm and 0.02 rad off, at states of home's aspect (`det A` of home's sign and at least a
+/// tenth of home's: a type-II locus crosses the 3-RPR's sampling range near `φ ≈ −0.16` rad,
+/// and beyond it a pose has a mirrored twin nearby with the same `q`). From home it always
+/// returns a pose with the same `q` (checked at every state), not always the same pose.
+/// Errors: `‖x_FK − x‖∞` (m and rad), `‖q(x_FK) − q‖∞ / ‖q‖∞`.
+#[test]
+fn forward_kinematics_round_trip() {
+    for m in [
+        model("planar_3rrr"),
+        data_model("planar_3prr"),
+        data_model("planar_3rpr"),
+    ] {
+        let plan = Plan::new(&m).unwrap();
+        let home = m.home_x();
+        let d_home = det_a(&plan, &home);
+        let mut rng = tests::rng(0xf0);
+        let (mut worst, mut worst_q): (f64, f64) = (0.0, 0.0);
+        let mut n = 0;
+        while n < 100 {
+            let (x, _, _) = state(&plan, &home, &mut rng);
+            let q = noc::inverse_kinematics(&plan, &x).unwrap();
+            let other = noc::forward_kinematics(&plan, &q, &home).unwrap();
+            let q_other = noc::inverse_kinematics(&plan, &other).unwrap();
+            worst_q = worst_q.max(rel(&q_other, &q));
+            if det_a(&plan, &x) / d_home < 0.1 {
+                continue;
+            }
+            n += 1;
+            let guess = [x[0] + 0.002, x[1] - 0.002, x[2] + 0.02];
+            let back = noc::forward_kinematics(&plan, &q, &guess).unwrap();
+            worst = worst.max((0..3).fold(0.0, |w: f64, i| w.max((back[i] - x[i]).abs())));
+        }
+        println!(
+            "{}: forward kinematics of q(x) over 100 states of home's aspect, worst ‖x_FK − x‖∞ {worst:.1e} (guess 2 mm, 0.02 rad off); from home, worst ‖q(x_FK) − q‖∞/‖q‖∞ {worst_q:.1e}",
+            m.name
+        );
+        assert!(worst <= 1e-9, "{}: {worst:e}", m.name);
+        assert!(worst_q <= 1e-9, "{}: {worst_q:e}", m.name);
+    }
+}
+
 /// The leg kinds are recognised, and their legs close at home.
 #[test]
 fn planar_leg_kinds_are_recognised() {

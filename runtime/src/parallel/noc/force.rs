@@ -201,8 +201,8 @@ pub(crate) fn linear<R: Real>(motion: PlatformMotion, u: &[R], ud: &[R]) -> (V<R
     }
 }
 
-/// Adds a turning platform body's `Tᵀ` of its wrench (moment `np` about the platform frame's
-/// origin, force `fp`) to `f`: `Sᵀ [n; f]`.
+/// Adds a turning platform body's Newton–Euler wrench (eq. 12; moment `np` about the platform
+/// frame's origin, force `fp`) to `f` through its twist-shaping block: `Sᵀ [n; f]`.
 fn add_platform<R: Real>(motion: PlatformMotion, f: &mut [R], np: V<R>, fp: V<R>) {
     match motion {
         PlatformMotion::PlanarPose { .. } => {
