@@ -109,6 +109,10 @@ fn main() {
     let joints = "data/delta_rl5_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "delta_joints", Path::new(joints), |_| {});
+    // The planar 3-RRR in joint coordinates, for the bench against its task form.
+    let joints = "data/planar_3rrr_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(&out, "planar3_joints", Path::new(joints), |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

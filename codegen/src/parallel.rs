@@ -308,6 +308,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         PlatformMotion::PlanarPoint { .. } => {
             "`x = [px, py]` (the point where the legs meet, m, base frame); `u = [vx, vy]` (m/s)"
         }
+        PlatformMotion::PlanarPose { .. } => {
+            "`x = [px, py, φ]` (platform frame origin, m, base frame, in the plane of its home height; φ its rotation about base z from home, rad); `u = [vx, vy, ω]` (m/s of the platform frame origin, rad/s about z)"
+        }
         PlatformMotion::Translation { .. } => {
             "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"
         }

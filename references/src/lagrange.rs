@@ -1053,6 +1053,15 @@ pub fn platform_pose(motion: PlatformMotion, x: &[f64]) -> Transform {
             rotation,
             translation: [x[0], x[1], x[2]],
         },
+        // The origin in the plane z = height; the home rotation turned by φ about z.
+        PlatformMotion::PlanarPose { height, rotation } => {
+            let (s, c) = x[2].sin_cos();
+            let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+            Transform {
+                rotation: runtime::model::mat_mul(&rz, &rotation),
+                translation: [x[0], x[1], height],
+            }
+        }
     }
 }
 
@@ -1116,7 +1125,8 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
                     PlatformMotion::Orientation { centre } => centre,
                     PlatformMotion::Pose
                     | PlatformMotion::PlanarPoint { .. }
-                    | PlatformMotion::Translation { .. } => plat.translation,
+                    | PlatformMotion::Translation { .. }
+                    | PlatformMotion::PlanarPose { .. } => plat.translation,
                 };
                 (
                     CJointKind::Revolute { axis },

@@ -7,13 +7,14 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 6] = [
+pub const PARALLEL: [&str; 7] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
     "agile_eye",
     "planar_five_bar",
     "delta_rl5",
+    "planar_3rrr",
 ];
 
 /// The spec file of a bundled mechanism.
@@ -57,7 +58,13 @@ pub fn random_state(
         let mut d = vec![0.0; n];
         for (i, v) in d.iter_mut().enumerate() {
             let planar = plan.motion.translates();
-            *v = if i < 3 && !planar { angle } else { reach } * rng.random_range(-1.0..1.0);
+            // A planar pose's φ is its third coordinate.
+            let turns = if plan.motion.planar_pose() {
+                i == 2
+            } else {
+                i < 3 && !planar
+            };
+            *v = if turns { angle } else { reach } * rng.random_range(-1.0..1.0);
         }
         let x = noc::retract(plan.motion, home, &d);
         if noc::inverse_dynamics(plan, &x, &vec![0.0; n], &vec![0.0; n]).is_err() {

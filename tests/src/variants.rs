@@ -100,3 +100,11 @@ pub mod delta_joints {
         "/variants/delta_joints/delta_rl5_joints.rs"
     ));
 }
+/// The planar 3-RRR of `mechanisms/specs/planar_3rrr.toml` in joint coordinates (`tests/data/
+/// planar_3rrr_joints.toml`, the closed-loop route), for the bench against its task form.
+pub mod planar3_joints {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/planar3_joints/planar_3rrr_joints.rs"
+    ));
+}

@@ -339,6 +339,12 @@ fn rotated_parallel(m: &ParallelModel, r: Mat3) -> ParallelModel {
             rotation: runtime::model::mat_mul(&r, &rotation),
         };
     }
+    if let PlatformMotion::PlanarPose { height, rotation } = m.motion {
+        out.motion = PlatformMotion::PlanarPose {
+            height,
+            rotation: runtime::model::mat_mul(&r, &rotation),
+        };
+    }
     out
 }
 
@@ -364,6 +370,11 @@ fn rotate_x(m: &ParallelModel, r: &Mat3, x: &[f64]) -> Vec<f64> {
             vec![p[0], p[1]]
         }
         PlatformMotion::Translation { .. } => mat_vec(r, &[x[0], x[1], x[2]]).to_vec(),
+        // Turned about z: φ stays (it is measured from the turned home rotation).
+        PlatformMotion::PlanarPose { .. } => {
+            let p = mat_vec(r, &[x[0], x[1], 0.0]);
+            vec![p[0], p[1], x[2]]
+        }
     }
 }
 
@@ -379,6 +390,7 @@ fn parallel_indices_are_invariant_under_a_rotation_of_the_whole_mechanism() {
         ("agile_eye", 0.5, 0.0, false),
         ("planar_five_bar", 0.0, 0.05, true),
         ("delta_rl5", 0.0, 0.05, false),
+        ("planar_3rrr", 0.3, 0.02, true),
     ] {
         let m = model(name);
         let plan = Plan::new(&m).unwrap();

@@ -29,6 +29,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
         PlatformMotion::Orientation { .. } => (0.4, 0.0),
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
         PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
+        PlatformMotion::PlanarPose { .. } => (0.15, 0.03 * m.size()),
     }
 }
 
@@ -123,6 +124,7 @@ generated_vs_runtime!(rus_hexapod);
 generated_vs_runtime!(agile_eye);
 generated_vs_runtime!(planar_five_bar);
 generated_vs_runtime!(delta_rl5);
+generated_vs_runtime!(planar_3rrr);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -191,6 +193,7 @@ power_balance!(power_balance_rus_hexapod, rus_hexapod);
 power_balance!(power_balance_agile_eye, agile_eye);
 power_balance!(power_balance_planar_five_bar, planar_five_bar);
 power_balance!(power_balance_delta_rl5, delta_rl5);
+power_balance!(power_balance_planar_3rrr, planar_3rrr);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]
@@ -259,6 +262,15 @@ macro_rules! against_lagrange {
                     // The Delta's parallelograms hold the platform's orientation; its own test
                     // (tests/tests/delta.rs) gives the reference U joints to hold it.
                     PlatformMotion::Translation { .. } => unreachable!("see tests/tests/delta.rs"),
+                    // t = S u: ω = (0, 0, u₂), the platform origin's velocity (u₀, u₁, 0).
+                    PlatformMotion::PlanarPose { height, .. } => (
+                        Prescribed::Pose {
+                            body: platform,
+                            point: [x[0], x[1], height],
+                        },
+                        vec![0.0, 0.0, u[2], u[0], u[1], 0.0],
+                        vec![0.0, 0.0, ud[2], ud[0], ud[1], 0.0],
+                    ),
                 };
                 let sol = lagrange::inverse_dynamics(&sys, &prescribed, &uu, &uud).unwrap();
                 let tau = g::inverse_dynamics(&arr(&x), &arr(&u), &arr(&ud)).unwrap();
@@ -278,6 +290,7 @@ against_lagrange!(lagrange_sliding_hexapod, sliding_hexapod);
 against_lagrange!(lagrange_rus_hexapod, rus_hexapod);
 against_lagrange!(lagrange_agile_eye, agile_eye);
 against_lagrange!(lagrange_planar_five_bar, planar_five_bar);
+against_lagrange!(lagrange_planar_3rrr, planar_3rrr);
 
 /// A generic leg (`LegKind::Generic`, inverse kinematics by a fixed number of Newton steps),
 /// compiled (`tests/build.rs`, `codegen/tests/data/good_parallel/generic_leg.toml`): the

@@ -90,6 +90,12 @@ fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
         PlatformMotion::Orientation { .. } => q.to_vec(),
         PlatformMotion::PlanarPoint { .. } => vec![p[0], p[1]],
         PlatformMotion::Translation { .. } => p.to_vec(),
+        // φ from the home rotation: the quaternion's turn about z against home's.
+        PlatformMotion::PlanarPose { .. } => {
+            let h = home_q(m);
+            let phi = 2.0 * (q[3] * h[0] - q[0] * h[3]).atan2(q[0] * h[0] + q[3] * h[3]);
+            vec![p[0], p[1], phi]
+        }
     }
 }
 
@@ -182,6 +188,7 @@ generated_routes!(sliding_hexapod);
 generated_routes!(rus_hexapod);
 generated_routes!(planar_five_bar);
 generated_routes!(delta_rl5);
+generated_routes!(planar_3rrr);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -191,6 +198,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "rus_hexapod" => &rus_hexapod::ROUTES,
         "planar_five_bar" => &planar_five_bar::ROUTES,
         "delta_rl5" => &delta_rl5::ROUTES,
+        "planar_3rrr" => &planar_3rrr::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }
@@ -493,6 +501,7 @@ fn reference_agrees_with_runtime_at_generic_states() {
         "rus_hexapod",
         "agile_eye",
         "delta_rl5",
+        "planar_3rrr",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -792,6 +801,139 @@ fn delta_type_two(y: f64) {
     finish(&bad);
 }
 
+/// Planar 3-RRR (`planar_3rrr`, task coordinates `[px, py, φ]`): leg 0's boundary, its
+/// proximal and distal links in one line (stretched, `|B₀ − A₀| = l₁ + l₂`): the leg Jacobian's
+/// determinant vanishes, a leg (type-I) singularity. The platform keeps its home rotation
+/// (`φ = 0`) and moves so that `B₀` runs along the line from `A₀` through `B₀`'s home position,
+/// `|B₀ − A₀| = 0.55 m − δ` (1e-1 … 1e-12 m, then 0). Measured (`--nocapture`): both `f64`
+/// routes `Ok` to ≤ 7.2e-9 against double-double down to δ = 1e-8 m, then `Err(Leg(0))` from
+/// 1e-9 m (double-double too) to δ = 0 (where double-double reports `Reach(0)`); 1 mm beyond,
+/// `Err(Reach(0))` from both.
+#[test]
+fn planar_3rrr_stretched_leg_singularity() {
+    let m = model("planar_3rrr");
+    let plan = plan(&m);
+    let home = home_x(&m);
+    let (a0, b0) = planar_3rrr_leg0(&m);
+    let dir = [b0[0] - a0[0], b0[1] - a0[1]];
+    let n = (dir[0] * dir[0] + dir[1] * dir[1]).sqrt();
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| {
+            let r = 0.55 - d;
+            // The platform origin that puts B₀ at A₀ + r·dir (B₀ − origin is fixed at φ = 0).
+            let p = [
+                a0[0] + r * dir[0] / n - (b0[0] - home[0]),
+                a0[1] + r * dir[1] / n - (b0[1] - home[1]),
+            ];
+            Point {
+                delta: d,
+                x: vec![p[0], p[1], 0.0],
+            }
+        })
+        .collect();
+    let bad = walk_report(
+        "Planar 3-RRR, |B₀ − A₀| = 0.55 m − δ (leg 0 stretched)",
+        &plan,
+        &walk,
+        &states(3, 0x3e),
+        Some(generated_id("planar_3rrr")),
+        &[
+            |s| matches!(s, Site::Leg(0)),
+            |s| matches!(s, Site::Reach(0)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
+    );
+    finish(&bad);
+    // Beyond the boundary (1 mm further): out of reach, generated and runtime alike.
+    let x = {
+        let r = 0.551;
+        [
+            a0[0] + r * dir[0] / n - (b0[0] - home[0]),
+            a0[1] + r * dir[1] / n - (b0[1] - home[1]),
+            0.0,
+        ]
+    };
+    let e = noc::inverse_kinematics(&plan, &x).unwrap_err();
+    assert_eq!(e.site, Site::Reach(0), "{e:?}");
+    let g = mechanisms::planar_3rrr::inverse_dynamics(&x, &[0.0; 3], &[0.0; 3]).unwrap_err();
+    assert_eq!(site_from_debug(&format!("{:?}", g.site)), Site::Reach(0));
+}
+
+/// Leg 0's base joint `A₀` and platform joint `B₀` at home (base frame, in the plane).
+fn planar_3rrr_leg0(m: &ParallelModel) -> ([f64; 2], [f64; 2]) {
+    let a = m.legs[0].joints[0].origin.translation;
+    let runtime::parallel::LegEnd::Spherical { on_platform, .. } = m.legs[0].end else {
+        panic!("a planar leg ends in a point")
+    };
+    let b = m.home.apply(&on_platform);
+    ([a[0], a[1]], [b[0], b[1]])
+}
+
+/// Planar 3-RRR: a parallel (type-II) singularity, where the three distal links' lines meet in
+/// one point (the rows of `A` dependent) while every leg stays regular. Found by turning the
+/// platform about its origin at home position: `φ*` is where the runtime's `det A` changes sign
+/// (bisection to rounding, legs regular); the walk is `φ = φ* − δ` (1e-1 … 1e-12 rad, then `φ*`).
+/// Measured: `φ* = 0.7120251828…` rad; both `f64` routes `Ok` to ≤ 1.3e-7 against
+/// double-double (pivot ratio 2.1e7) down to δ = 1e-9 rad, then `Err(Actuation(2))` from 1e-10 rad.
+#[test]
+fn planar_3rrr_parallel_singularity() {
+    let m = model("planar_3rrr");
+    let plan = plan(&m);
+    let home = home_x(&m);
+    let det = |phi: f64| {
+        let a = noc::actuation(&plan, &[home[0], home[1], phi]).ok()?;
+        Some(
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]),
+        )
+    };
+    // The first sign change of det A from home, turning counter-clockwise in 0.01 rad steps.
+    let mut lo = 0.0;
+    let mut d_lo = det(lo).unwrap();
+    let mut hi = lo;
+    loop {
+        hi += 0.01;
+        assert!(hi < 3.2, "no sign change of det A");
+        let d_hi = det(hi).expect("legs regular on the way");
+        if d_lo * d_hi < 0.0 {
+            break;
+        }
+        lo = hi;
+        d_lo = d_hi;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if det(mid).unwrap() * d_lo > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let ps = lo;
+    println!("Planar 3-RRR: det A changes sign at φ* = {ps} rad (origin at home)");
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![home[0], home[1], ps - d],
+        })
+        .collect();
+    let bad = walk_report(
+        "Planar 3-RRR, φ = φ* − δ (distal links concurrent)",
+        &plan,
+        &walk,
+        &states(3, 0x3f),
+        Some(generated_id("planar_3rrr")),
+        &[|s| matches!(s, Site::Actuation(_))],
+    );
+    finish(&bad);
+}
+
 /// A platform axis approaching the base axis of a *different* leg (`v₂ → u₃` by
 /// `R_z(30°)·R_y(−90° + δ)`, `v₁`, `v₃` generic) is *not* singular for the exact Agile-Eye
 /// geometry: the actuation matrix stays well conditioned (scaled pivot ratio → √3) and the
@@ -889,6 +1031,7 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
         "rus_hexapod",
         "agile_eye",
         "delta_rl5",
+        "planar_3rrr",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -997,9 +1140,10 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
 /// which tests `value > 0` instead of `|value| > 0` before dividing.
 #[test]
 fn out_of_reach() {
-    let cases: [(&str, [f64; 3]); 4] = [
+    let cases: [(&str, [f64; 3]); 5] = [
         ("rus_hexapod", [0.0, 0.0, 10.0]),
         ("delta_rl5", [3.0, 0.0, 0.0]),
+        ("planar_3rrr", [3.0, 0.0, 0.0]),
         ("sliding_hexapod", [10.0, 0.0, 0.0]),
         ("sliding_hexapod", [0.0, -10.0, 2.0]),
     ];

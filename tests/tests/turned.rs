@@ -63,6 +63,11 @@ fn turn_parallel(m: &ParallelModel, t: &Transform) -> ParallelModel {
         PlatformMotion::Translation { rotation } => PlatformMotion::Translation {
             rotation: runtime::model::mat_mul(&t.rotation, &rotation),
         },
+        // Turned about z (the plane stays): the home rotation turns, φ stays relative to it.
+        PlatformMotion::PlanarPose { height, rotation } => PlatformMotion::PlanarPose {
+            height,
+            rotation: runtime::model::mat_mul(&t.rotation, &rotation),
+        },
         other => other,
     };
     out
@@ -102,6 +107,11 @@ fn turn_state(motion: PlatformMotion, r: &Mat3, x: &[f64], u: &[f64]) -> (Vec<f6
             (vec![p[0], p[1]], vec![v[0], v[1]])
         }
         PlatformMotion::Translation { .. } => (rv(r, x).to_vec(), rv(r, u).to_vec()),
+        PlatformMotion::PlanarPose { .. } => {
+            let p = rv(r, &[x[0], x[1], 0.0]);
+            let v = rv(r, &[u[0], u[1], 0.0]);
+            (vec![p[0], p[1], x[2]], vec![v[0], v[1], u[2]])
+        }
     }
 }
 
@@ -139,7 +149,9 @@ fn turned_platforms_are_accepted_with_the_same_efforts() {
     for name in PARALLEL {
         let m = tests::pkm::model(name);
         let t = match m.motion {
-            PlatformMotion::PlanarPoint { .. } => turn_about_z(),
+            PlatformMotion::PlanarPoint { .. } | PlatformMotion::PlanarPose { .. } => {
+                turn_about_z()
+            }
             _ => generic_turn(),
         };
         let plan = pnoc::Plan::new(&m).unwrap();

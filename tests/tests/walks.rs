@@ -328,7 +328,8 @@ parallel_routes!(
     sliding_hexapod,
     rus_hexapod,
     planar_five_bar,
-    delta_rl5
+    delta_rl5,
+    planar_3rrr
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -414,6 +415,12 @@ fn turned(m: &ParallelModel, axis: usize, deg: f64, dp: [f64; 3]) -> Vec<f64> {
         PlatformMotion::Translation { .. } => {
             vec![home[0] + dp[0], home[1] + dp[1], home[2] + dp[2]]
         }
+        // Turned about z only (the plane's normal): φ.
+        PlatformMotion::PlanarPose { .. } => vec![
+            home[0] + dp[0],
+            home[1] + dp[1],
+            home[2] + if axis == 2 { deg.to_radians() } else { 0.0 },
+        ],
     }
 }
 
@@ -427,6 +434,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "agile_eye",
         "planar_five_bar",
         "delta_rl5",
+        "planar_3rrr",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
@@ -485,6 +493,28 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                             &mut bad,
                         );
                     }
+                }
+            }
+            PlatformMotion::PlanarPose { .. } => {
+                // Out of the workspace in the plane (legs stretched: leg singularities, then
+                // out of reach), and turned about z both ways (type-II singularities).
+                for (dx, dy) in [(1.0, 0.0), (0.0, 1.0), (0.0, -1.0), (-0.7, 0.7)] {
+                    for s in 0..=800 {
+                        let t = 0.6 * s as f64 / 800.0;
+                        at(
+                            turned(&m, 2, 0.0, [dx * t, dy * t, 0.0]),
+                            format!("{t} along ({dx}, {dy})"),
+                            &mut bad,
+                        );
+                    }
+                }
+                for s in 0..=720 {
+                    let deg = -180.0 + 360.0 * s as f64 / 720.0;
+                    at(
+                        turned(&m, 2, deg, [0.0; 3]),
+                        format!("{deg}° about z"),
+                        &mut bad,
+                    );
                 }
             }
             PlatformMotion::Translation { .. } => {

@@ -176,7 +176,9 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
     let (quaternion, has_position) = match plan.motion {
         PlatformMotion::Pose => (3usize, true),
         PlatformMotion::Orientation { .. } => (0usize, false),
-        PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => (0usize, false),
+        PlatformMotion::PlanarPoint { .. }
+        | PlatformMotion::Translation { .. }
+        | PlatformMotion::PlanarPose { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -185,7 +187,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .constant("FK_MAX_ITERATIONS", Literal::usize_unsuffixed(fk_max))
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
-    let retract = if plan.motion.translates() {
+    // A planar pose's [px, py, φ] ⊕ [δx, δy, δφ] is a sum too.
+    let retract = if plan.motion.translates() || plan.motion.planar_pose() {
         sp.items(RETRACT_SUM, &["retract"])
     } else {
         sp.items(RETRACT_QUATERNION, &["retract"])

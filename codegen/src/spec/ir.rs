@@ -193,6 +193,9 @@ pub(crate) enum Coordinates {
     Planar,
     /// Three DOF: the platform's position, its orientation fixed (a Delta robot).
     Translation,
+    /// Three DOF: the platform moves in a plane `z = const` and turns about its normal
+    /// (`x = [px, py, φ]`; a planar 3-RRR, 3-PRR, 3-RPR).
+    PlanarPose,
 }
 
 /// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`

@@ -78,6 +78,15 @@ fn end_map(motion: PlatformMotion, lk: &LegKin<f64>) -> DMatrix<f64> {
         PlatformMotion::Orientation { .. } => DMatrix::identity(3, 3),
         PlatformMotion::PlanarPoint { .. } => DMatrix::identity(3, 2),
         PlatformMotion::Translation { .. } => DMatrix::identity(3, 3),
+        // v_end = v + ω × arm, ω = (0, 0, u₂): columns e_x, e_y, e_z × arm.
+        PlatformMotion::PlanarPose { .. } => {
+            let mut g = DMatrix::zeros(3, 3);
+            g[(0, 0)] = 1.0;
+            g[(1, 1)] = 1.0;
+            g[(0, 2)] = -lk.arm[1];
+            g[(1, 2)] = lk.arm[0];
+            g
+        }
     }
 }
 
@@ -96,6 +105,14 @@ fn end_motion(motion: PlatformMotion, lk: &LegKin<f64>, u: &[f64], ud: &[f64]) -
         PlatformMotion::Orientation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         PlatformMotion::PlanarPoint { .. } => ([u[0], u[1], 0.0], [ud[0], ud[1], 0.0]),
         PlatformMotion::Translation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
+        PlatformMotion::PlanarPose { .. } => {
+            let (w, wd) = (v3([0.0, 0.0, u[2]]), v3([0.0, 0.0, ud[2]]));
+            let (v, a) = (v3([u[0], u[1], 0.0]), v3([ud[0], ud[1], 0.0]));
+            let arm = v3(lk.arm);
+            let ve = v + w.cross(&arm);
+            let ae = a + wd.cross(&arm) + w.cross(&w.cross(&arm));
+            (ve.into(), ae.into())
+        }
     }
 }
 
@@ -191,6 +208,22 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             t.view_mut((6 * b + 3, 0), (3, 3))
                 .copy_from(&Matrix3::identity());
             let rot = m3(&pl.rot);
+            let inertia = rot * m3(&inertia) * rot.transpose();
+            put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
+        }
+        PlatformMotion::PlanarPose { .. } => {
+            // T_P = S with the mass centre's velocity v + ω × r_c, ω = (0, 0, u₂):
+            // Ṫ u = ω × (ω × r_c).
+            let rot = m3(&pl.rot);
+            let rc = rot * v3(com);
+            t[(6 * b + 2, 2)] = 1.0;
+            t[(6 * b + 3, 0)] = 1.0;
+            t[(6 * b + 4, 1)] = 1.0;
+            t[(6 * b + 3, 2)] = -rc[1];
+            t[(6 * b + 4, 2)] = rc[0];
+            let w = v3([0.0, 0.0, u[2]]);
+            td_u.fixed_rows_mut::<3>(6 * b + 3)
+                .copy_from(&w.cross(&w.cross(&rc)));
             let inertia = rot * m3(&inertia) * rot.transpose();
             put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
         }

@@ -7,7 +7,8 @@
 //!   `x = [px, py, pz, qw, qx, qy, qz]`, `u = [ω; v]`) or its orientation about a fixed centre
 //!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`), or its position with
 //!   the orientation fixed ([`PlatformMotion::Translation`]: `x = [px, py, pz]`, `u = v`; a Delta
-//!   robot). Base-frame components;
+//!   robot), or its planar pose ([`PlatformMotion::PlanarPose`]: `x = [px, py, φ]`,
+//!   `u = [vx, vy, ω]`; a planar 3-RRR). Base-frame components;
 //!   `v` is the velocity of the platform frame's origin.
 //! * Leg `J` is a serial chain of one-DOF joints (U joints arrive expanded into two revolutes with
 //!   a massless body between them) whose last body meets the platform in a spherical joint (pose)
@@ -59,6 +60,19 @@ pub enum PlatformMotion {
         /// The platform's fixed rotation (platform → base).
         rotation: crate::model::Mat3,
     },
+    /// Three DOF: the platform moves in the plane `z = height` of the base frame and turns
+    /// about the base `z` axis (a planar 3-RRR, 3-PRR, 3-RPR). `x = [px, py, φ]`: the platform
+    /// frame's origin (m) and its rotation about `z` from its home rotation (rad, `φ = 0` at
+    /// home; platform → base `Rz(φ)·rotation`); `u = [vx, vy, ω]` (m/s, rad/s), so that
+    /// `x ⊕ δu` is a sum; the twist is `t = [ω; v] = S u` with `ω = (0, 0, u₂)`,
+    /// `v = (u₀, u₁, 0)` (docs/method.md, "nocdyn's formulation"). Each leg ends in a revolute
+    /// about `z` at a point of the platform (a [`LegEnd::Spherical`] point).
+    PlanarPose {
+        /// The plane's height `z` (base frame, m).
+        height: f64,
+        /// The platform's home rotation (platform → base).
+        rotation: crate::model::Mat3,
+    },
 }
 
 impl PlatformMotion {
@@ -68,7 +82,7 @@ impl PlatformMotion {
             PlatformMotion::Pose => 7,
             PlatformMotion::Orientation { .. } => 4,
             PlatformMotion::PlanarPoint { .. } => 2,
-            PlatformMotion::Translation { .. } => 3,
+            PlatformMotion::Translation { .. } | PlatformMotion::PlanarPose { .. } => 3,
         }
     }
     /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
@@ -77,7 +91,7 @@ impl PlatformMotion {
             PlatformMotion::Pose => 6,
             PlatformMotion::Orientation { .. } => 3,
             PlatformMotion::PlanarPoint { .. } => 2,
-            PlatformMotion::Translation { .. } => 3,
+            PlatformMotion::Translation { .. } | PlatformMotion::PlanarPose { .. } => 3,
         }
     }
     /// The unit group of each speed (`u`'s columns of the actuation matrix `A`): speeds of one
@@ -90,7 +104,12 @@ impl PlatformMotion {
             PlatformMotion::Pose => &[0, 0, 0, 1, 1, 1],
             PlatformMotion::Orientation { .. } | PlatformMotion::Translation { .. } => &[0, 0, 0],
             PlatformMotion::PlanarPoint { .. } => &[0, 0],
+            PlatformMotion::PlanarPose { .. } => &[0, 0, 1],
         }
+    }
+    /// Whether the platform moves in a plane and turns about its normal (`PlanarPose`).
+    pub fn planar_pose(&self) -> bool {
+        matches!(self, PlatformMotion::PlanarPose { .. })
     }
     /// Whether the platform only translates (`PlanarPoint`, `Translation`): `u` is the
     /// velocity of its origin, `ω = 0`, and `x ⊕ δu` is a sum.
@@ -160,7 +179,7 @@ pub struct ParallelModel {
     pub legs: Vec<Leg>,
 }
 
-/// The leg types, recognised from the joint geometry: five with closed-form inverse
+/// The leg types, recognised from the joint geometry: seven with closed-form inverse
 /// kinematics, and any other three-joint leg to a spherical joint by Newton's method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LegKind {
@@ -175,8 +194,15 @@ pub enum LegKind {
     /// orientation mechanism: spherical RRR.
     SphericalRr,
     /// Two revolutes with axes along the plane normal, to the point of a planar point platform:
-    /// the leg of a planar five-bar.
+    /// the leg of a planar five-bar, or of a planar 3-RRR ([`PlatformMotion::PlanarPose`]).
     PlanarRr,
+    /// A prismatic joint in the plane, then a revolute about the plane normal, to a point of a
+    /// planar platform: the P-R leg of a 3-PRR (the rod's end on the circle about the point, a
+    /// line–circle intersection, branch from home).
+    PlanarPr,
+    /// A revolute about the plane normal, then a prismatic joint along the line from it to a
+    /// point of a planar platform: the R-P leg of a 3-RPR (angle and length of that line).
+    PlanarRp,
     /// Any other chain of three one-DOF joints (revolute or prismatic, any axes) ending in a
     /// spherical joint at a 6-DOF platform: inverse kinematics by a fixed number of Newton
     /// steps from the home configuration (`noc::GENERIC_IK_ITERATIONS`), checked against
@@ -193,6 +219,8 @@ impl LegKind {
             LegKind::Rus => "RUS",
             LegKind::SphericalRr => "spherical RRR",
             LegKind::PlanarRr => "planar RR",
+            LegKind::PlanarPr => "planar PR",
+            LegKind::PlanarRp => "planar RP",
             LegKind::Generic => "generic (Newton)",
         }
     }
@@ -224,6 +252,9 @@ impl ParallelModel {
                 alloc::vec![self.home.translation[0], self.home.translation[1]]
             }
             PlatformMotion::Translation { .. } => self.home.translation.to_vec(),
+            PlatformMotion::PlanarPose { .. } => {
+                alloc::vec![self.home.translation[0], self.home.translation[1], 0.0]
+            }
         }
     }
 
@@ -367,6 +398,28 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
             }
             LegKind::PlanarRr
         }
+        (PlatformMotion::PlanarPose { .. }, LegEnd::Spherical { .. }, [_, _])
+            if planar_leg(&kinds, &ax).is_some() =>
+        {
+            let kind = planar_leg(&kinds, &ax).unwrap_or(LegKind::PlanarRr);
+            if kind == LegKind::PlanarRp {
+                // The prismatic line runs through the revolute axis to the platform point.
+                let h = sub(&leg_tip_home(leg), &ax[0].1);
+                let h = [h[0], h[1], 0.0];
+                if norm(&cross(&h, &ax[1].0)) > tol {
+                    return Err(format!(
+                        "leg {name}: its prismatic joint {} does not slide along the line from its revolute joint {} to the platform point (an R-P leg of a planar platform is a revolute about z, then a prismatic along that line)",
+                        leg.joints[1].name, leg.joints[0].name
+                    ));
+                }
+            }
+            kind
+        }
+        (PlatformMotion::PlanarPose { .. }, _, _) => {
+            return Err(format!(
+                "leg {name}: a planar platform in (x, y, φ) needs legs of two joints in the plane (R-R, P-R or R-P: revolute axes along z, prismatic directions in the plane) that end in a revolute about z at a point of the platform"
+            ));
+        }
         (PlatformMotion::PlanarPoint { .. }, _, _) => {
             return Err(format!(
                 "leg {name}: a planar point platform needs legs of two revolutes about z (R-R) that end in the point"
@@ -399,6 +452,20 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
         }
     };
     Ok(kind)
+}
+
+/// The planar leg type of a two-joint leg of a planar platform: revolute axes along `z`,
+/// prismatic directions in the plane (home axes `ax`, base frame).
+fn planar_leg(kinds: &[JointKind], ax: &[(Vec3, Vec3)]) -> Option<LegKind> {
+    use JointKind::{Prismatic as P, Revolute as R};
+    let along_z = |e: &Vec3| e[0].abs() <= 1e-12 && e[1].abs() <= 1e-12;
+    let in_plane = |e: &Vec3| e[2].abs() <= 1e-12;
+    match (kinds, ax) {
+        ([R, R], [a, b]) if along_z(&a.0) && along_z(&b.0) => Some(LegKind::PlanarRr),
+        ([P, R], [a, b]) if in_plane(&a.0) && along_z(&b.0) => Some(LegKind::PlanarPr),
+        ([R, P], [a, b]) if along_z(&a.0) && in_plane(&b.0) => Some(LegKind::PlanarRp),
+        _ => None,
+    }
 }
 
 /// The leg's end point at home in the base frame (spherical end), or the last body's origin.

@@ -62,6 +62,7 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => &["qw", "qx", "qy", "qz"],
             PlatformMotion::PlanarPoint { .. } => &["px", "py"],
             PlatformMotion::Translation { .. } => &["px", "py", "pz"],
+            PlatformMotion::PlanarPose { .. } => &["px", "py", "phi"],
         };
         names.iter().map(|n| String::from(*n)).collect()
     }
@@ -71,6 +72,9 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => vec![Speed::Rotation; 3],
             PlatformMotion::PlanarPoint { .. } => vec![Speed::Translation; 2],
             PlatformMotion::Translation { .. } => vec![Speed::Translation; 3],
+            PlatformMotion::PlanarPose { .. } => {
+                vec![Speed::Translation, Speed::Translation, Speed::Rotation]
+            }
         }
     }
     fn displaced(&self, p: &[f64]) -> Vec<f64> {
@@ -92,13 +96,25 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => vec![rot(0), rot(1), rot(2)],
             PlatformMotion::PlanarPoint { .. } => vec![pos(0), pos(1)],
             PlatformMotion::Translation { .. } => vec![pos(0), pos(1), pos(2)],
+            // φ is a coordinate of x (no quaternion): stepped as a joint angle.
+            PlatformMotion::PlanarPose { .. } => vec![
+                pos(0),
+                pos(1),
+                Axis::Joint {
+                    name: "phi".into(),
+                    index: 2,
+                    revolute: true,
+                },
+            ],
         }
     }
     fn quaternion(&self) -> Option<usize> {
         match self.model.motion {
             PlatformMotion::Pose => Some(3),
             PlatformMotion::Orientation { .. } => Some(0),
-            PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => None,
+            PlatformMotion::PlanarPoint { .. }
+            | PlatformMotion::Translation { .. }
+            | PlatformMotion::PlanarPose { .. } => None,
         }
     }
     fn inertia(&self, x: &[f64], space: Space) -> Result<DMatrix<f64>, EvalError> {
@@ -130,6 +146,7 @@ impl Workspace for Platform {
                         ("kg", "m/s^2 per unit effort")
                     }
                     PlatformMotion::Pose => ("kg m^2 | kg m | kg (mixed)", "mixed"),
+                    PlatformMotion::PlanarPose { .. } => ("kg | kg m | kg m^2 (mixed)", "mixed"),
                 };
                 InertiaWords {
                     matrix: "generalized inertia I in platform speeds u (mass_matrix), efforts tau = A^-T I u'",
@@ -148,10 +165,14 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => (0.3, 0.0),
             PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
             PlatformMotion::Translation { .. } => (0.0, 0.02 * self.model.size()),
+            PlatformMotion::PlanarPose { .. } => (0.1, 0.02 * self.model.size()),
         };
-        let planar = self.model.motion.translates();
-        (0..self.model.dof())
-            .map(|i| if i < 3 && !planar { angle } else { reach })
+        self.speeds()
+            .iter()
+            .map(|s| match s {
+                Speed::Translation => reach,
+                _ => angle,
+            })
             .collect()
     }
     /// The k-th body of every leg (the legs are alike); the platform stays.

@@ -135,6 +135,7 @@ fn check_closing_joint(
             Coordinates::Orientation => (Kind::Revolute, "orientation"),
             Coordinates::Planar => (Kind::Revolute, "planar"),
             Coordinates::Translation => (Kind::Spherical, "translation"),
+            Coordinates::PlanarPose => (Kind::Revolute, "planar_pose"),
         };
         if j.kind != want {
             diags.push(

@@ -31,6 +31,13 @@ const SUPPORTED_POSE: &[&[JointKind]] = &[
     ],
 ];
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
+const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
+    &[JointKind::Revolute, JointKind::Revolute],
+    &[JointKind::Prismatic, JointKind::Revolute],
+    &[JointKind::Revolute, JointKind::Prismatic],
+];
+/// The hint of an unsupported leg of a planar 3-DOF platform.
+pub(super) const SUPPORTED_PLANAR_POSE_HINT: &str = "supported legs for coordinates = \"planar_pose\": two joints in the plane, then the revolute about z into the platform: R-R-R (revolute axes along z), P-R-R (a slider in the plane, then the rod) or R-P-R (a revolute about z, then a prismatic along the line to the platform point); one of the two leg joints actuated";
 pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point); for coordinates = \"translation\" a revolute crank with a [[parallelogram]] (a Delta leg), or the legs of \"pose\"";
 
 /// The lowered tree with what the leg steps need: its topology, the build (model and
@@ -192,11 +199,14 @@ fn build_leg(
         diags,
     );
     let end = match j.kind {
-        // A planar point platform: the revolute joint at the point only ties the point.
-        Kind::Revolute if motion == Coordinates::Planar => LegEnd::Spherical {
-            on_leg: frame.translation,
-            on_platform: child_origin.translation,
-        },
+        // A planar platform: the revolute joint about z at the point ties the point (the
+        // platform's rotation is its own coordinate, or idle for a planar point).
+        Kind::Revolute if matches!(motion, Coordinates::Planar | Coordinates::PlanarPose) => {
+            LegEnd::Spherical {
+                on_leg: frame.translation,
+                on_platform: child_origin.translation,
+            }
+        }
         Kind::Revolute => {
             let e = axes[c].first().copied().unwrap_or([0.0, 0.0, 1.0]);
             LegEnd::Revolute {
@@ -282,6 +292,7 @@ fn check_leg_type(
     let supported = match motion {
         Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
+        Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE,
     };
     if !supported.contains(&kinds.as_slice()) {
         let word: Vec<&str> = spec_path
@@ -297,7 +308,11 @@ fn check_leg_type(
             ))
             .with_key(j.key.clone())
             .with_span(j.span.clone())
-            .with_hint(SUPPORTED_HINT),
+            .with_hint(if motion == Coordinates::PlanarPose {
+                SUPPORTED_PLANAR_POSE_HINT
+            } else {
+                SUPPORTED_HINT
+            }),
         );
     }
 }

@@ -21,6 +21,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Orientation => (3, 3, "spherical, λ = 3"),
         Coordinates::Planar => (3, 2, "planar, λ = 3"),
         Coordinates::Translation => (6, 3, "spatial, λ = 6"),
+        Coordinates::PlanarPose => (3, 3, "planar, λ = 3"),
     };
     // A parallelogram is counted as what it is, two rods with a ball joint at each end
     // (2 bodies, 4 S joints), not as its expansion (the equivalent rod, a U and an S: 1 body,
@@ -49,6 +50,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Orientation => "orientation",
         Coordinates::Planar => "planar",
         Coordinates::Translation => "translation",
+        Coordinates::PlanarPose => "planar_pose",
     };
     if m != dof {
         diags.push(
@@ -64,6 +66,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
                     Coordinates::Orientation => ": each leg of a spherical mechanism is R-R-R",
                     Coordinates::Planar => ": each leg of a planar five-bar is R-R, joined at the point by a revolute",
                     Coordinates::Translation => ": each leg of a Delta is a revolute crank carrying a [[parallelogram]] (two ball–ball rods, their idle spins not counted)",
+                    Coordinates::PlanarPose => ": each leg of a planar 3-DOF platform is R-R, P-R or R-P in the plane, joined to the platform by a revolute about z",
                 }
             )),
         );

@@ -31,7 +31,9 @@ pub(super) fn check_platform(
     diags: &mut Diagnostics,
 ) -> Option<usize> {
     match ps.coordinates {
-        Some(Coordinates::Pose | Coordinates::Translation) if ps.centre.is_some() => {
+        Some(Coordinates::Pose | Coordinates::Translation | Coordinates::PlanarPose)
+            if ps.centre.is_some() =>
+        {
             diags.push(
                 Diagnostic::error("`centre` is only for coordinates = \"orientation\"")
                     .with_key("platform.centre")
@@ -196,6 +198,10 @@ pub(super) fn assemble(
             height: ps.home.translation[2],
         },
         Coordinates::Translation => PlatformMotion::Translation {
+            rotation: ps.home.rotation,
+        },
+        Coordinates::PlanarPose => PlatformMotion::PlanarPose {
+            height: ps.home.translation[2],
             rotation: ps.home.rotation,
         },
     };

@@ -7,10 +7,10 @@
 use runtime::model::{Transform, mat_vec};
 use runtime::parallel::{GEOMETRY_TOLERANCE, LegEnd, ParallelModel, PlatformMotion};
 
-use super::legs::{SUPPORTED_HINT, Tree};
+use super::legs::{SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
-use crate::spec::ir::{PlatformSpec, Spec};
+use crate::spec::ir::{Coordinates, PlatformSpec, Spec};
 
 /// Revolute ends: the axis must pass through the centre on both sides (the runtime compares
 /// only the directions). Same tolerance as the runtime's geometric checks.
@@ -112,6 +112,8 @@ fn validate_diagnostic(
     });
     let hint = if msg.contains("does not close") {
         "at home every leg joint is at zero: place the leg's joint frames (`origin`) so that the joint on the leg meets `child_origin` on the platform at platform.home"
+    } else if ps.coordinates == Some(Coordinates::PlanarPose) {
+        SUPPORTED_PLANAR_POSE_HINT
     } else {
         SUPPORTED_HINT
     };

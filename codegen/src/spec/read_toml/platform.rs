@@ -66,7 +66,8 @@ impl Reader<'_> {
         Some(p)
     }
 
-    /// `platform.coordinates`: `"pose"`, `"orientation"`, `"planar"` or `"translation"`.
+    /// `platform.coordinates`: `"pose"`, `"orientation"`, `"planar"`, `"translation"` or
+    /// `"planar_pose"`.
     fn coordinates(&mut self, c: &Val<'_>) -> Option<Coordinates> {
         let s = self.string(c, "platform.coordinates")?;
         match s.as_str() {
@@ -74,13 +75,14 @@ impl Reader<'_> {
             "orientation" => Some(Coordinates::Orientation),
             "planar" => Some(Coordinates::Planar),
             "translation" => Some(Coordinates::Translation),
+            "planar_pose" => Some(Coordinates::PlanarPose),
             other => {
                 let hint = suggest_hint(
                     &other.to_ascii_lowercase(),
-                    &["pose", "orientation", "planar", "translation"],
+                    &["pose", "orientation", "planar", "translation", "planar_pose"],
                 )
                 .unwrap_or_else(|| {
-                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF) or \"translation\" (position, orientation fixed, 3 DOF)".into()
+                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF), \"translation\" (position, orientation fixed, 3 DOF) or \"planar_pose\" (position in a plane and rotation about its normal, 3 DOF)".into()
                 });
                 self.err(
                     format!("unknown platform coordinates {other:?}"),

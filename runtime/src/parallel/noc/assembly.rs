@@ -32,12 +32,14 @@ fn wrap(a: f64) -> f64 {
 
 /// `x` moved by the small motion `du` (`[δθ; δp]` or `δθ`, base frame): the rotation vector
 /// multiplies the quaternion from the left, the origin is translated (a translating platform's
-/// `x ⊕ δp` is the sum).
+/// `x ⊕ δp`, and a planar pose's `[px, py, φ] ⊕ [δx, δy, δφ]`, is the sum).
 pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
     let (qi, pi) = match motion {
         PlatformMotion::Pose => (3, Some(0)),
         PlatformMotion::Orientation { .. } => (0, None),
-        PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => {
+        PlatformMotion::PlanarPoint { .. }
+        | PlatformMotion::Translation { .. }
+        | PlatformMotion::PlanarPose { .. } => {
             return x.iter().zip(du).map(|(a, b)| a + b).collect();
         }
     };

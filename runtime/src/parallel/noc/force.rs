@@ -47,18 +47,13 @@ pub fn generalized_force_with<R: Real>(
     let planar = plan.motion.translates();
     // Platform angular velocity and acceleration (a planar point or a translational platform
     // does not turn).
-    let (w, wd) = if planar {
-        (zero3::<R>(), zero3::<R>())
-    } else {
-        ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
-    };
+    let (w, wd) = angular(plan.motion, u, ud);
     for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
         let n = lp.joints.len();
         // End velocity and acceleration (base frame), then in L.
         let (v_end, a_end) = match plan.motion {
-            PlatformMotion::Pose => {
-                let v = [u[3], u[4], u[5]];
-                let a = [ud[3], ud[4], ud[5]];
+            PlatformMotion::Pose | PlatformMotion::PlanarPose { .. } => {
+                let (v, a) = linear(plan.motion, u, ud);
                 let v_end = add(v, cross(w, lk.arm));
                 let a_end = add(add(a, cross(wd, lk.arm)), cross(w, cross(w, lk.arm)));
                 (v_end, a_end)
@@ -151,6 +146,12 @@ pub fn generalized_force_with<R: Real>(
                     f[i] = f[i] + y[i];
                 }
             }
+            // Sᵀ of the end point's wrench: (y_x, y_y, (arm × y)_z).
+            PlatformMotion::PlanarPose { .. } => {
+                f[0] = f[0] + y[0];
+                f[1] = f[1] + y[1];
+                f[2] = f[2] + (lk.arm[0] * y[1] - lk.arm[1] * y[0]);
+            }
         }
     }
     // The platform.
@@ -165,22 +166,62 @@ pub fn generalized_force_with<R: Real>(
     }
     let (mass, com, inertia) = plan.platform;
     let r = mv(&pl.rot, cv::<R>(&com));
-    let (a0,) = match plan.motion {
-        PlatformMotion::Pose => ([ud[3], ud[4], ud[5]],),
-        _ => (zero3::<R>(),),
-    };
+    let (a0, _) = linear(plan.motion, ud, ud);
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(R::c(mass), sub(a, cv(&g_world)));
     let np = add(euler(&pl.rot, &inertia, w, wd), cross(r, fp));
-    for i in 0..3 {
-        f[i] = f[i] + np[i];
-    }
-    if let PlatformMotion::Pose = plan.motion {
-        for i in 0..3 {
-            f[3 + i] = f[3 + i] + fp[i];
+    add_platform(plan.motion, &mut f, np, fp);
+    f
+}
+
+/// The platform's angular velocity and acceleration from `u`, `u̇` (`ω = 0` for a platform that
+/// only translates; `(0, 0, u₂)` for a planar pose).
+pub(crate) fn angular<R: Real>(motion: PlatformMotion, u: &[R], ud: &[R]) -> (V<R>, V<R>) {
+    let z = R::c(0.0);
+    match motion {
+        PlatformMotion::Pose | PlatformMotion::Orientation { .. } => {
+            ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
+        }
+        PlatformMotion::PlanarPose { .. } => ([z, z, u[2]], [z, z, ud[2]]),
+        PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => {
+            (zero3(), zero3())
         }
     }
-    f
+}
+
+/// The velocity and acceleration of the platform frame's origin from `u`, `u̇` of a platform
+/// that turns (`Pose`: `u[3..6]`; `PlanarPose`: `(u₀, u₁, 0)`; zero for an orientation
+/// platform, whose origin is the fixed centre).
+pub(crate) fn linear<R: Real>(motion: PlatformMotion, u: &[R], ud: &[R]) -> (V<R>, V<R>) {
+    let z = R::c(0.0);
+    match motion {
+        PlatformMotion::Pose => ([u[3], u[4], u[5]], [ud[3], ud[4], ud[5]]),
+        PlatformMotion::PlanarPose { .. } => ([u[0], u[1], z], [ud[0], ud[1], z]),
+        _ => (zero3(), zero3()),
+    }
+}
+
+/// Adds a turning platform body's Newton–Euler wrench (eq. 12; moment `np` about the platform
+/// frame's origin, force `fp`) to `f` through its twist-shaping block: `Sᵀ [n; f]`.
+fn add_platform<R: Real>(motion: PlatformMotion, f: &mut [R], np: V<R>, fp: V<R>) {
+    match motion {
+        PlatformMotion::PlanarPose { .. } => {
+            f[0] = f[0] + fp[0];
+            f[1] = f[1] + fp[1];
+            f[2] = f[2] + np[2];
+        }
+        PlatformMotion::Pose => {
+            for i in 0..3 {
+                f[i] = f[i] + np[i];
+                f[3 + i] = f[3 + i] + fp[i];
+            }
+        }
+        _ => {
+            for i in 0..3 {
+                f[i] = f[i] + np[i];
+            }
+        }
+    }
 }
 
 /// The payload's part of the generalized force `f = I u̇ + C u − γ` (`γ` only when `gravity`):
@@ -203,11 +244,8 @@ pub fn payload_force<R: Real>(
         }
         return f;
     }
-    let (w, wd) = ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]);
-    let a0 = match plan.motion {
-        PlatformMotion::Pose => [ud[3], ud[4], ud[5]],
-        _ => zero3::<R>(),
-    };
+    let (w, wd) = angular(plan.motion, u, ud);
+    let (a0, _) = linear(plan.motion, ud, ud);
     let r = mv(&pl.rot, payload.com);
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(payload.mass, sub(a, g));
@@ -218,9 +256,6 @@ pub fn payload_force<R: Real>(
         cross(wb, mv(&payload.inertia, wb)),
     );
     let np = add(mv(&pl.rot, nb), cross(r, fp));
-    f[..3].copy_from_slice(&np);
-    if let PlatformMotion::Pose = plan.motion {
-        f[3..6].copy_from_slice(&fp);
-    }
+    add_platform(plan.motion, &mut f, np, fp);
     f
 }

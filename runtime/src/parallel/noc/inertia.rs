@@ -21,12 +21,24 @@ use crate::scalar::Real;
 /// The twist columns of a body moving with the platform, `n` speeds: `(Some(e_j), e_j × r_c)`
 /// for the angular speeds (`r_c` the mass centre from the platform origin, base frame) and
 /// `(None, e_j)` for the linear ones (pose).
-fn platform_columns<R: Real>(n: usize, rc: V<R>) -> Vec<(Option<V<R>>, V<R>)> {
+fn platform_columns<R: Real>(
+    motion: PlatformMotion,
+    n: usize,
+    rc: V<R>,
+) -> Vec<(Option<V<R>>, V<R>)> {
     let unit = |j: usize| {
         let mut e = zero3::<R>();
         e[j] = R::c(1.0);
         e
     };
+    if let PlatformMotion::PlanarPose { .. } = motion {
+        // S: u = [vx, vy, ω], ω about z.
+        return vec![
+            (None, unit(0)),
+            (None, unit(1)),
+            (Some(unit(2)), cross(unit(2), rc)),
+        ];
+    }
     (0..n)
         .map(|j| {
             if j < 3 {
@@ -54,7 +66,7 @@ pub fn payload_inertia<R: Real>(
         }
         return out;
     }
-    let cols = platform_columns(n, mv(&pl.rot, payload.com));
+    let cols = platform_columns(plan.motion, n, mv(&pl.rot, payload.com));
     for i in 0..n {
         for j in i..n {
             let mut v = payload.mass * dot(cols[i].1, cols[j].1);
@@ -151,6 +163,18 @@ pub fn generalized_inertia_with<R: Real>(
                     out[j][i] = out[j][i] + q[j];
                 }
             }
+        } else if let PlatformMotion::PlanarPose { .. } = plan.motion {
+            // G = [e_x, e_y, e_z × r] (v_end = v + ω × r): the upper triangle of Gᵀ Λ G.
+            let r = lk.arm;
+            let c2 = [-r[1], r[0], R::c(0.0)];
+            let lc2: V<R> =
+                core::array::from_fn(|i| lam[i][0] * c2[0] + lam[i][1] * c2[1] + lam[i][2] * c2[2]);
+            out[0][0] = out[0][0] + lam[0][0];
+            out[0][1] = out[0][1] + lam[0][1];
+            out[1][1] = out[1][1] + lam[1][1];
+            out[0][2] = out[0][2] + lc2[0];
+            out[1][2] = out[1][2] + lc2[1];
+            out[2][2] = out[2][2] + dot(c2, lc2);
         } else {
             // Orientation (u = ω), planar point (u = in-plane velocity) or translation (u = v):
             // I += Λ's block.
@@ -170,7 +194,7 @@ pub fn generalized_inertia_with<R: Real>(
     }
     // The platform: ω columns e_j with mass-centre velocity e_j × r_c; v columns (pose) e_j.
     let (mass, com, inertia) = plan.platform;
-    let cols = platform_columns(n, mv(&pl.rot, cv::<R>(&com)));
+    let cols = platform_columns(plan.motion, n, mv(&pl.rot, cv::<R>(&com)));
     for i in 0..n {
         for j in i..n {
             let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);

@@ -11,7 +11,7 @@ use alloc::vec::Vec;
 use super::LEG_TOLERANCE;
 use super::delta::{DeltaKin, delta_kin};
 use super::generic_leg::generic_ik;
-use super::plan::{LegPlan, Plan, sub3};
+use super::plan::{LegPlan, Plan, cross3, dot3, sub3};
 use super::pose::{Platform, platform};
 use super::subproblems::{one_axis, rus_crank, two_axes};
 use super::ups::{UpsKin, UpsPlan};
@@ -137,6 +137,8 @@ fn closed_form_ik<R: Real>(
         LegKind::Pus => Ok((pus_ik(lp, k, target)?, None)),
         LegKind::Rus => Ok((rus_ik(lp, k, target)?, None)),
         LegKind::PlanarRr => Ok((planar_rr_ik(lp, k, target)?, None)),
+        LegKind::PlanarPr => Ok((planar_pr_ik(lp, k, target)?, None)),
+        LegKind::PlanarRp => Ok((planar_rp_ik(lp, k, target)?, None)),
         LegKind::SphericalRr => Ok((spherical_rr_ik(lp, k, target)?, None)),
         LegKind::Generic => Ok((generic_ik(lp, target, k)?, None)),
     }
@@ -274,6 +276,61 @@ fn planar_rr_ik<R: Real>(
     Ok(q)
 }
 
+/// Planar PR: the slider's displacement that puts the elbow at the rod length from `target`
+/// (the slider's line meets the circle about `target`; the branch of home), then the rod's
+/// angle about the elbow.
+fn planar_pr_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    target: V<R>,
+) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let e0 = lp.axes[0];
+    let dd = sub(target, cv(&lp.u_centre));
+    let t = dot(cv(&e0), dd);
+    let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
+    let disc = R::check(
+        disc,
+        R::c(0.0),
+        R::c(lp.length * lp.length),
+        Site::Reach(k),
+        false,
+    )?;
+    let s = t - R::c(lp.sigma_first) * disc.sqrt();
+    let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+    let p = sub3(&lp.end_home, &lp.u_centre);
+    let (s1, c1) = one_axis(&lp.axes[1], cv(&p), sub(target, u));
+    q.push(JointPos::P(s));
+    q.push(JointPos::R(s1, c1));
+    Ok(q)
+}
+
+/// Planar RP: the angle and the length of the line from the revolute axis to `target` (in the
+/// plane); `Site::Leg` when `target` is on the axis (the angle is undefined there).
+fn planar_rp_ik<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    target: V<R>,
+) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let e0 = lp.axes[0];
+    let d = sub(target, cv(&lp.points[0]));
+    let d = sub(d, scale(dot(cv(&e0), d), cv(&e0)));
+    let l2 = lp.length * lp.length;
+    let rr = R::check(dot(d, d), R::c(0.0), R::c(l2), Site::Leg(k), false)?;
+    let rho = rr.sqrt();
+    // The home line h (length `lp.length`) turned about e0 onto d.
+    let h = sub3(&lp.end_home, &lp.points[0]);
+    let hz = dot3(&e0, &h);
+    let h = [h[0] - hz * e0[0], h[1] - hz * e0[1], h[2] - hz * e0[2]];
+    let inv = R::c(1.0) / (R::c(lp.length) * rho);
+    let s0 = dot(cv(&cross3(&e0, &h)), d) * inv;
+    let c0 = dot(cv(&h), d) * inv;
+    q.push(JointPos::R(s0, c0));
+    q.push(JointPos::P(R::c(lp.sigma_first) * (rho - R::c(lp.length))));
+    Ok(q)
+}
+
 /// Spherical RR: the two angles that turn the end axis at home onto `target`.
 fn spherical_rr_ik<R: Real>(
     lp: &LegPlan,
@@ -371,6 +428,9 @@ fn jacobian_inverse<R: Real>(
             cross(e[1], sub(end, o[1])),
             e[0],
         ],
+        // The same virtual column (the revolute's axis is the plane normal).
+        LegKind::PlanarPr => vec![e[0], cross(e[1], sub(end, o[1])), e[1]],
+        LegKind::PlanarRp => vec![cross(e[0], sub(end, o[0])), e[1], e[0]],
         _ => (0..n)
             .map(|j| match lp.joints[j] {
                 JointKind::Revolute => cross(e[j], sub(end, o[j])),
@@ -459,6 +519,10 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                 PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
                 PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
                 PlatformMotion::Translation { .. } => vec![g[0], g[1], g[2]],
+                // v_end = v + ω × arm with ω = (0, 0, u₂): q̇ = g·v + (arm × g)_z ω.
+                PlatformMotion::PlanarPose { .. } => {
+                    vec![g[0], g[1], lk.arm[0] * g[1] - lk.arm[1] * g[0]]
+                }
             }
         })
         .collect()

@@ -143,14 +143,19 @@ impl Plan {
                 }
                 LegKind::Pus | LegKind::Rus => meet(&points[1], &axes[1], &points[2], &axes[2]),
                 // The elbow of a planar RR leg.
-                LegKind::PlanarRr => points[1],
+                LegKind::PlanarRr | LegKind::PlanarPr => points[1],
+                // The revolute's point (the line to the platform point starts on its axis).
+                LegKind::PlanarRp => points[0],
                 // Not used by the Newton route.
                 LegKind::Generic => points[0],
             };
             let (ui, uj) = match kind {
-                LegKind::Ups | LegKind::SphericalRr | LegKind::PlanarRr | LegKind::Generic => {
-                    (0, 1)
-                }
+                LegKind::Ups
+                | LegKind::SphericalRr
+                | LegKind::PlanarRr
+                | LegKind::PlanarPr
+                | LegKind::PlanarRp
+                | LegKind::Generic => (0, 1),
                 LegKind::Pus | LegKind::Rus => (1, 2),
             };
             let (e1, e2) = (axes[ui], axes[uj]);
@@ -217,6 +222,25 @@ impl Plan {
                 }
                 LegKind::SphericalRr => {
                     plan.sigma_u = sign(dot3(&end_home, &k));
+                }
+                LegKind::PlanarPr => {
+                    // The rod length; s = e·d − σ √(…) = 0 at home.
+                    let d = sub3(&end_home, &u_centre);
+                    plan.length = libm::sqrt(dot3(&d, &d));
+                    plan.sigma_first = sign(dot3(&axes[0], &d));
+                }
+                LegKind::PlanarRp => {
+                    // The home length of the line in the plane, and the prismatic direction
+                    // along it (+1) or against it (−1).
+                    let d = sub3(&end_home, &u_centre);
+                    let dz = dot3(&axes[0], &d);
+                    let h = [
+                        d[0] - dz * axes[0][0],
+                        d[1] - dz * axes[0][1],
+                        d[2] - dz * axes[0][2],
+                    ];
+                    plan.length = libm::sqrt(dot3(&h, &h));
+                    plan.sigma_first = sign(dot3(&h, &axes[1]));
                 }
                 LegKind::Generic => {
                     // The leg's size: the reach from its first joint to the S centre at home.

@@ -16,7 +16,8 @@ pub struct Platform<R> {
 }
 
 /// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`, `Translation`: `p` with
-/// the fixed rotation); the quaternion need not
+/// the fixed rotation, `PlanarPose`: `[px, py, φ]`, the home rotation turned by `φ` about `z`);
+/// the quaternion need not
 /// be unit (it is normalized), but it must not be zero (`Err(Site::Platform)`).
 pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> {
     let (origin, q) = match plan.motion {
@@ -32,6 +33,24 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             return Ok(Platform {
                 rot: cm(&rotation),
                 origin: [x[0], x[1], x[2]],
+            });
+        }
+        PlatformMotion::PlanarPose { height, rotation } => {
+            // Rz(φ)·rotation: the home rotation turned about the base z axis.
+            let (s, c) = x[2].sin_cos();
+            let h = cm::<R>(&rotation);
+            let rot = core::array::from_fn(|i| {
+                if i == 0 {
+                    core::array::from_fn(|j| c * h[0][j] - s * h[1][j])
+                } else if i == 1 {
+                    core::array::from_fn(|j| s * h[0][j] + c * h[1][j])
+                } else {
+                    h[2]
+                }
+            });
+            return Ok(Platform {
+                rot,
+                origin: [x[0], x[1], R::c(height)],
             });
         }
     };
