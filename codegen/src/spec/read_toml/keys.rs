@@ -75,7 +75,9 @@ pub(super) const JOINT_KEYS: &[&str] = &[
     "friction",
     "armature",
 ];
-pub(super) const ORIGIN_KEYS: &[&str] = &["xyz", "rpy"];
+pub(super) const ORIGIN_KEYS: &[&str] = &["xyz", "rpy", "quat", "matrix", "axis_angle"];
+/// The ways an origin gives its rotation (at most one).
+pub(super) const ROTATION_KEYS: &[&str] = &["rpy", "quat", "matrix", "axis_angle"];
 pub(super) const DH_KEYS: &[&str] = &["a", "alpha", "d", "theta"];
 
 /// Common misnomers: (written, meant).

@@ -8,7 +8,7 @@ use std::ops::Range;
 use runtime::model::{Mat3, Transform, Vec3};
 use toml::de::{DeTable, DeValue};
 
-use super::keys::{INERTIA_KEYS, ORIGIN_KEYS};
+use super::keys::{INERTIA_KEYS, ORIGIN_KEYS, ROTATION_KEYS};
 use super::{Reader, Val, get};
 use crate::diag::Diagnostic;
 use crate::spec::angle::{ANGLE_HINT, parse_angle};
@@ -275,6 +275,8 @@ impl Reader<'_> {
         ok.then_some([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
     }
 
+    /// `{ xyz, rpy }`, or the rotation as `quat = [w, x, y, z]`, `matrix = [[…], […], […]]`
+    /// (rows) or `axis_angle = { axis = […], angle = … }` instead of `rpy` (at most one).
     pub(super) fn origin(&mut self, v: &Val<'_>, path: &str) -> Option<Placement> {
         let t = self.table(v, path)?;
         self.unknown_keys(t, ORIGIN_KEYS, path);
@@ -282,10 +284,206 @@ impl Reader<'_> {
             None => Some([0.0; 3]),
             Some(e) => self.triple(e, &format!("{path}.xyz"), false),
         };
-        let rpy = match get(t, "rpy") {
-            None => Some([0.0; 3]),
-            Some(e) => self.triple(e, &format!("{path}.rpy"), true),
+        let given: Vec<(&str, &Val<'_>)> = ROTATION_KEYS
+            .iter()
+            .filter_map(|k| get(t, k).map(|e| (*k, e)))
+            .collect();
+        if let [(first, _), (second, e), ..] = given.as_slice() {
+            self.err(
+                format!("`{path}` gives its rotation twice, as `{first}` and as `{second}`"),
+                &format!("{path}.{second}"),
+                e.span(),
+            )
+            .hint = Some("give one of rpy, quat, matrix and axis_angle".into());
+            return None;
+        }
+        let rotation = match given.first() {
+            None => Some(Transform::IDENTITY.rotation),
+            Some(("rpy", e)) => self
+                .triple(e, &format!("{path}.rpy"), true)
+                .map(runtime::model::rpy_to_matrix),
+            Some(("quat", e)) => self.quaternion(e, &format!("{path}.quat")),
+            Some(("matrix", e)) => self.rotation_matrix(e, &format!("{path}.matrix")),
+            Some((_, e)) => self.axis_angle(e, &format!("{path}.axis_angle")),
         };
-        Some(Placement::Origin(Transform::from_xyz_rpy(xyz?, rpy?)))
+        Some(Placement::Origin(Transform {
+            rotation: rotation?,
+            translation: xyz?,
+        }))
+    }
+
+    /// A quaternion `[w, x, y, z]`, normalized; its norm must be within `1e-3` of 1 (values
+    /// read off a drawing or another format to a few digits are accepted).
+    fn quaternion(&mut self, v: &Val<'_>, key: &str) -> Option<Mat3> {
+        let q = self.numbers(v, key, 4)?;
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !((n - 1.0).abs() <= 1e-3) {
+            self.err(
+                format!("the quaternion's norm is {n}, not 1"),
+                key,
+                v.span(),
+            )
+            .hint = Some("give a unit quaternion [w, x, y, z] (w first); its norm may differ from 1 by at most 1e-3, and it is normalized".into());
+            return None;
+        }
+        let [w, x, y, z] = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+        Some([
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+            ],
+            [
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+            ],
+            [
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ])
+    }
+
+    /// A rotation matrix by rows; orthonormal with determinant +1 within `1e-6` (a matrix
+    /// within that is made exactly orthonormal, the nearest rotation by its polar factor).
+    fn rotation_matrix(&mut self, v: &Val<'_>, key: &str) -> Option<Mat3> {
+        let DeValue::Array(rows) = v.get_ref() else {
+            self.type_error("an array of three rows of three numbers", v, key);
+            return None;
+        };
+        if rows.len() != 3 {
+            self.err(
+                format!("expected three rows, found {}", rows.len()),
+                key,
+                v.span(),
+            );
+            return None;
+        }
+        let mut m = [[0.0; 3]; 3];
+        let mut ok = true;
+        for (i, r) in rows.iter().enumerate() {
+            match self.triple(r, &format!("{key}[{i}]"), false) {
+                Some(row) => m[i] = row,
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let a = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+        let off = (a.transpose() * a - nalgebra::Matrix3::identity()).amax();
+        let det = a.determinant();
+        if !(off <= 1e-6 && det > 0.0) {
+            let why = if det <= 0.0 {
+                format!("its determinant is {det:.6}, not +1 (a reflection or a singular matrix)")
+            } else {
+                format!(
+                    "its columns are not orthonormal (RᵀR differs from the identity by {off:.1e})"
+                )
+            };
+            self.err(format!("not a rotation matrix: {why}"), key, v.span())
+                .hint = Some("give the rotation's rows, R[i][j] = e_i · (the child frame's axis j), orthonormal within 1e-6".into());
+            return None;
+        }
+        if off == 0.0 {
+            return Some(m);
+        }
+        // The nearest rotation: U Vᵀ of the SVD.
+        let svd = a.svd(true, true);
+        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+            return Some(m);
+        };
+        let r = u * vt;
+        Some(core::array::from_fn(|i| {
+            core::array::from_fn(|j| r[(i, j)])
+        }))
+    }
+
+    /// `{ axis = [x, y, z], angle = … }`: a rotation by `angle` (rad, or an angle string) about
+    /// `axis` (normalized; not zero).
+    fn axis_angle(&mut self, v: &Val<'_>, key: &str) -> Option<Mat3> {
+        let t = self.table(v, key)?;
+        self.unknown_keys(t, &["axis", "angle"], key);
+        let axis = match get(t, "axis") {
+            Some(e) => self.triple(e, &format!("{key}.axis"), false),
+            None => {
+                self.missing(
+                    "axis",
+                    key,
+                    v.span(),
+                    "an axis-angle rotation needs `axis = [x, y, z]` and `angle`",
+                );
+                None
+            }
+        };
+        let angle = match get(t, "angle") {
+            Some(e) => self.angle(e, &format!("{key}.angle")),
+            None => {
+                self.missing(
+                    "angle",
+                    key,
+                    v.span(),
+                    "an axis-angle rotation needs `axis = [x, y, z]` and `angle`",
+                );
+                None
+            }
+        };
+        let (axis, angle) = (axis?, angle?);
+        let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        if !(n > 1e-9) {
+            self.err(
+                "the rotation axis is zero",
+                &format!("{key}.axis"),
+                v.span(),
+            )
+            .hint = Some("give a nonzero axis; it is normalized".into());
+            return None;
+        }
+        let e = [axis[0] / n, axis[1] / n, axis[2] / n];
+        let (s, c) = runtime::model::exact_sin_cos(angle);
+        let k = 1.0 - c;
+        Some([
+            [
+                c + e[0] * e[0] * k,
+                e[0] * e[1] * k - e[2] * s,
+                e[0] * e[2] * k + e[1] * s,
+            ],
+            [
+                e[1] * e[0] * k + e[2] * s,
+                c + e[1] * e[1] * k,
+                e[1] * e[2] * k - e[0] * s,
+            ],
+            [
+                e[2] * e[0] * k - e[1] * s,
+                e[2] * e[1] * k + e[0] * s,
+                c + e[2] * e[2] * k,
+            ],
+        ])
+    }
+
+    /// An array of `n` numbers.
+    fn numbers(&mut self, v: &Val<'_>, key: &str, n: usize) -> Option<Vec<f64>> {
+        let DeValue::Array(a) = v.get_ref() else {
+            self.type_error(&format!("an array of {n} numbers"), v, key);
+            return None;
+        };
+        if a.len() != n {
+            self.err(
+                format!(
+                    "expected an array of {n} numbers, found {} elements",
+                    a.len()
+                ),
+                key,
+                v.span(),
+            );
+            return None;
+        }
+        let mut out = Vec::with_capacity(n);
+        for (k, e) in a.iter().enumerate() {
+            out.push(self.number(e, &format!("{key}[{k}]")));
+        }
+        out.into_iter().collect()
     }
 }
