@@ -202,6 +202,7 @@ macro_rules! bench_parallel {
 bench_parallel!(gough_stewart, gough_stewart);
 bench_parallel!(agile_eye, agile_eye);
 bench_parallel!(delta_rl5, delta_rl5);
+bench_parallel!(tsai_3upu, tsai_3upu);
 
 /// A bundled closed-loop mechanism in joint coordinates: generated vs the runtime evaluator
 /// (`runtime::closed::noc`) vs the independent Newton–Euler + Lagrange-multiplier route (dense

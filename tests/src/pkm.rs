@@ -7,13 +7,14 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 6] = [
+pub const PARALLEL: [&str; 7] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
     "agile_eye",
     "planar_five_bar",
     "delta_rl5",
+    "tsai_3upu",
 ];
 
 /// The spec file of a bundled mechanism.

@@ -114,7 +114,8 @@ fn parallel_mechanisms_in_single_precision() {
         rus_hexapod,
         agile_eye,
         planar_five_bar,
-        delta_rl5
+        delta_rl5,
+        tsai_3upu
     );
 }
 

@@ -301,6 +301,7 @@ fn parallel_guards_match_the_runtime_tests() {
         "rus_hexapod",
         "planar_five_bar",
         "delta_rl5",
+        "tsai_3upu",
     ] {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();

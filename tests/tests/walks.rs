@@ -328,7 +328,8 @@ parallel_routes!(
     sliding_hexapod,
     rus_hexapod,
     planar_five_bar,
-    delta_rl5
+    delta_rl5,
+    tsai_3upu
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -427,6 +428,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "agile_eye",
         "planar_five_bar",
         "delta_rl5",
+        "tsai_3upu",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();

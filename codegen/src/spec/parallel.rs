@@ -29,13 +29,15 @@ mod joints;
 mod legs;
 mod mobility;
 mod platform;
+mod screws;
 mod validate;
 
 use joints::{check_actuated_kind, check_has_closing, check_joints, check_planar_point};
 use legs::{Tree, build_legs, split_legs};
 use mobility::check_mobility;
 use platform::{assemble, check_platform, on_platform};
-use validate::{check_orientation_axes, runtime_checks};
+use screws::check_declared_motion;
+use validate::{check_orientation_axes, check_upu_axes, check_upu_legs, runtime_checks};
 
 /// Validates a spec with a `[platform]` table and builds the parallel model. Errors and
 /// warnings go to `diags`; `None` when there was any error.
@@ -116,6 +118,15 @@ fn lower_checked(
     let legs = build_legs(&tree, &axes, &paths, motion, diags);
     let pm = assemble(spec, ps, motion, pname, &on.parts, legs);
     check_orientation_axes(&tree, &pm, diags);
+    check_upu_legs(&tree, &axes, &pm, diags);
+    // The declared motion against the legs' (even when the mobility count failed: it names the
+    // motions that the count only counts).
+    if !diags.has_errors() {
+        check_declared_motion(&tree, &axes, ps, &pm, diags);
+    }
+    if !diags.has_errors() {
+        check_upu_axes(&tree, &axes, &pm, diags);
+    }
     if diags.has_errors() || !run_validate {
         return None;
     }

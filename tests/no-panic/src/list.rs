@@ -31,6 +31,7 @@ macro_rules! for_each_mechanism {
             agile_eye,
             planar_five_bar,
             delta_rl5,
+            tsai_3upu,
             // Closed loops in joint coordinates.
             four_bar,
             five_bar_joints,

@@ -85,7 +85,8 @@ export_parallel!(
     rus_hexapod,
     agile_eye,
     planar_five_bar,
-    delta_rl5
+    delta_rl5,
+    tsai_3upu
 );
 
 macro_rules! export_closed {

@@ -1,0 +1,316 @@
+//! The declared motion against the motion the legs allow, by screw theory at home
+//! (docs/method.md, "The declared platform motion, checked by reciprocal screws"; Tsai, *Robot
+//! Analysis*, 1999, §4.7; Kong & Gosselin, *Type Synthesis of Parallel Mechanisms*, 2007, ch. 2).
+//!
+//! `[platform] coordinates` is the user's word for how the platform moves, and the evaluators
+//! trust it (a translational platform is given `ω = 0`). Here it is checked: each leg's joints
+//! allow the platform a space of twists; the leg's constraint wrenches are its reciprocal; the
+//! platform's allowed twists are the reciprocal of all the legs' wrenches together, and they
+//! must be the span of the declared motion's `S` at home.
+//!
+//! Conventions: a twist is `[ω; v]` (the module's order), `v` the velocity of the point at the
+//! base origin: a revolute about the line through `p` along `e` is `[e; p × e]`, a prismatic
+//! joint along `e` is `[0; e]`. A wrench `(f, m)` (force, moment about the base origin) is
+//! written in axis coordinates `[m; f]`, so that its power on a twist is the plain dot product
+//! `ω·m + v·f` and the reciprocal of a set of screws is the null space of their rows. Lengths
+//! are divided by the mechanism's size first, so that one tolerance serves both halves.
+//!
+//! This runs in the spec lowering because a `[[parallelogram]]`'s two rods are known only here
+//! (the model holds its equivalent rod, whose U and S would allow the platform everything).
+
+use nalgebra::{DMatrix, SVD};
+use runtime::model::{JointKind, Transform, Vec3, mat_mul, mat_vec};
+use runtime::parallel::{LegEnd, ParallelModel, PlatformMotion, leg_home_poses};
+
+use super::legs::Tree;
+use crate::diag::{Diagnostic, Diagnostics};
+use crate::spec::geom;
+use crate::spec::ir::{Kind, PlatformSpec};
+use crate::spec::lower::Axes;
+
+/// A twist `[ω; v]` or a wrench in axis coordinates `[m; f]`.
+type Screw = [f64; 6];
+
+/// Rank tolerance of the (size-scaled, unit-direction) screw matrices: singular values below it
+/// count as zero. The screws' entries are of order one, and exact geometry rounds at 1e-16.
+const RANK_TOLERANCE: f64 = 1e-9;
+
+fn revolute(p: &Vec3, e: &Vec3) -> Screw {
+    let m = geom::cross(p, e);
+    [e[0], e[1], e[2], m[0], m[1], m[2]]
+}
+
+fn prismatic(e: &Vec3) -> Screw {
+    [0.0, 0.0, 0.0, e[0], e[1], e[2]]
+}
+
+fn unit(v: &Vec3) -> Vec3 {
+    let n = geom::norm(v);
+    if n > 0.0 {
+        [v[0] / n, v[1] / n, v[2] / n]
+    } else {
+        *v
+    }
+}
+
+fn scaled(p: &Vec3, size: f64) -> Vec3 {
+    [p[0] / size, p[1] / size, p[2] / size]
+}
+
+/// An orthonormal basis of the span of `rows` (empty for no rows).
+fn span(rows: &[Screw]) -> Vec<Screw> {
+    split(rows).0
+}
+
+/// An orthonormal basis of the null space of `rows`: the screws reciprocal to all of them.
+fn reciprocal(rows: &[Screw]) -> Vec<Screw> {
+    split(rows).1
+}
+
+/// The right singular vectors of `rows` (padded to six rows): those of the range and those of
+/// the null space.
+fn split(rows: &[Screw]) -> (Vec<Screw>, Vec<Screw>) {
+    let n = rows.len().max(6);
+    let m = DMatrix::from_fn(n, 6, |r, c| rows.get(r).map_or(0.0, |s| s[c]));
+    let svd = SVD::new(m, false, true);
+    let (mut range, mut null) = (Vec::new(), Vec::new());
+    let Some(vt) = svd.v_t else {
+        return (range, null);
+    };
+    for (i, s) in svd.singular_values.iter().enumerate() {
+        let v: Screw = std::array::from_fn(|c| vt[(i, c)]);
+        if *s > RANK_TOLERANCE {
+            range.push(v);
+        } else {
+            null.push(v);
+        }
+    }
+    (range, null)
+}
+
+/// The rows of `a` less their projections on the orthonormal `basis`.
+fn outside(a: &[Screw], basis: &[Screw]) -> Vec<Screw> {
+    a.iter()
+        .map(|r| {
+            let mut out = *r;
+            for b in basis {
+                let d: f64 = (0..6).map(|i| r[i] * b[i]).sum();
+                for i in 0..6 {
+                    out[i] -= d * b[i];
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// The span of the declared motion's `S` at home (size-scaled twists), or `None` for a motion
+/// the check does not cover. One arm per [`PlatformMotion`].
+fn declared(motion: &PlatformMotion, size: f64) -> Option<Vec<Screw>> {
+    let e = |i: usize| -> Vec3 { std::array::from_fn(|k| f64::from(u8::from(k == i))) };
+    match motion {
+        PlatformMotion::Pose => Some(
+            (0..6)
+                .map(|i| std::array::from_fn(|k| f64::from(u8::from(k == i))))
+                .collect(),
+        ),
+        PlatformMotion::Orientation { centre } => Some(
+            (0..3)
+                .map(|i| revolute(&scaled(centre, size), &e(i)))
+                .collect(),
+        ),
+        PlatformMotion::Translation { .. } => Some((0..3).map(|i| prismatic(&e(i))).collect()),
+        // A point platform has no orientation: its legs end in revolutes about the plane normal
+        // at the point, whose spin of the "platform" is idle, and a point's motion is not a
+        // rigid body's twist. The planar five-bar's legs are checked by their type instead
+        // (every axis along z).
+        PlatformMotion::PlanarPoint { .. } => None,
+    }
+}
+
+/// The twists the joints of leg `li` allow the platform at home (size-scaled): its joint screws
+/// and those of its end, with a parallelogram's two rods in place of its equivalent rod's
+/// U and S.
+fn leg_twists(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    pm: &ParallelModel,
+    li: usize,
+    size: f64,
+) -> Vec<Screw> {
+    let leg = &pm.legs[li];
+    let c = tree.closing[li];
+    let j = &tree.spec.joints[c];
+    let poses = leg_home_poses(leg);
+    let tip = poses.last().copied().unwrap_or(Transform::IDENTITY);
+    let frame = tree.frame_in_tip(c);
+    let end = scaled(&tip.apply(&frame.translation), size);
+    let pg = tree.spec.parallelograms.iter().position(|n| *n == j.name);
+    // A parallelogram's equivalent rod hangs from a U at the elbow: its two model joints.
+    let keep = match pg {
+        Some(_) => leg.joints.len().saturating_sub(2),
+        None => leg.joints.len(),
+    };
+    let mut out: Vec<Screw> = leg.joints[..keep]
+        .iter()
+        .zip(&poses)
+        .map(|(joint, pose)| {
+            let e = unit(&mat_vec(&pose.rotation, &joint.axis));
+            match joint.kind {
+                JointKind::Revolute => revolute(&scaled(&pose.translation, size), &e),
+                JointKind::Prismatic => prismatic(&e),
+            }
+        })
+        .collect();
+    if let Some(i) = pg {
+        // The two rods, ball to ball, each a force along itself on the distal bar: the pair
+        // allows the 4-dim reciprocal of the two forces relative to the elbow (the rods' idle
+        // spins move nothing).
+        let (Some(u), Some(first)) = (poses.get(keep), leg.joints.get(keep)) else {
+            return out;
+        };
+        let elbow = scaled(&u.translation, size);
+        let a = unit(&mat_vec(&u.rotation, &first.axis));
+        let d = unit(&[end[0] - elbow[0], end[1] - elbow[1], end[2] - elbow[2]]);
+        let half = tree
+            .spec
+            .parallelogram_widths
+            .get(i)
+            .copied()
+            .unwrap_or(0.0)
+            / 2.0
+            / size;
+        let rods: Vec<Screw> = [-half, half]
+            .iter()
+            .map(|s| {
+                let q = [
+                    elbow[0] + s * a[0],
+                    elbow[1] + s * a[1],
+                    elbow[2] + s * a[2],
+                ];
+                let m = geom::cross(&q, &d);
+                [m[0], m[1], m[2], d[0], d[1], d[2]]
+            })
+            .collect();
+        out.extend(reciprocal(&rods));
+        return out;
+    }
+    let rot = mat_mul(&tip.rotation, &frame.rotation);
+    match (j.kind, leg.end) {
+        (Kind::Universal, _) => {
+            for ax in axes.get(c).into_iter().flatten() {
+                out.push(revolute(&end, &unit(&mat_vec(&rot, ax))));
+            }
+        }
+        (_, LegEnd::Revolute { on_leg, .. }) => {
+            out.push(revolute(&end, &unit(&mat_vec(&tip.rotation, &on_leg))));
+        }
+        (_, LegEnd::Spherical { .. }) => {
+            for k in 0..3 {
+                let e: Vec3 = std::array::from_fn(|i| f64::from(u8::from(i == k)));
+                out.push(revolute(&end, &e));
+            }
+        }
+    }
+    out
+}
+
+fn direction(v: &[f64]) -> String {
+    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    // The sign that makes the largest component positive: one way of naming an axis.
+    let big = v
+        .iter()
+        .fold(0.0f64, |b, x| if x.abs() > b.abs() { *x } else { b });
+    let s = if big < 0.0 { -1.0 } else { 1.0 } / n.max(f64::MIN_POSITIVE);
+    let c: Vec<String> = v
+        .iter()
+        .map(|x| {
+            let r = (s * x * 1e3).round() / 1e3;
+            format!("{}", if r == 0.0 { 0.0 } else { r })
+        })
+        .collect();
+    format!("({})", c.join(", "))
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+fn words(motion: &PlatformMotion) -> (&'static str, &'static str) {
+    match motion {
+        PlatformMotion::Pose => ("pose", "moves it freely"),
+        PlatformMotion::Orientation { .. } => ("orientation", "only turns it about the centre"),
+        PlatformMotion::Translation { .. } => ("translation", "holds its orientation fixed"),
+        PlatformMotion::PlanarPoint { .. } => ("planar", "moves a point in the plane"),
+    }
+}
+
+/// The platform's allowed twists at home against the declared motion's; an error at
+/// `[platform] coordinates` when they differ.
+pub(super) fn check_declared_motion(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    ps: &PlatformSpec,
+    pm: &ParallelModel,
+    diags: &mut Diagnostics,
+) {
+    let size = pm.size();
+    let Some(declared) = declared(&pm.motion, size) else {
+        return;
+    };
+    let declared = span(&declared);
+    let wrenches: Vec<Screw> = (0..pm.legs.len().min(tree.closing.len()))
+        .flat_map(|li| reciprocal(&leg_twists(tree, axes, pm, li, size)))
+        .collect();
+    let allowed = reciprocal(&wrenches);
+    let missing = span(&outside(&declared, &allowed));
+    let extra = span(&outside(&allowed, &declared));
+    if missing.is_empty() && extra.is_empty() {
+        return;
+    }
+    let (word, holds) = words(&pm.motion);
+    let mut parts: Vec<String> = Vec::new();
+    if !extra.is_empty() {
+        let mut turns: Vec<String> = Vec::new();
+        let mut moves: Vec<String> = Vec::new();
+        for t in &extra {
+            if t[..3].iter().map(|x| x * x).sum::<f64>().sqrt() > 1e-6 {
+                turns.push(direction(&t[..3]));
+            } else {
+                moves.push(direction(&t[3..]));
+            }
+        }
+        let mut what: Vec<String> = Vec::new();
+        if !turns.is_empty() {
+            what.push(format!("rotate about {}", list(&turns)));
+        }
+        if !moves.is_empty() {
+            what.push(format!("translate along {}", list(&moves)));
+        }
+        parts.push(format!(
+            "the legs let the platform {} but coordinates = \"{word}\" {holds}",
+            what.join(" and ")
+        ));
+    }
+    if !missing.is_empty() {
+        parts.push(format!(
+            "the legs allow only {} of the declared {} motions",
+            declared.len() - missing.len(),
+            declared.len()
+        ));
+    }
+    let msg = parts.join("; and ");
+    diags.push(
+        Diagnostic::error(format!("{msg} (at home, by reciprocal screws)"))
+            .with_key("platform.coordinates")
+            .with_span(ps.coordinates_span.clone())
+            .with_hint(format!(
+                "the platform's motion is what the legs' constraint wrenches leave it: coordinates = \"{word}\" needs legs that allow exactly that (a Delta's [[parallelogram]]s or Tsai's 3-UPU with the base U's first axis parallel to the platform U's second and the inner axes parallel, for \"translation\"; every axis through the centre, for \"orientation\"); choose the coordinates of the motion the legs allow, or change the legs (docs/spec.md, \"The declared motion\")"
+            )),
+    );
+}
