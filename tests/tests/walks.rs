@@ -512,6 +512,18 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                         );
                     }
                 }
+                // Exactly into the base plane (a 3-UPU's legs all in it: parallel and, at
+                // points, leg singularities, which the steps above pass between).
+                at(
+                    turned(&m, 0, 0.0, [0.0, 0.0, -home[2]]),
+                    "into the base plane".into(),
+                    &mut bad,
+                );
+                at(
+                    turned(&m, 0, 0.0, [0.15, 0.3, -home[2]]),
+                    "into the base plane, leg 0 along its first axis".into(),
+                    &mut bad,
+                );
             }
         }
         println!("{name}: runtime sites met {sites:?}");
