@@ -107,6 +107,10 @@ fn main() {
     let joints = "data/delta_rl5_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "delta_joints", Path::new(joints), |_| {});
+    // Tsai's 3-UPU in joint coordinates, likewise.
+    let joints = "data/tsai_3upu_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(&out, "upu_joints", Path::new(joints), |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

@@ -100,3 +100,11 @@ pub mod delta_joints {
         "/variants/delta_joints/delta_rl5_joints.rs"
     ));
 }
+/// Tsai's 3-UPU of `mechanisms/specs/tsai_3upu.toml` in joint coordinates (`tests/data/
+/// tsai_3upu_joints.toml`, the closed-loop route), for the bench against its platform form.
+pub mod upu_joints {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/upu_joints/tsai_3upu_joints.rs"
+    ));
+}
