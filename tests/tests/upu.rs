@@ -198,3 +198,70 @@ fn upu_round_trip_and_power_balance() {
     assert!(trip <= 1e-10, "{trip:e}");
     assert!(power <= 1e-10, "{power:e}");
 }
+
+/// With viscous friction on the actuated prismatic joints (`[scene] friction = true`), the
+/// legs leave the closed form for the generic leg route (Newton–Euler of the U-P chain to the
+/// platform U's centre, the drives at the joints); the platform form still agrees with the
+/// joint-coordinate route, which applies the same damping at the same joints.
+#[test]
+fn upu_with_joint_damping_matches_joint_coordinates() {
+    let load = |file: &str, before: &str| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let src = src
+            .replacen(before, &format!("[scene]\nfriction = true\n\n{before}"), 1)
+            .replace("actuated = true\n", "actuated = true\ndamping = 20.0\n");
+        assert_eq!(src.matches("damping = 20.0").count(), 3);
+        codegen::spec::load_mechanism(&path.to_string_lossy(), &src)
+            .unwrap_or_else(|d| panic!("{d}"))
+    };
+    let (codegen::spec::Mechanism::Parallel(pm), _) =
+        load("../mechanisms/specs/tsai_3upu.toml", "[platform]")
+    else {
+        panic!("not a parallel mechanism")
+    };
+    let (codegen::spec::Mechanism::Closed(jm), _) = load("data/tsai_3upu_joints.toml", "[[body]]")
+    else {
+        panic!("not a closed-loop mechanism")
+    };
+    let pplan = Plan::new(&pm).unwrap();
+    assert!(
+        pplan.legs.iter().all(|l| l.ups.is_none()),
+        "drives take the generic route"
+    );
+    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let home = pm.home_x();
+    let mut rng = tests::rng(0x0b05);
+    let mut worst: f64 = 0.0;
+    let mut damping: f64 = 0.0;
+    for _ in 0..100 {
+        let (p, v, a) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
+        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
+        let t = literal::terms(&pplan, &p, &v).unwrap();
+        let amat: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
+            .collect();
+        let bias: Vec<f64> = pplan
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
+            .collect();
+        let qd = mat_vec(&amat, &v);
+        let qdd: Vec<f64> = mat_vec(&amat, &a)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
+        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
+        worst = worst.max(rel(&tp, &tj));
+        damping = damping.max(qd.iter().fold(0.0f64, |m, r| m.max((20.0 * r).abs())));
+    }
+    println!(
+        "tsai_3upu with damping 20 N·s/m on the prismatic joints (up to {damping:.2} N), platform form (generic legs) vs joint coordinates, 100 states, worst relative error (∞-norm): {worst:.1e}"
+    );
+    assert!(damping > 1.0, "the damping must matter");
+    assert!(worst <= 1e-12, "{worst:e}");
+}
