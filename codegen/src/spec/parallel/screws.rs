@@ -104,22 +104,31 @@ fn outside(a: &[Screw], basis: &[Screw]) -> Vec<Screw> {
         .collect()
 }
 
-/// The span of the declared motion's `S` at home (size-scaled twists), or `None` for a motion
-/// the check does not cover. One arm per [`PlatformMotion`].
-fn declared(motion: &PlatformMotion, size: f64) -> Option<Vec<Screw>> {
+/// The declared motion: the span of its `S` at home (size-scaled twists) and its words (the
+/// `coordinates` value, what it does to the platform), or `None` for a motion the check does
+/// not cover. One arm per [`PlatformMotion`].
+fn declared(motion: &PlatformMotion, size: f64) -> Option<Declared> {
     let e = |i: usize| -> Vec3 { std::array::from_fn(|k| f64::from(u8::from(k == i))) };
     match motion {
-        PlatformMotion::Pose => Some(
+        PlatformMotion::Pose => Some((
             (0..6)
                 .map(|i| std::array::from_fn(|k| f64::from(u8::from(k == i))))
                 .collect(),
-        ),
-        PlatformMotion::Orientation { centre } => Some(
+            "pose",
+            "moves it freely",
+        )),
+        PlatformMotion::Orientation { centre } => Some((
             (0..3)
                 .map(|i| revolute(&scaled(centre, size), &e(i)))
                 .collect(),
-        ),
-        PlatformMotion::Translation { .. } => Some((0..3).map(|i| prismatic(&e(i))).collect()),
+            "orientation",
+            "only turns it about the centre",
+        )),
+        PlatformMotion::Translation { .. } => Some((
+            (0..3).map(|i| prismatic(&e(i))).collect(),
+            "translation",
+            "holds its orientation fixed",
+        )),
         // A point platform has no orientation: its legs end in revolutes about the plane normal
         // at the point, whose spin of the "platform" is idle, and a point's motion is not a
         // rigid body's twist. The planar five-bar's legs are checked by their type instead
@@ -127,6 +136,9 @@ fn declared(motion: &PlatformMotion, size: f64) -> Option<Vec<Screw>> {
         PlatformMotion::PlanarPoint { .. } => None,
     }
 }
+
+/// The declared twists, the `coordinates` word and what the motion does to the platform.
+type Declared = (Vec<Screw>, &'static str, &'static str);
 
 /// The twists the joints of leg `li` allow the platform at home (size-scaled): its joint screws
 /// and those of its end, with a parallelogram's two rods in place of its equivalent rod's
@@ -241,15 +253,6 @@ fn list(items: &[String]) -> String {
     }
 }
 
-fn words(motion: &PlatformMotion) -> (&'static str, &'static str) {
-    match motion {
-        PlatformMotion::Pose => ("pose", "moves it freely"),
-        PlatformMotion::Orientation { .. } => ("orientation", "only turns it about the centre"),
-        PlatformMotion::Translation { .. } => ("translation", "holds its orientation fixed"),
-        PlatformMotion::PlanarPoint { .. } => ("planar", "moves a point in the plane"),
-    }
-}
-
 /// The platform's allowed twists at home against the declared motion's; an error at
 /// `[platform] coordinates` when they differ.
 pub(super) fn check_declared_motion(
@@ -260,7 +263,7 @@ pub(super) fn check_declared_motion(
     diags: &mut Diagnostics,
 ) {
     let size = pm.size();
-    let Some(declared) = declared(&pm.motion, size) else {
+    let Some((declared, word, holds)) = declared(&pm.motion, size) else {
         return;
     };
     let declared = span(&declared);
@@ -273,7 +276,6 @@ pub(super) fn check_declared_motion(
     if missing.is_empty() && extra.is_empty() {
         return;
     }
-    let (word, holds) = words(&pm.motion);
     let mut parts: Vec<String> = Vec::new();
     if !extra.is_empty() {
         let mut turns: Vec<String> = Vec::new();
