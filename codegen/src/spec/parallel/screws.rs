@@ -316,3 +316,84 @@ pub(super) fn check_declared_motion(
             )),
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dot(a: &Screw, b: &Screw) -> f64 {
+        (0..6).map(|i| a[i] * b[i]).sum()
+    }
+
+    /// `t` lies in the span of the orthonormal `basis`.
+    fn inside(t: &Screw, basis: &[Screw]) -> bool {
+        outside(&[*t], basis)[0].iter().all(|x| x.abs() < 1e-12)
+    }
+
+    /// A leg of Tsai's 3-UPU (outer axes `e₀` parallel, inner axes `e₁` parallel) is held by one
+    /// couple, along `e₀ × e₁` (Tsai, Robot Analysis, §4.7): `[m; f] = [e₀ × e₁; 0]`.
+    #[test]
+    fn a_upu_leg_is_held_by_one_couple() {
+        let (b, t) = ([0.3, 0.0, 0.0], [0.15, 0.1, 0.4]);
+        let e0 = [0.0, 1.0, 0.0];
+        let s = unit(&[t[0] - b[0], t[1] - b[1], t[2] - b[2]]);
+        let e1 = unit(&geom::cross(&e0, &s));
+        let twists = [
+            revolute(&b, &e0),
+            revolute(&b, &e1),
+            prismatic(&s),
+            revolute(&t, &e1),
+            revolute(&t, &e0),
+        ];
+        let w = reciprocal(&twists);
+        assert_eq!(w.len(), 1);
+        let c = geom::cross(&e0, &e1);
+        let couple = [c[0], c[1], c[2], 0.0, 0.0, 0.0];
+        assert!(inside(&couple, &w), "{w:?}");
+        // The platform U's axes swapped leave the couple at home (the axis order is checked apart).
+        let swapped = [
+            twists[0],
+            twists[1],
+            twists[2],
+            revolute(&t, &e0),
+            revolute(&t, &e1),
+        ];
+        assert!(inside(&couple, &reciprocal(&swapped)));
+    }
+
+    /// A parallelogram's two rods (forces along `d` through `E ± (w/2) a`) allow the distal bar
+    /// the rotations about `a` and `d` through `E` and the translations along `a` and `a × d`,
+    /// but not the rotation about `a × d` nor the translation along `d`.
+    #[test]
+    fn a_parallelogram_allows_four_motions() {
+        let (e, a, d) = ([0.5, 0.2, -0.1], [0.0, 1.0, 0.0], unit(&[-0.3, 0.0, -1.0]));
+        let n = geom::cross(&a, &d);
+        let rods: Vec<Screw> = [-0.05, 0.05]
+            .iter()
+            .map(|h| {
+                let q = [e[0] + h * a[0], e[1] + h * a[1], e[2] + h * a[2]];
+                let m = geom::cross(&q, &d);
+                [m[0], m[1], m[2], d[0], d[1], d[2]]
+            })
+            .collect();
+        let allowed = reciprocal(&rods);
+        assert_eq!(allowed.len(), 4);
+        for t in [
+            revolute(&e, &a),
+            revolute(&e, &d),
+            prismatic(&a),
+            prismatic(&n),
+        ] {
+            assert!(inside(&t, &allowed));
+        }
+        for t in [revolute(&e, &n), prismatic(&d)] {
+            assert!(!inside(&t, &allowed));
+        }
+        // The allowed twists do no work against either rod force.
+        for t in &allowed {
+            for r in &rods {
+                assert!(dot(t, r).abs() < 1e-12);
+            }
+        }
+    }
+}
