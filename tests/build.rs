@@ -113,6 +113,10 @@ fn main() {
     let joints = "data/planar_3rrr_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "planar3_joints", Path::new(joints), |_| {});
+    // Tsai's 3-UPU in joint coordinates, likewise.
+    let joints = "data/tsai_3upu_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(&out, "upu_joints", Path::new(joints), |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

@@ -204,6 +204,7 @@ bench_parallel!(gough_stewart, gough_stewart);
 bench_parallel!(agile_eye, agile_eye);
 bench_parallel!(delta_rl5, delta_rl5);
 bench_parallel!(planar_3rrr, planar_3rrr);
+bench_parallel!(tsai_3upu, tsai_3upu);
 
 /// A bundled closed-loop mechanism in joint coordinates: generated vs the runtime evaluator
 /// (`runtime::closed::noc`) vs the independent Newton–Euler + Lagrange-multiplier route (dense
@@ -337,9 +338,32 @@ fn planar3_task_vs_joints(c: &mut Criterion) {
     g.finish();
 }
 
+/// Tsai's 3-UPU in platform coordinates against the same robot in joint coordinates, as
+/// [`delta_task_vs_joints`].
+fn upu_task_vs_joints(c: &mut Criterion) {
+    use mechanisms::tsai_3upu as task;
+    use tests::variants::upu_joints as joints;
+    let x = task::HOME;
+    let (u, ud) = ([0.3, -0.2, 0.1], [1.0, 0.5, -2.0]);
+    let q = task::inverse_kinematics(&x).expect("home in reach");
+    let qd = task::actuator_rates(&x, &u).expect("regular");
+    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
+    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
+    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
+    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
+    let mut g = c.benchmark_group("tsai_3upu/inverse_dynamics_task_vs_joints");
+    g.bench_function("platform_coordinates", |b| {
+        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("joint_coordinates", |b| {
+        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, five_bar_joints, spherical_five_bar
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, five_bar_joints, spherical_five_bar
 }
 criterion_main!(benches);

@@ -108,3 +108,12 @@ pub mod planar3_joints {
         "/variants/planar3_joints/planar_3rrr_joints.rs"
     ));
 }
+
+/// Tsai's 3-UPU of `mechanisms/specs/tsai_3upu.toml` in joint coordinates (`tests/data/
+/// tsai_3upu_joints.toml`, the closed-loop route), for the bench against its platform form.
+pub mod upu_joints {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/upu_joints/tsai_3upu_joints.rs"
+    ));
+}

@@ -116,7 +116,8 @@ fn parallel_mechanisms_in_single_precision() {
         agile_eye,
         planar_five_bar,
         delta_rl5,
-        planar_3rrr
+        planar_3rrr,
+        tsai_3upu
     );
 }
 

@@ -189,6 +189,7 @@ generated_routes!(rus_hexapod);
 generated_routes!(planar_five_bar);
 generated_routes!(delta_rl5);
 generated_routes!(planar_3rrr);
+generated_routes!(tsai_3upu);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -199,6 +200,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "planar_five_bar" => &planar_five_bar::ROUTES,
         "delta_rl5" => &delta_rl5::ROUTES,
         "planar_3rrr" => &planar_3rrr::ROUTES,
+        "tsai_3upu" => &tsai_3upu::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }
@@ -929,6 +931,65 @@ fn planar_3rrr_parallel_singularity() {
         &walk,
         &states(3, 0x3f),
         Some(generated_id("planar_3rrr")),
+        &[|s| matches!(s, Site::Actuation(_))],
+    );
+    finish(&bad);
+}
+
+/// Tsai's 3-UPU (`tsai_3upu`): leg 0 turns toward its base U's first axis (the tangent
+/// `e₀ = e_y` at `B₀ = (0.3, 0, 0)`): the platform at `(0.15, 0.3, δ)` puts leg 0's platform
+/// U centre at `(0.3, 0.3, δ)`, so the leg direction tends to `e₀` and the U's second axis
+/// `e₀ × s` is lost (a leg singularity, `|e₀ × s| → 0`). With every base U's first axis in the
+/// base plane (Tsai's arrangement) a leg can lie along it only at `z = 0`, where all three legs
+/// lie in the base plane and `A` is singular too: both kinds meet there. Measured: `A`'s pivot
+/// test reports `Actuation(2)` from δ = 1e-9 m, and the UPS leg's own test (`|e₀ × s| > 0`)
+/// `Leg(0)` at δ = 0, runtime and generated alike; the dynamic error grows to 1.9e-9 at 1e-7 m
+/// before that.
+#[test]
+fn upu_leg_singularity() {
+    let m = model("tsai_3upu");
+    let plan = plan(&m);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![0.15, 0.3, d],
+        })
+        .collect();
+    let bad = walk_report(
+        "3-UPU, platform at (0.15, 0.3, δ) (leg 0 along its base U's first axis)",
+        &plan,
+        &walk,
+        &states(3, 0x0b0),
+        Some(generated_id("tsai_3upu")),
+        &[
+            |s| matches!(s, Site::Leg(0)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
+    );
+    finish(&bad);
+}
+
+/// Tsai's 3-UPU (`tsai_3upu`): the platform lowered into the base plane, `(0, 0, δ)`: the three
+/// leg directions `s_k` (the rows of `A`) become coplanar while every leg stays regular (each
+/// leg radial, `|e₀ × s| = 1`), a parallel (type-II) singularity.
+#[test]
+fn upu_parallel_singularity() {
+    let m = model("tsai_3upu");
+    let plan = plan(&m);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![0.0, 0.0, d],
+        })
+        .collect();
+    let bad = walk_report(
+        "3-UPU, platform at (0, 0, δ) (legs coplanar)",
+        &plan,
+        &walk,
+        &states(3, 0x0b1),
+        Some(generated_id("tsai_3upu")),
         &[|s| matches!(s, Site::Actuation(_))],
     );
     finish(&bad);

@@ -329,7 +329,8 @@ parallel_routes!(
     rus_hexapod,
     planar_five_bar,
     delta_rl5,
-    planar_3rrr
+    planar_3rrr,
+    tsai_3upu
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -435,6 +436,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "planar_five_bar",
         "delta_rl5",
         "planar_3rrr",
+        "tsai_3upu",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
@@ -540,6 +542,18 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                         );
                     }
                 }
+                // Exactly into the base plane (a 3-UPU's legs all in it: parallel and, at
+                // points, leg singularities, which the steps above pass between).
+                at(
+                    turned(&m, 0, 0.0, [0.0, 0.0, -home[2]]),
+                    "into the base plane".into(),
+                    &mut bad,
+                );
+                at(
+                    turned(&m, 0, 0.0, [0.15, 0.3, -home[2]]),
+                    "into the base plane, leg 0 along its first axis".into(),
+                    &mut bad,
+                );
             }
         }
         println!("{name}: runtime sites met {sites:?}");

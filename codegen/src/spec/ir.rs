@@ -32,6 +32,9 @@ pub(crate) struct Spec {
     /// into `bodies` and `joints` (their equivalent rod, a U at the elbow and an S at the
     /// platform); their names, for the mobility count.
     pub parallelograms: Vec<String>,
+    /// Each `[[parallelogram]]`'s short-side width (m), in the order of `parallelograms`: the
+    /// declared-motion check places its two rods.
+    pub parallelogram_widths: Vec<f64>,
 }
 
 /// A `[[spring]]` entry: a linear spring-damper between a point of `body_a` and one of

@@ -29,13 +29,17 @@ mod joints;
 mod legs;
 mod mobility;
 mod platform;
+mod screws;
 mod validate;
 
 use joints::{check_actuated_kind, check_has_closing, check_joints, check_planar_point};
 use legs::{Tree, build_legs, split_legs};
 use mobility::check_mobility;
 use platform::{assemble, check_platform, on_platform};
-use validate::{check_orientation_axes, runtime_checks};
+use screws::check_declared_motion;
+use validate::{
+    check_orientation_axes, check_upu_axes, check_upu_legs, rank_check, runtime_checks,
+};
 
 /// Validates a spec with a `[platform]` table and builds the parallel model. Errors and
 /// warnings go to `diags`; `None` when there was any error.
@@ -116,11 +120,23 @@ fn lower_checked(
     let legs = build_legs(&tree, &axes, &paths, motion, diags);
     let pm = assemble(spec, ps, motion, pname, &on.parts, legs);
     check_orientation_axes(&tree, &pm, diags);
+    check_upu_legs(&tree, &axes, &pm, diags);
+    // Each leg's type and geometry (the runtime's checks, which name the leg and the joint)
+    // before the declared motion against the legs' (which names only the motions), then the
+    // rank at home.
+    if !diags.has_errors() && run_validate {
+        runtime_checks(spec, ps, &closing_joints, &pm, diags);
+    }
+    if !diags.has_errors() {
+        check_declared_motion(&tree, &axes, ps, &pm, diags);
+    }
+    if !diags.has_errors() {
+        check_upu_axes(&tree, &axes, &pm, diags);
+    }
     if diags.has_errors() || !run_validate {
         return None;
     }
-
-    runtime_checks(spec, ps, &closing_joints, &pm, diags);
+    rank_check(spec, ps, &closing_joints, &pm, diags);
     if diags.has_errors() { None } else { Some(pm) }
 }
 

@@ -112,6 +112,7 @@ impl Reader<'_> {
             scene,
             springs,
             parallelograms: Vec::new(),
+            parallelogram_widths: Vec::new(),
         };
         self.expand_parallelograms(&mut spec, parallelograms);
         spec

@@ -72,6 +72,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         scene: Default::default(),
         springs: Vec::new(),
         parallelograms: Vec::new(),
+        parallelogram_widths: Vec::new(),
     })
 }
 

@@ -353,7 +353,15 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
         return Err(format!("leg {name}: no actuated joint"));
     }
     let kind = match (m.motion, leg.end, kinds.as_slice()) {
-        (PlatformMotion::Pose, LegEnd::Spherical { .. }, [R, R, P]) => {
+        // A UPS leg; on a translational platform also a UPU leg (Tsai's 3-UPU), whose U at the
+        // platform arrives as the point at its centre: with ω = 0 its cross is massless and its
+        // angles follow from the rod's (docs/spec.md, "Universal joints into a translational
+        // platform").
+        (
+            PlatformMotion::Pose | PlatformMotion::Translation { .. },
+            LegEnd::Spherical { .. },
+            [R, R, P],
+        ) => {
             // The prismatic axis must run through the U centre towards the S centre.
             let tip = leg_tip_home(leg);
             let d = sub(&tip, &ax[1].1);

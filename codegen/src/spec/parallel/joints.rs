@@ -137,7 +137,10 @@ fn check_closing_joint(
             Coordinates::Translation => (Kind::Spherical, "translation"),
             Coordinates::PlanarPose => (Kind::Revolute, "planar_pose"),
         };
-        if j.kind != want {
+        // Tsai's 3-UPU: a universal joint into a translational platform (its cross is massless
+        // and, with ω = 0, its angles follow from the leg's; docs/spec.md).
+        let upu = coords == Coordinates::Translation && j.kind == Kind::Universal;
+        if j.kind != want && !upu {
             diags.push(
                 Diagnostic::error(format!(
                     "the platform \"{pname}\" is the child of {} joint \"{}\", but with coordinates = \"{word}\" a joint into the platform must be {}",
@@ -147,7 +150,7 @@ fn check_closing_joint(
                 ))
                 .with_key(format!("{}.kind", j.key))
                 .with_span(j.kind_span.clone())
-                .with_hint("the joints into the platform close the legs' loops: spherical joints for a 6-DOF (pose) or translational platform (a Delta's [[parallelogram]] brings its own), revolute joints with axes through the centre for an orientation platform; attach bodies rigidly to the platform with fixed joints from the platform instead"),
+                .with_hint("the joints into the platform close the legs' loops: spherical joints for a 6-DOF (pose) or translational platform (a Delta's [[parallelogram]] brings its own; a translational platform also takes universal joints, Tsai's 3-UPU), revolute joints with axes through the centre for an orientation platform; attach bodies rigidly to the platform with fixed joints from the platform instead"),
             );
         }
     }

@@ -30,6 +30,11 @@ const SUPPORTED_POSE: &[&[JointKind]] = &[
         JointKind::Revolute,
     ],
 ];
+const SUPPORTED_UPU: &[&[JointKind]] = &[&[
+    JointKind::Revolute,
+    JointKind::Revolute,
+    JointKind::Prismatic,
+]];
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
 const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
     &[JointKind::Revolute, JointKind::Revolute],
@@ -38,7 +43,7 @@ const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
 ];
 /// The hint of an unsupported leg of a planar 3-DOF platform.
 pub(super) const SUPPORTED_PLANAR_POSE_HINT: &str = "supported legs for coordinates = \"planar_pose\": two joints in the plane, then the revolute about z into the platform: R-R-R (revolute axes along z), P-R-R (a slider in the plane, then the rod) or R-P-R (a revolute about z, then a prismatic along the line to the platform point); one of the two leg joints actuated";
-pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point); for coordinates = \"translation\" a revolute crank with a [[parallelogram]] (a Delta leg), or the legs of \"pose\"";
+pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point); for coordinates = \"translation\" a revolute crank with a [[parallelogram]] (a Delta leg), a U-P leg ending in a universal joint (Tsai's 3-UPU), or the legs of \"pose\"";
 
 /// The lowered tree with what the leg steps need: its topology, the build (model and
 /// bookkeeping), and the spec joints into the platform, one per leg in declared order.
@@ -214,6 +219,8 @@ fn build_leg(
                 on_platform: mat_vec(&child_origin.rotation, &e),
             }
         }
+        // A universal joint into a translational platform (Tsai's 3-UPU) meets it at its centre:
+        // the leg is evaluated as a UPS leg to that point (docs/spec.md).
         _ => LegEnd::Spherical {
             on_leg: frame.translation,
             on_platform: child_origin.translation,
@@ -290,6 +297,8 @@ fn check_leg_type(
     let (spec, model) = (tree.spec, &tree.built.model);
     let kinds: Vec<JointKind> = path.iter().map(|&k| model.joints[k].kind).collect();
     let supported = match motion {
+        // A universal joint into a translational platform ends a U-P leg (Tsai's 3-UPU).
+        Coordinates::Translation if j.kind == Kind::Universal => SUPPORTED_UPU,
         Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
         Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE,

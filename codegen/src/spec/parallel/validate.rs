@@ -4,13 +4,14 @@
 //!
 //! [`Plan::new`]: runtime::parallel::Plan::new
 
-use runtime::model::{Transform, mat_vec};
+use runtime::model::{Transform, Vec3, mat_mul, mat_vec};
 use runtime::parallel::{GEOMETRY_TOLERANCE, LegEnd, ParallelModel, PlatformMotion};
 
 use super::legs::{SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
-use crate::spec::ir::{Coordinates, PlatformSpec, Spec};
+use crate::spec::ir::{Coordinates, Kind, PlatformSpec, Spec};
+use crate::spec::lower::Axes;
 
 /// Revolute ends: the axis must pass through the centre on both sides (the runtime compares
 /// only the directions). Same tolerance as the runtime's geometric checks.
@@ -60,6 +61,176 @@ pub(super) fn check_orientation_axes(tree: &Tree<'_>, pm: &ParallelModel, diags:
     }
 }
 
+/// The legs that end in a universal joint into a translational platform (Tsai's 3-UPU), their
+/// closing joint and the U's two axes at home (base frame, unit; the cross's first axis first).
+fn upu_legs<'a>(
+    tree: &'a Tree<'_>,
+    axes: &'a Axes,
+    pm: &'a ParallelModel,
+) -> impl Iterator<Item = (&'a runtime::parallel::Leg, usize, Vec<Vec3>)> + 'a {
+    pm.legs
+        .iter()
+        .zip(tree.closing)
+        .filter(move |(_, c)| {
+            matches!(pm.motion, PlatformMotion::Translation { .. })
+                && tree.spec.joints[**c].kind == Kind::Universal
+        })
+        .map(move |(leg, &c)| {
+            let tip = runtime::parallel::leg_home_poses(leg)
+                .last()
+                .copied()
+                .unwrap_or(Transform::IDENTITY);
+            let rot = mat_mul(&tip.rotation, &tree.frame_in_tip(c).rotation);
+            let e: Vec<Vec3> = axes
+                .get(c)
+                .into_iter()
+                .flatten()
+                .map(|a| unit(&mat_vec(&rot, a)))
+                .collect();
+            (leg, c, e)
+        })
+}
+
+fn unit(v: &Vec3) -> Vec3 {
+    let n = geom::norm(v);
+    if n > 0.0 {
+        [v[0] / n, v[1] / n, v[2] / n]
+    } else {
+        *v
+    }
+}
+
+fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// A U-P leg into a translational platform's universal joint (Tsai's 3-UPU): the base U's two
+/// axes meet, and the prismatic joint runs along the line from the base U's centre to the
+/// platform U's. (The leg is evaluated as a UPS leg to the platform U's centre, which needs
+/// both.) At the joint into the platform.
+pub(super) fn check_upu_legs(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    pm: &ParallelModel,
+    diags: &mut Diagnostics,
+) {
+    let tol = GEOMETRY_TOLERANCE * pm.size();
+    for (leg, c, _) in upu_legs(tree, axes, pm) {
+        let j = &tree.spec.joints[c];
+        let poses = runtime::parallel::leg_home_poses(leg);
+        if leg.joints.len() != 3 || poses.len() != 3 {
+            continue; // reported by the leg-type check
+        }
+        let ax: Vec<(Vec3, Vec3)> = poses
+            .iter()
+            .zip(&leg.joints)
+            .map(|(p, jt)| (unit(&mat_vec(&p.rotation, &jt.axis)), p.translation))
+            .collect();
+        let (e0, p0) = ax[0];
+        let (e1, p1) = ax[1];
+        let n = geom::cross(&e0, &e1);
+        let nn = geom::norm(&n);
+        let gap = if nn < 1e-9 {
+            f64::INFINITY
+        } else {
+            let d = sub(&p1, &p0);
+            (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]).abs() / nn
+        };
+        let base_word = |k: usize| {
+            tree.spec.joints[tree.built.spec_joint[tree_index(tree, leg, k)]]
+                .name
+                .clone()
+        };
+        if gap > tol {
+            diags.push(
+                Diagnostic::error(format!(
+                    "leg \"{}\": the two axes of its base U (joints \"{}\" and \"{}\") do not meet",
+                    j.name,
+                    base_word(0),
+                    base_word(1)
+                ))
+                .with_key(j.key.clone())
+                .with_span(j.span.clone())
+                .with_hint("a 3-UPU leg is a universal joint at the base, a prismatic joint and a universal joint at the platform: write the base joint as kind = \"universal\" (its two axes meet at its origin)"),
+            );
+            continue;
+        }
+        // The U centre: the meeting point (on the first axis, nearest the second).
+        let w = sub(&p0, &p1);
+        let (b, d, e) = (
+            e0[0] * e1[0] + e0[1] * e1[1] + e0[2] * e1[2],
+            e0[0] * w[0] + e0[1] * w[1] + e0[2] * w[2],
+            e1[0] * w[0] + e1[1] * w[1] + e1[2] * w[2],
+        );
+        let s = (b * e - d) / (1.0 - b * b).max(f64::MIN_POSITIVE);
+        let centre = [p0[0] + s * e0[0], p0[1] + s * e0[1], p0[2] + s * e0[2]];
+        let tip = poses[2];
+        let top = tip.apply(&tree.frame_in_tip(c).translation);
+        let off = geom::norm(&geom::cross(&sub(&top, &centre), &ax[2].0));
+        if off > tol {
+            diags.push(
+                Diagnostic::error(format!(
+                    "leg \"{}\": its prismatic joint \"{}\" does not run along the line from the base U's centre to the platform U's centre (off by {} m at home)",
+                    j.name,
+                    base_word(2),
+                    geom::num(off)
+                ))
+                .with_key(j.key.clone())
+                .with_span(j.span.clone())
+                .with_hint("in a 3-UPU leg the prismatic joint's axis is the line through the two U centres: point the prismatic joint's axis from the base U's centre at the platform U's centre"),
+            );
+        }
+    }
+}
+
+/// The spec joint behind model joint `k` of `leg` (found by name in the built model).
+fn tree_index(tree: &Tree<'_>, leg: &runtime::parallel::Leg, k: usize) -> usize {
+    let name = &leg.joints[k].name;
+    tree.built
+        .model
+        .joints
+        .iter()
+        .position(|j| j.name == *name)
+        .unwrap_or(0)
+}
+
+/// Tsai's condition that keeps a 3-UPU translating beyond home: in each leg the base U's first
+/// axis is parallel to the platform U's second, and the base U's second to the platform U's
+/// first (Tsai 1996; Di Gregorio & Parenti-Castelli 1998). At home the declared-motion check
+/// has already passed; this one is about every other pose.
+pub(super) fn check_upu_axes(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    pm: &ParallelModel,
+    diags: &mut Diagnostics,
+) {
+    for (leg, c, e) in upu_legs(tree, axes, pm) {
+        let j = &tree.spec.joints[c];
+        let poses = runtime::parallel::leg_home_poses(leg);
+        if leg.joints.len() != 3 || e.len() != 2 {
+            continue;
+        }
+        let base: Vec<Vec3> = poses
+            .iter()
+            .zip(&leg.joints)
+            .take(2)
+            .map(|(p, jt)| unit(&mat_vec(&p.rotation, &jt.axis)))
+            .collect();
+        let parallel = |a: &Vec3, b: &Vec3| geom::norm(&geom::cross(a, b)) <= 1e-9;
+        if !(parallel(&base[0], &e[1]) && parallel(&base[1], &e[0])) {
+            diags.push(
+                Diagnostic::error(format!(
+                    "leg \"{}\": the platform U's axes are not parallel to the base U's in reverse order, so the platform would turn away from home",
+                    j.name
+                ))
+                .with_key(format!("{}.axes", j.key))
+                .with_span(j.axes.first().and_then(|a| a.span.clone()).or(j.span.clone()))
+                .with_hint("Tsai's translational 3-UPU: the platform U's first axis parallel to the base U's second, its second axis parallel to the base U's first"),
+            );
+        }
+    }
+}
+
 /// The runtime's own checks (leg geometry, loop closure at home), leg by leg so that every
 /// leg's problem is reported, then once for the whole model; then the full rank of the
 /// constraint Jacobian at home.
@@ -85,15 +256,22 @@ pub(super) fn runtime_checks(
     {
         messages.push(e);
     }
-    // Full rank of the constraint Jacobian at home: `Plan::new` evaluates the legs and the
-    // actuation matrix there.
-    if messages.is_empty()
-        && let Err(e) = runtime::parallel::Plan::new(pm)
-    {
-        messages.push(e);
-    }
     for msg in messages {
         diags.push(validate_diagnostic(spec, ps, closing, msg));
+    }
+}
+
+/// Full rank of the constraint Jacobian at home: `Plan::new` evaluates the legs and the
+/// actuation matrix there (after [`runtime_checks`], which the leg evaluators rely on).
+pub(super) fn rank_check(
+    spec: &Spec,
+    ps: &PlatformSpec,
+    closing: &[usize],
+    pm: &ParallelModel,
+    diags: &mut Diagnostics,
+) {
+    if let Err(e) = runtime::parallel::Plan::new(pm) {
+        diags.push(validate_diagnostic(spec, ps, closing, e));
     }
 }
 

@@ -195,6 +195,7 @@ impl Reader<'_> {
                 spec.bodies.push(body);
                 spec.joints.extend(joints);
             }
+            spec.parallelogram_widths.push(pg.elbow_width);
             spec.parallelograms.push(pg.name);
         }
     }

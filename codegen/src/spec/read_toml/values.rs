@@ -317,7 +317,7 @@ impl Reader<'_> {
     fn quaternion(&mut self, v: &Val<'_>, key: &str) -> Option<Mat3> {
         let q = self.numbers(v, key, 4)?;
         let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !((n - 1.0).abs() <= 1e-3) {
+        if (n - 1.0).abs() > 1e-3 || n.is_nan() {
             self.err(
                 format!("the quaternion's norm is {n}, not 1"),
                 key,
@@ -375,7 +375,7 @@ impl Reader<'_> {
         let a = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
         let off = (a.transpose() * a - nalgebra::Matrix3::identity()).amax();
         let det = a.determinant();
-        if !(off <= 1e-6 && det > 0.0) {
+        if off > 1e-6 || off.is_nan() || det <= 0.0 || det.is_nan() {
             let why = if det <= 0.0 {
                 format!("its determinant is {det:.6}, not +1 (a reflection or a singular matrix)")
             } else {
@@ -432,7 +432,7 @@ impl Reader<'_> {
         };
         let (axis, angle) = (axis?, angle?);
         let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-        if !(n > 1e-9) {
+        if n <= 1e-9 || n.is_nan() {
             self.err(
                 "the rotation axis is zero",
                 &format!("{key}.axis"),

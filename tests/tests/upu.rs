@@ -1,0 +1,267 @@
+//! Tsai's translational 3-UPU (`mechanisms/specs/tsai_3upu.toml`: a translational platform,
+//! three legs of a base U, an actuated prismatic joint and a platform U, evaluated as UPS legs to
+//! the platform U centres) against two independent routes:
+//! - the same machine in joint coordinates (`tests/data/tsai_3upu_joints.toml`: every U
+//!   written out, leg 1 carrying the platform, legs 2 and 3 closing on it by revolute cuts),
+//!   evaluated by the closed-loop route (`runtime::closed::noc`: its own loop equations,
+//!   Newton assembly and `Φ_d` solves), which knows nothing of `ω = 0`: the legs' U joints hold
+//!   the platform's orientation;
+//! - Newton–Euler of every body with the joint reactions and efforts as Lagrange multipliers
+//!   (`references::lagrange`), the platform's S joints replaced by the legs' platform U joints.
+//!
+//! Errors are relative, `‖a − b‖∞ / ‖b‖∞` (the ∞-norm of the difference over that of the
+//! reference).
+
+use runtime::closed::noc as cnoc;
+use runtime::parallel::literal;
+use runtime::parallel::noc::{self, Plan};
+use tests::pkm::{model, random_state, rel};
+
+/// Random regular states per check.
+const STATES: usize = 500;
+
+fn joints_model() -> runtime::closed::ClosedModel {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/tsai_3upu_joints.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Closed(m), _)) => m,
+        Ok(_) => panic!("not a closed-loop mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
+fn mat_vec(a: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
+    a.iter()
+        .map(|r| r.iter().zip(v).map(|(x, y)| x * y).sum())
+        .collect()
+}
+
+/// The platform form and the joint-coordinate form agree at corresponding states: `q` by the
+/// platform's inverse kinematics, the joint coordinates `x_J` by the closed route's assembly
+/// from `q`, `q̇ = A v`, `q̈ = A a + Ȧ v` (`Ȧ v` the actuated rows of the literal route's
+/// `L̇ u`, kinematics only). Inverse dynamics, actuator-space inertia `A⁻ᵀ I A⁻¹` against the
+/// closed route's `I`, and forward dynamics (`q̈` of the closed route against `A u̇ + Ȧ v`).
+#[test]
+fn upu_in_joint_coordinates_matches_the_platform_form() {
+    let pm = model("tsai_3upu");
+    let pplan = Plan::new(&pm).unwrap();
+    let jm = joints_model();
+    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let home = pm.home_x();
+    let mut rng = tests::rng(0x0b03);
+    let mut worst = [0.0f64; 3];
+    for _ in 0..STATES {
+        let (p, v, a) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
+        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
+        let t = literal::terms(&pplan, &p, &v).unwrap();
+        let amat: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
+            .collect();
+        let bias: Vec<f64> = pplan
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
+            .collect();
+        let qd = mat_vec(&amat, &v);
+        let qdd: Vec<f64> = mat_vec(&amat, &a)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        // Inverse dynamics.
+        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
+        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
+        worst[0] = worst[0].max(rel(&tp, &tj));
+        // Actuator-space inertia.
+        let mp = noc::actuator_mass_matrix(&pplan, &p).unwrap();
+        let mj = cnoc::mass_matrix(&jplan, &x).unwrap();
+        worst[1] = worst[1].max(rel(&mp.concat(), &mj.concat()));
+        // Forward dynamics under the same efforts.
+        let tau: Vec<f64> = tp
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 10.0 * (i as f64 - 1.0))
+            .collect();
+        let ap = noc::forward_dynamics(&pplan, &p, &v, &tau).unwrap();
+        let qdd_p: Vec<f64> = mat_vec(&amat, &ap)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        let qdd_j = cnoc::forward_dynamics(&jplan, &x, &qd, &tau).unwrap();
+        worst[2] = worst[2].max(rel(&qdd_p, &qdd_j));
+    }
+    println!(
+        "tsai_3upu: platform form vs joint coordinates over {STATES} states, worst relative error (∞-norm): ID {:.1e}, A⁻ᵀIA⁻¹ vs I_J {:.1e}, FD {:.1e}",
+        worst[0], worst[1], worst[2]
+    );
+    for w in worst {
+        assert!(w <= 1e-12, "{worst:?}");
+    }
+}
+
+/// The generated inverse dynamics against Newton–Euler with Lagrange multipliers, the platform's
+/// orientation held by each leg's platform U (its first axis on the piston, parallel to the base
+/// U's second axis now; its second on the platform, parallel to the base U's first), its motion
+/// prescribed as `ω = 0`, `v`.
+#[test]
+fn upu_against_lagrange_multipliers() {
+    use mechanisms::tsai_3upu as g;
+    use references::lagrange::{self, CJointKind, Prescribed};
+    let m = model("tsai_3upu");
+    let plan = Plan::new(&m).unwrap();
+    let home = m.home_x();
+    let mut rng = tests::rng(0x1a9b0);
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let (x, u, ud) = random_state(&plan, &home, &mut rng, 0.0, 0.05 * m.size());
+        let leg_q = noc::leg_joint_positions(&plan, &x).unwrap();
+        let mut sys = lagrange::from_parallel(&m, &leg_q, &x);
+        assert!(lagrange::closure_residual(&sys) < 1e-12 * m.size());
+        let platform = sys.bodies.len() - 1;
+        let (_, legs) = noc::kinematics(&plan, &x).unwrap();
+        let ends: Vec<usize> = (0..sys.joints.len())
+            .filter(|&j| sys.joints[j].child == platform)
+            .collect();
+        for (&j, lk) in ends.iter().zip(&legs) {
+            let f = |v: [f64; 3]| runtime::model::mat_vec(&lk.frame, &v);
+            sys.joints[j].kind = CJointKind::Universal {
+                axis_parent: f(lk.e[1]),
+                axis_child: f(lk.e[0]),
+            };
+        }
+        let prescribed = Prescribed::Pose {
+            body: platform,
+            point: [x[0], x[1], x[2]],
+        };
+        let uu = [0.0, 0.0, 0.0, u[0], u[1], u[2]];
+        let uud = [0.0, 0.0, 0.0, ud[0], ud[1], ud[2]];
+        let sol = lagrange::inverse_dynamics(&sys, &prescribed, &uu, &uud).unwrap();
+        let xa: [f64; 3] = x.clone().try_into().unwrap();
+        let tau = g::inverse_dynamics(&xa, &[u[0], u[1], u[2]], &[ud[0], ud[1], ud[2]]).unwrap();
+        worst = worst.max(rel(&tau, &sol.efforts));
+    }
+    println!(
+        "tsai_3upu: generated vs Lagrange multipliers (platform U joints), worst relative error (∞-norm): {worst:.1e}"
+    );
+    assert!(worst <= 1e-10, "{worst:e}");
+}
+
+/// Forward dynamics undoes inverse dynamics (runtime and generated), and the inertial efforts'
+/// power at rest matches the kinetic-energy form of the generalized inertia: with
+/// `τ_I = τ(x, 0, u̇) − τ(x, 0, 0)` and `q̈ = A u̇`, `τ_I·q̈ = u̇ᵀ I u̇` (`I` by the per-leg
+/// end-point inertias, `τ` by the leg-wise Newton–Euler: two routes). The power balance along
+/// motions (`τ·q̇` against `d(T + V)/dt`) is `power_balance_tsai_3upu` in tests/tests/parallel.rs.
+#[test]
+fn upu_round_trip_and_power_balance() {
+    use mechanisms::tsai_3upu as g;
+    let m = model("tsai_3upu");
+    let plan = Plan::new(&m).unwrap();
+    let home = m.home_x();
+    let mut rng = tests::rng(0x0b04);
+    let (mut trip, mut power) = (0.0f64, 0.0f64);
+    for _ in 0..STATES {
+        let (x, v, a) = random_state(&plan, &home, &mut rng, 0.0, 0.05 * m.size());
+        let xa: [f64; 3] = x.clone().try_into().unwrap();
+        let va: [f64; 3] = v.clone().try_into().unwrap();
+        let tau = noc::inverse_dynamics(&plan, &x, &v, &a).unwrap();
+        let back = noc::forward_dynamics(&plan, &x, &v, &tau).unwrap();
+        trip = trip.max(rel(&back, &a));
+        let tg: [f64; 3] = tau.clone().try_into().unwrap();
+        let back_g = g::forward_dynamics(&xa, &va, &tg).unwrap();
+        trip = trip.max(rel(&back_g, &a));
+        let zero = vec![0.0; 3];
+        let t_static = noc::inverse_dynamics(&plan, &x, &zero, &zero).unwrap();
+        let t_acc = noc::inverse_dynamics(&plan, &x, &zero, &a).unwrap();
+        let amat = noc::actuation(&plan, &x).unwrap();
+        let qdd: Vec<f64> = amat
+            .iter()
+            .map(|r| r.iter().zip(&a).map(|(x, y)| x * y).sum())
+            .collect();
+        let lhs: f64 = t_acc
+            .iter()
+            .zip(&t_static)
+            .zip(&qdd)
+            .map(|((t, s), q)| (t - s) * q)
+            .sum();
+        let inertia = noc::mass_matrix(&plan, &x).unwrap();
+        let rhs: f64 = (0..3)
+            .map(|i| (0..3).map(|j| a[i] * inertia[i][j] * a[j]).sum::<f64>())
+            .sum();
+        power = power.max((lhs - rhs).abs() / rhs.abs().max(1e-300));
+    }
+    println!(
+        "tsai_3upu over {STATES} states: forward-dynamics round trip (runtime and generated) {trip:.1e}, power of the inertial efforts at rest τ·(A u̇) vs u̇ᵀ I u̇ {power:.1e} (relative, ∞-norm / absolute ratio)"
+    );
+    assert!(trip <= 1e-10, "{trip:e}");
+    assert!(power <= 1e-10, "{power:e}");
+}
+
+/// With viscous friction on the actuated prismatic joints (`[scene] friction = true`), the
+/// legs leave the closed form for the generic leg route (Newton–Euler of the U-P chain to the
+/// platform U's centre, the drives at the joints); the platform form still agrees with the
+/// joint-coordinate route, which applies the same damping at the same joints.
+#[test]
+fn upu_with_joint_damping_matches_joint_coordinates() {
+    let load = |file: &str, before: &str| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let src = src
+            .replacen(before, &format!("[scene]\nfriction = true\n\n{before}"), 1)
+            .replace("actuated = true\n", "actuated = true\ndamping = 20.0\n");
+        assert_eq!(src.matches("damping = 20.0").count(), 3);
+        codegen::spec::load_mechanism(&path.to_string_lossy(), &src)
+            .unwrap_or_else(|d| panic!("{d}"))
+    };
+    let (codegen::spec::Mechanism::Parallel(pm), _) =
+        load("../mechanisms/specs/tsai_3upu.toml", "[platform]")
+    else {
+        panic!("not a parallel mechanism")
+    };
+    let (codegen::spec::Mechanism::Closed(jm), _) = load("data/tsai_3upu_joints.toml", "[[body]]")
+    else {
+        panic!("not a closed-loop mechanism")
+    };
+    let pplan = Plan::new(&pm).unwrap();
+    assert!(
+        pplan.legs.iter().all(|l| l.ups.is_none()),
+        "drives take the generic route"
+    );
+    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let home = pm.home_x();
+    let mut rng = tests::rng(0x0b05);
+    let mut worst: f64 = 0.0;
+    let mut damping: f64 = 0.0;
+    for _ in 0..100 {
+        let (p, v, a) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
+        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
+        let t = literal::terms(&pplan, &p, &v).unwrap();
+        let amat: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
+            .collect();
+        let bias: Vec<f64> = pplan
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
+            .collect();
+        let qd = mat_vec(&amat, &v);
+        let qdd: Vec<f64> = mat_vec(&amat, &a)
+            .iter()
+            .zip(&bias)
+            .map(|(x, b)| x + b)
+            .collect();
+        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
+        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
+        worst = worst.max(rel(&tp, &tj));
+        damping = damping.max(qd.iter().fold(0.0f64, |m, r| m.max((20.0 * r).abs())));
+    }
+    println!(
+        "tsai_3upu with damping 20 N·s/m on the prismatic joints (up to {damping:.2} N), platform form (generic legs) vs joint coordinates, 100 states, worst relative error (∞-norm): {worst:.1e}"
+    );
+    assert!(damping > 1.0, "the damping must matter");
+    assert!(worst <= 1e-12, "{worst:e}");
+}
