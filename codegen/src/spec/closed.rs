@@ -31,7 +31,7 @@ pub(crate) fn lower_closed_attached(
 ) -> Option<(ClosedModel, Vec<Option<lower::Attach>>)> {
     let axes = lower::check_values(spec, diags);
     let mut skip = Skip::none(spec);
-    check_misplaced_child_origin(spec, diags);
+    check_misplaced_child_origin(spec, diags, &mut skip);
     check_cut_joints(spec, diags, &mut skip);
     check_some_actuated(spec, diags);
     let topo = lower::check_topology(spec, diags, &skip);
@@ -80,8 +80,51 @@ fn in_tree(spec: &Spec, name: &str) -> bool {
 /// A joint with `child_origin` whose child no tree joint reaches: `child_origin` is misplaced
 /// and the joint stays in the tree (one precise error instead of an echo about an unattached
 /// body).
-fn check_misplaced_child_origin(spec: &Spec, diags: &mut Diagnostics) {
+///
+/// When several joints reach a body and every one carries `child_origin`, they contradict each
+/// other (each would close a loop, none places the body): one error names them all, and the
+/// others than the first are left out of the topology so that nothing echoes it.
+fn check_misplaced_child_origin(spec: &Spec, diags: &mut Diagnostics, skip: &mut Skip) {
+    let mut grouped: Vec<&str> = Vec::new();
     for j in &spec.joints {
+        if j.child_origin.is_none()
+            || in_tree(spec, &j.child)
+            || grouped.contains(&j.child.as_str())
+        {
+            continue;
+        }
+        let all: Vec<usize> = (0..spec.joints.len())
+            .filter(|&k| spec.joints[k].child == j.child)
+            .collect();
+        if all.len() < 2 {
+            continue;
+        }
+        grouped.push(&j.child);
+        let names: Vec<String> = all
+            .iter()
+            .map(|&k| format!("\"{}\"", spec.joints[k].name))
+            .collect();
+        for &k in &all[1..] {
+            skip.joint[k] = true;
+        }
+        diags.push(
+            Diagnostic::error(format!(
+                "body \"{}\" is reached only by joints with `child_origin` ({}): one of these joints must stay in the tree",
+                j.child,
+                names.join(", ")
+            ))
+            .with_key(format!("{}.child_origin", j.key))
+            .with_span(j.child_origin_span.clone().or(j.span.clone()))
+            .with_hint(format!(
+                "`child_origin` marks a joint that closes a loop between two bodies the other joints already place; remove it from one of these {} joints (its child's frame is then its joint frame), and the others close the loops",
+                all.len()
+            )),
+        );
+    }
+    for j in &spec.joints {
+        if grouped.contains(&j.child.as_str()) {
+            continue;
+        }
         if j.child_origin.is_some() && !in_tree(spec, &j.child) {
             diags.push(
                 Diagnostic::error(format!(
