@@ -40,6 +40,19 @@ pub struct Diagnostic {
     pub span: Option<Range<usize>>,
     /// How to fix it, e.g. `did you mean "inertia"?`.
     pub hint: Option<String>,
+    /// A change that applies the warning's correction to the spec (`codegen fix-home`).
+    pub fix: Option<Fix>,
+}
+
+/// A change of the spec text that a [`Diagnostic`] proposes: set the key `key` of the table
+/// that holds the diagnostic's span to `value` (TOML text). When the span is that key, its
+/// value is replaced; otherwise a line `key = value` is added after the span's line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fix {
+    /// The key to set, within the table of the span (e.g. `child_origin`).
+    pub key: String,
+    /// Its new value, as TOML text (e.g. `{ xyz = [0.5, 0.0, 0.0] }`).
+    pub value: String,
 }
 
 impl Diagnostic {
@@ -51,6 +64,7 @@ impl Diagnostic {
             key: None,
             span: None,
             hint: None,
+            fix: None,
         }
     }
 
@@ -77,6 +91,15 @@ impl Diagnostic {
     /// Sets the hint.
     pub fn with_hint(mut self, hint: impl Into<String>) -> Self {
         self.hint = Some(hint.into());
+        self
+    }
+
+    /// Sets the proposed change of the spec text.
+    pub fn with_fix(mut self, key: impl Into<String>, value: impl Into<String>) -> Self {
+        self.fix = Some(Fix {
+            key: key.into(),
+            value: value.into(),
+        });
         self
     }
 

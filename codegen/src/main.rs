@@ -120,6 +120,9 @@ enum Command {
     Isotropy(cli::isotropy::IsotropyArgs),
     /// The cheapest fidelity (point-mass or massless bodies) within an effort tolerance.
     Reduce(cli::reduce::ReduceArgs),
+    /// Write the corrections made at home (loops left a little open by rounded numbers) into
+    /// the spec.
+    FixHome(cli::fix_home::FixHomeArgs),
 }
 
 fn main() -> ExitCode {
@@ -128,6 +131,7 @@ fn main() -> ExitCode {
         Some(Command::Map(args)) => return cli::map::run(&args),
         Some(Command::Isotropy(args)) => return cli::isotropy::run(&args),
         Some(Command::Reduce(args)) => return cli::reduce::run(&args),
+        Some(Command::FixHome(args)) => return cli::fix_home::run(&args),
         None => {}
     }
     // `required = true` makes clap reject a missing spec when there is no subcommand.

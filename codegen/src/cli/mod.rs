@@ -10,6 +10,7 @@
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
 pub mod design;
+pub mod fix_home;
 pub mod isotropy;
 pub mod map;
 pub mod reduce;

@@ -52,13 +52,14 @@ pub(crate) fn lower_closed_attached(
     if diags.has_errors() {
         return None;
     }
-    let closed = ClosedModel {
+    let mut closed = ClosedModel {
         name: spec.name.clone(),
         tree: model,
         cuts,
         independent,
         springs,
     };
+    close_at_home(spec, &mut closed, diags);
     check_spring_lengths(spec, &closed, diags);
     if diags.has_errors() {
         return None;
@@ -330,25 +331,56 @@ fn check_spring_lengths(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnosti
     }
 }
 
-/// `{ xyz = […], rpy = […] }` of a transform (fixed-axis X-Y-Z angles, `R = Rz Ry Rx`), to 12
-/// significant digits; `rpy` left out when it is zero.
-fn xyz_rpy(t: &runtime::model::Transform) -> String {
-    let m = &t.rotation;
-    let rpy = [
-        m[2][1].atan2(m[2][2]),
-        (-m[2][0]).atan2(m[0][0].hypot(m[1][0])),
-        m[1][0].atan2(m[0][0]),
-    ];
-    let num = |v: f64| {
-        let v = if v.abs() < 1e-15 { 0.0 } else { v };
-        let s = format!("{v:.12e}").parse::<f64>().unwrap_or(v);
-        format!("{s:?}")
-    };
-    let list = |v: &[f64; 3]| format!("[{}, {}, {}]", num(v[0]), num(v[1]), num(v[2]));
-    if rpy.iter().all(|a| a.abs() < 1e-15) {
-        format!("{{ xyz = {} }}", list(&t.translation))
-    } else {
-        format!("{{ xyz = {}, rpy = {} }}", list(&t.translation), list(&rpy))
+/// Loops that miss closing at home by little (rounded numbers: at most
+/// [`HOME_CORRECTION`](runtime::closed::HOME_CORRECTION) × the size, and
+/// [`HOME_CORRECTION_ANGLE`](runtime::closed::HOME_CORRECTION_ANGLE) for a revolute cut's
+/// axis) are closed by moving the cut's frame on its child side, each with a warning that
+/// gives the `child_origin` used (`codegen fix-home` writes it into the spec). Larger gaps are
+/// left to [`check_plan`]'s error.
+fn close_at_home(spec: &Spec, closed: &mut ClosedModel, diags: &mut Diagnostics) {
+    let bound = runtime::closed::HOME_CORRECTION * closed.size();
+    for _ in 0..closed.cuts.len() {
+        let Some((k, fix)) = closed.open_cut() else {
+            return;
+        };
+        let t = &fix.translation;
+        let gap = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+        let r = &fix.rotation;
+        let turn = ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0)
+            .clamp(-1.0, 1.0)
+            .acos();
+        let cut = &closed.cuts[k];
+        let Some(j) = spec.joints.iter().find(|j| j.name == cut.name) else {
+            return;
+        };
+        if gap > bound || turn > runtime::closed::HOME_CORRECTION_ANGLE || gap.is_nan() {
+            return;
+        }
+        let now = j
+            .child_origin
+            .unwrap_or(runtime::model::Transform::IDENTITY);
+        let to = now.compose(&fix);
+        let what = if turn > 0.0 {
+            format!("{gap:.2e} m and {:.2e}°", turn.to_degrees())
+        } else {
+            format!("{gap:.2e} m")
+        };
+        let value = super::geom::xyz_rpy(&to);
+        diags.push(
+            Diagnostic::warning(format!(
+                "the loop through joint \"{}\" is {what} open at home; it is closed by moving the joint's frame on its child side to `child_origin = {value}`",
+                j.name,
+            ))
+            .with_fix("child_origin", value.clone())
+            .with_key(format!("{}.child_origin", j.key))
+            .with_span(j.child_origin_span.clone().or(j.span.clone()))
+            .with_hint(format!(
+                "gaps up to {:.0e} × the mechanism's size ({bound:.2e} m here) and 1° are closed so, as rounded numbers leave them; `codegen fix-home FILE` writes the corrected child_origin into the spec",
+                runtime::closed::HOME_CORRECTION
+            )),
+        );
+        let c = &mut closed.cuts[k];
+        c.frame_child = c.frame_child.compose(&fix);
     }
 }
 
@@ -369,7 +401,7 @@ fn check_plan(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) -> Opt
                 let to = now.compose(&fix);
                 format!(
                     "with every tree joint at zero, `child_origin = {}` closes this loop (if that is not the intended geometry, check the joint origins along the loop)",
-                    xyz_rpy(&to)
+                    super::geom::xyz_rpy(&to)
                 )
             }
             None => "the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)".to_string(),

@@ -247,3 +247,29 @@ pub(crate) fn num(x: f64) -> String {
     let r: f64 = format!("{x:.5e}").parse().unwrap_or(x);
     format!("{r}")
 }
+
+/// `{ xyz = […], rpy = […] }` of a transform (fixed-axis X-Y-Z angles, `R = Rz Ry Rx`), to 12
+/// significant digits; `rpy` left out when it is zero.
+pub(crate) fn xyz_rpy(t: &runtime::model::Transform) -> String {
+    let m = &t.rotation;
+    let rpy = [
+        m[2][1].atan2(m[2][2]),
+        (-m[2][0]).atan2(m[0][0].hypot(m[1][0])),
+        m[1][0].atan2(m[0][0]),
+    ];
+    let num = toml_num;
+    let list = |v: &[f64; 3]| format!("[{}, {}, {}]", num(v[0]), num(v[1]), num(v[2]));
+    if rpy.iter().all(|a| a.abs() < 1e-15) {
+        format!("{{ xyz = {} }}", list(&t.translation))
+    } else {
+        format!("{{ xyz = {}, rpy = {} }}", list(&t.translation), list(&rpy))
+    }
+}
+
+/// A number for a spec's text, to 13 significant digits (a TOML float: `0.0`, `1e-6`), with
+/// magnitudes below `1e-15` written as zero.
+pub(crate) fn toml_num(v: f64) -> String {
+    let v = if v.abs() < 1e-15 { 0.0 } else { v };
+    let s = format!("{v:.12e}").parse::<f64>().unwrap_or(v);
+    format!("{s:?}")
+}

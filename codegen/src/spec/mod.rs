@@ -12,6 +12,7 @@
 
 mod angle;
 mod closed;
+mod fix;
 mod function;
 mod geom;
 mod input;
@@ -33,6 +34,7 @@ use runtime::parallel::ParallelModel;
 
 use crate::diag::{Diagnostic, Diagnostics};
 
+pub use fix::apply_fixes;
 pub use function::{Function, FunctionSet, Kind};
 pub use input::{
     MAX_DOF, MAX_ENTRIES, MAX_MAGNITUDE, MAX_NAME_LEN, MAX_SNAP, MAX_SOURCE_BYTES,

@@ -38,7 +38,8 @@ use mobility::check_mobility;
 use platform::{assemble, check_platform, on_platform};
 use screws::check_declared_motion;
 use validate::{
-    check_orientation_axes, check_upu_axes, check_upu_legs, rank_check, runtime_checks,
+    check_orientation_axes, check_upu_axes, check_upu_legs, close_at_home, rank_check,
+    runtime_checks,
 };
 
 /// Validates a spec with a `[platform]` table and builds the parallel model. Errors and
@@ -118,9 +119,10 @@ fn lower_checked(
     }
 
     let legs = build_legs(&tree, &axes, &paths, motion, diags);
-    let pm = assemble(spec, ps, motion, pname, &on.parts, legs);
+    let mut pm = assemble(spec, ps, motion, pname, &on.parts, legs);
+    close_at_home(&tree, &mut pm, diags);
     check_orientation_axes(&tree, &pm, diags);
-    check_upu_legs(&tree, &axes, &pm, diags);
+    check_upu_legs(&tree, &axes, &mut pm, diags);
     // Each leg's type and geometry (the runtime's checks, which name the leg and the joint)
     // before the declared motion against the legs' (which names only the motions), then the
     // rank at home.

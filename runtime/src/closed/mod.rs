@@ -129,6 +129,13 @@ pub struct ClosedModel {
 
 /// Length tolerance of the closure check at home, relative to the mechanism's size.
 pub const HOME_TOLERANCE: f64 = 1e-9;
+/// The largest gap at home that the spec reader closes by itself (moving the loop-closing
+/// joint's frame on its child side, with a warning): this fraction of the mechanism's size
+/// (m), and [`HOME_CORRECTION_ANGLE`] for a revolute cut's axis. Values typed to four or five
+/// digits leave gaps far below it; a gap above it is an error (a wrong spec, not rounding).
+pub const HOME_CORRECTION: f64 = 1e-3;
+/// The largest turn (rad, 1°) of a revolute cut's axis that the spec reader closes by itself.
+pub const HOME_CORRECTION_ANGLE: f64 = 0.017453292519943295;
 
 impl ClosedModel {
     /// Position coordinates (tree joints).

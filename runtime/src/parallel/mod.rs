@@ -294,6 +294,64 @@ impl ParallelModel {
     }
 }
 
+impl ParallelModel {
+    /// The first leg whose loop does not close at home within [`GEOMETRY_TOLERANCE`] × the
+    /// size, with the end that closes it: the platform-side point (or axis) moved to where
+    /// the leg ends. `None` when every leg closes.
+    pub fn open_leg(&self) -> Option<(usize, LegEnd)> {
+        let tol = GEOMETRY_TOLERANCE * self.size();
+        self.legs.iter().enumerate().find_map(|(k, leg)| {
+            let last = leg_home_poses(leg)
+                .last()
+                .copied()
+                .unwrap_or(Transform::IDENTITY);
+            let rt = |v: &Vec3| -> Vec3 {
+                let r = &self.home.rotation;
+                [
+                    r[0][0] * v[0] + r[1][0] * v[1] + r[2][0] * v[2],
+                    r[0][1] * v[0] + r[1][1] * v[1] + r[2][1] * v[2],
+                    r[0][2] * v[0] + r[1][2] * v[1] + r[2][2] * v[2],
+                ]
+            };
+            match leg.end {
+                LegEnd::Spherical {
+                    on_leg,
+                    on_platform,
+                } => {
+                    let a = last.apply(&on_leg);
+                    let b = self.home.apply(&on_platform);
+                    (norm(&sub(&a, &b)) > tol).then(|| {
+                        let at = rt(&sub(&a, &self.home.translation));
+                        (
+                            k,
+                            LegEnd::Spherical {
+                                on_leg,
+                                on_platform: at,
+                            },
+                        )
+                    })
+                }
+                LegEnd::Revolute {
+                    on_leg,
+                    on_platform,
+                } => {
+                    let a = mat_vec(&last.rotation, &on_leg);
+                    let b = mat_vec(&self.home.rotation, &on_platform);
+                    (norm(&sub(&a, &b)) > 1e-9).then(|| {
+                        (
+                            k,
+                            LegEnd::Revolute {
+                                on_leg,
+                                on_platform: rt(&a),
+                            },
+                        )
+                    })
+                }
+            }
+        })
+    }
+}
+
 /// Poses (base frame) of the leg's bodies at home, joints at zero.
 pub fn leg_home_poses(leg: &Leg) -> Vec<Transform> {
     let mut out: Vec<Transform> = Vec::with_capacity(leg.joints.len());

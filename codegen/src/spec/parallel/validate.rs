@@ -111,11 +111,12 @@ fn sub(a: &Vec3, b: &Vec3) -> Vec3 {
 pub(super) fn check_upu_legs(
     tree: &Tree<'_>,
     axes: &Axes,
-    pm: &ParallelModel,
+    pm: &mut ParallelModel,
     diags: &mut Diagnostics,
 ) {
     let tol = GEOMETRY_TOLERANCE * pm.size();
-    for (leg, c, _) in upu_legs(tree, axes, pm) {
+    let before = pm.clone();
+    for (leg, c, _) in upu_legs(tree, axes, &before) {
         let j = &tree.spec.joints[c];
         let poses = runtime::parallel::leg_home_poses(leg);
         if leg.joints.len() != 3 || poses.len() != 3 {
@@ -167,7 +168,33 @@ pub(super) fn check_upu_legs(
         let tip = poses[2];
         let top = tip.apply(&tree.frame_in_tip(c).translation);
         let off = geom::norm(&geom::cross(&sub(&top, &centre), &ax[2].0));
-        if off > tol {
+        if off > tol && off <= runtime::closed::HOME_CORRECTION * pm.size() {
+            // Rounded numbers: the prismatic axis is turned onto the line of the U centres
+            // (a turn of about `off` / the leg's length), so that the leg is the UPS leg it
+            // was meant to be.
+            let along = unit(&sub(&top, &centre));
+            let k = before.legs.iter().position(|l| std::ptr::eq(l, leg));
+            if let Some(k) = k {
+                let r = &poses[2].rotation;
+                pm.legs[k].joints[2].axis = std::array::from_fn(|i| {
+                    r[0][i] * along[0] + r[1][i] * along[1] + r[2][i] * along[2]
+                });
+            }
+            diags.push(
+                Diagnostic::warning(format!(
+                    "leg \"{}\": its prismatic joint \"{}\" runs {} m off the line from the base U's centre to the platform U's centre at home; its axis is taken along that line",
+                    j.name,
+                    base_word(2),
+                    geom::num(off)
+                ))
+                .with_key(j.key.clone())
+                .with_span(j.span.clone())
+                .with_hint(format!(
+                    "offsets up to {:.0e} × the mechanism's size are corrected so, as rounded numbers leave them; point the prismatic joint's axis at the platform U's centre to silence this",
+                    runtime::closed::HOME_CORRECTION
+                )),
+            );
+        } else if off > tol {
             diags.push(
                 Diagnostic::error(format!(
                     "leg \"{}\": its prismatic joint \"{}\" does not run along the line from the base U's centre to the platform U's centre (off by {} m at home)",
@@ -300,4 +327,87 @@ fn validate_diagnostic(
         Some(j) => d.with_key(j.key.clone()).with_span(j.span.clone()),
         None => d.with_key("platform").with_span(ps.span.clone()),
     }
+}
+
+/// Legs that miss closing at home by little (rounded numbers: at most
+/// [`HOME_CORRECTION`](runtime::closed::HOME_CORRECTION) × the size, and 1° for a revolute
+/// end's axis) are closed by moving the joint's point (or axis) on the platform to where the
+/// leg ends, each with a warning that gives the `child_origin` used (`codegen fix-home`
+/// writes it into the spec). Larger gaps are left to [`runtime_checks`]' error.
+pub(super) fn close_at_home(tree: &Tree<'_>, pm: &mut ParallelModel, diags: &mut Diagnostics) {
+    let bound = runtime::closed::HOME_CORRECTION * pm.size();
+    for _ in 0..pm.legs.len() {
+        let Some((k, end)) = pm.open_leg() else {
+            return;
+        };
+        let Some(j) = tree.closing.get(k).map(|&c| &tree.spec.joints[c]) else {
+            return;
+        };
+        let now = j.child_origin.unwrap_or(Transform::IDENTITY);
+        let (gap, to, what) = match (pm.legs[k].end, end) {
+            (
+                LegEnd::Spherical { on_platform: a, .. },
+                LegEnd::Spherical { on_platform: b, .. },
+            ) => {
+                let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let gap = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let t = &now.translation;
+                let to = Transform {
+                    rotation: now.rotation,
+                    translation: [t[0] + d[0], t[1] + d[1], t[2] + d[2]],
+                };
+                (gap, to, format!("{gap:.2e} m"))
+            }
+            (LegEnd::Revolute { on_platform: a, .. }, LegEnd::Revolute { on_platform: b, .. }) => {
+                let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).clamp(-1.0, 1.0);
+                let turn = c.acos();
+                let gap = 0.0;
+                let to = Transform {
+                    rotation: mat_mul(&turning(&a, &b), &now.rotation),
+                    translation: now.translation,
+                };
+                if turn > runtime::closed::HOME_CORRECTION_ANGLE || turn.is_nan() {
+                    return;
+                }
+                (gap, to, format!("{:.2e}°", turn.to_degrees()))
+            }
+            _ => return,
+        };
+        if gap > bound || gap.is_nan() {
+            return;
+        }
+        let value = crate::spec::geom::xyz_rpy(&to);
+        diags.push(
+            Diagnostic::warning(format!(
+                "leg {}'s loop is {what} open at home; it is closed by moving the joint's frame on the platform to `child_origin = {value}`",
+                pm.legs[k].name,
+            ))
+            .with_fix("child_origin", value.clone())
+            .with_key(format!("{}.child_origin", j.key))
+            .with_span(j.child_origin_span.clone().or(j.span.clone()))
+            .with_hint(format!(
+                "gaps up to {:.0e} × the mechanism's size ({bound:.2e} m here) and 1° are closed so, as rounded numbers leave them; `codegen fix-home FILE` writes the corrected child_origin into the spec",
+                runtime::closed::HOME_CORRECTION
+            )),
+        );
+        pm.legs[k].end = end;
+    }
+}
+
+/// The rotation about `a × b` that turns the unit `a` onto the unit `b` (Rodrigues; the
+/// identity when they are parallel: the turns closed here are small).
+fn turning(a: &Vec3, b: &Vec3) -> runtime::model::Mat3 {
+    let k = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    let c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let ss = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+    let f = if ss > 0.0 { (1.0 - c) / ss } else { 0.0 };
+    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+    let kx2 = mat_mul(&kx, &kx);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| f64::from(u8::from(i == j)) + kx[i][j] + f * kx2[i][j])
+    })
 }

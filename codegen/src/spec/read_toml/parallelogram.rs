@@ -20,6 +20,7 @@ use toml::de::DeTable;
 
 use super::keys::PARALLELOGRAM_KEYS;
 use super::{Reader, Val, get};
+use crate::diag::Diagnostic;
 use crate::spec::geom::{self, compose};
 use crate::spec::ir::{
     AxisSpec, BodySpec, Coordinates, DriveSpec, JointSpec, Kind, Placement, Spec,
@@ -247,7 +248,29 @@ impl Reader<'_> {
         let p = ps.home.apply(&pg.platform_point);
         let d = [p[0] - e[0], p[1] - e[1], p[2] - e[2]];
         let dist = geom::norm(&d);
-        if (dist - pg.length).abs() > TOLERANCE * w.max(dist) {
+        let mismatch = (dist - pg.length).abs();
+        if mismatch > TOLERANCE * w.max(dist)
+            && mismatch <= runtime::closed::HOME_CORRECTION * w.max(dist)
+        {
+            // Rounded numbers: the home geometry decides (the rods run from the elbow point to
+            // the platform point; `length` is only checked).
+            self.diags.push(
+                Diagnostic::warning(format!(
+                    "the rods are {} m long, but at home the elbow point and the platform point are {} m apart: the rods are taken as {} m, the home geometry",
+                    geom::num(pg.length),
+                    geom::num(dist),
+                    geom::num(dist)
+                ))
+                .with_key(key("length"))
+                .with_span(pg.length_span.clone())
+                .with_fix("length", geom::toml_num(dist))
+                .with_hint(format!(
+                    "differences up to {:.0e} × the parallelogram's size are accepted so, as rounded numbers leave them; write length = {} to silence this (`codegen fix-home FILE` does)",
+                    runtime::closed::HOME_CORRECTION,
+                    geom::num(dist)
+                )),
+            );
+        } else if mismatch > TOLERANCE * w.max(dist) {
             self.err(
                 format!(
                     "the rods are {} m long, but at home the elbow point and the platform point are {} m apart",
