@@ -16,13 +16,17 @@
 //! # Arguments
 //!
 //! ```text
-//! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"])
+//! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"]
+//!            [, implement = "P"] [, friction = true] [, rotor_inertia = true] [, snap = 1e-4])
 //! ```
 //!
 //! - The path is relative to the calling crate's `CARGO_MANIFEST_DIR` (its `Cargo.toml`
 //!   directory), not to the source file; an absolute path is used as it is.
 //! - `math` (default `"libm"`) is the CLI's `--math`: where `sin_cos` and `sqrt` come from.
 //! - `float` (default `"f64"`) is the CLI's `--float`: the scalar type of the generated code.
+//! - `implement`, `friction`, `rotor_inertia` and `snap` are the CLI's `--implement` (with its
+//!   `--runtime-path`: the runtime crate's path as the calling crate names it), `--friction`,
+//!   `--rotor-inertia` and `--snap TOL` (and `Builder`'s methods of the same names).
 //!   - `"libm"`: the calling crate needs the `libm` crate as a dependency (`libm = "0.2"`); the
 //!     code is `no_std`.
 //!   - `"std"`: `f64::sin_cos` from std.
@@ -87,7 +91,7 @@ use codegen::{Config, MathBackend, macro_support};
 use proc_macro2::TokenStream;
 use quote::quote;
 use syn::parse::{Parse, ParseStream};
-use syn::{Error, Ident, LitStr, Token};
+use syn::{Error, Ident, Lit, LitBool, LitStr, Token};
 
 /// Expands to the items of the generated dynamics module of a mechanism spec; see the crate
 /// docs.
@@ -98,13 +102,20 @@ pub fn mechanism(input: proc_macro::TokenStream) -> proc_macro::TokenStream {
         .into()
 }
 
-/// `"spec" [, key = "value"]*`.
+/// `"spec" [, key = value]*`.
 struct Args {
     spec: LitStr,
     math: Option<LitStr>,
     runtime_path: Option<LitStr>,
     float: Option<LitStr>,
+    implement: Option<LitStr>,
+    friction: Option<LitBool>,
+    rotor_inertia: Option<LitBool>,
+    snap: Option<Lit>,
 }
+
+/// The options and the kind of literal each takes.
+const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement` (strings), `friction`, `rotor_inertia` (`true` or `false`) or `snap` (a number)";
 
 impl Parse for Args {
     fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
@@ -114,6 +125,10 @@ impl Parse for Args {
             math: None,
             runtime_path: None,
             float: None,
+            implement: None,
+            friction: None,
+            rotor_inertia: None,
+            snap: None,
         };
         while !input.is_empty() {
             input.parse::<Token![,]>()?;
@@ -122,24 +137,48 @@ impl Parse for Args {
             }
             let key: Ident = input.parse()?;
             input.parse::<Token![=]>()?;
-            let value: LitStr = input.parse()?;
-            let slot = match key.to_string().as_str() {
-                "math" => &mut args.math,
-                "runtime_path" => &mut args.runtime_path,
-                "float" => &mut args.float,
-                other => {
+            let value: Lit = input.parse()?;
+            let twice = || Error::new(key.span(), format!("`{key}` is given twice"));
+            let wrong = |what: &str| Error::new(value.span(), format!("`{key}` takes {what}"));
+            match (key.to_string().as_str(), &value) {
+                (name @ ("math" | "runtime_path" | "float" | "implement"), Lit::Str(v)) => {
+                    let slot = match name {
+                        "math" => &mut args.math,
+                        "runtime_path" => &mut args.runtime_path,
+                        "float" => &mut args.float,
+                        _ => &mut args.implement,
+                    };
+                    if slot.replace(v.clone()).is_some() {
+                        return Err(twice());
+                    }
+                }
+                ("math" | "runtime_path" | "float" | "implement", _) => {
+                    return Err(wrong("a string"));
+                }
+                (name @ ("friction" | "rotor_inertia"), Lit::Bool(v)) => {
+                    let slot = if name == "friction" {
+                        &mut args.friction
+                    } else {
+                        &mut args.rotor_inertia
+                    };
+                    if slot.replace(v.clone()).is_some() {
+                        return Err(twice());
+                    }
+                }
+                ("friction" | "rotor_inertia", _) => return Err(wrong("`true` or `false`")),
+                ("snap", Lit::Float(_) | Lit::Int(_)) => {
+                    if args.snap.replace(value.clone()).is_some() {
+                        return Err(twice());
+                    }
+                }
+                ("snap", _) => return Err(wrong("a number (the tolerance)")),
+                (other, _) => {
                     return Err(Error::new(
                         key.span(),
-                        format!(
-                            "unknown option `{other}`: expected `math`, `runtime_path` or `float`"
-                        ),
+                        format!("unknown option `{other}`: expected {OPTIONS}"),
                     ));
                 }
-            };
-            if slot.is_some() {
-                return Err(Error::new(key.span(), format!("`{key}` is given twice")));
             }
-            *slot = Some(value);
         }
         Ok(args)
     }
@@ -190,11 +229,42 @@ impl Args {
                 }
             },
         };
+        let mut snap = None;
+        if let Some(lit) = &self.snap {
+            let tol: f64 = match lit {
+                Lit::Float(f) => f.base10_parse()?,
+                Lit::Int(i) => i.base10_parse::<u64>()? as f64,
+                _ => unreachable!("checked when parsed"),
+            };
+            if !codegen::spec::is_snap_tolerance(tol) {
+                return Err(Error::new(
+                    lit.span(),
+                    format!(
+                        "the snap tolerance must be in (0, {}] (as `[scene] snap`)",
+                        codegen::spec::MAX_SNAP
+                    ),
+                ));
+            }
+            snap = Some(tol);
+        }
+        let scene = codegen::spec::SceneOverrides {
+            friction: self.friction.as_ref().is_some_and(LitBool::value),
+            rotor_inertia: self.rotor_inertia.as_ref().is_some_and(LitBool::value),
+            snap,
+        };
+        if let Some(p) = &self.implement
+            && syn::parse_str::<syn::Path>(&p.value()).is_err()
+        {
+            return Err(Error::new(
+                p.span(),
+                "`implement` takes the runtime crate's path (e.g. \"runtime\")",
+            ));
+        }
         Ok(Config {
             math,
             float,
-            scene: Default::default(),
-            implement: None,
+            scene,
+            implement: self.implement.as_ref().map(LitStr::value),
         })
     }
 }
@@ -252,6 +322,36 @@ mod tests {
     }
 
     #[test]
+    fn scene_options_map_to_the_cli_flags() {
+        let cfg = parse(quote!(
+            "a.urdf",
+            friction = true,
+            rotor_inertia = true,
+            snap = 1e-4,
+            implement = "runtime"
+        ))
+        .and_then(|a| a.config())
+        .unwrap();
+        assert!(cfg.scene.friction && cfg.scene.rotor_inertia);
+        assert_eq!(cfg.scene.snap, Some(1e-4));
+        assert_eq!(cfg.implement.as_deref(), Some("runtime"));
+        let off = parse(quote!("a.toml", friction = false))
+            .and_then(|a| a.config())
+            .unwrap();
+        assert!(!off.scene.friction && off.scene.snap.is_none() && off.implement.is_none());
+        let err = |t: TokenStream| match parse(t).and_then(|a| a.config()) {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err(quote!("a.toml", friction = "yes")).contains("`true` or `false`"));
+        assert!(err(quote!("a.toml", snap = 0.5)).contains("snap tolerance"));
+        assert!(err(quote!("a.toml", snap = "1e-4")).contains("a number"));
+        assert!(err(quote!("a.toml", implement = "not a path")).contains("runtime crate's path"));
+        assert!(err(quote!("a.toml", snap = 1e-4, snap = 1e-5)).contains("twice"));
+        assert!(err(quote!("a.toml", speed = 1)).contains("unknown option"));
+    }
+
+    #[test]
     fn options_map_to_the_cli_backends() {
         assert_eq!(math(quote!("a.toml")), Ok(MathBackend::Libm));
         assert_eq!(math(quote!("a.toml",)), Ok(MathBackend::Libm));
@@ -293,7 +393,7 @@ mod tests {
                 quote!("a.toml", math = "std", math = "std"),
                 "`math` is given twice",
             ),
-            (quote!("a.toml", math = std), "expected string literal"),
+            (quote!("a.toml", math = std), "expected literal"),
             (
                 quote!("a.toml", runtime_path = "rt"),
                 "needs `math = \"runtime\"`",
