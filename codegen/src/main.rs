@@ -215,6 +215,11 @@ fn main() -> ExitCode {
     if !out.warnings.is_empty() {
         eprint!("{}", out.warnings.render());
     }
+    if cli.snap.is_none()
+        && let Some(note) = snap_note(&name, &source, &cfg_for_snap(&cli), &out)
+    {
+        eprintln!("{note}");
+    }
     // The table goes to stderr: the module always goes where it would without `--stats`.
     if cli.stats {
         eprintln!("{}", out.stats_table().join("\n"));
@@ -230,6 +235,65 @@ fn main() -> ExitCode {
         None => out!("{text}"),
     }
     ExitCode::SUCCESS
+}
+
+/// The tolerance `snap_note` tries: four or five digits, as published files round π/2.
+const SUGGESTED_SNAP: f64 = 1e-4;
+
+/// The generation options of `cli` with `--snap` at [`SUGGESTED_SNAP`].
+fn cfg_for_snap(cli: &Cli) -> Config {
+    Config {
+        math: MathBackend::Libm,
+        float: match cli.float {
+            FloatArg::F64 => codegen::Float::F64,
+            FloatArg::F32 => codegen::Float::F32,
+        },
+        scene: codegen::spec::SceneOverrides {
+            friction: cli.friction,
+            rotor_inertia: cli.rotor_inertia,
+            snap: Some(SUGGESTED_SNAP),
+        },
+        implement: None,
+    }
+}
+
+/// A note when the spec has angles or offsets within [`SUGGESTED_SNAP`] of exact values that
+/// it does not snap (a URDF's `1.5708`), with the flops `--snap` would save; `None` when
+/// snapping changes nothing (the spec is loaded first: generating again only then).
+fn snap_note(
+    name: &str,
+    source: &str,
+    snapped: &Config,
+    out: &codegen::Generated,
+) -> Option<String> {
+    let plain = codegen::spec::load(
+        name,
+        source,
+        &codegen::spec::SceneOverrides {
+            snap: None,
+            ..snapped.scene
+        },
+    )
+    .ok()?;
+    let with = codegen::spec::load(name, source, &snapped.scene).ok()?;
+    let changes = with.warnings.len().saturating_sub(plain.warnings.len());
+    if changes == 0 {
+        return None;
+    }
+    let g = codegen::compile(name, source, snapped).ok()?;
+    let (f, before) = out
+        .stats
+        .iter()
+        .find(|(n, _)| n == "inverse_dynamics")
+        .or_else(|| out.stats.first())?;
+    let after = g.stats.iter().find(|(n, _)| n == f)?.1.flops();
+    let before = before.flops();
+    (after < before).then(|| {
+        format!(
+            "note: {changes} value{} within {SUGGESTED_SNAP:e} of exact angles or offsets (as published files round π/2); `--snap {SUGGESTED_SNAP:e}` takes them as exact, with a warning for each: {f} {before} → {after} flops (docs/scene.md, \"Snapping\")",
+            if changes == 1 { " is" } else { "s are" }
+        )
+    })
 }
 
 /// Write `args` (and a newline) to standard output; see `out!`.

@@ -658,3 +658,44 @@ fn a_reader_that_stops_early_is_not_a_crash() {
     assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
     assert!(stderr(&o).is_empty(), "stderr: {}", stderr(&o));
 }
+
+/// A URDF with its quarter turns rounded to five digits (as published files write them) gets
+/// a note with the flops `--snap` would save; the exact file, `--snap` itself and a TOML spec
+/// without such values get none. The module is the same with or without the note.
+#[cfg(feature = "urdf")]
+#[test]
+fn rounded_angles_get_a_snap_note() {
+    let dir = scratch("snap_note");
+    let exact = std::fs::read_to_string("../mechanisms/specs/iiwa14.urdf").unwrap();
+    let rounded = exact
+        .replace("1.5707963267948966", "1.5708")
+        .replace("3.141592653589793", "3.1416");
+    assert_ne!(exact, rounded);
+    let file = dir.join("iiwa_rounded.urdf");
+    std::fs::write(&file, &rounded).unwrap();
+    let o = run(&[path_str(&file)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let note = stderr(&o);
+    assert!(
+        note.contains("note:") && note.contains("--snap 1e-4") && note.contains("inverse_dynamics"),
+        "{note}"
+    );
+    // The saving is real: the numbers in the note fall.
+    let flops: Vec<usize> = note
+        .split("inverse_dynamics ")
+        .nth(1)
+        .unwrap()
+        .split(" flops")
+        .next()
+        .unwrap()
+        .split(" → ")
+        .map(|n| n.parse().unwrap())
+        .collect();
+    assert!(flops[1] < flops[0], "{note}");
+    let snapped = run(&[path_str(&file), "--snap", "1e-4"]);
+    assert!(!stderr(&snapped).contains("note:"));
+    for quiet in ["../mechanisms/specs/iiwa14.urdf", PUMA] {
+        let o = run(&[quiet]);
+        assert!(!stderr(&o).contains("note:"), "{quiet}: {}", stderr(&o));
+    }
+}
