@@ -123,6 +123,9 @@ enum Command {
     /// Write the corrections made at home (loops left a little open by rounded numbers) into
     /// the spec.
     FixHome(cli::fix_home::FixHomeArgs),
+    /// A URDF as a TOML spec that generates the same module (for a `[scene]`, `reduce`, …).
+    #[cfg(feature = "urdf")]
+    Convert(cli::convert::ConvertArgs),
 }
 
 fn main() -> ExitCode {
@@ -132,6 +135,8 @@ fn main() -> ExitCode {
         Some(Command::Isotropy(args)) => return cli::isotropy::run(&args),
         Some(Command::Reduce(args)) => return cli::reduce::run(&args),
         Some(Command::FixHome(args)) => return cli::fix_home::run(&args),
+        #[cfg(feature = "urdf")]
+        Some(Command::Convert(args)) => return cli::convert::run(&args),
         None => {}
     }
     // `required = true` makes clap reject a missing spec when there is no subcommand.

@@ -9,6 +9,8 @@
 //! * closed loops: the inertia of the independent joints, assembled on the home branch. Where the runtime returns
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
+#[cfg(feature = "urdf")]
+pub mod convert;
 pub mod design;
 pub mod fix_home;
 pub mod isotropy;

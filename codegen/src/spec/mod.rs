@@ -362,6 +362,19 @@ fn other_xml(root: &str, span: std::ops::Range<usize>) -> Diagnostic {
     Diagnostic::error(what).with_span(span).with_hint(hint)
 }
 
+/// A URDF as a TOML spec that generates the same module, number for number (`codegen
+/// convert`), with the URDF's warnings. The URDF is loaded first: an invalid one is its
+/// diagnostics.
+#[cfg(feature = "urdf")]
+pub fn urdf_to_toml(file_name: &str, source: &str) -> Result<(String, Diagnostics), Diagnostics> {
+    let (_, warnings) = load_mechanism(file_name, source)?;
+    let mut d = Diagnostics::new(file_name, source);
+    match urdf::to_toml(source, &mut d) {
+        Some(text) if !d.has_errors() => Ok((text, warnings)),
+        _ => Err(d),
+    }
+}
+
 fn is_urdf(file_name: &str) -> bool {
     file_name.to_ascii_lowercase().ends_with(".urdf")
 }

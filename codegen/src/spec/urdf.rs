@@ -28,6 +28,132 @@ use xml::{Doc, Tag, scan, strip_ignored};
 
 /// Reads a URDF document.
 pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
+    read_robot(source, diags).map(|(_, _, spec)| spec)
+}
+
+/// A URDF document as a TOML spec that generates the same module (`codegen convert`): the
+/// links and joints in the order the reader takes them, every number as the URDF writes it
+/// (origins as `xyz` and `rpy`, the inertia in its `<inertial>` frame with `inertia_rpy`), so
+/// that the TOML reader builds the same model, bit for bit. Limits are not part of either
+/// model; a `<mimic>` is kept as a comment.
+pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
+    use std::fmt::Write;
+    let (r, names, spec) = read_robot(source, diags)?;
+    // TOML names are identifiers (ASCII letters, digits, `_`, not starting with a digit); a
+    // URDF name that is not becomes one, kept unique, with its URDF name in a comment.
+    let mut taken: Vec<String> = Vec::new();
+    let mut renamed: std::collections::HashMap<String, String> = Default::default();
+    let mut ident = |name: &str| -> String {
+        if let Some(v) = renamed.get(name) {
+            return v.clone();
+        }
+        let mut t: String = name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+            .collect();
+        if t.is_empty() || t.starts_with(|c: char| c.is_ascii_digit()) {
+            t.insert(0, '_');
+        }
+        while taken.contains(&t) {
+            t.push('_');
+        }
+        taken.push(t.clone());
+        renamed.insert(name.to_string(), t.clone());
+        t
+    };
+    let was = |old: &str, new: &str| {
+        if old == new {
+            String::new()
+        } else {
+            format!("  # URDF name {old:?}")
+        }
+    };
+    let n = |v: f64| format!("{v:?}");
+    let v3 = |v: &[f64; 3]| format!("[{}, {}, {}]", n(v[0]), n(v[1]), n(v[2]));
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# Converted from the URDF robot \"{}\" by `codegen convert`: the same model, number for\n# number. Joint limits are not part of nocdyn's model. Add a [scene] table for payloads,\n# locked joints, point masses or run-time parameters (docs/spec.md, docs/scene.md).\n",
+        r.name
+    );
+    let _ = writeln!(out, "[mechanism]");
+    let _ = writeln!(out, "name = {:?}", spec.name);
+    let _ = writeln!(out, "gravity = {}", v3(&spec.gravity));
+    let _ = writeln!(
+        out,
+        "source = {:?}",
+        format!("URDF robot \"{}\", converted by codegen convert", r.name)
+    );
+    for l in r
+        .links
+        .iter()
+        .filter(|l| Some(&l.name) != names.root.as_ref())
+    {
+        let inl = &l.inertial;
+        let it = &inl.inertia;
+        let _ = writeln!(out, "\n[[body]]");
+        let body = names.rename(&l.name);
+        let id = ident(&body);
+        let _ = writeln!(out, "name = {id:?}{}", was(&body, &id));
+        let _ = writeln!(out, "mass = {}", n(inl.mass.value));
+        let _ = writeln!(out, "com = {}", v3(&inl.origin.xyz.0));
+        let _ = writeln!(
+            out,
+            "inertia = {{ ixx = {}, iyy = {}, izz = {}, ixy = {}, ixz = {}, iyz = {} }}",
+            n(it.ixx),
+            n(it.iyy),
+            n(it.izz),
+            n(it.ixy),
+            n(it.ixz),
+            n(it.iyz)
+        );
+        if inl.origin.rpy.0 != [0.0; 3] {
+            let _ = writeln!(out, "inertia_rpy = {}", v3(&inl.origin.rpy.0));
+        }
+    }
+    for js in &spec.joints {
+        let Some(j) = r.joints.iter().find(|j| j.name == js.name) else {
+            continue;
+        };
+        let _ = writeln!(out, "\n[[joint]]");
+        let id = ident(&js.name);
+        let _ = writeln!(out, "name = {id:?}{}", was(&js.name, &id));
+        let _ = writeln!(out, "kind = {:?}", js.kind.word());
+        let parent = if js.parent == BASE { BASE.to_string() } else { ident(&js.parent) };
+        let _ = writeln!(out, "parent = {parent:?}");
+        let _ = writeln!(out, "child = {:?}", ident(&js.child));
+        let _ = writeln!(
+            out,
+            "origin = {{ xyz = {}, rpy = {} }}",
+            v3(&j.origin.xyz.0),
+            v3(&j.origin.rpy.0)
+        );
+        if js.kind != Kind::Fixed {
+            let _ = writeln!(out, "axis = {}", v3(&j.axis.xyz.0));
+        }
+        if let Some(d) = &j.dynamics {
+            if d.damping > 0.0 {
+                let _ = writeln!(out, "damping = {}", n(d.damping));
+            }
+            if d.friction > 0.0 {
+                let _ = writeln!(out, "friction = {}", n(d.friction));
+            }
+        }
+        if let Some(m) = &j.mimic {
+            let _ = writeln!(
+                out,
+                "# mimics {:?} (multiplier {}, offset {}): read as an independent joint, as from the URDF",
+                m.joint,
+                m.multiplier.map_or("1".into(), n),
+                m.offset.map_or("0".into(), n)
+            );
+        }
+    }
+    Some(out)
+}
+
+/// The URDF document parsed (urdf-rs), the link names as read, and the spec.
+fn read_robot(source: &str, diags: &mut Diagnostics) -> Option<(urdf_rs::Robot, Names, Spec)> {
     let tags = scan(source, diags);
     if diags.has_errors() {
         return None;
@@ -61,7 +187,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
     let joints = joints(&r, &names, &joint_spans, diags)?;
     let joints = depth_first(joints);
 
-    Some(Spec {
+    let spec = Spec {
         name: sanitize_name(&r.name),
         gravity: [0.0, 0.0, -9.81],
         bodies,
@@ -73,7 +199,8 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         springs: Vec::new(),
         parallelograms: Vec::new(),
         parallelogram_widths: Vec::new(),
-    })
+    };
+    Some((r, names, spec))
 }
 
 /// The index of the top-level `<robot>` tag, else an error.
