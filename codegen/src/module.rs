@@ -80,6 +80,29 @@ pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStrea
             pub iterations: usize,
             #[doc = #residual]
             pub residual: #real,
+            /// Why it stopped: tells a `q` outside the workspace from a guess too far away.
+            pub stop: Stop,
+        }
+
+        /// Why forward kinematics stopped without converging.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Stop {
+            /// A non-finite `q` or guess.
+            Input,
+            /// The guess itself, with these actuated coordinates, cannot be evaluated (out of
+            /// reach, or singular): give a guess inside the workspace.
+            Guess,
+            /// The Jacobian became singular on the way: `q` is at or near the workspace's
+            /// boundary, or a singularity lies between the guess and `q`.
+            Singular,
+            /// No step reduces the residual any more: most likely `q` is outside the
+            /// workspace, or beyond a singularity seen from the guess.
+            Stalled,
+            /// The residual still fell at the iteration limit: a closer guess converges.
+            Iterations,
+            /// Closed loops: the kept loop equations hold but not all of them (a spurious
+            /// branch): give a guess on the intended assembly.
+            Branch,
         }
     }
 }

@@ -87,11 +87,19 @@ fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoCon
         x[INDEPENDENT[k]] = q[k];
     }
     let abs = |v: f64| if v < 0.0 { -v } else { v };
-    let Ok((mut dx, mut r, mut full)) = newton_step(&x) else {
-        return Err(NoConvergence {
-            iterations: 0,
-            residual: f64::INFINITY,
-        });
+    let (mut dx, mut r, mut full) = match newton_step(&x) {
+        Ok(s) => s,
+        Err(e) => {
+            return Err(NoConvergence {
+                iterations: 0,
+                residual: f64::INFINITY,
+                stop: if e.site == Site::Input {
+                    Stop::Input
+                } else {
+                    Stop::Guess
+                },
+            });
+        }
     };
     for it in 0..FK_MAX_ITERATIONS {
         if abs(r) <= FK_TOLERANCE {
@@ -100,6 +108,7 @@ fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoCon
                 return Err(NoConvergence {
                     iterations: it,
                     residual: abs(full),
+                    stop: Stop::Branch,
                 });
             }
             // One more full step: the coordinates to rounding.
@@ -141,11 +150,13 @@ fn newton_assembly(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX], NoCon
             return Err(NoConvergence {
                 iterations: it + 1,
                 residual: abs(r),
+                stop: Stop::Stalled,
             });
         }
     }
     Err(NoConvergence {
         iterations: FK_MAX_ITERATIONS,
         residual: abs(r),
+        stop: Stop::Iterations,
     })
 }

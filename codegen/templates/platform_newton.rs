@@ -47,6 +47,7 @@ pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX]
             return Err(NoConvergence {
                 iterations: 0,
                 residual: f64::INFINITY,
+                stop: Stop::Input,
             });
         }
     }
@@ -66,6 +67,7 @@ pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX]
         return Err(NoConvergence {
             iterations: 0,
             residual: f64::INFINITY,
+            stop: Stop::Guess,
         });
     };
     for it in 0..FK_MAX_ITERATIONS {
@@ -76,6 +78,7 @@ pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX]
             return Err(NoConvergence {
                 iterations: it,
                 residual: cur.1,
+                stop: Stop::Singular,
             });
         };
         let mut step = 1.0;
@@ -100,6 +103,7 @@ pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX]
             return Err(NoConvergence {
                 iterations: it + 1,
                 residual: cur.1,
+                stop: Stop::Stalled,
             });
         }
     }
@@ -109,6 +113,7 @@ pub fn forward_kinematics(q: &[f64; DOF], guess: &[f64; NX]) -> Result<[f64; NX]
         Err(NoConvergence {
             iterations: FK_MAX_ITERATIONS,
             residual: cur.1,
+            stop: Stop::Iterations,
         })
     }
 }

@@ -80,4 +80,29 @@ pub struct NoConvergence {
     pub iterations: usize,
     /// The last residual `max |q(x) − q|` (m or rad; infinite when no pose was reachable).
     pub residual: f64,
+    /// Why it stopped, which tells a `q` outside the workspace from a guess too far away.
+    pub stop: Stop,
+}
+
+/// Why forward kinematics stopped without converging.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stop {
+    /// A non-finite `q` or guess.
+    Input,
+    /// The guess itself, with these actuated coordinates, cannot be evaluated (a leg cannot
+    /// reach it, or it is singular): give a guess inside the workspace.
+    Guess,
+    /// The Jacobian of `q(x)` became singular on the way: `q` is at or near the workspace's
+    /// boundary or a singularity lies between the guess and `q`.
+    Singular,
+    /// No step along Newton's direction reduces the residual any more, though it is not zero:
+    /// most likely `q` is outside the workspace (no configuration has it), or beyond a
+    /// singularity seen from the guess.
+    Stalled,
+    /// The residual still fell at the iteration limit: Newton was on its way; a closer guess
+    /// (the last configuration of a trajectory) converges.
+    Iterations,
+    /// Closed loops: the kept loop equations hold but not all of them (a spurious branch of
+    /// the kept equations): give a guess on the intended assembly.
+    Branch,
 }

@@ -63,6 +63,14 @@ fn forward_kinematics_returns_at_once_for_bad_or_huge_targets() {
                 noc::forward_kinematics(&plan, &q, &g::HOME).map_err(|e| g::NoConvergence {
                     iterations: e.iterations,
                     residual: e.residual,
+                    stop: match e.stop {
+                        runtime::solve::Stop::Input => g::Stop::Input,
+                        runtime::solve::Stop::Guess => g::Stop::Guess,
+                        runtime::solve::Stop::Singular => g::Stop::Singular,
+                        runtime::solve::Stop::Stalled => g::Stop::Stalled,
+                        runtime::solve::Stop::Iterations => g::Stop::Iterations,
+                        runtime::solve::Stop::Branch => g::Stop::Branch,
+                    },
                 }),
             ),
         ] {
@@ -195,4 +203,48 @@ fn functions_that_invert_a_agree_on_the_verdict() {
         errs += usize::from(id.is_err());
     }
     assert!(errs > 0, "the walk met no singularity in {n} states");
+}
+
+/// `forward_kinematics` says why it stopped: a non-finite target is `Input`; a Gough–Stewart
+/// target with every leg 6 cm long (its base and platform joints lie on circles 0.9 m apart in
+/// radius: outside the workspace) ends without a step that helps (`Stalled`) or at a singular
+/// Jacobian (`Singular`), never `Iterations`;
+/// the five-bar in joint coordinates with its cranks opened beyond reach likewise; the same
+/// verdict from the runtime and the generated code.
+#[test]
+fn forward_kinematics_says_why_it_stopped() {
+    use mechanisms::gough_stewart as g;
+    use runtime::solve::Stop;
+    let plan = Plan::new(&model("gough_stewart")).unwrap();
+    let q0 = g::inverse_kinematics(&g::HOME).unwrap();
+    let e = g::forward_kinematics(&[f64::NAN; 6], &g::HOME).unwrap_err();
+    assert_eq!(e.stop, g::Stop::Input);
+    // The actuated coordinates are the legs' lengths less their home lengths (about 1.26 m).
+    let far = q0.map(|v| v - 1.2);
+    let generated = g::forward_kinematics(&far, &g::HOME).unwrap_err();
+    let run = noc::forward_kinematics(&plan, &far, &g::HOME).unwrap_err();
+    println!("Gough–Stewart, legs 6 cm long: generated {generated:?}, runtime {run:?}");
+    assert!(
+        matches!(generated.stop, g::Stop::Stalled | g::Stop::Singular),
+        "{generated:?}"
+    );
+    assert!(
+        matches!(run.stop, Stop::Stalled | Stop::Singular),
+        "{run:?}"
+    );
+    assert_eq!(format!("{:?}", generated.stop), format!("{:?}", run.stop));
+    // Closed loops: the five-bar's two cranks turned apart until its distal links cannot meet.
+    use mechanisms::five_bar_joints as f;
+    let cplan = runtime::closed::noc::Plan::new(&tests::closed::model("five_bar_joints")).unwrap();
+    let out = [2.5, -2.5];
+    let generated = f::forward_kinematics(&out, &f::HOME).unwrap_err();
+    let run = runtime::closed::noc::forward_kinematics(&cplan, &out, &f::HOME).unwrap_err();
+    println!("five-bar out of reach: generated {generated:?}, runtime {run:?}");
+    assert!(
+        matches!(generated.stop, f::Stop::Stalled | f::Stop::Guess),
+        "{generated:?}"
+    );
+    assert_eq!(format!("{:?}", generated.stop), format!("{:?}", run.stop));
+    let e = f::forward_kinematics(&[f64::INFINITY, 0.0], &f::HOME).unwrap_err();
+    assert_eq!(e.stop, f::Stop::Input);
 }

@@ -40,6 +40,17 @@ macro_rules! error_types {
         pub struct NoConvergence {
             pub iterations: usize,
             pub residual: f64,
+            pub stop: Stop,
+        }
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        #[allow(dead_code)]
+        pub enum Stop {
+            Input,
+            Guess,
+            Singular,
+            Stalled,
+            Iterations,
+            Branch,
         }
     };
 }

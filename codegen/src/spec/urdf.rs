@@ -49,7 +49,13 @@ pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
         }
         let mut t: String = name
             .chars()
-            .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
             .collect();
         if t.is_empty() || t.starts_with(|c: char| c.is_ascii_digit()) {
             t.insert(0, '_');
@@ -119,7 +125,11 @@ pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
         let id = ident(&js.name);
         let _ = writeln!(out, "name = {id:?}{}", was(&js.name, &id));
         let _ = writeln!(out, "kind = {:?}", js.kind.word());
-        let parent = if js.parent == BASE { BASE.to_string() } else { ident(&js.parent) };
+        let parent = if js.parent == BASE {
+            BASE.to_string()
+        } else {
+            ident(&js.parent)
+        };
         let _ = writeln!(out, "parent = {parent:?}");
         let _ = writeln!(out, "child = {:?}", ident(&js.child));
         let _ = writeln!(

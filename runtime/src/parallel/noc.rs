@@ -75,7 +75,7 @@ mod subproblems;
 mod ups;
 
 pub use crate::payload::Payload;
-pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, check_finite, solve_spd};
+pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, Stop, check_finite, solve_spd};
 
 pub use api::{
     actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics, friction,

@@ -9,8 +9,8 @@ use super::loop_equations::{alignment, row_value};
 use super::plan::{Plan, row_scale};
 use super::{FK_MAX_ITERATIONS, FK_MAX_STAGES, FK_STEP, FK_TOLERANCE, FULL_TOLERANCE};
 use crate::model::JointKind;
-use crate::scalar::{Real, Singular};
-use crate::solve::NoConvergence;
+use crate::scalar::{Real, Singular, Site};
+use crate::solve::{NoConvergence, Stop};
 
 /// One Newton step of the kept loop equations at `x` (the independent coordinates held; with
 /// spare rows, of those the LU's pivoting chose): the full step `Δx` (zero on the independent
@@ -127,18 +127,21 @@ pub fn newton_assembly(plan: &Plan, xi: &[f64], guess: &[f64]) -> Result<Vec<f64
     for (k, &j) in plan.independent.iter().enumerate() {
         x[j] = xi[k];
     }
-    let fail = |it, r: f64| NoConvergence {
+    let fail = |it, r: f64, stop| NoConvergence {
         iterations: it,
         residual: r,
+        stop,
     };
-    let Ok((mut dx, mut r, mut full)) = newton_step(plan, &x) else {
-        return Err(fail(0, f64::INFINITY));
+    let (mut dx, mut r, mut full) = match newton_step(plan, &x) {
+        Ok(s) => s,
+        Err(e) if e.site == Site::Input => return Err(fail(0, f64::INFINITY, Stop::Input)),
+        Err(_) => return Err(fail(0, f64::INFINITY, Stop::Guess)),
     };
     for it in 0..FK_MAX_ITERATIONS {
         if r.abs() <= FK_TOLERANCE {
             if !(full.abs() <= FULL_TOLERANCE) {
                 // The kept equations hold but not all of them: a spurious branch.
-                return Err(fail(it, full.abs()));
+                return Err(fail(it, full.abs(), Stop::Branch));
             }
             // One more full step (Newton converges quadratically): the coordinates to rounding.
             let xn: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
@@ -168,10 +171,10 @@ pub fn newton_assembly(plan: &Plan, xi: &[f64], guess: &[f64]) -> Result<Vec<f64
             step *= 0.5;
         }
         if !moved {
-            return Err(fail(it + 1, r.abs()));
+            return Err(fail(it + 1, r.abs(), Stop::Stalled));
         }
     }
-    Err(fail(FK_MAX_ITERATIONS, r.abs()))
+    Err(fail(FK_MAX_ITERATIONS, r.abs(), Stop::Iterations))
 }
 
 /// The dependent revolute coordinates of `x` moved by whole turns to within ±π of `guess`'s.

@@ -10,7 +10,7 @@ use super::lu::solve_dyn;
 use super::plan::Plan;
 use crate::model::JointKind;
 use crate::parallel::PlatformMotion;
-use crate::solve::{NoConvergence, check_finite};
+use crate::solve::{NoConvergence, Stop, check_finite};
 
 /// Newton iterations of [`forward_kinematics`] at most.
 pub const FK_MAX_ITERATIONS: usize = 50;
@@ -89,6 +89,7 @@ pub fn forward_kinematics(
         return Err(NoConvergence {
             iterations: 0,
             residual: f64::INFINITY,
+            stop: Stop::Input,
         });
     }
     let tol = FK_TOLERANCE * plan.fk_scale();
@@ -127,6 +128,7 @@ pub fn forward_kinematics(
         return Err(NoConvergence {
             iterations: 0,
             residual: f64::INFINITY,
+            stop: Stop::Guess,
         });
     };
     for it in 0..FK_MAX_ITERATIONS {
@@ -137,6 +139,7 @@ pub fn forward_kinematics(
             return Err(NoConvergence {
                 iterations: it,
                 residual: cur.1,
+                stop: Stop::Singular,
             });
         };
         let mut step = 1.0;
@@ -161,6 +164,7 @@ pub fn forward_kinematics(
                 return Err(NoConvergence {
                     iterations: it + 1,
                     residual: cur.1,
+                    stop: Stop::Stalled,
                 });
             }
         }
@@ -171,6 +175,7 @@ pub fn forward_kinematics(
         Err(NoConvergence {
             iterations: FK_MAX_ITERATIONS,
             residual: cur.1,
+            stop: Stop::Iterations,
         })
     }
 }
