@@ -84,7 +84,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let (kin, kin_guards) = guarded(|| noc::kinematics(plan, &x));
     let (pl, legs) = kin?;
     let with_kin = |outputs: Vec<ExprId>| Kernel::new(outputs, kin_guards.clone());
-    let a = noc::actuation_matrix(plan, &legs);
+    let a = noc::actuation_matrix(plan, &pl, &legs);
     let rates: Vec<Sx> = a
         .iter()
         .map(|row| {
@@ -310,6 +310,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         }
         PlatformMotion::PlanarPose { .. } => {
             "`x = [px, py, φ]` (platform frame origin, m, base frame, in the plane of its home height; φ its rotation about base z from home, rad); `u = [vx, vy, ω]` (m/s of the platform frame origin, rad/s about z)"
+        }
+        PlatformMotion::HeaveTilt { .. } => {
+            "`x = [pz, α, β]` (heave: the platform frame origin's z, m, base frame; tilts α, β, rad, 0 at home: rotation `Rz(γ)·Ry(β)·Rx(α)·R_home` about base axes, with the parasitic `px`, `py`, `γ` from the legs' constraints, see `platform_pose`); `u = [ż, α̇, β̇]`, the platform twist `[ω; v] = S(x) u`"
         }
         PlatformMotion::Translation { .. } => {
             "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"

@@ -132,7 +132,8 @@ macro_rules! bench_parallel {
                 runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
                 runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
                 runtime::parallel::PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
-                runtime::parallel::PlatformMotion::PlanarPose { .. } => (0.1, 0.02 * model.size()),
+                runtime::parallel::PlatformMotion::PlanarPose { .. }
+                | runtime::parallel::PlatformMotion::HeaveTilt { .. } => (0.1, 0.02 * model.size()),
             };
             let (x, u, ud) =
                 tests::pkm::random_state(&plan, &home, &mut rng(N as u64), angle, reach);

@@ -61,6 +61,9 @@ pub fn random_state(
             // A planar pose's φ is its third coordinate.
             let turns = if plan.motion.planar_pose() {
                 i == 2
+            } else if plan.motion.parasitic() {
+                // A 1T2R platform's x = [pz, α, β].
+                i >= 1
             } else {
                 i < 3 && !planar
             };

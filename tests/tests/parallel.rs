@@ -30,6 +30,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
         PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
         PlatformMotion::PlanarPose { .. } => (0.15, 0.03 * m.size()),
+        PlatformMotion::HeaveTilt { .. } => (0.2, 0.03 * m.size()),
     }
 }
 
@@ -262,6 +263,8 @@ macro_rules! against_lagrange {
                     // The Delta's parallelograms hold the platform's orientation; its own test
                     // (tests/tests/delta.rs) gives the reference U joints to hold it.
                     PlatformMotion::Translation { .. } => unreachable!("see tests/tests/delta.rs"),
+                    // A 1T2R platform's reference is in tests/tests/prs.rs (as a pose).
+                    PlatformMotion::HeaveTilt { .. } => unreachable!("see tests/tests/prs.rs"),
                     // t = S u: ω = (0, 0, u₂), the platform origin's velocity (u₀, u₁, 0).
                     PlatformMotion::PlanarPose { height, .. } => (
                         Prescribed::Pose {

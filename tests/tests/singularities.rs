@@ -96,6 +96,15 @@ fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
             let phi = 2.0 * (q[3] * h[0] - q[0] * h[3]).atan2(q[0] * h[0] + q[3] * h[3]);
             vec![p[0], p[1], phi]
         }
+        // The tilts of R = Rz(γ)·Ry(β)·Rx(α) (home rotation the identity): α, β.
+        PlatformMotion::HeaveTilt { .. } => {
+            let [w, a, b, c] = q;
+            let n = w * w + a * a + b * b + c * c;
+            let r20 = 2.0 * (a * c - w * b) / n;
+            let r21 = 2.0 * (b * c + w * a) / n;
+            let r22 = 1.0 - 2.0 * (a * a + b * b) / n;
+            vec![p[2], r21.atan2(r22), (-r20).asin()]
+        }
     }
 }
 

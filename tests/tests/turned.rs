@@ -112,6 +112,7 @@ fn turn_state(motion: PlatformMotion, r: &Mat3, x: &[f64], u: &[f64]) -> (Vec<f6
             let v = rv(r, &[u[0], u[1], 0.0]);
             (vec![p[0], p[1], x[2]], vec![v[0], v[1], u[2]])
         }
+        PlatformMotion::HeaveTilt { .. } => unreachable!("not turned"),
     }
 }
 

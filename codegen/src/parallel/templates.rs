@@ -178,7 +178,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         PlatformMotion::Orientation { .. } => (0usize, false),
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
-        | PlatformMotion::PlanarPose { .. } => (0usize, false),
+        | PlatformMotion::PlanarPose { .. }
+        | PlatformMotion::HeaveTilt { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -188,11 +189,12 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
     // A planar pose's [px, py, φ] ⊕ [δx, δy, δφ] is a sum too.
-    let retract = if plan.motion.translates() || plan.motion.planar_pose() {
-        sp.items(RETRACT_SUM, &["retract"])
-    } else {
-        sp.items(RETRACT_QUATERNION, &["retract"])
-    };
+    let retract =
+        if plan.motion.translates() || plan.motion.planar_pose() || plan.motion.parasitic() {
+            sp.items(RETRACT_SUM, &["retract"])
+        } else {
+            sp.items(RETRACT_QUATERNION, &["retract"])
+        };
     let rest = sp.items(NEWTON, &["fk_residual", "forward_kinematics"]);
     quote!(#retract #rest)
 }

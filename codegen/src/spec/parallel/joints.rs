@@ -136,6 +136,7 @@ fn check_closing_joint(
             Coordinates::Planar => (Kind::Revolute, "planar"),
             Coordinates::Translation => (Kind::Spherical, "translation"),
             Coordinates::PlanarPose => (Kind::Revolute, "planar_pose"),
+            Coordinates::HeaveTilt => (Kind::Spherical, "heave_tilt"),
         };
         if j.kind != want {
             diags.push(
