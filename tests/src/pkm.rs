@@ -7,7 +7,7 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 7] = [
+pub const PARALLEL: [&str; 8] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
@@ -15,6 +15,7 @@ pub const PARALLEL: [&str; 7] = [
     "planar_five_bar",
     "delta_rl5",
     "planar_3rrr",
+    "prs_head",
 ];
 
 /// The spec file of a bundled mechanism.

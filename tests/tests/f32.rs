@@ -117,7 +117,8 @@ fn parallel_mechanisms_in_single_precision() {
         agile_eye,
         planar_five_bar,
         delta_rl5,
-        planar_3rrr
+        planar_3rrr,
+        prs_head
     );
 }
 

@@ -302,6 +302,7 @@ fn parallel_guards_match_the_runtime_tests() {
         "planar_five_bar",
         "delta_rl5",
         "planar_3rrr",
+        "prs_head",
     ] {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();

@@ -126,6 +126,7 @@ generated_vs_runtime!(agile_eye);
 generated_vs_runtime!(planar_five_bar);
 generated_vs_runtime!(delta_rl5);
 generated_vs_runtime!(planar_3rrr);
+generated_vs_runtime!(prs_head);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -195,6 +196,7 @@ power_balance!(power_balance_agile_eye, agile_eye);
 power_balance!(power_balance_planar_five_bar, planar_five_bar);
 power_balance!(power_balance_delta_rl5, delta_rl5);
 power_balance!(power_balance_planar_3rrr, planar_3rrr);
+power_balance!(power_balance_prs_head, prs_head);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]

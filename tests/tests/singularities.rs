@@ -198,6 +198,7 @@ generated_routes!(rus_hexapod);
 generated_routes!(planar_five_bar);
 generated_routes!(delta_rl5);
 generated_routes!(planar_3rrr);
+generated_routes!(prs_head);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -208,6 +209,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "planar_five_bar" => &planar_five_bar::ROUTES,
         "delta_rl5" => &delta_rl5::ROUTES,
         "planar_3rrr" => &planar_3rrr::ROUTES,
+        "prs_head" => &prs_head::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }

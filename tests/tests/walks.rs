@@ -329,7 +329,8 @@ parallel_routes!(
     rus_hexapod,
     planar_five_bar,
     delta_rl5,
-    planar_3rrr
+    planar_3rrr,
+    prs_head
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -441,6 +442,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "planar_five_bar",
         "delta_rl5",
         "planar_3rrr",
+        "prs_head",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();

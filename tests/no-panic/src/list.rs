@@ -32,6 +32,7 @@ macro_rules! for_each_mechanism {
             planar_five_bar,
             delta_rl5,
             planar_3rrr,
+            prs_head,
             // Closed loops in joint coordinates.
             four_bar,
             five_bar_joints,

@@ -86,7 +86,8 @@ export_parallel!(
     agile_eye,
     planar_five_bar,
     delta_rl5,
-    planar_3rrr
+    planar_3rrr,
+    prs_head
 );
 
 macro_rules! export_closed {

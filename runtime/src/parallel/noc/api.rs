@@ -11,6 +11,7 @@ use super::force::generalized_force;
 use super::inertia::generalized_inertia;
 use super::legs::{JointPos, actuated_positions, actuation_matrix, kinematics, positions};
 use super::lu::solve_dyn;
+use super::parasitic::parasitic_pose;
 use super::plan::Plan;
 use super::pose::platform;
 use crate::algebra::{V, add, dot, mv};
@@ -31,11 +32,15 @@ pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> 
 }
 
 /// The platform's full pose at `x`, `[px, py, pz, qw, qx, qy, qz]` (the platform frame's
-/// origin, m, and its unit quaternion, platform → base, `qw ≥ 0`): for a 1T2R platform
-/// (`HeaveTilt`) the parasitic components `px`, `py` and the turn `γ` about `z` come from the
-/// legs' constraints (`parasitic.rs`).
+/// origin, m, and its unit quaternion, platform → base): for a 1T2R platform (`HeaveTilt`)
+/// the parasitic components `px`, `py` and the turn `γ` about `z` come from the legs'
+/// constraints, the quaternion is `qz(γ) ⊗ qy(β) ⊗ qx(α) ⊗ q_home` ([`parasitic_pose`], as the
+/// generated `platform_pose`); for the others it is the rotation's with `qw ≥ 0`.
 pub fn platform_pose(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
     check_finite(&[x])?;
+    if plan.motion.parasitic() {
+        return finite(parasitic_pose(plan, x)?.to_vec());
+    }
     let pl = platform(plan, x)?;
     let q = crate::model::matrix_quaternion(&pl.rot);
     let s = if q[0] < 0.0 { -1.0 } else { 1.0 };

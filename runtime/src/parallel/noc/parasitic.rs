@@ -201,6 +201,44 @@ pub fn parasitic<R: Real>(plan: &Plan, x: &[R]) -> Result<(M<R>, V<R>, Parasitic
     ))
 }
 
+/// The full pose of a 1T2R platform, `[px, py, pz, qw, qx, qy, qz]`: the origin with the
+/// parasitic `px`, `py`, and the unit quaternion `qz(γ) ⊗ qy(β) ⊗ qx(α) ⊗ q_home` of
+/// `R = Rz(γ)·Ry(β)·Rx(α)·R_home` (`q_home` with `qw ≥ 0`), from the half angles, so that no
+/// branch is taken.
+pub fn parasitic_pose<R: Real>(plan: &Plan, x: &[R]) -> Result<[R; 7], Singular> {
+    let PlatformMotion::HeaveTilt { rotation, .. } = plan.motion else {
+        return Err(Singular {
+            site: Site::Platform,
+            value: 0.0,
+            condition_estimate: f64::INFINITY,
+        });
+    };
+    let (_, origin, par) = parasitic(plan, x)?;
+    let half = R::c(0.5);
+    let (sa, ca) = (x[1] * half).sin_cos();
+    let (sb, cb) = (x[2] * half).sin_cos();
+    let (sg, cg) = (par.y[2] * half).sin_cos();
+    let h = crate::model::matrix_quaternion(&rotation);
+    let s = if h[0] < 0.0 { -1.0 } else { 1.0 };
+    let h: [R; 4] = core::array::from_fn(|i| R::c(s * h[i]));
+    let z = R::c(0.0);
+    let q = qmul(
+        &[cg, z, z, sg],
+        &qmul(&[cb, z, sb, z], &qmul(&[ca, sa, z, z], &h)),
+    );
+    Ok([origin[0], origin[1], origin[2], q[0], q[1], q[2], q[3]])
+}
+
+/// Hamilton product `a ⊗ b` of quaternions `[w, x, y, z]`.
+fn qmul<R: Real>(a: &[R; 4], b: &[R; 4]) -> [R; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
 impl<R: Real> Parasitic<R> {
     /// `t = S u` (`[ω; v]`).
     pub fn twist(&self, u: &[R]) -> [R; 6] {
