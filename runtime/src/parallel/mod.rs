@@ -8,7 +8,9 @@
 //!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`), or its position with
 //!   the orientation fixed ([`PlatformMotion::Translation`]: `x = [px, py, pz]`, `u = v`; a Delta
 //!   robot), or its planar pose ([`PlatformMotion::PlanarPose`]: `x = [px, py, φ]`,
-//!   `u = [vx, vy, ω]`; a planar 3-RRR). Base-frame components;
+//!   `u = [vx, vy, ω]`; a planar 3-RRR), or its heave and two tilts with parasitic motion
+//!   ([`PlatformMotion::HeaveTilt`]: `x = [pz, α, β]`, `u = [ż, α̇, β̇]`, the twist `S(x) u`;
+//!   a 3-PRS or 3-RPS head). Base-frame components;
 //!   `v` is the velocity of the platform frame's origin.
 //! * Leg `J` is a serial chain of one-DOF joints (U joints arrive expanded into two revolutes with
 //!   a massless body between them) whose last body meets the platform in a spherical joint (pose)
