@@ -6,8 +6,10 @@
 //!   (`runtime::closed::noc`: its own loop equations, Newton assembly and `Φ_d` solves): the
 //!   efforts, the actuator-space inertia, forward dynamics, and the parasitic components
 //!   against the platform pose of the assembled joint-coordinate configuration;
-//! - the parasitic motion's constraints and its twist map `S` against central differences of
-//!   the pose.
+//! - Newton–Euler with Lagrange multipliers (`references::lagrange`), the actuated joints'
+//!   motion prescribed, for the bundled head (generated), the tripod and a 3-RPS
+//!   (`tests/data/rps_task.toml`, runtime);
+//! - the twist map `S` against central differences of the pose; singular walks.
 //!
 //! Errors are relative, `‖a − b‖∞ / ‖b‖∞` (∞-norm of the difference over the ∞-norm of the
 //! reference; matrices flattened).
@@ -43,7 +45,11 @@ fn joints_model() -> runtime::closed::ClosedModel {
 }
 
 fn task_model() -> ParallelModel {
-    let (path, src) = data("tripod_3prs_task");
+    data_model("tripod_3prs_task")
+}
+
+fn data_model(name: &str) -> ParallelModel {
+    let (path, src) = data(name);
     match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
         Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
         Ok(_) => panic!("not a parallel mechanism"),
@@ -206,6 +212,7 @@ fn prs_against_lagrange_multipliers() {
     for (name, m, generated) in [
         ("prs_head", tests::pkm::model("prs_head"), true),
         ("tripod_3prs_task", task_model(), false),
+        ("rps_task", data_model("rps_task"), false),
     ] {
         let plan = Plan::new(&m).unwrap();
         let pm = as_pose(&m);
