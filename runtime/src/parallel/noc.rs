@@ -100,7 +100,7 @@ pub use legs::{
 pub use lu::lu_solve;
 pub(crate) use motion::leg_motion;
 pub use parasitic::{
-    PARASITIC_ITERATIONS, PARASITIC_TOLERANCE, Parasitic, parasitic, parasitic_pose,
+    FullPose, PARASITIC_ITERATIONS, PARASITIC_TOLERANCE, Parasitic, parasitic, parasitic_pose,
 };
 pub use plan::{LegPlan, Plan};
 pub use pose::{Platform, platform};

@@ -99,9 +99,12 @@ fn evaluate<R: Real>(y: &[R; 3], pz: R, rp: &[V<R>; 3], n: &[V<R>; 3], off: &[f6
     (h, r, adj, det, hn, (s, c))
 }
 
+/// A 1T2R platform's rotation `R` (platform → base), origin, and twist map.
+pub type FullPose<R> = (M<R>, V<R>, Parasitic<R>);
+
 /// The full pose of a 1T2R platform from `x = [pz, α, β]`: the rotation `R`, the origin, and
 /// the twist map ([`Parasitic`]).
-pub fn parasitic<R: Real>(plan: &Plan, x: &[R]) -> Result<(M<R>, V<R>, Parasitic<R>), Singular> {
+pub fn parasitic<R: Real>(plan: &Plan, x: &[R]) -> Result<FullPose<R>, Singular> {
     let PlatformMotion::HeaveTilt { rotation, xy } = plan.motion else {
         return Err(Singular {
             site: Site::Platform,
