@@ -454,3 +454,45 @@ fn prs_head_leg_singularity_before_reach() {
     assert_eq!(first, Some(runtime::parallel::Site::Leg(0)), "{sites:?}");
     assert_eq!(site(hi + 1e-3), Some(runtime::parallel::Site::Reach(0)));
 }
+
+/// A payload on a 1T2R platform (`payload_force`, `payload_inertia`, which take the 6-DOF
+/// pose's route with the twist `S u` and project by `Sᵀ`): the head's own platform body moved
+/// into a payload on a massless platform gives the same generalized force and inertia.
+#[test]
+fn prs_head_payload_equals_the_platform_body() {
+    use runtime::payload::Payload;
+    let m = tests::pkm::model("prs_head");
+    let plan = Plan::new(&m).unwrap();
+    let mut bare = plan.clone();
+    let (mass, com, inertia) = plan.platform;
+    bare.platform = (0.0, [0.0; 3], [[0.0; 3]; 3]);
+    let payload = Payload::<f64>::from_f64(mass, com, inertia);
+    let home = m.home_x();
+    let mut rng = tests::rng(0x9a71);
+    let mut worst = [0.0f64; 2];
+    for _ in 0..200 {
+        let (x, u, ud) = state(&plan, &home, &mut rng);
+        let (pl, legs) = noc::kinematics(&plan, &x).unwrap();
+        let f = noc::generalized_force(&plan, &pl, &legs, &u, &ud, true);
+        let mut fb = noc::generalized_force(&bare, &pl, &legs, &u, &ud, true);
+        let fp = noc::payload_force(&bare, &pl, &payload, &u, &ud, true);
+        for (a, b) in fb.iter_mut().zip(&fp) {
+            *a += b;
+        }
+        worst[0] = worst[0].max(rel(&fb, &f));
+        let i = noc::generalized_inertia(&plan, &pl, &legs);
+        let mut ib = noc::generalized_inertia(&bare, &pl, &legs);
+        let ip = noc::payload_inertia(&bare, &pl, &payload);
+        for (ra, rb) in ib.iter_mut().zip(&ip) {
+            for (a, b) in ra.iter_mut().zip(rb) {
+                *a += b;
+            }
+        }
+        worst[1] = worst[1].max(rel(&ib.concat(), &i.concat()));
+    }
+    println!(
+        "prs_head: platform as a payload vs as the platform body, worst relative error: force {:.1e}, inertia {:.1e}",
+        worst[0], worst[1]
+    );
+    assert!(worst[0] <= 1e-13 && worst[1] <= 1e-13, "{worst:?}");
+}
