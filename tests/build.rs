@@ -117,6 +117,11 @@ fn main() {
     let joints = "data/tsai_3upu_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "upu_joints", Path::new(joints), |_| {});
+    // The 3-PRS tripod of mechanisms/specs/tripod_3prs.toml in task coordinates (heave_tilt),
+    // for the bench against its joint-coordinate form.
+    let task = "data/tripod_3prs_task.toml";
+    println!("cargo:rerun-if-changed={task}");
+    generate(&out, "tripod_task", Path::new(task), |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));

@@ -37,6 +37,8 @@ pub enum Part {
     Matrix,
     /// `[f64; NX]` with `NX` given (closed loops: all joint coordinates).
     Coords(usize),
+    /// `[f64; N]` with the literal length `N` (a 1T2R platform's full pose, `N = 7`).
+    Array(usize),
     /// `f64`.
     Scalar,
     /// This many outputs that are checked for finiteness but not returned (a tree's
@@ -49,7 +51,7 @@ impl Part {
         match self {
             Part::Vector => dof,
             Part::Matrix => dof * dof,
-            Part::Coords(n) | Part::Hidden(n) => n,
+            Part::Coords(n) | Part::Array(n) | Part::Hidden(n) => n,
             Part::Scalar => 1,
         }
     }
@@ -59,6 +61,10 @@ impl Part {
             Part::Vector => quote!([#real; DOF]),
             Part::Matrix => quote!([[#real; DOF]; DOF]),
             Part::Coords(_) => quote!([#real; NX]),
+            Part::Array(n) => {
+                let n = proc_macro2::Literal::usize_unsuffixed(n);
+                quote!([#real; #n])
+            }
             Part::Scalar => quote!(#real),
             Part::Hidden(_) => quote!(()),
         }
@@ -370,7 +376,7 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
         let (now, later) = rest.split_at(p.len(n).min(rest.len()));
         rest = later;
         items.push(match p {
-            Part::Vector | Part::Coords(_) => quote!([#(#now),*]),
+            Part::Vector | Part::Coords(_) | Part::Array(_) => quote!([#(#now),*]),
             Part::Scalar => quote!(#(#now)*),
             Part::Hidden(_) => continue,
             Part::Matrix => {

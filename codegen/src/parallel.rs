@@ -11,7 +11,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 use runtime::drive::DriveInputs;
 use runtime::model::JointKind;
-use runtime::parallel::noc::{self, Plan};
+use runtime::parallel::noc::{self, PARASITIC_ITERATIONS, PARASITIC_TOLERANCE, Plan};
 use runtime::parallel::{ParallelModel, PlatformMotion};
 use runtime::scalar::{Real, Singular};
 
@@ -55,6 +55,9 @@ pub struct Kernels {
     pub coriolis_parts: Kernel,
     /// `A` then the leg joints' friction mapped to `u` (`friction`); `None` without friction.
     pub friction_parts: Option<Kernel>,
+    /// A 1T2R platform's full pose `[px, py, pz, qw, qx, qy, qz]` (`platform_pose`: the
+    /// parasitic components); `None` for the other motions.
+    pub platform_pose: Option<Kernel>,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -84,7 +87,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     let (kin, kin_guards) = guarded(|| noc::kinematics(plan, &x));
     let (pl, legs) = kin?;
     let with_kin = |outputs: Vec<ExprId>| Kernel::new(outputs, kin_guards.clone());
-    let a = noc::actuation_matrix(plan, &legs);
+    let a = noc::actuation_matrix(plan, &pl, &legs);
     let rates: Vec<Sx> = a
         .iter()
         .map(|row| {
@@ -122,6 +125,13 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     // they were without it.
     let (fg, fc, ffr) = split(plan, &pl, &legs, &u, drives.as_ref(), &payloads);
     let split_kernel = |f: Vec<Sx>| with_kin(cat(flat(&a), ids(&f)));
+    // Last, so that the nodes above stay as they are without it.
+    let platform_pose = if plan.motion.parasitic() {
+        let (pose, guards) = guarded(|| noc::parasitic_pose(plan, &x));
+        Some(Kernel::new(ids(&pose?), guards))
+    } else {
+        None
+    };
     Ok(Kernels {
         graph: Graph::new(),
         inverse_kinematics: Kernel::new(ids(&q), pos_guards),
@@ -134,6 +144,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         gravity_parts: split_kernel(fg),
         coriolis_parts: split_kernel(fc),
         friction_parts: ffr.map(split_kernel),
+        platform_pose,
     })
 }
 
@@ -311,6 +322,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         PlatformMotion::PlanarPose { .. } => {
             "`x = [px, py, φ]` (platform frame origin, m, base frame, in the plane of its home height; φ its rotation about base z from home, rad); `u = [vx, vy, ω]` (m/s of the platform frame origin, rad/s about z)"
         }
+        PlatformMotion::HeaveTilt { .. } => {
+            "`x = [pz, α, β]` (heave: the platform frame origin's z, m, base frame; tilts α, β, rad, 0 at home: rotation `Rz(γ)·Ry(β)·Rx(α)·R_home` about base axes, with the parasitic `px`, `py`, `γ` from the legs' constraints, see `platform_pose`); `u = [ż, α̇, β̇]`, the platform twist `[ω; v] = S(x) u`"
+        }
         PlatformMotion::Translation { .. } => {
             "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"
         }
@@ -422,9 +436,22 @@ fn functions(
             false,
         )
     });
+    let pose = k.platform_pose.as_ref().map(|kernel| {
+        fns.make(
+            "platform_pose",
+            vec![format!(
+                "The platform's full pose `[px, py, pz, qw, qx, qy, qz]` at `x` (m; unit quaternion platform → base): the parasitic components `px`, `py` and the turn `γ` about base z that the legs impose, with `R = Rz(γ)·Ry(β)·Rx(α)·R_home` as the quaternion `qz(γ) ⊗ qy(β) ⊗ qx(α) ⊗ q_home`. {coords}. `Err(Site::Platform)` where the legs' constraints do not fix the parasitic motion, `Err(Site::Reach(i))` where its {PARASITIC_ITERATIONS} Newton steps leave leg `i`'s constraint unmet (beyond {PARASITIC_TOLERANCE:e} of the platform radius)."
+            )],
+            vec![Arg::X],
+            kernel,
+            fallible(&[Part::Array(7)]),
+            true,
+        )
+    });
     functions
         .into_iter()
         .chain(friction)
+        .chain(pose)
         .filter(|f| {
             want(match f.name {
                 "id_parts" => "inverse_dynamics",
@@ -473,9 +500,14 @@ fn stats(
         .iter()
         .any(|f| f.name == "friction_parts")
         .then(|| ("friction".to_string(), plus(ops("friction_parts"), lu, 1)));
+    let pose = functions
+        .iter()
+        .any(|f| f.name == "platform_pose")
+        .then(|| ("platform_pose".to_string(), ops("platform_pose")));
     stats
         .into_iter()
         .chain(friction)
+        .chain(pose)
         .filter(|(n, _)| want(n))
         .collect()
 }
@@ -501,7 +533,12 @@ fn header(
             plan.legs.len(),
             plan.legs
                 .iter()
-                .map(|l| l.kind.word())
+                .map(|l| match (plan.motion.parasitic(), l.kind) {
+                    // A 1T2R platform's P-R and R-P legs end in a spherical joint.
+                    (true, runtime::parallel::LegKind::PlanarPr) => "PRS",
+                    (true, runtime::parallel::LegKind::PlanarRp) => "RPS",
+                    (_, kind) => kind.word(),
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         ),

@@ -467,8 +467,8 @@ fn lift(v: &[f64]) -> Vec<DD> {
 
 /// The actuation matrix `A` (`q̇ = A u`) at `x`, evaluated in double-double.
 pub fn actuation_dd(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<DD>>, Singular> {
-    let (_, legs) = noc::kinematics::<DD>(plan, &lift(x))?;
-    Ok(noc::actuation_matrix(plan, &legs))
+    let (pl, legs) = noc::kinematics::<DD>(plan, &lift(x))?;
+    Ok(noc::actuation_matrix(plan, &pl, &legs))
 }
 
 /// The high-precision reference of `noc::inverse_dynamics`: the same equations
@@ -486,7 +486,7 @@ pub fn inverse_dynamics_dd(
 ) -> Result<Vec<f64>, Singular> {
     let (pl, legs) = noc::kinematics::<DD>(plan, &lift(x))?;
     let f = noc::generalized_force(plan, &pl, &legs, &lift(u), &lift(ud), true);
-    let a = noc::actuation_matrix(plan, &legs);
+    let a = noc::actuation_matrix(plan, &pl, &legs);
     let (tau, piv) = solve_pivots(&a, &f, true);
     if let Some(k) = piv
         .iter()

@@ -1062,6 +1062,11 @@ pub fn platform_pose(motion: PlatformMotion, x: &[f64]) -> Transform {
                 translation: [x[0], x[1], height],
             }
         }
+        // The parasitic components come from the legs: the caller passes the model as a
+        // 6-DOF pose with `x = noc::platform_pose(plan, x)` (tests/tests/prs.rs).
+        PlatformMotion::HeaveTilt { .. } => {
+            panic!("a 1T2R platform's pose needs its parasitic components: pass it as a pose")
+        }
     }
 }
 
@@ -1126,7 +1131,8 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
                     PlatformMotion::Pose
                     | PlatformMotion::PlanarPoint { .. }
                     | PlatformMotion::Translation { .. }
-                    | PlatformMotion::PlanarPose { .. } => plat.translation,
+                    | PlatformMotion::PlanarPose { .. }
+                    | PlatformMotion::HeaveTilt { .. } => plat.translation,
                 };
                 (
                     CJointKind::Revolute { axis },

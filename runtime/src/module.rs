@@ -16,7 +16,7 @@
 /// | kind | `x` (`NX`) | `u`, `ud` (`DOF`) | `q`, `tau` (`DOF`) |
 /// |---|---|---|---|
 /// | tree | the joint positions `q` (`NX = DOF`) | joint rates `q̇`, accelerations `q̈` | the joints: `q = x`, efforts `τ` |
-/// | parallel platform | the platform's pose: `[px, py, pz, qw, qx, qy, qz]` (`Pose`), a unit quaternion (`Orientation`), `[px, py]` (`PlanarPoint`), `[px, py, pz]` (`Translation`) or `[px, py, φ]` (`PlanarPose`) | the platform's twist `[ω; v]`, `ω`, `[vx, vy]`, `v` or `[vx, vy, ω]`, and its rate | the actuated joints' positions and efforts, in `ACTUATOR_NAMES` order |
+/// | parallel platform | the platform's pose: `[px, py, pz, qw, qx, qy, qz]` (`Pose`), a unit quaternion (`Orientation`), `[px, py]` (`PlanarPoint`), `[px, py, pz]` (`Translation`), `[px, py, φ]` (`PlanarPose`) or `[pz, α, β]` (`HeaveTilt`: heave and two tilts, the parasitic `px`, `py`, `γ` from the legs, output by `platform_pose`) | the platform's twist `[ω; v]`, `ω`, `[vx, vy]`, `v`, `[vx, vy, ω]` or `[ż, α̇, β̇]` (twist `S(x) u`), and its rate | the actuated joints' positions and efforts, in `ACTUATOR_NAMES` order |
 /// | closed loops in joint coordinates | every spanning-tree joint's position (`JOINT_NAMES` order), closing the loops | the rates of the independent coordinates `x[INDEPENDENT[k]]`, and their rates | the independent (actuated) joints: `q = x[INDEPENDENT]`, their efforts |
 ///
 /// Positions in rad or m, speeds in rad/s or m/s, efforts in N·m or N (SI throughout).

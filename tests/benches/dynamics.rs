@@ -132,7 +132,8 @@ macro_rules! bench_parallel {
                 runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
                 runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
                 runtime::parallel::PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
-                runtime::parallel::PlatformMotion::PlanarPose { .. } => (0.1, 0.02 * model.size()),
+                runtime::parallel::PlatformMotion::PlanarPose { .. }
+                | runtime::parallel::PlatformMotion::HeaveTilt { .. } => (0.1, 0.02 * model.size()),
             };
             let (x, u, ud) =
                 tests::pkm::random_state(&plan, &home, &mut rng(N as u64), angle, reach);
@@ -361,9 +362,36 @@ fn upu_task_vs_joints(c: &mut Criterion) {
     g.finish();
 }
 
+/// The 3-PRS tripod's inverse dynamics in task coordinates `[pz, α, β]` (inverse kinematics and
+/// the parasitic motion included) against the same robot in joint coordinates (the bundled
+/// `tripod_3prs`, the closed-loop route), both generated, at the same configuration (a tilted
+/// pose; the joint form assembled at its actuated positions) and rates (the platform speeds
+/// `u`; the actuator rates they imply); the accelerations are arbitrary, the same numbers for
+/// both (the cost does not depend on them).
+fn prs_task_vs_joints(c: &mut Criterion) {
+    use mechanisms::tripod_3prs as joints;
+    use tests::variants::tripod_task as task;
+    let x = [task::HOME[0] + 0.01, 0.1, -0.05];
+    let (u, ud) = ([0.03, -0.2, 0.5], [1.0, 0.5, -2.0]);
+    let q = task::inverse_kinematics(&x).expect("in reach");
+    let qd = task::actuator_rates(&x, &u).expect("regular");
+    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
+    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
+    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
+    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
+    let mut g = c.benchmark_group("tripod_3prs/inverse_dynamics_task_vs_joints");
+    g.bench_function("task_coordinates", |b| {
+        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("joint_coordinates", |b| {
+        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, five_bar_joints, spherical_five_bar
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, prs_task_vs_joints, five_bar_joints, spherical_five_bar
 }
 criterion_main!(benches);

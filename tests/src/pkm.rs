@@ -7,7 +7,7 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 8] = [
+pub const PARALLEL: [&str; 9] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
@@ -16,6 +16,7 @@ pub const PARALLEL: [&str; 8] = [
     "delta_rl5",
     "planar_3rrr",
     "tsai_3upu",
+    "prs_head",
 ];
 
 /// The spec file of a bundled mechanism.
@@ -62,6 +63,9 @@ pub fn random_state(
             // A planar pose's φ is its third coordinate.
             let turns = if plan.motion.planar_pose() {
                 i == 2
+            } else if plan.motion.parasitic() {
+                // A 1T2R platform's x = [pz, α, β].
+                i >= 1
             } else {
                 i < 3 && !planar
             };

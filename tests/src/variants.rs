@@ -117,3 +117,12 @@ pub mod upu_joints {
         "/variants/upu_joints/tsai_3upu_joints.rs"
     ));
 }
+/// The 3-PRS tripod of `mechanisms/specs/tripod_3prs.toml` in task coordinates `[pz, α, β]`
+/// (`tests/data/tripod_3prs_task.toml`, `coordinates = "heave_tilt"`), for the bench against its
+/// joint-coordinate form.
+pub mod tripod_task {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/tripod_task/tripod_3prs_task.rs"
+    ));
+}

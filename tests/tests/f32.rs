@@ -81,7 +81,8 @@ macro_rules! parallel {
                 runtime::parallel::PlatformMotion::Orientation { .. } => (0.3, 0.0),
                 runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
                 runtime::parallel::PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
-                runtime::parallel::PlatformMotion::PlanarPose { .. } => (0.1, 0.02 * model.size()),
+                runtime::parallel::PlatformMotion::PlanarPose { .. }
+                | runtime::parallel::PlatformMotion::HeaveTilt { .. } => (0.1, 0.02 * model.size()),
             };
             let mut rng = tests::rng(22);
             let mut worst: f64 = 0.0;
@@ -117,7 +118,8 @@ fn parallel_mechanisms_in_single_precision() {
         planar_five_bar,
         delta_rl5,
         planar_3rrr,
-        tsai_3upu
+        tsai_3upu,
+        prs_head
     );
 }
 

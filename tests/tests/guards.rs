@@ -303,6 +303,7 @@ fn parallel_guards_match_the_runtime_tests() {
         "delta_rl5",
         "planar_3rrr",
         "tsai_3upu",
+        "prs_head",
     ] {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();

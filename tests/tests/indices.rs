@@ -375,6 +375,8 @@ fn rotate_x(m: &ParallelModel, r: &Mat3, x: &[f64]) -> Vec<f64> {
             let p = mat_vec(r, &[x[0], x[1], 0.0]);
             vec![p[0], p[1], x[2]]
         }
+        // Not turned (the tilts are about base axes): the same coordinates.
+        PlatformMotion::HeaveTilt { .. } => x.to_vec(),
     }
 }
 

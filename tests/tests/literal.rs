@@ -27,6 +27,7 @@ fn amplitudes(m: &runtime::parallel::ParallelModel) -> (f64, f64) {
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
         PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
         PlatformMotion::PlanarPose { .. } => (0.15, 0.03 * m.size()),
+        PlatformMotion::HeaveTilt { .. } => (0.2, 0.03 * m.size()),
     }
 }
 

@@ -30,6 +30,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
         PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
         PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
         PlatformMotion::PlanarPose { .. } => (0.15, 0.03 * m.size()),
+        PlatformMotion::HeaveTilt { .. } => (0.2, 0.03 * m.size()),
     }
 }
 
@@ -126,6 +127,7 @@ generated_vs_runtime!(planar_five_bar);
 generated_vs_runtime!(delta_rl5);
 generated_vs_runtime!(planar_3rrr);
 generated_vs_runtime!(tsai_3upu);
+generated_vs_runtime!(prs_head);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -196,6 +198,7 @@ power_balance!(power_balance_planar_five_bar, planar_five_bar);
 power_balance!(power_balance_delta_rl5, delta_rl5);
 power_balance!(power_balance_planar_3rrr, planar_3rrr);
 power_balance!(power_balance_tsai_3upu, tsai_3upu);
+power_balance!(power_balance_prs_head, prs_head);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]
@@ -264,6 +267,8 @@ macro_rules! against_lagrange {
                     // The Delta's parallelograms hold the platform's orientation; its own test
                     // (tests/tests/delta.rs) gives the reference U joints to hold it.
                     PlatformMotion::Translation { .. } => unreachable!("see tests/tests/delta.rs"),
+                    // A 1T2R platform's reference is in tests/tests/prs.rs (as a pose).
+                    PlatformMotion::HeaveTilt { .. } => unreachable!("see tests/tests/prs.rs"),
                     // t = S u: ω = (0, 0, u₂), the platform origin's velocity (u₀, u₁, 0).
                     PlatformMotion::PlanarPose { height, .. } => (
                         Prescribed::Pose {

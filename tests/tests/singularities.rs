@@ -96,6 +96,15 @@ fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
             let phi = 2.0 * (q[3] * h[0] - q[0] * h[3]).atan2(q[0] * h[0] + q[3] * h[3]);
             vec![p[0], p[1], phi]
         }
+        // The tilts of R = Rz(γ)·Ry(β)·Rx(α) (home rotation the identity): α, β.
+        PlatformMotion::HeaveTilt { .. } => {
+            let [w, a, b, c] = q;
+            let n = w * w + a * a + b * b + c * c;
+            let r20 = 2.0 * (a * c - w * b) / n;
+            let r21 = 2.0 * (b * c + w * a) / n;
+            let r22 = 1.0 - 2.0 * (a * a + b * b) / n;
+            vec![p[2], r21.atan2(r22), (-r20).asin()]
+        }
     }
 }
 
@@ -190,6 +199,7 @@ generated_routes!(planar_five_bar);
 generated_routes!(delta_rl5);
 generated_routes!(planar_3rrr);
 generated_routes!(tsai_3upu);
+generated_routes!(prs_head);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -201,6 +211,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "delta_rl5" => &delta_rl5::ROUTES,
         "planar_3rrr" => &planar_3rrr::ROUTES,
         "tsai_3upu" => &tsai_3upu::ROUTES,
+        "prs_head" => &prs_head::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }

@@ -112,6 +112,7 @@ fn turn_state(motion: PlatformMotion, r: &Mat3, x: &[f64], u: &[f64]) -> (Vec<f6
             let v = rv(r, &[u[0], u[1], 0.0]);
             (vec![p[0], p[1], x[2]], vec![v[0], v[1], u[2]])
         }
+        PlatformMotion::HeaveTilt { .. } => unreachable!("not turned"),
     }
 }
 
@@ -148,6 +149,11 @@ fn turned_platforms_are_accepted_with_the_same_efforts() {
     let mut worst_all: f64 = 0.0;
     for name in PARALLEL {
         let m = tests::pkm::model(name);
+        if m.motion.parasitic() {
+            // A 1T2R platform's tilts are about the base axes: turning the base changes what
+            // the coordinates mean (no state of the turned model matches `x` as simply).
+            continue;
+        }
         let t = match m.motion {
             PlatformMotion::PlanarPoint { .. } | PlatformMotion::PlanarPose { .. } => {
                 turn_about_z()

@@ -330,7 +330,8 @@ parallel_routes!(
     planar_five_bar,
     delta_rl5,
     planar_3rrr,
-    tsai_3upu
+    tsai_3upu,
+    prs_head
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -422,6 +423,12 @@ fn turned(m: &ParallelModel, axis: usize, deg: f64, dp: [f64; 3]) -> Vec<f64> {
             home[1] + dp[1],
             home[2] + if axis == 2 { deg.to_radians() } else { 0.0 },
         ],
+        // Heave dz, tilted about x (α) or y (β).
+        PlatformMotion::HeaveTilt { .. } => vec![
+            home[0] + dp[2],
+            home[1] + if axis == 0 { deg.to_radians() } else { 0.0 },
+            home[2] + if axis == 1 { deg.to_radians() } else { 0.0 },
+        ],
     }
 }
 
@@ -437,6 +444,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "delta_rl5",
         "planar_3rrr",
         "tsai_3upu",
+        "prs_head",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
@@ -515,6 +523,29 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                     at(
                         turned(&m, 2, deg, [0.0; 3]),
                         format!("{deg}° about z"),
+                        &mut bad,
+                    );
+                }
+            }
+            PlatformMotion::HeaveTilt { .. } => {
+                // Tilted both ways about x and y (legs folding and stretching: leg
+                // singularities, out of reach, the parasitic solve's limits), and heaved up
+                // and down.
+                for axis in 0..2 {
+                    for s in 0..=720 {
+                        let deg = -90.0 + 180.0 * s as f64 / 720.0;
+                        at(
+                            turned(&m, axis, deg, [0.0; 3]),
+                            format!("{deg}° about {axis}"),
+                            &mut bad,
+                        );
+                    }
+                }
+                for s in 0..=800 {
+                    let dz = home[0] * (-1.0 + 2.0 * s as f64 / 800.0);
+                    at(
+                        turned(&m, 0, 0.0, [0.0, 0.0, dz]),
+                        format!("dz {dz}"),
                         &mut bad,
                     );
                 }

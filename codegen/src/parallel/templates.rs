@@ -32,7 +32,7 @@ pub(super) fn templates(
     want: &dyn Fn(&str) -> bool,
     params: bool,
 ) -> TokenStream {
-    let types = error_types();
+    let types = error_types(plan.motion.parasitic());
     let lu_solve = lu_fn(
         cfg,
         plan,
@@ -99,7 +99,7 @@ pub(super) fn templates(
 
 /// `Site` (its leg and actuation variants documented with the tolerances), `Singular` and
 /// `NoConvergence`.
-fn error_types() -> TokenStream {
+fn error_types(parasitic: bool) -> TokenStream {
     let tol = crate::scalar::tolerance;
     let leg_tol = tol(noc::LEG_TOLERANCE);
     let act_tol = tol(noc::ACTUATION_TOLERANCE);
@@ -109,6 +109,17 @@ fn error_types() -> TokenStream {
     let act_doc = format!(
         " Pivot `i` of the actuation matrix `A` (each column scaled by the largest norm of its unit group, partial pivoting) is `≤ {act_tol:e}` times the larger of 1 and the largest pivot: a parallel (type-II) singularity."
     );
+    // A 1T2R platform's pose comes from its legs' constraints, not from a quaternion.
+    let platform_doc = if parasitic {
+        " The legs' constraints do not fix the platform's parasitic motion: their Jacobian in `(px, py, γ)` is singular."
+    } else {
+        " The platform quaternion is zero (or not finite)."
+    };
+    let reach_doc = if parasitic {
+        " Leg `k` cannot reach the platform: the pose is outside the workspace (or the parasitic motion's Newton steps leave leg `k`'s constraint unmet)."
+    } else {
+        " Leg `k` cannot reach the platform: the pose is outside the workspace."
+    };
     let errors = crate::module::error_types(
         "Which matrix, leg or pivot.",
         "The determinant, pivot or discriminant that failed its test.",
@@ -122,11 +133,11 @@ fn error_types() -> TokenStream {
             MassMatrix(usize),
             #[doc = #leg_doc]
             Leg(usize),
-            /// Leg `k` cannot reach the platform: the pose is outside the workspace.
+            #[doc = #reach_doc]
             Reach(usize),
             #[doc = #act_doc]
             Actuation(usize),
-            /// The platform quaternion is zero (or not finite).
+            #[doc = #platform_doc]
             Platform,
             /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite, or so large that a result
             /// overflows.
@@ -178,7 +189,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         PlatformMotion::Orientation { .. } => (0usize, false),
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
-        | PlatformMotion::PlanarPose { .. } => (0usize, false),
+        | PlatformMotion::PlanarPose { .. }
+        | PlatformMotion::HeaveTilt { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -188,11 +200,12 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
     // A planar pose's [px, py, φ] ⊕ [δx, δy, δφ] is a sum too.
-    let retract = if plan.motion.translates() || plan.motion.planar_pose() {
-        sp.items(RETRACT_SUM, &["retract"])
-    } else {
-        sp.items(RETRACT_QUATERNION, &["retract"])
-    };
+    let retract =
+        if plan.motion.translates() || plan.motion.planar_pose() || plan.motion.parasitic() {
+            sp.items(RETRACT_SUM, &["retract"])
+        } else {
+            sp.items(RETRACT_QUATERNION, &["retract"])
+        };
     let rest = sp.items(NEWTON, &["fk_residual", "forward_kinematics"]);
     quote!(#retract #rest)
 }

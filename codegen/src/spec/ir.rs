@@ -199,6 +199,9 @@ pub(crate) enum Coordinates {
     /// Three DOF: the platform moves in a plane `z = const` and turns about its normal
     /// (`x = [px, py, φ]`; a planar 3-RRR, 3-PRR, 3-RPR).
     PlanarPose,
+    /// Three DOF with parasitic motion (1T2R): heave and two tilts, `x = [pz, α, β]`; the
+    /// parasitic `(px, py, γ)` follow from the legs (a 3-PRS or 3-RPS head).
+    HeaveTilt,
 }
 
 /// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`

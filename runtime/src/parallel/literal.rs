@@ -66,8 +66,8 @@ fn m3(m: &[[f64; 3]; 3]) -> Matrix3<f64> {
 /// velocity for a spherical leg), base frame, `3 × n`.
 fn end_map(motion: PlatformMotion, lk: &LegKin<f64>) -> DMatrix<f64> {
     match motion {
-        // v_end = v + ω × arm = −CPM(arm) ω + v.
-        PlatformMotion::Pose => {
+        // v_end = v + ω × arm = −CPM(arm) ω + v (a 1T2R platform's times its `S`, in `terms`).
+        PlatformMotion::Pose | PlatformMotion::HeaveTilt { .. } => {
             let mut g = DMatrix::zeros(3, 6);
             g.fixed_view_mut::<3, 3>(0, 0)
                 .copy_from(&(-v3(lk.arm).cross_matrix()));
@@ -94,7 +94,8 @@ fn end_map(motion: PlatformMotion, lk: &LegKin<f64>) -> DMatrix<f64> {
 /// acceleration of every leg, from `u` and `u̇` (base frame).
 fn end_motion(motion: PlatformMotion, lk: &LegKin<f64>, u: &[f64], ud: &[f64]) -> (V<f64>, V<f64>) {
     match motion {
-        PlatformMotion::Pose => {
+        // A 1T2R platform's `u`, `u̇` arrive as its twist `t = S u` and rate (`terms`).
+        PlatformMotion::Pose | PlatformMotion::HeaveTilt { .. } => {
             let (w, wd) = (v3([u[0], u[1], u[2]]), v3([ud[0], ud[1], ud[2]]));
             let (v, a) = (v3([u[3], u[4], u[5]]), v3([ud[3], ud[4], ud[5]]));
             let arm = v3(lk.arm);
@@ -153,17 +154,29 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
     let mut a = DMatrix::zeros(n, n);
     let g_world = v3(plan.gravity);
     let zero = vec![0.0; n];
+    // A 1T2R platform: its twist map `S` (6 × 3), the twist `S u` and its rate at `u̇ = 0`,
+    // `Ṡ u`, drive the 6-DOF pose's terms.
+    let par = pl.parasitic.map(|p| {
+        let s6 = DMatrix::from_fn(6, 3, |i, j| p.s[i][j]);
+        (s6, p.twist(u), p.twist_rate(u, &zero))
+    });
     let mut b = 0;
     for (li, (lp, lk)) in plan.legs.iter().zip(&legs).enumerate() {
         let frame = m3(&lk.frame);
         // L_J = J_J⁻¹ Fᵀ G (rows in joint order; J_J⁻¹ acts on leg-frame vectors).
-        let g = end_map(plan.motion, lk);
+        let g = match &par {
+            Some((s6, _, _)) => end_map(plan.motion, lk) * s6,
+            None => end_map(plan.motion, lk),
+        };
         let jinv = Matrix3::from_fn(|i, j| lk.jinv[i][j]);
         let lj = jinv * frame.transpose() * &g;
         l.view_mut((3 * li, 0), (3, n)).copy_from(&lj);
         a.row_mut(li).copy_from(&lj.row(lp.actuated));
         // Twist rates at u̇ = 0: the joint accelerations L̇ u and the bodies' motions.
-        let (ve, ae) = end_motion(plan.motion, lk, u, &zero);
+        let (ve, ae) = match &par {
+            Some((_, t6, td6)) => end_motion(plan.motion, lk, t6, td6),
+            None => end_motion(plan.motion, lk, u, &zero),
+        };
         let (_, qdd0, motion) = leg_motion(lp, lk, ve, ae);
         for k in 0..3 {
             ld_u[3 * li + k] = qdd0[k];
@@ -224,6 +237,32 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             let w = v3([0.0, 0.0, u[2]]);
             td_u.fixed_rows_mut::<3>(6 * b + 3)
                 .copy_from(&w.cross(&w.cross(&rc)));
+            let inertia = rot * m3(&inertia) * rot.transpose();
+            put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
+        }
+        PlatformMotion::HeaveTilt { .. } => {
+            // T_P = T₆ S with T₆ = [1₃ 0; −CPM(r_c) 1₃]; Ṫ u = T₆ Ṡ u + [0; ω × (ω × r_c)].
+            let Some((s6, t6, td6)) = &par else {
+                return Err(Singular {
+                    site: Site::Platform,
+                    value: 0.0,
+                    condition_estimate: f64::INFINITY,
+                });
+            };
+            let rot = m3(&pl.rot);
+            let rc = rot * v3(com);
+            let mut tp = DMatrix::zeros(6, 6);
+            tp.view_mut((0, 0), (3, 3)).copy_from(&Matrix3::identity());
+            tp.view_mut((3, 0), (3, 3)).copy_from(&(-rc.cross_matrix()));
+            tp.view_mut((3, 3), (3, 3)).copy_from(&Matrix3::identity());
+            t.view_mut((6 * b, 0), (6, 3)).copy_from(&(&tp * s6));
+            let w = v3([t6[0], t6[1], t6[2]]);
+            let mut rate = &tp * DVector::from_column_slice(td6);
+            let extra = w.cross(&w.cross(&rc));
+            for i in 0..3 {
+                rate[3 + i] += extra[i];
+            }
+            td_u.rows_mut(6 * b, 6).copy_from(&rate);
             let inertia = rot * m3(&inertia) * rot.transpose();
             put_body(&mut m, &mut gravity, b, inertia, mass, g_world);
         }

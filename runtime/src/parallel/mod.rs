@@ -8,7 +8,9 @@
 //!   ([`PlatformMotion::Orientation`]: `x = [qw, qx, qy, qz]`, `u = ω`), or its position with
 //!   the orientation fixed ([`PlatformMotion::Translation`]: `x = [px, py, pz]`, `u = v`; a Delta
 //!   robot), or its planar pose ([`PlatformMotion::PlanarPose`]: `x = [px, py, φ]`,
-//!   `u = [vx, vy, ω]`; a planar 3-RRR). Base-frame components;
+//!   `u = [vx, vy, ω]`; a planar 3-RRR), or its heave and two tilts with parasitic motion
+//!   ([`PlatformMotion::HeaveTilt`]: `x = [pz, α, β]`, `u = [ż, α̇, β̇]`, the twist `S(x) u`;
+//!   a 3-PRS or 3-RPS head). Base-frame components;
 //!   `v` is the velocity of the platform frame's origin.
 //! * Leg `J` is a serial chain of one-DOF joints (U joints arrive expanded into two revolutes with
 //!   a massless body between them) whose last body meets the platform in a spherical joint (pose)
@@ -73,6 +75,20 @@ pub enum PlatformMotion {
         /// The platform's home rotation (platform → base).
         rotation: crate::model::Mat3,
     },
+    /// Three DOF, one translation and two rotations with parasitic motion (1T2R: a 3-PRS or
+    /// 3-RPS tilting head). The full pose is the origin `p = (px, py, pz)` and the rotation
+    /// `R = Rz(γ)·Ry(β)·Rx(α)·rotation` (base-frame axes; `rotation` the home rotation);
+    /// `x = [pz, α, β]` (heave in m, then the two tilts in rad, zero at home), `u = [ż, α̇, β̇]`,
+    /// so that `x ⊕ δu` is a sum. The parasitic components `(px, py, γ)` follow from the legs'
+    /// constraints: leg `i` keeps its S centre in a fixed plane (`nᵢ·(p + R sᵢ − bᵢ) = 0`),
+    /// solved by `noc::PARASITIC_ITERATIONS` Newton steps from their home values `xy`, `0`
+    /// (docs/method.md, "Parasitic motion"). The twist is `t = [ω; v] = S(x) u`.
+    HeaveTilt {
+        /// The platform's home rotation (platform → base).
+        rotation: crate::model::Mat3,
+        /// The platform origin's home `(px, py)` (base frame, m): the Newton steps' start.
+        xy: [f64; 2],
+    },
 }
 
 impl PlatformMotion {
@@ -82,7 +98,9 @@ impl PlatformMotion {
             PlatformMotion::Pose => 7,
             PlatformMotion::Orientation { .. } => 4,
             PlatformMotion::PlanarPoint { .. } => 2,
-            PlatformMotion::Translation { .. } | PlatformMotion::PlanarPose { .. } => 3,
+            PlatformMotion::Translation { .. }
+            | PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. } => 3,
         }
     }
     /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
@@ -91,7 +109,9 @@ impl PlatformMotion {
             PlatformMotion::Pose => 6,
             PlatformMotion::Orientation { .. } => 3,
             PlatformMotion::PlanarPoint { .. } => 2,
-            PlatformMotion::Translation { .. } | PlatformMotion::PlanarPose { .. } => 3,
+            PlatformMotion::Translation { .. }
+            | PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. } => 3,
         }
     }
     /// The unit group of each speed (`u`'s columns of the actuation matrix `A`): speeds of one
@@ -105,7 +125,13 @@ impl PlatformMotion {
             PlatformMotion::Orientation { .. } | PlatformMotion::Translation { .. } => &[0, 0, 0],
             PlatformMotion::PlanarPoint { .. } => &[0, 0],
             PlatformMotion::PlanarPose { .. } => &[0, 0, 1],
+            PlatformMotion::HeaveTilt { .. } => &[0, 1, 1],
         }
+    }
+    /// Whether the platform has parasitic motion (`HeaveTilt`): its pose follows from `x` by
+    /// the legs' constraints, and `x ⊕ δu` is a sum.
+    pub fn parasitic(&self) -> bool {
+        matches!(self, PlatformMotion::HeaveTilt { .. })
     }
     /// Whether the platform moves in a plane and turns about its normal (`PlanarPose`).
     pub fn planar_pose(&self) -> bool {
@@ -255,6 +281,7 @@ impl ParallelModel {
             PlatformMotion::PlanarPose { .. } => {
                 alloc::vec![self.home.translation[0], self.home.translation[1], 0.0]
             }
+            PlatformMotion::HeaveTilt { .. } => alloc::vec![self.home.translation[2], 0.0, 0.0],
         }
     }
 
@@ -481,6 +508,14 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
             }
             kind
         }
+        (PlatformMotion::HeaveTilt { .. }, LegEnd::Spherical { .. }, [_, _]) => {
+            heave_tilt_leg(leg, &kinds, &ax, tol)?
+        }
+        (PlatformMotion::HeaveTilt { .. }, _, _) => {
+            return Err(format!(
+                "leg {name}: a 1T2R platform in (pz, α, β) needs legs P-R or R-P whose S centre moves in a plane (P-R-S: a slider, then a revolute whose axis is perpendicular to the rail; R-P-S: a revolute, then a prismatic along the line from its axis to the S centre, perpendicular to it) that end in a spherical joint"
+            ));
+        }
         (PlatformMotion::PlanarPose { .. }, _, _) => {
             return Err(format!(
                 "leg {name}: a planar platform in (x, y, φ) needs legs of two joints in the plane (R-R, P-R or R-P: revolute axes along z, prismatic directions in the plane) that end in a revolute about z at a point of the platform"
@@ -532,6 +567,58 @@ fn planar_leg(kinds: &[JointKind], ax: &[(Vec3, Vec3)]) -> Option<LegKind> {
         ([R, P], [a, b]) if along_z(&a.0) && in_plane(&b.0) => Some(LegKind::PlanarRp),
         _ => None,
     }
+}
+
+/// The leg type of a two-joint leg of a 1T2R platform ([`PlatformMotion::HeaveTilt`]): P-R
+/// with the revolute axis perpendicular to the rail ([`LegKind::PlanarPr`] in the plane
+/// normal to that axis), or R-P with the prismatic direction perpendicular to the revolute
+/// axis and along the line from it to the S centre ([`LegKind::PlanarRp`]). Either keeps the
+/// S centre in the plane through the revolute's point normal to its axis.
+fn heave_tilt_leg(
+    leg: &Leg,
+    kinds: &[JointKind],
+    ax: &[(Vec3, Vec3)],
+    tol: f64,
+) -> Result<LegKind, String> {
+    use JointKind::{Prismatic as P, Revolute as R};
+    let name = &leg.name;
+    let tip = leg_tip_home(leg);
+    let (kind, n, o) = match kinds {
+        [P, R] => (LegKind::PlanarPr, ax[1].0, ax[1].1),
+        [R, P] => (LegKind::PlanarRp, ax[0].0, ax[0].1),
+        _ => {
+            return Err(format!(
+                "leg {name}: a 1T2R platform's leg is P-R-S or R-P-S (two joints, then the spherical joint)"
+            ));
+        }
+    };
+    if dot(&ax[0].0, &ax[1].0).abs() > 1e-9 {
+        return Err(format!(
+            "leg {name}: its joints {} and {} are not perpendicular (a P-R-S leg's revolute axis is perpendicular to its rail; an R-P-S leg's prismatic direction is perpendicular to its revolute axis), so the S centre does not stay in one plane",
+            leg.joints[0].name, leg.joints[1].name
+        ));
+    }
+    // The S centre lies in the plane through the revolute's point normal to its axis.
+    if dot(&n, &sub(&tip, &o)).abs() > tol {
+        return Err(format!(
+            "leg {name}: its spherical joint's centre is not in the plane of its revolute joint {} (the plane through the joint's point perpendicular to its axis)",
+            leg.joints[if kind == LegKind::PlanarPr { 1 } else { 0 }].name
+        ));
+    }
+    if kind == LegKind::PlanarRp {
+        let h = sub(&tip, &ax[0].1);
+        let h = sub(
+            &h,
+            &[n[0] * dot(&n, &h), n[1] * dot(&n, &h), n[2] * dot(&n, &h)],
+        );
+        if norm(&cross(&h, &ax[1].0)) > tol {
+            return Err(format!(
+                "leg {name}: its prismatic joint {} does not slide along the line from its revolute joint {} to the spherical joint",
+                leg.joints[1].name, leg.joints[0].name
+            ));
+        }
+    }
+    Ok(kind)
 }
 
 /// The leg's end point at home in the base frame (spherical end), or the last body's origin.

@@ -38,6 +38,9 @@
 //!   leg of a translational platform whose rod (a parallelogram's equivalent) has no spin
 //!   inertia, with the scalar leg Jacobian `s = d·(e₀ × (E − O))`.
 //! * `pose.rs`: step 1, the platform's pose ([`Platform`]).
+//! * `parasitic.rs`: step 1 of a 1T2R platform (`HeaveTilt`): the parasitic components by
+//!   the legs' constraints, the twist map `t = S(x) u` and its rate ([`Parasitic`]); every
+//!   later step runs as for a 6-DOF pose with `t`, `ṫ`, then projects by `Sᵀ`.
 //! * `subproblems.rs`: the Paden–Kahan subproblems of step 2.
 //! * `legs.rs`: steps 2–3, [`leg_kinematics`] ([`LegKin`]) and [`kinematics`] of every leg;
 //!   step 6's [`actuation_matrix`].
@@ -69,6 +72,7 @@ mod inertia;
 mod legs;
 mod lu;
 mod motion;
+mod parasitic;
 mod plan;
 mod pose;
 mod subproblems;
@@ -80,7 +84,7 @@ pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, Stop, check_finite, solve
 pub use api::{
     actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics, friction,
     generalized_effort, gravity, inverse_dynamics, inverse_kinematics, leg_joint_positions,
-    mass_matrix, potential_energy,
+    mass_matrix, platform_pose, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
 pub use delta::{DeltaKin, DeltaPlan};
@@ -95,6 +99,9 @@ pub use legs::{
 };
 pub use lu::lu_solve;
 pub(crate) use motion::leg_motion;
+pub use parasitic::{
+    FullPose, PARASITIC_ITERATIONS, PARASITIC_TOLERANCE, Parasitic, parasitic, parasitic_pose,
+};
 pub use plan::{LegPlan, Plan};
 pub use pose::{Platform, platform};
 pub use ups::{UpsBody, UpsKin, UpsPlan};

@@ -63,6 +63,7 @@ impl Workspace for Platform {
             PlatformMotion::PlanarPoint { .. } => &["px", "py"],
             PlatformMotion::Translation { .. } => &["px", "py", "pz"],
             PlatformMotion::PlanarPose { .. } => &["px", "py", "phi"],
+            PlatformMotion::HeaveTilt { .. } => &["pz", "alpha", "beta"],
         };
         names.iter().map(|n| String::from(*n)).collect()
     }
@@ -74,6 +75,9 @@ impl Workspace for Platform {
             PlatformMotion::Translation { .. } => vec![Speed::Translation; 3],
             PlatformMotion::PlanarPose { .. } => {
                 vec![Speed::Translation, Speed::Translation, Speed::Rotation]
+            }
+            PlatformMotion::HeaveTilt { .. } => {
+                vec![Speed::Translation, Speed::Rotation, Speed::Rotation]
             }
         }
     }
@@ -106,6 +110,24 @@ impl Workspace for Platform {
                     revolute: true,
                 },
             ],
+            // The tilts are coordinates of x (no quaternion): stepped as joint angles.
+            PlatformMotion::HeaveTilt { .. } => vec![
+                Axis::Position {
+                    name: "pz".into(),
+                    index: 0,
+                    home: home[0],
+                },
+                Axis::Joint {
+                    name: "alpha".into(),
+                    index: 1,
+                    revolute: true,
+                },
+                Axis::Joint {
+                    name: "beta".into(),
+                    index: 2,
+                    revolute: true,
+                },
+            ],
         }
     }
     fn quaternion(&self) -> Option<usize> {
@@ -114,7 +136,8 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => Some(0),
             PlatformMotion::PlanarPoint { .. }
             | PlatformMotion::Translation { .. }
-            | PlatformMotion::PlanarPose { .. } => None,
+            | PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. } => None,
         }
     }
     fn inertia(&self, x: &[f64], space: Space) -> Result<DMatrix<f64>, EvalError> {
@@ -146,7 +169,9 @@ impl Workspace for Platform {
                         ("kg", "m/s^2 per unit effort")
                     }
                     PlatformMotion::Pose => ("kg m^2 | kg m | kg (mixed)", "mixed"),
-                    PlatformMotion::PlanarPose { .. } => ("kg | kg m | kg m^2 (mixed)", "mixed"),
+                    PlatformMotion::PlanarPose { .. } | PlatformMotion::HeaveTilt { .. } => {
+                        ("kg | kg m | kg m^2 (mixed)", "mixed")
+                    }
                 };
                 InertiaWords {
                     matrix: "generalized inertia I in platform speeds u (mass_matrix), efforts tau = A^-T I u'",
@@ -165,7 +190,9 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => (0.3, 0.0),
             PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
             PlatformMotion::Translation { .. } => (0.0, 0.02 * self.model.size()),
-            PlatformMotion::PlanarPose { .. } => (0.1, 0.02 * self.model.size()),
+            PlatformMotion::PlanarPose { .. } | PlatformMotion::HeaveTilt { .. } => {
+                (0.1, 0.02 * self.model.size())
+            }
         };
         self.speeds()
             .iter()

@@ -33,6 +33,7 @@ macro_rules! for_each_mechanism {
             delta_rl5,
             planar_3rrr,
             tsai_3upu,
+            prs_head,
             // Closed loops in joint coordinates.
             four_bar,
             five_bar_joints,

@@ -87,7 +87,8 @@ export_parallel!(
     planar_five_bar,
     delta_rl5,
     planar_3rrr,
-    tsai_3upu
+    tsai_3upu,
+    prs_head
 );
 
 macro_rules! export_closed {

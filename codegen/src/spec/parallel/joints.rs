@@ -136,6 +136,7 @@ fn check_closing_joint(
             Coordinates::Planar => (Kind::Revolute, "planar"),
             Coordinates::Translation => (Kind::Spherical, "translation"),
             Coordinates::PlanarPose => (Kind::Revolute, "planar_pose"),
+            Coordinates::HeaveTilt => (Kind::Spherical, "heave_tilt"),
         };
         // Tsai's 3-UPU: a universal joint into a translational platform (its cross is massless
         // and, with ω = 0, its angles follow from the leg's; docs/spec.md).

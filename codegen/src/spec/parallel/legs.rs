@@ -41,6 +41,12 @@ const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
     &[JointKind::Prismatic, JointKind::Revolute],
     &[JointKind::Revolute, JointKind::Prismatic],
 ];
+const SUPPORTED_HEAVE_TILT: &[&[JointKind]] = &[
+    &[JointKind::Prismatic, JointKind::Revolute],
+    &[JointKind::Revolute, JointKind::Prismatic],
+];
+/// The hint of an unsupported leg of a 1T2R platform.
+pub(super) const SUPPORTED_HEAVE_TILT_HINT: &str = "supported legs for coordinates = \"heave_tilt\": P-R-S (a slider, then a revolute whose axis is perpendicular to the rail, then the spherical joint at the platform) or R-P-S (a revolute, then a prismatic perpendicular to its axis along the line to the S centre, then the spherical joint); each keeps its S centre in the plane of its revolute joint; one of the two leg joints actuated";
 /// The hint of an unsupported leg of a planar 3-DOF platform.
 pub(super) const SUPPORTED_PLANAR_POSE_HINT: &str = "supported legs for coordinates = \"planar_pose\": two joints in the plane, then the revolute about z into the platform: R-R-R (revolute axes along z), P-R-R (a slider in the plane, then the rod) or R-P-R (a revolute about z, then a prismatic along the line to the platform point); one of the two leg joints actuated";
 pub(super) const SUPPORTED_HINT: &str = "supported legs: for coordinates = \"pose\" any three revolute or prismatic joints (a U counts as two revolutes) ending in a spherical joint, in closed form for UPS, PUS and RUS and by Newton otherwise; R-R-R with every axis through the centre for coordinates = \"orientation\"; for coordinates = \"planar\" R-R-R with every axis along z (a five-bar's R-R leg, then the revolute at the platform point); for coordinates = \"translation\" a revolute crank with a [[parallelogram]] (a Delta leg), a U-P leg ending in a universal joint (Tsai's 3-UPU), or the legs of \"pose\"";
@@ -302,6 +308,7 @@ fn check_leg_type(
         Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
         Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE,
+        Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT,
     };
     if !supported.contains(&kinds.as_slice()) {
         let word: Vec<&str> = spec_path
@@ -317,10 +324,10 @@ fn check_leg_type(
             ))
             .with_key(j.key.clone())
             .with_span(j.span.clone())
-            .with_hint(if motion == Coordinates::PlanarPose {
-                SUPPORTED_PLANAR_POSE_HINT
-            } else {
-                SUPPORTED_HINT
+            .with_hint(match motion {
+                Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE_HINT,
+                Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT_HINT,
+                _ => SUPPORTED_HINT,
             }),
         );
     }

@@ -22,6 +22,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Planar => (3, 2, "planar, λ = 3"),
         Coordinates::Translation => (6, 3, "spatial, λ = 6"),
         Coordinates::PlanarPose => (3, 3, "planar, λ = 3"),
+        Coordinates::HeaveTilt => (6, 3, "spatial, λ = 6"),
     };
     // A parallelogram is counted as what it is, two rods with a ball joint at each end
     // (2 bodies, 4 S joints), not as its expansion (the equivalent rod, a U and an S: 1 body,
@@ -51,6 +52,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Planar => "planar",
         Coordinates::Translation => "translation",
         Coordinates::PlanarPose => "planar_pose",
+        Coordinates::HeaveTilt => "heave_tilt",
     };
     if m != dof {
         diags.push(
@@ -67,6 +69,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
                     Coordinates::Planar => ": each leg of a planar five-bar is R-R, joined at the point by a revolute",
                     Coordinates::Translation => ": each leg of a Delta is a revolute crank carrying a [[parallelogram]] (two ball–ball rods, their idle spins not counted)",
                     Coordinates::PlanarPose => ": each leg of a planar 3-DOF platform is R-R, P-R or R-P in the plane, joined to the platform by a revolute about z",
+                    Coordinates::HeaveTilt => ": each leg of a 1T2R platform is P-R-S or R-P-S (5 DOF, one constraint each)",
                 }
             )),
         );

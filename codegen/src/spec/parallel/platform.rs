@@ -31,9 +31,12 @@ pub(super) fn check_platform(
     diags: &mut Diagnostics,
 ) -> Option<usize> {
     match ps.coordinates {
-        Some(Coordinates::Pose | Coordinates::Translation | Coordinates::PlanarPose)
-            if ps.centre.is_some() =>
-        {
+        Some(
+            Coordinates::Pose
+            | Coordinates::Translation
+            | Coordinates::PlanarPose
+            | Coordinates::HeaveTilt,
+        ) if ps.centre.is_some() => {
             diags.push(
                 Diagnostic::error("`centre` is only for coordinates = \"orientation\"")
                     .with_key("platform.centre")
@@ -203,6 +206,10 @@ pub(super) fn assemble(
         Coordinates::PlanarPose => PlatformMotion::PlanarPose {
             height: ps.home.translation[2],
             rotation: ps.home.rotation,
+        },
+        Coordinates::HeaveTilt => PlatformMotion::HeaveTilt {
+            rotation: ps.home.rotation,
+            xy: [ps.home.translation[0], ps.home.translation[1]],
         },
     };
     let parts: Vec<MassProps> = parts

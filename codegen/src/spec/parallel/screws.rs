@@ -134,6 +134,12 @@ fn declared(motion: &PlatformMotion, size: f64) -> Option<Declared> {
         // rigid body's twist. The planar five-bar's legs are checked by their type instead
         // (every axis along z).
         PlatformMotion::PlanarPoint { .. } => None,
+        // A 1T2R platform's S is built from the legs' own plane constraints
+        // (runtime/src/parallel/noc/parasitic.rs): with the leg geometry its leg-type check
+        // requires (each revolute axis perpendicular to its rail, the S centre in the
+        // revolute's plane) the legs allow exactly its span, and the check would compare the
+        // legs with themselves.
+        PlatformMotion::HeaveTilt { .. } => None,
         // In-plane translations and the turn about the plane normal (through any point: with
         // the translations they span the same).
         PlatformMotion::PlanarPose { .. } => Some((

@@ -7,7 +7,7 @@
 use runtime::model::{Transform, Vec3, mat_mul, mat_vec};
 use runtime::parallel::{GEOMETRY_TOLERANCE, LegEnd, ParallelModel, PlatformMotion};
 
-use super::legs::{SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
+use super::legs::{SUPPORTED_HEAVE_TILT_HINT, SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
 use crate::spec::ir::{Coordinates, Kind, PlatformSpec, Spec};
@@ -319,6 +319,8 @@ fn validate_diagnostic(
         "at home every leg joint is at zero: place the leg's joint frames (`origin`) so that the joint on the leg meets `child_origin` on the platform at platform.home"
     } else if ps.coordinates == Some(Coordinates::PlanarPose) {
         SUPPORTED_PLANAR_POSE_HINT
+    } else if ps.coordinates == Some(Coordinates::HeaveTilt) {
+        SUPPORTED_HEAVE_TILT_HINT
     } else {
         SUPPORTED_HINT
     };

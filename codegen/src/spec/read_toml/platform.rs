@@ -67,7 +67,7 @@ impl Reader<'_> {
     }
 
     /// `platform.coordinates`: `"pose"`, `"orientation"`, `"planar"`, `"translation"` or
-    /// `"planar_pose"`.
+    /// `"planar_pose"` or `"heave_tilt"`.
     fn coordinates(&mut self, c: &Val<'_>) -> Option<Coordinates> {
         let s = self.string(c, "platform.coordinates")?;
         match s.as_str() {
@@ -76,13 +76,21 @@ impl Reader<'_> {
             "planar" => Some(Coordinates::Planar),
             "translation" => Some(Coordinates::Translation),
             "planar_pose" => Some(Coordinates::PlanarPose),
+            "heave_tilt" => Some(Coordinates::HeaveTilt),
             other => {
                 let hint = suggest_hint(
                     &other.to_ascii_lowercase(),
-                    &["pose", "orientation", "planar", "translation", "planar_pose"],
+                    &[
+                        "pose",
+                        "orientation",
+                        "planar",
+                        "translation",
+                        "planar_pose",
+                        "heave_tilt",
+                    ],
                 )
                 .unwrap_or_else(|| {
-                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF), \"translation\" (position, orientation fixed, 3 DOF) or \"planar_pose\" (position in a plane and rotation about its normal, 3 DOF)".into()
+                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF), \"translation\" (position, orientation fixed, 3 DOF) \"planar_pose\" (position in a plane and rotation about its normal, 3 DOF) or \"heave_tilt\" (heave and two tilts with parasitic motion, 3 DOF: a 3-PRS or 3-RPS head)".into()
                 });
                 self.err(
                     format!("unknown platform coordinates {other:?}"),

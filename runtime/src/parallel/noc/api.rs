@@ -11,7 +11,9 @@ use super::force::generalized_force;
 use super::inertia::generalized_inertia;
 use super::legs::{JointPos, actuated_positions, actuation_matrix, kinematics, positions};
 use super::lu::solve_dyn;
+use super::parasitic::parasitic_pose;
 use super::plan::Plan;
+use super::pose::platform;
 use crate::algebra::{V, add, dot, mv};
 use crate::scalar::Singular;
 use crate::solve::check_finite;
@@ -27,6 +29,31 @@ pub fn inverse_kinematics(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> 
     check_finite(&[x])?;
     let (_, legs) = positions(plan, x)?;
     finite(actuated_positions(plan, &legs))
+}
+
+/// The platform's full pose at `x`, `[px, py, pz, qw, qx, qy, qz]` (the platform frame's
+/// origin, m, and its unit quaternion, platform → base): for a 1T2R platform (`HeaveTilt`)
+/// the parasitic components `px`, `py` and the turn `γ` about `z` come from the legs'
+/// constraints, the quaternion is `qz(γ) ⊗ qy(β) ⊗ qx(α) ⊗ q_home` ([`parasitic_pose`], as the
+/// generated `platform_pose`); for the others it is the rotation's with `qw ≥ 0`.
+pub fn platform_pose(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
+    check_finite(&[x])?;
+    if plan.motion.parasitic() {
+        return finite(parasitic_pose(plan, x)?.to_vec());
+    }
+    let pl = platform(plan, x)?;
+    let q = crate::model::matrix_quaternion(&pl.rot);
+    let s = if q[0] < 0.0 { -1.0 } else { 1.0 };
+    let o = pl.origin;
+    finite(vec![
+        o[0],
+        o[1],
+        o[2],
+        s * q[0],
+        s * q[1],
+        s * q[2],
+        s * q[3],
+    ])
 }
 
 /// Every leg's joint positions (rad or m, the spec's joint order after U expansion) at `x`.
@@ -49,8 +76,8 @@ pub fn leg_joint_positions(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sing
 /// The actuation matrix `A` at `x` (`q̇ = A u`).
 pub fn actuation(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Singular> {
     check_finite(&[x])?;
-    let (_, legs) = kinematics(plan, x)?;
-    Ok(actuation_matrix(plan, &legs))
+    let (pl, legs) = kinematics(plan, x)?;
+    Ok(actuation_matrix(plan, &pl, &legs))
 }
 
 /// Actuator rates `q̇ = A u`.
@@ -74,7 +101,7 @@ pub fn inverse_dynamics(
     check_finite(&[x, u, ud])?;
     let (pl, legs) = kinematics(plan, x)?;
     let f = generalized_force(plan, &pl, &legs, u, ud, true);
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
@@ -85,7 +112,7 @@ pub fn gravity(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
     let (pl, legs) = kinematics(plan, x)?;
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(plan, &pl, &legs, &z, &z, true);
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
@@ -96,7 +123,7 @@ pub fn coriolis(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular>
     let (pl, legs) = kinematics(plan, x)?;
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(&plan.without_friction(), &pl, &legs, u, &z, false);
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
@@ -107,7 +134,7 @@ pub fn friction(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular>
     let (pl, legs) = kinematics(plan, x)?;
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(&plan.friction_only(), &pl, &legs, u, &z, false);
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     solve_dyn(&a, &f, true, plan.motion.unit_groups())
 }
 
@@ -137,7 +164,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
     check_finite(&[x])?;
     let (pl, legs) = kinematics(plan, x)?;
     let i = generalized_inertia(plan, &pl, &legs);
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     let n = plan.dof();
     // B = I A⁻¹ column by column (A⁻¹ e_j), then A⁻ᵀ B.
     let mut b = vec![vec![0.0; n]; n];

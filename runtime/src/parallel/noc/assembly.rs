@@ -39,7 +39,8 @@ pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
         PlatformMotion::Orientation { .. } => (0, None),
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
-        | PlatformMotion::PlanarPose { .. } => {
+        | PlatformMotion::PlanarPose { .. }
+        | PlatformMotion::HeaveTilt { .. } => {
             return x.iter().zip(du).map(|(a, b)| a + b).collect();
         }
     };
@@ -109,7 +110,7 @@ pub fn forward_kinematics(
         })
         .collect();
     let residual = |x: &[f64]| -> Option<(Vec<f64>, f64, Vec<Vec<f64>>)> {
-        let (_, legs) = kinematics(plan, x).ok()?;
+        let (pl, legs) = kinematics(plan, x).ok()?;
         let qx = actuated_positions(plan, &legs);
         let r: Vec<f64> = (0..n)
             .map(|i| {
@@ -121,7 +122,7 @@ pub fn forward_kinematics(
         if !m.is_finite() {
             return None;
         }
-        Some((r, m, actuation_matrix(plan, &legs)))
+        Some((r, m, actuation_matrix(plan, &pl, &legs)))
     };
     let mut x = retract(plan.motion, guess, &vec![0.0; n]);
     let Some(mut cur) = residual(&x) else {

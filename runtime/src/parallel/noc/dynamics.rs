@@ -44,7 +44,7 @@ pub fn forward_dynamics_with<R: Real>(
             h[i] = h[i] + hp[i];
         }
     }
-    let a = actuation_matrix(plan, &legs);
+    let a = actuation_matrix(plan, &pl, &legs);
     let rhs: Vec<R> = (0..n)
         .map(|i| {
             let mut s = -h[i];

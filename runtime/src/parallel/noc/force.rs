@@ -41,19 +41,54 @@ pub fn generalized_force_with<R: Real>(
     gravity: bool,
     drives: Option<&DriveInputs<R>>,
 ) -> Vec<R> {
-    let dof = plan.dof();
+    match &pl.parasitic {
+        // A 1T2R platform: the 6-DOF pose's force of t = S u, ṫ = S u̇ + Ṡ u, then Sᵀ.
+        Some(par) => {
+            let (t, td) = (par.twist(u), par.twist_rate(u, ud));
+            let f6 = force_in(
+                plan,
+                PlatformMotion::Pose,
+                pl,
+                legs,
+                &t,
+                &td,
+                gravity,
+                drives,
+            );
+            par.project(&f6)
+        }
+        None => force_in(plan, plan.motion, pl, legs, u, ud, gravity, drives),
+    }
+}
+
+/// [`generalized_force_with`] for the speeds of `motion`.
+#[allow(clippy::too_many_arguments)]
+fn force_in<R: Real>(
+    plan: &Plan,
+    motion: PlatformMotion,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+    drives: Option<&DriveInputs<R>>,
+) -> Vec<R> {
+    let dof = motion.dof();
     let mut f: Vec<R> = vec![R::c(0.0); dof];
     let g_world: Vec3 = if gravity { plan.gravity } else { [0.0; 3] };
-    let planar = plan.motion.translates();
+    let planar = motion.translates();
     // Platform angular velocity and acceleration (a planar point or a translational platform
     // does not turn).
-    let (w, wd) = angular(plan.motion, u, ud);
+    let (w, wd) = angular(motion, u, ud);
     for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
         let n = lp.joints.len();
         // End velocity and acceleration (base frame), then in L.
-        let (v_end, a_end) = match plan.motion {
-            PlatformMotion::Pose | PlatformMotion::PlanarPose { .. } => {
-                let (v, a) = linear(plan.motion, u, ud);
+        let (v_end, a_end) = match motion {
+            // (A 1T2R platform arrives here as a 6-DOF pose with its twist.)
+            PlatformMotion::Pose
+            | PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. } => {
+                let (v, a) = linear(motion, u, ud);
                 let v_end = add(v, cross(w, lk.arm));
                 let a_end = add(add(a, cross(wd, lk.arm)), cross(w, cross(w, lk.arm)));
                 (v_end, a_end)
@@ -76,7 +111,7 @@ pub fn generalized_force_with<R: Real>(
         }
         if let (Some(up), Some(uk), None) = (&lp.ups, &lk.ups, drives) {
             let y = ups_force(up, uk, v_end, a_end, cv(&g_world));
-            if let PlatformMotion::Translation { .. } = plan.motion {
+            if let PlatformMotion::Translation { .. } = motion {
                 for i in 0..3 {
                     f[i] = f[i] + y[i];
                 }
@@ -89,7 +124,7 @@ pub fn generalized_force_with<R: Real>(
             }
             continue;
         }
-        let (qd, qdd, motion) = leg_motion(lp, lk, v_end, a_end);
+        let (qd, qdd, bodies) = leg_motion(lp, lk, v_end, a_end);
         // Body wrenches (about each mass centre) and the leg's joint efforts.
         let g_l = mtv(&lk.frame, cv::<R>(&g_world));
         let mut force = zero3::<R>();
@@ -100,7 +135,7 @@ pub fn generalized_force_with<R: Real>(
             let massless = mass == 0.0 && inertia.iter().flatten().all(|&x| x == 0.0);
             if !massless {
                 let c = lk.com[k];
-                let m = &motion[k];
+                let m = &bodies[k];
                 let a = m.accel_at(lk.o[k], c);
                 let nk = euler(&lk.rot[k], &inertia, m.w, m.alpha);
                 let fk = scale(R::c(mass), sub(a, g_l));
@@ -128,8 +163,8 @@ pub fn generalized_force_with<R: Real>(
             scale(tau[2], lk.jinv[2]),
         );
         let y = mv(&lk.frame, y_l);
-        match plan.motion {
-            PlatformMotion::Pose => {
+        match motion {
+            PlatformMotion::Pose | PlatformMotion::HeaveTilt { .. } => {
                 let m = cross(lk.arm, y);
                 for i in 0..3 {
                     f[i] = f[i] + m[i];
@@ -166,11 +201,11 @@ pub fn generalized_force_with<R: Real>(
     }
     let (mass, com, inertia) = plan.platform;
     let r = mv(&pl.rot, cv::<R>(&com));
-    let (a0, _) = linear(plan.motion, ud, ud);
+    let (a0, _) = linear(motion, ud, ud);
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(R::c(mass), sub(a, cv(&g_world)));
     let np = add(euler(&pl.rot, &inertia, w, wd), cross(r, fp));
-    add_platform(plan.motion, &mut f, np, fp);
+    add_platform(motion, &mut f, np, fp);
     f
 }
 
@@ -179,9 +214,9 @@ pub fn generalized_force_with<R: Real>(
 pub(crate) fn angular<R: Real>(motion: PlatformMotion, u: &[R], ud: &[R]) -> (V<R>, V<R>) {
     let z = R::c(0.0);
     match motion {
-        PlatformMotion::Pose | PlatformMotion::Orientation { .. } => {
-            ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
-        }
+        PlatformMotion::Pose
+        | PlatformMotion::Orientation { .. }
+        | PlatformMotion::HeaveTilt { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         PlatformMotion::PlanarPose { .. } => ([z, z, u[2]], [z, z, ud[2]]),
         PlatformMotion::PlanarPoint { .. } | PlatformMotion::Translation { .. } => {
             (zero3(), zero3())
@@ -235,17 +270,44 @@ pub fn payload_force<R: Real>(
     ud: &[R],
     gravity: bool,
 ) -> Vec<R> {
-    let n = plan.dof();
+    match &pl.parasitic {
+        Some(par) => {
+            let (t, td) = (par.twist(u), par.twist_rate(u, ud));
+            par.project(&payload_in(
+                plan,
+                PlatformMotion::Pose,
+                pl,
+                payload,
+                &t,
+                &td,
+                gravity,
+            ))
+        }
+        None => payload_in(plan, plan.motion, pl, payload, u, ud, gravity),
+    }
+}
+
+/// [`payload_force`] for the speeds of `motion`.
+fn payload_in<R: Real>(
+    plan: &Plan,
+    motion: PlatformMotion,
+    pl: &Platform<R>,
+    payload: &Payload<R>,
+    u: &[R],
+    ud: &[R],
+    gravity: bool,
+) -> Vec<R> {
+    let n = motion.dof();
     let mut f = vec![R::c(0.0); n];
     let g: V<R> = cv(&if gravity { plan.gravity } else { [0.0; 3] });
-    if plan.motion.translates() {
+    if motion.translates() {
         for i in 0..n {
             f[i] = payload.mass * (ud[i] - g[i]);
         }
         return f;
     }
-    let (w, wd) = angular(plan.motion, u, ud);
-    let (a0, _) = linear(plan.motion, ud, ud);
+    let (w, wd) = angular(motion, u, ud);
+    let (a0, _) = linear(motion, ud, ud);
     let r = mv(&pl.rot, payload.com);
     let a = add(add(a0, cross(wd, r)), cross(w, cross(w, r)));
     let fp = scale(payload.mass, sub(a, g));
@@ -256,6 +318,6 @@ pub fn payload_force<R: Real>(
         cross(wb, mv(&payload.inertia, wb)),
     );
     let np = add(mv(&pl.rot, nb), cross(r, fp));
-    add_platform(plan.motion, &mut f, np, fp);
+    add_platform(motion, &mut f, np, fp);
     f
 }

@@ -57,16 +57,28 @@ pub fn payload_inertia<R: Real>(
     pl: &Platform<R>,
     payload: &Payload<R>,
 ) -> Vec<Vec<R>> {
-    let n = plan.dof();
+    match &pl.parasitic {
+        Some(par) => par.project_inertia(&payload_inertia_in(PlatformMotion::Pose, pl, payload)),
+        None => payload_inertia_in(plan.motion, pl, payload),
+    }
+}
+
+/// [`payload_inertia`] for the speeds of `motion`.
+fn payload_inertia_in<R: Real>(
+    motion: PlatformMotion,
+    pl: &Platform<R>,
+    payload: &Payload<R>,
+) -> Vec<Vec<R>> {
+    let n = motion.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
-    if plan.motion.translates() {
+    if motion.translates() {
         for (i, row) in out.iter_mut().enumerate() {
             row[i] = payload.mass;
         }
         return out;
     }
-    let cols = platform_columns(plan.motion, n, mv(&pl.rot, payload.com));
+    let cols = platform_columns(motion, n, mv(&pl.rot, payload.com));
     for i in 0..n {
         for j in i..n {
             let mut v = payload.mass * dot(cols[i].1, cols[j].1);
@@ -127,10 +139,25 @@ pub fn generalized_inertia_with<R: Real>(
     legs: &[LegKin<R>],
     drives: Option<&DriveInputs<R>>,
 ) -> Vec<Vec<R>> {
-    let n = plan.dof();
+    match &pl.parasitic {
+        // A 1T2R platform: Sᵀ I₆ S with the 6-DOF pose's inertia of the twist.
+        Some(par) => par.project_inertia(&inertia_in(plan, PlatformMotion::Pose, pl, legs, drives)),
+        None => inertia_in(plan, plan.motion, pl, legs, drives),
+    }
+}
+
+/// [`generalized_inertia_with`] for the speeds of `motion`.
+fn inertia_in<R: Real>(
+    plan: &Plan,
+    motion: PlatformMotion,
+    pl: &Platform<R>,
+    legs: &[LegKin<R>],
+    drives: Option<&DriveInputs<R>>,
+) -> Vec<Vec<R>> {
+    let n = motion.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
-    let pose = matches!(plan.motion, PlatformMotion::Pose);
+    let pose = matches!(motion, PlatformMotion::Pose);
     for (li, (lp, lk)) in plan.legs.iter().zip(legs).enumerate() {
         let armature: [Option<R>; 3] = match drives {
             Some(d) => core::array::from_fn(|k| d.armature.as_ref().map(|a| a[3 * li + k])),
@@ -163,7 +190,7 @@ pub fn generalized_inertia_with<R: Real>(
                     out[j][i] = out[j][i] + q[j];
                 }
             }
-        } else if let PlatformMotion::PlanarPose { .. } = plan.motion {
+        } else if let PlatformMotion::PlanarPose { .. } = motion {
             // G = [e_x, e_y, e_z × r] (v_end = v + ω × r): the upper triangle of Gᵀ Λ G.
             let r = lk.arm;
             let c2 = [-r[1], r[0], R::c(0.0)];
@@ -185,7 +212,7 @@ pub fn generalized_inertia_with<R: Real>(
             }
         }
     }
-    if plan.motion.translates() {
+    if motion.translates() {
         let (mass, _, _) = plan.platform;
         for i in 0..n {
             out[i][i] = out[i][i] + R::c(mass);
@@ -194,7 +221,7 @@ pub fn generalized_inertia_with<R: Real>(
     }
     // The platform: ω columns e_j with mass-centre velocity e_j × r_c; v columns (pose) e_j.
     let (mass, com, inertia) = plan.platform;
-    let cols = platform_columns(plan.motion, n, mv(&pl.rot, cv::<R>(&com)));
+    let cols = platform_columns(motion, n, mv(&pl.rot, cv::<R>(&com)));
     for i in 0..n {
         for j in i..n {
             let mut v = R::c(mass) * dot(cols[i].1, cols[j].1);

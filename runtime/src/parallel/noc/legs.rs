@@ -497,9 +497,15 @@ pub fn actuated_positions<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<R> {
         .collect()
 }
 
-/// The actuation matrix `A` (`q̇ = A u`), row-major `DOF × DOF`.
-pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>> {
-    plan.legs
+/// The actuation matrix `A` (`q̇ = A u`), row-major `DOF × DOF` (a 1T2R platform's is the
+/// 6-DOF pose's rows times its twist map: `A = A₆ S`).
+pub fn actuation_matrix<R: Real>(plan: &Plan, pl: &Platform<R>, legs: &[LegKin<R>]) -> Vec<Vec<R>> {
+    let motion = match pl.parasitic {
+        Some(_) => PlatformMotion::Pose,
+        None => plan.motion,
+    };
+    let rows: Vec<Vec<R>> = plan
+        .legs
         .iter()
         .zip(legs)
         .map(|(lp, lk)| {
@@ -511,8 +517,8 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                 (None, Some(dk)) => mv(&lk.frame, scale(dk.inv_s, dk.d)),
                 (None, None) => mv(&lk.frame, lk.jinv[lp.actuated]),
             };
-            match plan.motion {
-                PlatformMotion::Pose => {
+            match motion {
+                PlatformMotion::Pose | PlatformMotion::HeaveTilt { .. } => {
                     let m = cross(lk.arm, g);
                     vec![m[0], m[1], m[2], g[0], g[1], g[2]]
                 }
@@ -525,5 +531,22 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<Vec<R>>
                 }
             }
         })
-        .collect()
+        .collect();
+    match &pl.parasitic {
+        Some(par) => rows
+            .iter()
+            .map(|row| {
+                (0..3)
+                    .map(|j| {
+                        let mut a = R::c(0.0);
+                        for k in 0..6 {
+                            a = a + row[k] * par.s[k][j];
+                        }
+                        a
+                    })
+                    .collect()
+            })
+            .collect(),
+        None => rows,
+    }
 }

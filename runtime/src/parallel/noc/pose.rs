@@ -1,6 +1,7 @@
 //! Step 1: the platform's pose from `x` ([`Platform`]: its rotation from the quaternion,
 //! normalized on the fly, and its origin).
 
+use super::parasitic::{Parasitic, parasitic};
 use super::plan::Plan;
 use crate::algebra::{M, V, cm, cv, ident};
 use crate::parallel::PlatformMotion;
@@ -13,6 +14,9 @@ pub struct Platform<R> {
     pub rot: M<R>,
     /// Origin of the platform frame (base frame).
     pub origin: V<R>,
+    /// A 1T2R platform's parasitic components and twist map `t = S u` (`HeaveTilt`); `None`
+    /// for every other motion, whose `u` shapes the twist directly.
+    pub parasitic: Option<Parasitic<R>>,
 }
 
 /// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`, `Translation`: `p` with
@@ -27,12 +31,14 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             return Ok(Platform {
                 rot: ident(),
                 origin: [x[0], x[1], R::c(height)],
+                parasitic: None,
             });
         }
         PlatformMotion::Translation { rotation } => {
             return Ok(Platform {
                 rot: cm(&rotation),
                 origin: [x[0], x[1], x[2]],
+                parasitic: None,
             });
         }
         PlatformMotion::PlanarPose { height, rotation } => {
@@ -51,6 +57,15 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             return Ok(Platform {
                 rot,
                 origin: [x[0], x[1], R::c(height)],
+                parasitic: None,
+            });
+        }
+        PlatformMotion::HeaveTilt { .. } => {
+            let (rot, origin, par) = parasitic(plan, x)?;
+            return Ok(Platform {
+                rot,
+                origin,
+                parasitic: Some(par),
             });
         }
     };
@@ -84,5 +99,9 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
             one - s * (a * a + b * b),
         ],
     ];
-    Ok(Platform { rot, origin })
+    Ok(Platform {
+        rot,
+        origin,
+        parasitic: None,
+    })
 }
