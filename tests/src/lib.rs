@@ -4,6 +4,7 @@
 pub mod closed;
 
 pub mod pkm;
+pub mod routes;
 pub mod variants;
 
 use rand::{Rng, SeedableRng, rngs::StdRng};

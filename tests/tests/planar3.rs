@@ -12,10 +12,10 @@
 //! Errors are relative, `‖a − b‖∞ / ‖b‖∞` (∞-norm of the difference over the ∞-norm of the
 //! reference; matrices flattened).
 
-use runtime::closed::noc as cnoc;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, literal};
 use tests::pkm::{model, random_state, rel};
+use tests::routes::Pair;
 
 /// Random regular states per check.
 const STATES: usize = 500;
@@ -27,12 +27,7 @@ fn data(name: &str) -> (std::path::PathBuf, String) {
 }
 
 fn joints_model() -> runtime::closed::ClosedModel {
-    let (path, src) = data("planar_3rrr_joints");
-    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
-        Ok((codegen::spec::Mechanism::Closed(m), _)) => m,
-        Ok(_) => panic!("not a closed-loop mechanism"),
-        Err(d) => panic!("{d}"),
-    }
+    tests::routes::closed_data("planar_3rrr_joints.toml")
 }
 
 fn data_model(name: &str) -> ParallelModel {
@@ -42,12 +37,6 @@ fn data_model(name: &str) -> ParallelModel {
         Ok(_) => panic!("{name} is not a parallel mechanism"),
         Err(d) => panic!("{d}"),
     }
-}
-
-fn mat_vec(a: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
-    a.iter()
-        .map(|r| r.iter().zip(v).map(|(x, y)| x * y).sum())
-        .collect()
 }
 
 fn arr(v: &[f64]) -> [f64; 3] {
@@ -71,54 +60,18 @@ fn state(
 #[test]
 fn planar_3rrr_in_joint_coordinates_matches_the_task_form() {
     let pm = model("planar_3rrr");
-    let pplan = Plan::new(&pm).unwrap();
     let jm = joints_model();
-    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let pair = Pair::new(&pm, &jm);
+    let pplan = &pair.task;
     let home = pm.home_x();
     let mut rng = tests::rng(0x3a44);
     let mut worst = [0.0f64; 3];
     for _ in 0..STATES {
-        let (p, v, a) = state(&pplan, &home, &mut rng);
-        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
-        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
-        let t = literal::terms(&pplan, &p, &v).unwrap();
-        let amat: Vec<Vec<f64>> = (0..3)
-            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
-            .collect();
-        let bias: Vec<f64> = pplan
-            .legs
-            .iter()
-            .enumerate()
-            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
-            .collect();
-        let qd = mat_vec(&amat, &v);
-        let qdd: Vec<f64> = mat_vec(&amat, &a)
-            .iter()
-            .zip(&bias)
-            .map(|(x, b)| x + b)
-            .collect();
-        // Inverse dynamics.
-        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
-        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
-        worst[0] = worst[0].max(rel(&tp, &tj));
-        // Actuator-space inertia.
-        let mp = noc::actuator_mass_matrix(&pplan, &p).unwrap();
-        let mj = cnoc::mass_matrix(&jplan, &x).unwrap();
-        worst[1] = worst[1].max(rel(&mp.concat(), &mj.concat()));
-        // Forward dynamics under the same efforts.
-        let tau: Vec<f64> = tp
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v + 3.0 * (i as f64 - 1.0))
-            .collect();
-        let ap = noc::forward_dynamics(&pplan, &p, &v, &tau).unwrap();
-        let qdd_p: Vec<f64> = mat_vec(&amat, &ap)
-            .iter()
-            .zip(&bias)
-            .map(|(x, b)| x + b)
-            .collect();
-        let qdd_j = cnoc::forward_dynamics(&jplan, &x, &qd, &tau).unwrap();
-        worst[2] = worst[2].max(rel(&qdd_p, &qdd_j));
+        let (p, v, a) = state(pplan, &home, &mut rng);
+        let (e, _) = pair.compare(&p, &v, &a, 3.0);
+        for (w, e) in worst.iter_mut().zip(e) {
+            *w = w.max(e);
+        }
     }
     println!(
         "planar_3rrr: task form vs joint coordinates over {STATES} states, worst relative error (∞-norm): ID {:.1e}, A⁻ᵀIA⁻¹ vs I_J {:.1e}, FD {:.1e}",

@@ -20,6 +20,7 @@ use runtime::closed::noc as cnoc;
 use runtime::parallel::noc::{self, Plan};
 use runtime::parallel::{ParallelModel, literal};
 use tests::pkm::{random_state, rel};
+use tests::routes::Pair;
 
 /// Random regular states per check.
 const STATES: usize = 500;
@@ -30,20 +31,8 @@ fn data(name: &str) -> (std::path::PathBuf, String) {
     (path, src)
 }
 
-fn spec(name: &str) -> (std::path::PathBuf, String) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../mechanisms/specs/{name}.toml"));
-    let src = std::fs::read_to_string(&path).unwrap();
-    (path, src)
-}
-
 fn joints_model() -> runtime::closed::ClosedModel {
-    let (path, src) = spec("tripod_3prs");
-    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
-        Ok((codegen::spec::Mechanism::Closed(m), _)) => m,
-        Ok(_) => panic!("not a closed-loop mechanism"),
-        Err(d) => panic!("{d}"),
-    }
+    tests::closed::model("tripod_3prs")
 }
 
 fn task_model() -> ParallelModel {
@@ -57,12 +46,6 @@ fn data_model(name: &str) -> ParallelModel {
         Ok(_) => panic!("not a parallel mechanism"),
         Err(d) => panic!("{d}"),
     }
-}
-
-fn mat_vec(a: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
-    a.iter()
-        .map(|r| r.iter().zip(v).map(|(x, y)| x * y).sum())
-        .collect()
 }
 
 /// Random states: tilts within ±0.2 rad, heave within ±2 cm of home.
@@ -106,9 +89,9 @@ fn quat_matrix(q: &[f64]) -> [[f64; 3]; 3] {
 #[test]
 fn tripod_3prs_in_joint_coordinates_matches_the_task_form() {
     let pm = task_model();
-    let pplan = Plan::new(&pm).unwrap();
     let jm = joints_model();
-    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let pair = Pair::new(&pm, &jm);
+    let pplan = &pair.task;
     let platform_body = jm
         .tree
         .bodies
@@ -120,57 +103,21 @@ fn tripod_3prs_in_joint_coordinates_matches_the_task_form() {
     let mut worst = [0.0f64; 4];
     let mut gamma_max: f64 = 0.0;
     for _ in 0..STATES {
-        let (p, v, a) = state(&pplan, &home, &mut rng);
-        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
-        let x = cnoc::forward_kinematics(&jplan, &q, &vec![0.0; jplan.nx()]).unwrap();
-        let t = literal::terms(&pplan, &p, &v).unwrap();
-        let amat: Vec<Vec<f64>> = (0..3)
-            .map(|r| (0..3).map(|c| t.a[(r, c)]).collect())
-            .collect();
-        let bias: Vec<f64> = pplan
-            .legs
-            .iter()
-            .enumerate()
-            .map(|(k, lp)| t.ld_u[3 * k + lp.actuated])
-            .collect();
-        let qd = mat_vec(&amat, &v);
-        let qdd: Vec<f64> = mat_vec(&amat, &a)
-            .iter()
-            .zip(&bias)
-            .map(|(x, b)| x + b)
-            .collect();
-        // Inverse dynamics.
-        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
-        let tj = cnoc::inverse_dynamics(&jplan, &x, &qd, &qdd).unwrap();
-        worst[0] = worst[0].max(rel(&tp, &tj));
-        // Actuator-space inertia.
-        let mp = noc::actuator_mass_matrix(&pplan, &p).unwrap();
-        let mj = cnoc::mass_matrix(&jplan, &x).unwrap();
-        worst[1] = worst[1].max(rel(&mp.concat(), &mj.concat()));
-        // Forward dynamics under the same efforts.
-        let tau: Vec<f64> = tp
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v + 3.0 * (i as f64 - 1.0))
-            .collect();
-        let ap = noc::forward_dynamics(&pplan, &p, &v, &tau).unwrap();
-        let qdd_p: Vec<f64> = mat_vec(&amat, &ap)
-            .iter()
-            .zip(&bias)
-            .map(|(x, b)| x + b)
-            .collect();
-        let qdd_j = cnoc::forward_dynamics(&jplan, &x, &qd, &tau).unwrap();
-        worst[2] = worst[2].max(rel(&qdd_p, &qdd_j));
+        let (p, v, a) = state(pplan, &home, &mut rng);
+        let (e, x) = pair.compare(&p, &v, &a, 3.0);
+        for (w, e) in worst.iter_mut().zip(e) {
+            *w = w.max(e);
+        }
         // The parasitic components: the closed route's platform body (frame at leg 1's S
         // centre, base orientation at home) against the task form's pose, its origin moved to
         // that S centre.
-        let pose = noc::platform_pose(&pplan, &p).unwrap();
+        let pose = noc::platform_pose(pplan, &p).unwrap();
         let r = quat_matrix(&pose[3..]);
         let s1 = [0.0, 0.15, 0.0];
         let at_s1: Vec<f64> = (0..3)
             .map(|i| pose[i] + r[i][0] * s1[0] + r[i][1] * s1[1] + r[i][2] * s1[2])
             .collect();
-        let kin = cnoc::kinematics(&jplan, &x);
+        let kin = cnoc::kinematics(&pair.joints, &x);
         let mut mine = at_s1.clone();
         let mut theirs = kin.pos[platform_body].to_vec();
         for i in 0..3 {
