@@ -287,107 +287,85 @@ fn config() -> Criterion {
         .sample_size(30)
 }
 
-/// The Delta's inverse dynamics in platform coordinates (inverse kinematics included) against
-/// the same robot in joint coordinates (the closed-loop route), both generated, at the same
-/// configuration (the platform's home; the joint form assembled at its crank angles) and
-/// rates (the platform velocity `u`; the cranks' rates it implies); the accelerations are
-/// arbitrary, the same numbers for both (the cost does not depend on them).
-fn delta_task_vs_joints(c: &mut Criterion) {
-    use mechanisms::delta_rl5 as task;
-    use tests::variants::delta_joints as joints;
-    let x = task::HOME;
-    let (u, ud) = ([0.3, -0.2, 0.1], [1.0, 0.5, -2.0]);
-    let q = task::inverse_kinematics(&x).expect("home in reach");
-    let qd = task::actuator_rates(&x, &u).expect("regular");
-    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
-    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
-    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
-    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
-    let mut g = c.benchmark_group("delta_rl5/inverse_dynamics_task_vs_joints");
-    g.bench_function("platform_coordinates", |b| {
-        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
-    });
-    g.bench_function("joint_coordinates", |b| {
-        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
-    });
-    g.finish();
+/// One robot's inverse dynamics in task coordinates (inverse kinematics included) against the
+/// same robot in joint coordinates (the closed-loop route), both generated, at the same
+/// configuration (`$x`; the joint form assembled at its actuated coordinates) and rates (the
+/// platform speeds `$u`; the actuator rates they imply); the accelerations are arbitrary, the
+/// same numbers for both (the cost does not depend on them). `$label` names the task side
+/// (the platform's coordinates, or task coordinates) as the figures in docs/parallel.md do.
+macro_rules! task_vs_joints {
+    ($name:ident, $task:path, $joints:path, $group:literal, $label:literal, $x:expr, $u:expr, $ud:expr) => {
+        fn $name(c: &mut Criterion) {
+            use $joints as joints;
+            use $task as task;
+            let x = $x;
+            let (u, ud) = ($u, $ud);
+            let q = task::inverse_kinematics(&x).expect("in reach");
+            let qd = task::actuator_rates(&x, &u).expect("regular");
+            let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
+            let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
+            let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
+            assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
+            let mut g = c.benchmark_group($group);
+            g.bench_function($label, |b| {
+                b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+            });
+            g.bench_function("joint_coordinates", |b| {
+                b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
+            });
+            g.finish();
+        }
+    };
 }
 
-/// The planar 3-RRR's inverse dynamics in task coordinates `[px, py, φ]` (inverse kinematics
-/// included) against the same robot in joint coordinates (the closed-loop route), both
-/// generated, at the same configuration (the platform's home; the joint form assembled at its
-/// actuated angles) and rates (the platform speeds `u`; the actuator rates they imply); the
-/// accelerations are arbitrary, the same numbers for both (the cost does not depend on them).
-fn planar3_task_vs_joints(c: &mut Criterion) {
-    use mechanisms::planar_3rrr as task;
-    use tests::variants::planar3_joints as joints;
-    let x = task::HOME;
-    let (u, ud) = ([0.3, -0.2, 0.5], [1.0, 0.5, -2.0]);
-    let q = task::inverse_kinematics(&x).expect("home in reach");
-    let qd = task::actuator_rates(&x, &u).expect("regular");
-    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
-    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
-    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
-    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
-    let mut g = c.benchmark_group("planar_3rrr/inverse_dynamics_task_vs_joints");
-    g.bench_function("task_coordinates", |b| {
-        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
-    });
-    g.bench_function("joint_coordinates", |b| {
-        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
-    });
-    g.finish();
-}
-
-/// Tsai's 3-UPU in platform coordinates against the same robot in joint coordinates, as
-/// [`delta_task_vs_joints`].
-fn upu_task_vs_joints(c: &mut Criterion) {
-    use mechanisms::tsai_3upu as task;
-    use tests::variants::upu_joints as joints;
-    let x = task::HOME;
-    let (u, ud) = ([0.3, -0.2, 0.1], [1.0, 0.5, -2.0]);
-    let q = task::inverse_kinematics(&x).expect("home in reach");
-    let qd = task::actuator_rates(&x, &u).expect("regular");
-    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
-    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
-    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
-    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
-    let mut g = c.benchmark_group("tsai_3upu/inverse_dynamics_task_vs_joints");
-    g.bench_function("platform_coordinates", |b| {
-        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
-    });
-    g.bench_function("joint_coordinates", |b| {
-        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
-    });
-    g.finish();
-}
-
-/// The 3-PRS tripod's inverse dynamics in task coordinates `[pz, α, β]` (inverse kinematics and
-/// the parasitic motion included) against the same robot in joint coordinates (the bundled
-/// `tripod_3prs`, the closed-loop route), both generated, at the same configuration (a tilted
-/// pose; the joint form assembled at its actuated positions) and rates (the platform speeds
-/// `u`; the actuator rates they imply); the accelerations are arbitrary, the same numbers for
-/// both (the cost does not depend on them).
-fn prs_task_vs_joints(c: &mut Criterion) {
-    use mechanisms::tripod_3prs as joints;
-    use tests::variants::tripod_task as task;
-    let x = [task::HOME[0] + 0.01, 0.1, -0.05];
-    let (u, ud) = ([0.03, -0.2, 0.5], [1.0, 0.5, -2.0]);
-    let q = task::inverse_kinematics(&x).expect("in reach");
-    let qd = task::actuator_rates(&x, &u).expect("regular");
-    let xj = joints::forward_kinematics(&q, &joints::HOME).expect("assembles");
-    let tau = task::inverse_dynamics(&x, &u, &ud).expect("regular");
-    let tau_j = joints::inverse_dynamics(&xj, &qd, &ud).expect("regular");
-    assert!(tau.iter().chain(&tau_j).all(|v| v.is_finite()));
-    let mut g = c.benchmark_group("tripod_3prs/inverse_dynamics_task_vs_joints");
-    g.bench_function("task_coordinates", |b| {
-        b.iter(|| task::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
-    });
-    g.bench_function("joint_coordinates", |b| {
-        b.iter(|| joints::inverse_dynamics(black_box(&xj), black_box(&qd), black_box(&ud)))
-    });
-    g.finish();
-}
+// The Delta at home, in its platform coordinates.
+task_vs_joints!(
+    delta_task_vs_joints,
+    mechanisms::delta_rl5,
+    tests::variants::delta_joints,
+    "delta_rl5/inverse_dynamics_task_vs_joints",
+    "platform_coordinates",
+    mechanisms::delta_rl5::HOME,
+    [0.3, -0.2, 0.1],
+    [1.0, 0.5, -2.0]
+);
+// The planar 3-RRR at home, `[px, py, φ]`.
+task_vs_joints!(
+    planar3_task_vs_joints,
+    mechanisms::planar_3rrr,
+    tests::variants::planar3_joints,
+    "planar_3rrr/inverse_dynamics_task_vs_joints",
+    "task_coordinates",
+    mechanisms::planar_3rrr::HOME,
+    [0.3, -0.2, 0.5],
+    [1.0, 0.5, -2.0]
+);
+// Tsai's 3-UPU at home, in its platform coordinates.
+task_vs_joints!(
+    upu_task_vs_joints,
+    mechanisms::tsai_3upu,
+    tests::variants::upu_joints,
+    "tsai_3upu/inverse_dynamics_task_vs_joints",
+    "platform_coordinates",
+    mechanisms::tsai_3upu::HOME,
+    [0.3, -0.2, 0.1],
+    [1.0, 0.5, -2.0]
+);
+// The 3-PRS tripod at a tilted pose, `[pz, α, β]` (the parasitic motion included), against the
+// bundled `tripod_3prs` in joint coordinates.
+task_vs_joints!(
+    prs_task_vs_joints,
+    tests::variants::tripod_task,
+    mechanisms::tripod_3prs,
+    "tripod_3prs/inverse_dynamics_task_vs_joints",
+    "task_coordinates",
+    {
+        let h = tests::variants::tripod_task::HOME;
+        [h[0] + 0.01, 0.1, -0.05]
+    },
+    [0.03, -0.2, 0.5],
+    [1.0, 0.5, -2.0]
+);
 
 criterion_group! {
     name = benches;
