@@ -259,6 +259,29 @@ pub fn mat_vec(a: &Mat3, v: &Vec3) -> Vec3 {
     ]
 }
 
+/// The rotation matrix of a unit quaternion `[w, x, y, z]` (the inverse of
+/// [`matrix_quaternion`]; the quaternion is taken as given, not normalized).
+pub fn quaternion_matrix(q: &[f64; 4]) -> Mat3 {
+    let [w, x, y, z] = *q;
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
 /// Unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method: the largest
 /// component first, so no division by a small number).
 pub fn matrix_quaternion(r: &Mat3) -> [f64; 4] {

@@ -59,24 +59,7 @@ fn state(
 
 /// The rotation matrix of a unit quaternion `[w, x, y, z]`.
 fn quat_matrix(q: &[f64]) -> [[f64; 3]; 3] {
-    let [w, x, y, z] = [q[0], q[1], q[2], q[3]];
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
+    runtime::model::quaternion_matrix(&[q[0], q[1], q[2], q[3]])
 }
 
 /// The task-coordinate form and the joint-coordinate form agree at corresponding states: `q` by

@@ -326,24 +326,12 @@ impl Reader<'_> {
             .hint = Some("give a unit quaternion [w, x, y, z] (w first); its norm may differ from 1 by at most 1e-3, and it is normalized".into());
             return None;
         }
-        let [w, x, y, z] = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
-        Some([
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ])
+        Some(runtime::model::quaternion_matrix(&[
+            q[0] / n,
+            q[1] / n,
+            q[2] / n,
+            q[3] / n,
+        ]))
     }
 
     /// A rotation matrix by rows; orthonormal with determinant +1 within `1e-6` (a matrix
