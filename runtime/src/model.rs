@@ -259,6 +259,35 @@ pub fn mat_vec(a: &Mat3, v: &Vec3) -> Vec3 {
     ]
 }
 
+/// The rotation about `u × v` that turns the unit `u` onto the unit `v` (a half turn about a
+/// perpendicular when they are opposite).
+pub fn align(u: &Vec3, v: &Vec3) -> Mat3 {
+    let k = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let ss = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+    let (k, f) = if ss > 1e-24 {
+        (k, (1.0 - c) / ss)
+    } else if c > 0.0 {
+        return Transform::IDENTITY.rotation;
+    } else {
+        // A half turn about a unit perpendicular p: R = 2 p pᵀ − 1.
+        let (p, _) = crate::closed::perpendiculars(u);
+        return core::array::from_fn(|i| {
+            core::array::from_fn(|j| 2.0 * p[i] * p[j] - if i == j { 1.0 } else { 0.0 })
+        });
+    };
+    // Rodrigues: R = 1 + [k]× + [k]×² (1 − c)/|k|².
+    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+    let kx2 = mat_mul(&kx, &kx);
+    core::array::from_fn(|i| {
+        core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 } + kx[i][j] + f * kx2[i][j])
+    })
+}
+
 /// The rotation matrix of a unit quaternion `[w, x, y, z]` (the inverse of
 /// [`matrix_quaternion`]; the quaternion is taken as given, not normalized).
 pub fn quaternion_matrix(q: &[f64; 4]) -> Mat3 {

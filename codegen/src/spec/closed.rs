@@ -331,6 +331,15 @@ fn check_spring_lengths(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnosti
     }
 }
 
+/// The hint of a loop closed at home (closed loops and platforms alike): the bound `bound`
+/// (m) and `codegen fix-home`.
+pub(super) fn home_correction_hint(bound: f64) -> String {
+    format!(
+        "gaps up to {:.0e} × the mechanism's size ({bound:.2e} m here) and 1° are closed so, as rounded numbers leave them; `codegen fix-home FILE` writes the corrected child_origin into the spec",
+        runtime::closed::HOME_CORRECTION
+    )
+}
+
 /// Loops that miss closing at home by little (rounded numbers: at most
 /// [`HOME_CORRECTION`](runtime::closed::HOME_CORRECTION) × the size, and
 /// [`HOME_CORRECTION_ANGLE`](runtime::closed::HOME_CORRECTION_ANGLE) for a revolute cut's
@@ -374,10 +383,7 @@ fn close_at_home(spec: &Spec, closed: &mut ClosedModel, diags: &mut Diagnostics)
             .with_fix("child_origin", value.clone())
             .with_key(format!("{}.child_origin", j.key))
             .with_span(j.child_origin_span.clone().or(j.span.clone()))
-            .with_hint(format!(
-                "gaps up to {:.0e} × the mechanism's size ({bound:.2e} m here) and 1° are closed so, as rounded numbers leave them; `codegen fix-home FILE` writes the corrected child_origin into the spec",
-                runtime::closed::HOME_CORRECTION
-            )),
+            .with_hint(home_correction_hint(bound)),
         );
         let c = &mut closed.cuts[k];
         c.frame_child = c.frame_child.compose(&fix);

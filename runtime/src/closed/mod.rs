@@ -52,7 +52,7 @@ use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use crate::model::{Mat3, Model, Transform, Vec3, mat_mul, mat_vec};
+use crate::model::{Mat3, Model, Transform, Vec3, mat_vec};
 
 pub mod noc;
 
@@ -260,7 +260,7 @@ impl ClosedModel {
                     let (ea, eb) = (mat_vec(&a.rotation, &axis), mat_vec(&b.rotation, &axis));
                     let e = [ea[0] - eb[0], ea[1] - eb[1], ea[2] - eb[2]];
                     (!(libm::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) <= 1e-9))
-                        .then(|| align(&axis, &mat_vec(&bt, &ea)))
+                        .then(|| crate::model::align(&axis, &mat_vec(&bt, &ea)))
                 }
                 CutKind::Spherical => None,
             };
@@ -278,35 +278,6 @@ impl ClosedModel {
             ))
         })
     }
-}
-
-/// The rotation about `u × v` that turns the unit `u` onto the unit `v` (a half turn about a
-/// perpendicular when they are opposite).
-fn align(u: &Vec3, v: &Vec3) -> Mat3 {
-    let k = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    let ss = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-    let (k, f) = if ss > 1e-24 {
-        (k, (1.0 - c) / ss)
-    } else if c > 0.0 {
-        return Transform::IDENTITY.rotation;
-    } else {
-        // A half turn about a unit perpendicular p: R = 2 p pᵀ − 1.
-        let (p, _) = perpendiculars(u);
-        return core::array::from_fn(|i| {
-            core::array::from_fn(|j| 2.0 * p[i] * p[j] - if i == j { 1.0 } else { 0.0 })
-        });
-    };
-    // Rodrigues: R = 1 + [k]× + [k]×² (1 − c)/|k|².
-    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
-    let kx2 = mat_mul(&kx, &kx);
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 } + kx[i][j] + f * kx2[i][j])
-    })
 }
 
 fn transpose(m: &Mat3) -> Mat3 {

@@ -365,7 +365,7 @@ pub(super) fn close_at_home(tree: &Tree<'_>, pm: &mut ParallelModel, diags: &mut
                 let turn = c.acos();
                 let gap = 0.0;
                 let to = Transform {
-                    rotation: mat_mul(&turning(&a, &b), &now.rotation),
+                    rotation: mat_mul(&runtime::model::align(&a, &b), &now.rotation),
                     translation: now.translation,
                 };
                 if turn > runtime::closed::HOME_CORRECTION_ANGLE || turn.is_nan() {
@@ -387,29 +387,8 @@ pub(super) fn close_at_home(tree: &Tree<'_>, pm: &mut ParallelModel, diags: &mut
             .with_fix("child_origin", value.clone())
             .with_key(format!("{}.child_origin", j.key))
             .with_span(j.child_origin_span.clone().or(j.span.clone()))
-            .with_hint(format!(
-                "gaps up to {:.0e} × the mechanism's size ({bound:.2e} m here) and 1° are closed so, as rounded numbers leave them; `codegen fix-home FILE` writes the corrected child_origin into the spec",
-                runtime::closed::HOME_CORRECTION
-            )),
+            .with_hint(crate::spec::closed::home_correction_hint(bound)),
         );
         pm.legs[k].end = end;
     }
-}
-
-/// The rotation about `a × b` that turns the unit `a` onto the unit `b` (Rodrigues; the
-/// identity when they are parallel: the turns closed here are small).
-fn turning(a: &Vec3, b: &Vec3) -> runtime::model::Mat3 {
-    let k = [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ];
-    let c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let ss = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-    let f = if ss > 0.0 { (1.0 - c) / ss } else { 0.0 };
-    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
-    let kx2 = mat_mul(&kx, &kx);
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| f64::from(u8::from(i == j)) + kx[i][j] + f * kx2[i][j])
-    })
 }

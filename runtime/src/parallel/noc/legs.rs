@@ -211,9 +211,10 @@ fn ups_frame<R: Real>(
     })
 }
 
-/// PUS: the slider's displacement on the rod-length sphere about `target`, then the U angles.
-fn pus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<R>>, Singular> {
-    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+/// A first prismatic joint (PUS, planar PR): the slider's displacement `s` that puts the
+/// elbow `u` (the U centre or the elbow revolute) at the fixed length from `target` (its line
+/// meets the sphere about `target`; the branch of home), and `u`. Out of reach: `Site::Reach`.
+fn slider_to_sphere<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<(R, V<R>), Singular> {
     let e0 = lp.axes[0];
     let dd = sub(target, cv(&lp.u_centre));
     let t = dot(cv(&e0), dd);
@@ -226,7 +227,27 @@ fn pus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<
         false,
     )?;
     let s = t - R::c(lp.sigma_first) * disc.sqrt();
-    let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+    Ok((s, add(cv(&lp.u_centre), scale(s, cv(&e0)))))
+}
+
+/// A first revolute joint (RUS, planar RR): the crank's `(sin, cos)` that puts the elbow at the
+/// fixed length from `target`, and the direction elbow → `target` in the crank's home frame.
+fn crank_to_sphere<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    target: V<R>,
+) -> Result<((R, R), V<R>), Singular> {
+    let (s0, c0) = rus_crank(lp, target, k)?;
+    let r0 = rot(&lp.axes[0], s0, c0);
+    let o0 = cv(&lp.points[0]);
+    let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
+    Ok(((s0, c0), mtv(&r0, sub(target, u))))
+}
+
+/// PUS: the slider's displacement on the rod-length sphere about `target`, then the U angles.
+fn pus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<R>>, Singular> {
+    let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
+    let (s, u) = slider_to_sphere(lp, k, target)?;
     let qv = sub(target, u);
     let p = sub3(&lp.end_home, &lp.u_centre);
     let [a, b] = two_axes(&lp.axes[1], &lp.axes[2], cv(&p), qv, lp.sigma_u, k, true)?;
@@ -239,12 +260,8 @@ fn pus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<
 /// RUS: the crank angle, then the U angles of the rod in the crank's home frame.
 fn rus_ik<R: Real>(lp: &LegPlan, k: usize, target: V<R>) -> Result<Vec<JointPos<R>>, Singular> {
     let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
-    let (s0, c0) = rus_crank(lp, target, k)?;
-    let r0 = rot(&lp.axes[0], s0, c0);
-    let o0 = cv(&lp.points[0]);
-    let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
     // The rod direction in the crank's home frame.
-    let qv = mtv(&r0, sub(target, u));
+    let ((s0, c0), qv) = crank_to_sphere(lp, k, target)?;
     let p = sub3(&lp.end_home, &lp.u_centre);
     // A Delta leg's U angles serve only the positions (its closed form does not use them, and
     // its own test covers the leg): unchecked.
@@ -263,12 +280,8 @@ fn planar_rr_ik<R: Real>(
     target: V<R>,
 ) -> Result<Vec<JointPos<R>>, Singular> {
     let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
-    let (s0, c0) = rus_crank(lp, target, k)?;
-    let r0 = rot(&lp.axes[0], s0, c0);
-    let o0 = cv(&lp.points[0]);
-    let u = add(o0, mv(&r0, sub(cv(&lp.u_centre), o0)));
     // The distal link's direction in the proximal link's home frame.
-    let qv = mtv(&r0, sub(target, u));
+    let ((s0, c0), qv) = crank_to_sphere(lp, k, target)?;
     let p = sub3(&lp.end_home, &lp.u_centre);
     let (s1, c1) = one_axis(&lp.axes[1], cv(&p), qv);
     q.push(JointPos::R(s0, c0));
@@ -285,19 +298,7 @@ fn planar_pr_ik<R: Real>(
     target: V<R>,
 ) -> Result<Vec<JointPos<R>>, Singular> {
     let mut q: Vec<JointPos<R>> = Vec::with_capacity(lp.joints.len());
-    let e0 = lp.axes[0];
-    let dd = sub(target, cv(&lp.u_centre));
-    let t = dot(cv(&e0), dd);
-    let disc = t * t - dot(dd, dd) + R::c(lp.length * lp.length);
-    let disc = R::check(
-        disc,
-        R::c(0.0),
-        R::c(lp.length * lp.length),
-        Site::Reach(k),
-        false,
-    )?;
-    let s = t - R::c(lp.sigma_first) * disc.sqrt();
-    let u = add(cv(&lp.u_centre), scale(s, cv(&e0)));
+    let (s, u) = slider_to_sphere(lp, k, target)?;
     let p = sub3(&lp.end_home, &lp.u_centre);
     let (s1, c1) = one_axis(&lp.axes[1], cv(&p), sub(target, u));
     q.push(JointPos::P(s));
