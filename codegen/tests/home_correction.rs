@@ -54,10 +54,16 @@ fn rounded(text: &str) -> String {
     out
 }
 
+/// The bundled spec with every number written out: the written-out form kept beside the specs
+/// written with parameters and patterns (`data/expanded/`), else the bundled file.
 fn bundled(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../mechanisms/specs")
-        .join(format!("{name}.toml"));
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let expanded = dir.join(format!("tests/data/expanded/{name}.toml"));
+    let p = if expanded.exists() {
+        expanded
+    } else {
+        dir.join(format!("../mechanisms/specs/{name}.toml"))
+    };
     std::fs::read_to_string(p).unwrap()
 }
 

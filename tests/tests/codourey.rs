@@ -45,11 +45,11 @@ fn edit(src: &str, text: &str, by: &str) -> String {
 /// origin) to the elbow at 0.42 m: mass centre at 0.21 m, `m l²/12` across (the spec's
 /// illustrative value already), nothing along.
 fn rod_arms(src: &str) -> String {
-    let s = edit(src, "com = [0.2463, 0.0, 0.0]", "com = [0.21, 0.0, 0.0]");
+    let s = edit(src, "arm_com = 0.2463", "arm_com = 0.21");
     edit(
         &s,
-        "inertia = { ixx = 0.001, iyy = 0.054331199999999996",
-        "inertia = { ixx = 0.0, iyy = 0.054331199999999996",
+        "inertia = { ixx = 0.001, iyy = \"arm_inertia\"",
+        "inertia = { ixx = 0.0, iyy = \"arm_inertia\"",
     )
 }
 

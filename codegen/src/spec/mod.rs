@@ -12,6 +12,7 @@
 
 mod angle;
 mod closed;
+mod expr;
 mod fix;
 mod function;
 mod geom;

@@ -21,6 +21,8 @@ mod joints;
 mod keys;
 mod mechanism;
 mod parallelogram;
+mod parameters;
+mod pattern;
 mod platform;
 mod scene;
 mod springs;
@@ -43,6 +45,9 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
     let mut r = Reader {
         diags,
         joints_incomplete: false,
+        params: Vec::new(),
+        declared: Vec::new(),
+        copy: None,
     };
     Some(r.spec(&root))
 }
@@ -53,6 +58,13 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
 struct Reader<'d> {
     diags: &'d mut Diagnostics,
     joints_incomplete: bool,
+    /// `[parameters]`, as evaluated so far.
+    params: Vec<(String, crate::spec::expr::Value)>,
+    /// Every parameter name written (the file's and the patterns'), evaluated or not: a
+    /// reference to one whose value failed is not reported again, and hints suggest them.
+    declared: Vec<String>,
+    /// The pattern copy being read, if any.
+    copy: Option<pattern::Copy>,
 }
 
 fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t Val<'i>> {
@@ -70,6 +82,11 @@ impl Reader<'_> {
     /// into bodies and joints), in that order.
     fn spec(&mut self, root: &DeTable<'_>) -> Spec {
         self.unknown_keys(root, TOP_KEYS, "");
+        if let Some(v) = get(root, "parameters")
+            && let Some(t) = self.table(v, "parameters")
+        {
+            self.parameter_table(t, "parameters");
+        }
         let (name, mut gravity, anchor) = self.mechanism(root);
         let platform = get(root, "platform").and_then(|v| {
             let span = key_span(root, "platform").unwrap_or(v.span());
@@ -81,26 +98,32 @@ impl Reader<'_> {
         {
             self.scene(t, &mut scene, &mut gravity);
         }
-        let bodies = self
+        let mut bodies: Vec<_> = self
             .entries(root, "body")
             .into_iter()
             .filter_map(|(i, t, span)| self.body(i, t, span))
             .collect();
-        let joints = self
+        let mut joints: Vec<_> = self
             .entries(root, "joint")
             .into_iter()
             .filter_map(|(i, t, span)| self.joint(i, t, span))
             .collect();
-        let springs = self
+        let mut springs: Vec<_> = self
             .entries(root, "spring")
             .into_iter()
             .filter_map(|(i, t, span)| self.spring(i, t, span))
             .collect();
-        let parallelograms: Vec<_> = self
+        let mut parallelograms: Vec<_> = self
             .entries(root, "parallelogram")
             .into_iter()
             .filter_map(|(i, t, span)| self.parallelogram(i, t, span))
             .collect();
+        // The patterns' copies follow the entries written out, in file order.
+        let copies = self.patterns(root);
+        bodies.extend(copies.bodies);
+        joints.extend(copies.joints);
+        springs.extend(copies.springs);
+        parallelograms.extend(copies.parallelograms);
         let mut spec = Spec {
             name,
             gravity,
@@ -150,10 +173,11 @@ impl Reader<'_> {
         out
     }
 
-    /// `body "name"` when the entry has a string name, else `body[i]`.
-    fn path(t: &DeTable<'_>, what: &str, i: usize) -> String {
+    /// `body "name"` when the entry has a string name, else `body[i]` (in a pattern's copy,
+    /// the name with `{i}` replaced).
+    fn path(&self, t: &DeTable<'_>, what: &str, i: usize) -> String {
         match get(t, "name").map(|v| v.get_ref()) {
-            Some(DeValue::String(s)) => format!("{what} \"{s}\""),
+            Some(DeValue::String(s)) => format!("{what} \"{}\"", self.substitute(s)),
             _ => format!("{what}[{i}]"),
         }
     }

@@ -4,18 +4,11 @@ use std::path::Path;
 
 use super::*;
 
-const GOUGH_STEWART_HEADER: &str = "\nGough-Stewart platform, 6-UPS: the example of L.-W. Tsai, \"Solving the inverse dynamics of a\nStewart-Gough manipulator by the principle of virtual work\", ASME J. Mech. Des. 122(1):3-9, 2000.\nNumbers as in a public re-implementation citing the paper (as collected in docs/method.md,\n\"Test cases from the literature\"):\n  base joints b_i (world, z = 0), platform joints p_i (platform frame, origin at the platform's\n  mass centre), platform m = 1.5 kg, I = diag(0.08) kg m^2, cylinder and piston 0.1 kg each,\n  gravity 9.81 m/s^2 along -z.\n*Unconfirmed* against the paper: the leg inertias diag(1/160) kg m^2 about the mass centres, and\nthe leg mass-centre offsets (cylinder 0.5 m from the base joint, piston 0.5 m from the platform\njoint).\nHome: platform frame at (-1.5, 0, 1.0) m, identity orientation (the centre of Tsai's motions).\nLeg i: U at b_i whose joint frame has its z axis along the leg at home (U axes: that frame's x,\nhorizontal, then y); the cylinder is the U's second body; an actuated P joint along z from the\nU centre moves the piston (so q_i = leg length - home length); the S joint at p_i on the piston's\nz axis. Tsai's no-spin assumption holds by construction (a U joint at the base).\n";
-
 const SLIDING_HEXAPOD_HEADER: &str = "\nSliding-leg (fixed-length leg) hexapod, 6-PUS, in the manner of the HexaM (Toyoda), Hexaglide\n(ETH) and Linapod (Stuttgart) machines (docs/method.md, \"Test cases from the literature\"; Sinatra & Xi 2008). ILLUSTRATIVE\nnumbers, not a real machine: six vertical rails on a semi-regular hexagon of radius 0.6 m (pairs\n+-10 deg about 90, 210, 330 deg), an actuated slider (P, along z) on each, a U on the slider,\na fixed-length leg of 0.6 m (steel tube: 0.8 kg, radius 15 mm) to an S joint on the platform, whose\njoints lie on a semi-regular hexagon of radius 0.25 m (pairs +-15 deg about 30, 150, 270 deg),\n5 cm below the platform frame. Base and platform hexagons are not similar (no architecture\nsingularity). Platform: 8 kg disc (radius 0.3 m, 30 mm thick), mass centre at the platform frame\norigin. Sliders: 1.5 kg boxes 0.1 x 0.1 x 0.15 m, mass centre 3 cm radially outward of the U\ncentre. Home: platform frame at (0, 0, 1.0) m, identity orientation; every slider's coordinate is\nmeasured from its home height.\n";
 
 const RUS_HEXAPOD_HEADER: &str = "\nRotary hexapod, 6-RUS (revolute-actuated cranks, as in the common servo-driven Stewart\nplatforms). ILLUSTRATIVE numbers, not a real machine: six motor shafts on a semi-regular hexagon\nof radius 0.2 m (pairs +-15 deg about 90, 210, 330 deg) with horizontal axes tangent to that\ncircle; a 0.1 m crank on each (actuated R; at home the crank points radially outward and is\nhorizontal); a U at the crank tip; a 0.3 m rod (0.15 kg, radius 5 mm) to an S joint on the\nplatform, whose joints lie on a semi-regular hexagon of radius 0.12 m (pairs +-20 deg about 30,\n150, 270 deg) in the plane of the platform frame. Base and platform hexagons are not similar.\nCranks: 0.2 kg bars 0.1 m long, mass centre at mid-length. Platform: 1.2 kg disc (radius 0.15 m,\n10 mm thick), mass centre at the platform frame origin. Home: platform frame above the base\ncentre at the height where every rod meets its platform joint with the cranks horizontal,\nidentity orientation.\n";
 
 const AGILE_EYE_HEADER: &str = "\nAgile Eye: spherical 3-RRR camera-orienting mechanism after C. M. Gosselin and J.-F. Hamel,\n\"The agile eye: a high-performance three-degree-of-freedom camera-orienting device\", IEEE ICRA\n1994, pp. 781-786 (geometry as in Bonev, Chablat & Wenger, ICRA 2006: all adjacent joint axes\northogonal). Every axis passes through the centre of rotation, the origin. At home (identity)\nleg i has base axis u_i, intermediate axis w_i and platform axis v_i with (u, w, v) = (x, y, z),\n(y, z, x), (z, x, y); the base revolutes are actuated, and at home the actuation matrix is the\nidentity. Masses and inertias are ILLUSTRATIVE: each link is a thin 90-degree circular arc about\nthe centre (proximal link: 0.25 kg, radius 0.12 m, from the u axis to the w axis; distal link:\n0.2 kg, radius 0.10 m, from w to v) plus 2e-5 kg m^2 on the diagonal for its cross-section; the\ncamera platform is 0.3 kg, I = diag(4e-4, 4e-4, 2.5e-4) kg m^2, mass centre 2 cm along its z\naxis. The joints sit on their axes at 0.15 m (base), 0.12 m (intermediate) and 0.10 m\n(platform) from the centre; each body frame has the base orientation at home.\n";
-
-fn pct4(lengths: &[f64]) -> String {
-    let items: Vec<String> = lengths.iter().map(|l| format!("'{l:.4}'")).collect();
-    format!("[{}]", items.join(", "))
-}
 
 /// The `[mechanism]` and `[platform]` tables.
 fn head(s: &mut Spec, name: &str, source: &str, platform: &[(&str, String)]) {
@@ -37,113 +30,6 @@ fn pose_platform(body: &str, home: V3) -> Vec<(&'static str, String)> {
         ("coordinates", "\"pose\"".into()),
         ("home", origin(home, Some([0.0, 0.0, 0.0]))),
     ]
-}
-
-// ---------------------------------------------------------------- 1. Gough–Stewart (Tsai 2000)
-pub fn gough_stewart(dir: &Path) -> std::io::Result<()> {
-    let base: [V3; 6] = [
-        [-2.12, 1.374, 0.0],
-        [-2.38, 1.224, 0.0],
-        [-2.38, -1.224, 0.0],
-        [-2.12, -1.374, 0.0],
-        [0.0, -0.15, 0.0],
-        [0.0, 0.15, 0.0],
-    ];
-    let plat: [V3; 6] = [
-        [0.17, 0.595, -0.4],
-        [-0.6, 0.15, -0.4],
-        [-0.6, -0.15, -0.4],
-        [0.17, -0.595, -0.4],
-        [0.43, -0.445, -0.4],
-        [0.43, 0.445, -0.4],
-    ];
-    let home = [-1.5, 0.0, 1.0];
-    let i_leg = 1.0 / 160.0;
-    let leg_inertia = || Inertia::Diagonal([i_leg, i_leg, i_leg]);
-    let mut s = Spec::new(GOUGH_STEWART_HEADER);
-    head(
-        &mut s,
-        "gough_stewart",
-        "Tsai (2000), ASME J. Mech. Des. 122(1):3-9, via a public re-implementation; leg inertias and mass-centre offsets unconfirmed",
-        &pose_platform("platform", home),
-    );
-    s.body(
-        "platform",
-        1.5,
-        [0.0, 0.0, 0.0],
-        &Inertia::Diagonal([0.08, 0.08, 0.08]),
-    );
-    let (mut points, mut dirs, mut lengths) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..6 {
-        let n = i + 1;
-        let b = base[i];
-        let p_world = add(home, plat[i]);
-        let d = sub(p_world, b);
-        let length = norm(d);
-        let z = unit(d);
-        let rpy = rpy_of(frame_with_z(z));
-        let tip = add(b, mat_vec(rpy_matrix(rpy), [0.0, 0.0, length]));
-        check_closure(&format!("gough_stewart leg {n}"), tip, p_world);
-        points.push(sub(p_world, home));
-        dirs.push(z);
-        lengths.push(length);
-        s.comment(&format!(
-            "Leg {n}: b = {}, p = {}, home length {length:.6} m",
-            vec(&b),
-            vec(&plat[i])
-        ));
-        s.body(
-            &format!("cylinder{n}"),
-            0.1,
-            [0.0, 0.0, 0.5],
-            &leg_inertia(),
-        );
-        s.body(
-            &format!("piston{n}"),
-            0.1,
-            [0.0, 0.0, length - 0.5],
-            &leg_inertia(),
-        );
-        s.joint(
-            &format!("u{n}"),
-            "U",
-            "base",
-            &format!("cylinder{n}"),
-            JointKeys {
-                origin: Some(origin(b, Some(rpy))),
-                ..Default::default()
-            },
-        );
-        s.joint(
-            &format!("p{n}"),
-            "P",
-            &format!("cylinder{n}"),
-            &format!("piston{n}"),
-            JointKeys {
-                axis: Some([0.0, 0.0, 1.0]),
-                actuated: true,
-                ..Default::default()
-            },
-        );
-        s.joint(
-            &format!("s{n}"),
-            "S",
-            &format!("piston{n}"),
-            "platform",
-            JointKeys {
-                origin: Some(origin([0.0, 0.0, length], None)),
-                child_origin: Some(origin(plat[i], None)),
-                ..Default::default()
-            },
-        );
-    }
-    s.write(dir, "gough_stewart.toml")?;
-    println!(
-        "  leg lengths {} cond(A) {}",
-        pct4(&lengths),
-        g(plucker_condition(&points, &dirs), 3)
-    );
-    Ok(())
 }
 
 // ---------------------------------------------------------------- 2. sliding-leg hexapod (6-PUS)

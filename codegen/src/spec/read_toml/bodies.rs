@@ -15,7 +15,7 @@ impl Reader<'_> {
         t: &DeTable<'_>,
         span: Range<usize>,
     ) -> Option<BodySpec> {
-        let path = Self::path(t, "body", i);
+        let path = self.path(t, "body", i);
         self.unknown_keys(t, BODY_KEYS, &path);
         let name = self.name(t, &path, span.clone());
         let name_span = get(t, "name").map_or(span.clone(), |v| v.span());

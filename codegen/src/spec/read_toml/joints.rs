@@ -45,7 +45,7 @@ impl Reader<'_> {
         t: &DeTable<'_>,
         span: Range<usize>,
     ) -> Option<JointSpec> {
-        let path = Self::path(t, "joint", i);
+        let path = self.path(t, "joint", i);
         self.unknown_keys(t, JOINT_KEYS, &path);
         let name = self.name(t, &path, span.clone());
         let name_span = get(t, "name").map_or(span.clone(), |v| v.span());

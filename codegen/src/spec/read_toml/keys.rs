@@ -14,6 +14,19 @@ pub(super) const TOP_KEYS: &[&str] = &[
     "joint",
     "spring",
     "parallelogram",
+    "parameters",
+    "pattern",
+];
+pub(super) const PATTERN_KEYS: &[&str] = &[
+    "name",
+    "copies",
+    "axis",
+    "angle",
+    "parameters",
+    "body",
+    "joint",
+    "parallelogram",
+    "spring",
 ];
 pub(super) const PARALLELOGRAM_KEYS: &[&str] = &[
     "name",

@@ -64,6 +64,25 @@ fn unit(v: &Vec3) -> Vec3 {
     }
 }
 
+impl ParallelogramSpec {
+    pub(super) fn parent(&self) -> &str {
+        &self.parent
+    }
+    pub(super) fn child(&self) -> &str {
+        &self.child
+    }
+    /// A pattern copy's turn `r` of the points on bodies outside the pattern: `elbow` when the
+    /// parent is outside, `platform_point` when the child is.
+    pub(super) fn turn(&mut self, r: &runtime::model::Mat3, parent: bool, child: bool) {
+        if parent {
+            self.elbow = mat_vec(r, &self.elbow);
+        }
+        if child {
+            self.platform_point = mat_vec(r, &self.platform_point);
+        }
+    }
+}
+
 /// Relative tolerance of the parallelogram's equalities (widths, the rods' transverse moments,
 /// the rod length against the home placement).
 const TOLERANCE: f64 = 1e-9;
@@ -76,7 +95,7 @@ impl Reader<'_> {
         t: &DeTable<'_>,
         span: Range<usize>,
     ) -> Option<ParallelogramSpec> {
-        let path = Self::path(t, "parallelogram", i);
+        let path = self.path(t, "parallelogram", i);
         self.unknown_keys(t, PARALLELOGRAM_KEYS, &path);
         let name = self.name(t, &path, span.clone());
         let name_span = get(t, "name").map_or(span.clone(), |v| v.span());

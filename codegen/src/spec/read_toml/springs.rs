@@ -18,7 +18,7 @@ impl Reader<'_> {
         t: &DeTable<'_>,
         span: Range<usize>,
     ) -> Option<SpringSpec> {
-        let path = Self::path(t, "spring", i);
+        let path = self.path(t, "spring", i);
         self.unknown_keys(t, SPRING_KEYS, &path);
         let name = self.name(t, &path, span.clone());
         let body = |r: &mut Self, k: &str| -> Option<Named> {

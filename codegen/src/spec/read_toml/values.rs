@@ -35,6 +35,12 @@ fn number_with_unit(s: &str) -> Option<(&str, &str)> {
     (!num.is_empty() && num.parse::<f64>().is_ok() && !unit.is_empty()).then_some((num, unit))
 }
 
+/// Whether an angle string that is not a plain angle (`"pi/2"`, `"90 deg"`) is meant as an
+/// expression: it calls a function or names a parameter.
+fn is_expression(s: &str) -> bool {
+    s.contains('(') || !crate::spec::expr::names(s).is_empty()
+}
+
 impl Reader<'_> {
     pub(super) fn err(
         &mut self,
@@ -77,7 +83,7 @@ impl Reader<'_> {
 
     pub(super) fn string(&mut self, v: &Val<'_>, key: &str) -> Option<String> {
         match v.get_ref() {
-            DeValue::String(s) => Some(s.to_string()),
+            DeValue::String(s) => Some(self.substitute(s)),
             _ => {
                 self.type_error("a string", v, key);
                 None
@@ -112,6 +118,17 @@ impl Reader<'_> {
             DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix())
                 .ok()
                 .map(|i| i as f64),
+            // A number with a unit other than an angle's is a unit mistake, not an expression.
+            DeValue::String(s)
+                if number_with_unit(s).is_some_and(|(_, u)| {
+                    !matches!(u, "deg" | "rad" | "°")
+                        && u.chars().all(|c| c.is_alphabetic() || "°·²³/".contains(c))
+                }) =>
+            {
+                self.type_error("a number", v, key);
+                return None;
+            }
+            DeValue::String(s) => Some(self.expression(s, v, key)?),
             _ => {
                 self.type_error("a number", v, key);
                 return None;
@@ -139,6 +156,21 @@ impl Reader<'_> {
     /// An angle: a number in radians or an angle string.
     pub(super) fn angle(&mut self, v: &Val<'_>, key: &str) -> Option<f64> {
         match v.get_ref() {
+            // An expression (other than an angle string's `2*pi/3`, `90 deg`): see `expression`.
+            DeValue::String(s) if parse_angle(s).is_err() && is_expression(s) => self
+                .expression(s, v, key)
+                .map(crate::spec::expr::quarter_turns_exact)
+                .filter(|a| {
+                    crate::spec::in_range(*a) || {
+                        self.err(
+                            format!("angle {s:?} ({a:e} rad) is out of range"),
+                            key,
+                            v.span(),
+                        )
+                        .hint = Some(crate::spec::RANGE_HINT.into());
+                        false
+                    }
+                }),
             DeValue::String(s) => match parse_angle(s) {
                 Ok(a) if crate::spec::in_range(a) => Some(a),
                 Ok(a) => {
