@@ -120,9 +120,11 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// Lengths in the labels: mm below 1 m.
+/// Lengths in the labels: µm below 1 mm, mm below 1 m.
 fn length(x: f64) -> String {
-    if x < 1.0 {
+    if x < 1e-3 {
+        format!("{:.3} µm", x * 1e6)
+    } else if x < 1.0 {
         format!("{:.3} mm", x * 1e3)
     } else {
         format!("{x:.4} m")
@@ -197,7 +199,10 @@ pub fn svg(home: &HomePose) -> Drawing {
     let height = TITLE + PANEL + LEGEND;
     // Names go where the mechanism spreads widest (the first such view on a tie).
     let spread = |v: &View| {
-        let (mut a, mut b) = ((f64::INFINITY, f64::NEG_INFINITY), (f64::INFINITY, f64::NEG_INFINITY));
+        let (mut a, mut b) = (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        );
         for p in home.points() {
             let (x, y) = v.project(&p);
             a = (a.0.min(x), a.1.max(x));
@@ -244,7 +249,15 @@ pub fn svg(home: &HomePose) -> Drawing {
     }
 }
 
+fn dist(a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 - b.0).hypot(a.1 - b.1)
+}
+
+/// A line, left out when it is seen end-on (shorter than a hundredth of a pixel).
 fn line(s: &mut String, a: (f64, f64), b: (f64, f64), style: &str) {
+    if (a.0 - b.0).hypot(a.1 - b.1) < 0.01 {
+        return;
+    }
     let _ = writeln!(
         s,
         r##"<line x1="{}" y1="{}" x2="{}" y2="{}" {style}/>"##,
@@ -313,7 +326,8 @@ fn draw_view(s: &mut String, home: &HomePose, v: &View, names: bool) {
             let d = [c[0] - j.at[0], c[1] - j.at[1], c[2] - j.at[2]];
             let gap = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             let (a, b) = (v.project(&j.at), v.project(&c));
-            if gap > 1e-9 {
+            // Open beyond the generator's tolerance (1e-9 × the mechanism's size).
+            if gap * v.scale > 1e-9 * (PANEL - 2.0 * MARGIN) {
                 line(
                     s,
                     a,
@@ -338,14 +352,30 @@ fn draw_view(s: &mut String, home: &HomePose, v: &View, names: bool) {
         }
     }
     if names {
+        // Joints drawn at one place share a label; a label that would leave the panel on the
+        // right ends left of its joint.
+        let mut labels: Vec<((f64, f64), Vec<&str>)> = Vec::new();
         for j in &home.joints {
-            let (x, y) = v.project(&j.at);
+            let at = v.project(&j.at);
+            match labels.iter_mut().find(|(p, _)| dist(*p, at) < 2.0) {
+                Some((_, names)) => names.push(&j.name),
+                None => labels.push((at, vec![&j.name])),
+            }
+        }
+        for ((x, y), names) in labels {
+            let text = names.join(", ");
+            let wide = 5.5 * text.chars().count() as f64;
+            let (tx, anchor) = if x + 7.0 + wide > x0 + PANEL - 2.0 {
+                (x - 7.0, r#" text-anchor="end""#)
+            } else {
+                (x + 7.0, "")
+            };
             let _ = writeln!(
                 s,
-                r##"<text x="{}" y="{}" font-size="9" fill="#444444">{}</text>"##,
-                n(x + 7.0),
+                r##"<text x="{}" y="{}" font-size="9" fill="#444444" stroke="#ffffff" stroke-width="2.5" paint-order="stroke"{anchor}>{}</text>"##,
+                n(tx),
                 n(y - 6.0),
-                esc(&j.name)
+                esc(&text)
             );
         }
     }
@@ -564,7 +594,10 @@ fn legend(s: &mut String, top: f64) {
                 s,
                 (x - 8.0, y),
                 (x + 8.0, y),
-                &format!(r##"stroke="{}" stroke-width="2" stroke-dasharray="3 2""##, rgb(CUT)),
+                &format!(
+                    r##"stroke="{}" stroke-width="2" stroke-dasharray="3 2""##,
+                    rgb(CUT)
+                ),
             );
         },
         "gap: loop open at home",

@@ -36,8 +36,8 @@ use runtime::parallel::ParallelModel;
 use crate::diag::{Diagnostic, Diagnostics};
 
 pub use fix::apply_fixes;
-pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use function::{Function, FunctionSet, Kind};
+pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use input::{
     MAX_DOF, MAX_ENTRIES, MAX_MAGNITUDE, MAX_NAME_LEN, MAX_SNAP, MAX_SOURCE_BYTES,
     is_snap_tolerance, source_text,
