@@ -7,6 +7,8 @@
 //! composes the joints' placements; a joint with `child_origin` (a loop cut, or a leg's joint
 //! into the platform) is placed from both sides.
 
+use std::collections::{HashMap, VecDeque};
+
 use runtime::model::{Transform, Vec3, mat_vec};
 
 use super::geom::{self, compose};
@@ -129,16 +131,24 @@ fn distinct(a: &Vec3, b: &Vec3) -> bool {
 /// exist, a joint whose parent is never reached: the spec's diagnostics say why).
 pub(crate) fn home_pose(spec: &Spec) -> Option<HomePose> {
     let nb = spec.bodies.len();
-    let index = |name: &str| spec.bodies.iter().position(|b| b.name == name);
+    // Body index by name (the first of duplicates, which the spec's checks report).
+    let mut by_name: HashMap<&str, usize> = HashMap::new();
+    for (i, b) in spec.bodies.iter().enumerate() {
+        by_name.entry(b.name.as_str()).or_insert(i);
+    }
+    let index = |name: &str| by_name.get(name).copied();
     // Pose of each body's frame at home; the base is `None` in `index`, kept apart.
     let mut pose: Vec<Option<Transform>> = vec![None; nb];
     // The point a body's lines start from (the joint that moves it, then the DH `d` point).
     let mut start: Vec<Vec<Vec3>> = vec![Vec::new(); nb];
     let platform = spec.platform.as_ref();
+    let mut queue: VecDeque<&str> = VecDeque::from([BASE]);
     if let Some(ps) = platform
-        && let Some(i) = ps.body.as_deref().and_then(index)
+        && let Some(name) = ps.body.as_deref()
+        && let Some(i) = index(name)
     {
         pose[i] = Some(ps.home);
+        queue.push_back(name);
     }
     let pose_of = |pose: &[Option<Transform>], name: &str| -> Option<Transform> {
         if name == BASE {
@@ -147,21 +157,25 @@ pub(crate) fn home_pose(spec: &Spec) -> Option<HomePose> {
             index(name).and_then(|i| pose[i])
         }
     };
-    // Tree joints, parents first: as many passes as there are joints at most.
+    // Tree joints by parent, in the spec's order; placed outward from the base (and the
+    // platform), each body once.
+    let mut carried: HashMap<&str, Vec<usize>> = HashMap::new();
+    for (ji, j) in spec.joints.iter().enumerate() {
+        if j.child_origin.is_none() {
+            carried.entry(j.parent.as_str()).or_default().push(ji);
+        }
+    }
     let mut frame: Vec<Option<Transform>> = vec![None; spec.joints.len()];
-    for _ in 0..=spec.joints.len() {
-        let mut progress = false;
-        for (ji, j) in spec.joints.iter().enumerate() {
-            if frame[ji].is_some() || j.child_origin.is_some() {
-                continue;
-            }
+    while let Some(body) = queue.pop_front() {
+        let Some(p) = pose_of(&pose, body) else {
+            continue;
+        };
+        for &ji in carried.get(body).map_or(&[][..], |v| v.as_slice()) {
+            let j = &spec.joints[ji];
             let Some(c) = index(&j.child) else { continue };
             if pose[c].is_some() {
                 continue;
             }
-            let Some(p) = pose_of(&pose, &j.parent) else {
-                continue;
-            };
             let (origin, offset) = placement_frames(&j.placement);
             let f = compose(&p, &origin);
             frame[ji] = Some(f);
@@ -172,10 +186,7 @@ pub(crate) fn home_pose(spec: &Spec) -> Option<HomePose> {
             {
                 start[c].push(f.apply(&[0.0, 0.0, dh.d]));
             }
-            progress = true;
-        }
-        if !progress {
-            break;
+            queue.push_back(j.child.as_str());
         }
     }
     // Loop-closing joints: placed from their parent; their child side from the child's pose.
@@ -300,11 +311,12 @@ pub(crate) fn home_pose(spec: &Spec) -> Option<HomePose> {
             if ends.is_empty() && distinct(&from, &bp.translation) {
                 ends.push(bp.translation);
             }
-            for e in ends {
-                if distinct(&from, &e) {
+            for (k, e) in ends.iter().enumerate() {
+                // Once per place (a fixed pin and a joint at one point).
+                if distinct(&from, e) && ends[..k].iter().all(|o| distinct(o, e)) {
                     segments.push(Segment {
                         from,
-                        to: e,
+                        to: *e,
                         part: Part::Body,
                     });
                 }
