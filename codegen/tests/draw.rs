@@ -312,3 +312,27 @@ fn no_input_panics() {
     }
     assert!(seen > 20, "{seen}");
 }
+
+/// A long chain written leaf first: every joint placed, each link 0.1 m along x.
+#[test]
+fn a_chain_written_backwards_draws() {
+    let n = 100;
+    let mut text = String::from("[mechanism]\nname = \"chain\"\n");
+    for i in (0..n).rev() {
+        let parent = if i == 0 {
+            "base".to_string()
+        } else {
+            format!("b{}", i - 1)
+        };
+        text.push_str(&format!(
+            "[[body]]\nname = \"b{i}\"\nmass = 1.0\n[[joint]]\nname = \"j{i}\"\nkind = \"revolute\"\nparent = \"{parent}\"\nchild = \"b{i}\"\norigin = {{ xyz = [0.1, 0.0, 0.0] }}\naxis = [0.0, 0.0, 1.0]\n"
+        ));
+    }
+    let (home, _) = codegen::spec::home_pose("chain.toml", &text).expect("placed");
+    assert_eq!(home.joints.len(), n);
+    for j in &home.joints {
+        let i: f64 = j.name[1..].parse().unwrap();
+        assert!((j.at[0] - 0.1 * (i + 1.0)).abs() < 1e-12, "{}: {:?}", j.name, j.at);
+        assert!(j.actuated);
+    }
+}
