@@ -40,14 +40,17 @@ const TICK: f64 = 16.0;
 /// Radius of a joint marker (px).
 const R: f64 = 5.0;
 
+/// A base axis (0 = x, 1 = y, 2 = z) and its sign, as a view shows it.
+pub type Direction = (usize, f64);
+
 /// One orthographic view: which base axes it shows and where (px, y down).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
     /// Its label (`front (x–z)`, …).
     pub label: &'static str,
     /// The base axes along the view's right and up directions, with their signs.
-    pub right: (usize, f64),
-    pub up: (usize, f64),
+    pub right: Direction,
+    pub up: Direction,
     /// The panel's top-left corner (px).
     pub origin: (f64, f64),
     /// The world point at the panel's centre, along `right` and `up` (m, signed as shown).
@@ -174,7 +177,7 @@ fn views(home: &HomePose) -> [View; 3] {
     let extent = if extent > 1e-9 { extent } else { 1.0 };
     let scale = (PANEL - 2.0 * MARGIN) / extent;
     let mid = |k: usize| 0.5 * (lo[k] + hi[k]);
-    let specs: [(&'static str, (usize, f64), (usize, f64)); 3] = [
+    let specs: [(&'static str, Direction, Direction); 3] = [
         ("front (x right, z up)", (0, 1.0), (2, 1.0)),
         ("side (y right, z up)", (1, 1.0), (2, 1.0)),
         ("top (x right, y up)", (0, 1.0), (1, 1.0)),

@@ -332,7 +332,12 @@ fn a_chain_written_backwards_draws() {
     assert_eq!(home.joints.len(), n);
     for j in &home.joints {
         let i: f64 = j.name[1..].parse().unwrap();
-        assert!((j.at[0] - 0.1 * (i + 1.0)).abs() < 1e-12, "{}: {:?}", j.name, j.at);
+        assert!(
+            (j.at[0] - 0.1 * (i + 1.0)).abs() < 1e-12,
+            "{}: {:?}",
+            j.name,
+            j.at
+        );
         assert!(j.actuated);
     }
 }
