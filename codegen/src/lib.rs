@@ -35,6 +35,7 @@
 pub mod build_script;
 pub mod closed;
 pub mod diag;
+pub mod draw;
 pub mod dynamics;
 pub mod emit;
 mod implement;

@@ -5,6 +5,7 @@
 //! cargo run -p codegen -- SPEC.(toml|urdf) [-o OUT.rs] [--check] [--stats] [--math libm|std|runtime]
 //! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
 //! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
+//! cargo run -p codegen -- draw SPEC [-o home.svg]
 //! ```
 //! Exit codes: 0 success, 2 invalid spec (also one that is not UTF-8) or arguments (diagnostics
 //! on stderr, nothing written), 1 I/O error. A spec file literally named `map` or `isotropy`
@@ -123,6 +124,9 @@ enum Command {
     /// Write the corrections made at home (loops left a little open by rounded numbers) into
     /// the spec.
     FixHome(cli::fix_home::FixHomeArgs),
+    /// Draw the home pose in three orthographic views (SVG): joints by kind, actuated joints
+    /// and loop cuts highlighted.
+    Draw(cli::draw::DrawArgs),
     /// A URDF as a TOML spec that generates the same module (for a `[scene]`, `reduce`, …).
     #[cfg(feature = "urdf")]
     Convert(cli::convert::ConvertArgs),
@@ -135,6 +139,7 @@ fn main() -> ExitCode {
         Some(Command::Isotropy(args)) => return cli::isotropy::run(&args),
         Some(Command::Reduce(args)) => return cli::reduce::run(&args),
         Some(Command::FixHome(args)) => return cli::fix_home::run(&args),
+        Some(Command::Draw(args)) => return cli::draw::run(&args),
         #[cfg(feature = "urdf")]
         Some(Command::Convert(args)) => return cli::convert::run(&args),
         None => {}

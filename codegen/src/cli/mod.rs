@@ -12,6 +12,7 @@
 #[cfg(feature = "urdf")]
 pub mod convert;
 pub mod design;
+pub mod draw;
 pub mod fix_home;
 pub mod isotropy;
 pub mod map;

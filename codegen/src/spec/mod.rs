@@ -16,6 +16,7 @@ mod expr;
 mod fix;
 mod function;
 mod geom;
+mod home;
 mod input;
 mod ir;
 mod lower;
@@ -37,6 +38,7 @@ use crate::diag::{Diagnostic, Diagnostics};
 
 pub use fix::apply_fixes;
 pub use function::{Function, FunctionSet, Kind};
+pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use input::{
     MAX_DOF, MAX_ENTRIES, MAX_MAGNITUDE, MAX_NAME_LEN, MAX_SNAP, MAX_SOURCE_BYTES,
     is_snap_tolerance, source_text,
@@ -174,21 +176,7 @@ fn load_any(
     }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let mut d = Diagnostics::new(file_name, source);
-        let root = xml_root(source);
-        let spec = match root
-            .as_ref()
-            .map(|(name, span)| (name.as_str(), span.clone()))
-        {
-            _ if is_urdf(file_name) => read_urdf(source, &mut d),
-            // A URDF under another name (`robot.xml`).
-            Some(("robot", _)) => read_urdf(source, &mut d),
-            Some((other, span)) => {
-                d.push(other_xml(other, span));
-                None
-            }
-            None => read_toml::read(source, &mut d),
-        };
-        let spec = spec.filter(|s| check_size(s, &mut d)).map(|mut s| {
+        let spec = read_ir(file_name, source, &mut d).map(|mut s| {
             prepare(&mut s, overrides, &mut d);
             if s.scene.runtime_params
                 && s.platform.is_none()
@@ -296,6 +284,65 @@ fn load_any(
                     .with_hint("this is a bug in nocdyn; please report it with the input file"),
             );
             (None, diags, None)
+        }
+    }
+}
+
+/// The format-neutral spec of `source` (TOML or URDF by `file_name`, as [`load`] chooses),
+/// within the size limits; `None` after errors in `d`.
+fn read_ir(file_name: &str, source: &str, d: &mut Diagnostics) -> Option<ir::Spec> {
+    let root = xml_root(source);
+    let spec = match root
+        .as_ref()
+        .map(|(name, span)| (name.as_str(), span.clone()))
+    {
+        _ if is_urdf(file_name) => read_urdf(source, d),
+        // A URDF under another name (`robot.xml`).
+        Some(("robot", _)) => read_urdf(source, d),
+        Some((other, span)) => {
+            d.push(other_xml(other, span));
+            None
+        }
+        None => read_toml::read(source, d),
+    };
+    spec.filter(|s| check_size(s, d))
+}
+
+/// The home pose of a spec as written, for drawing it (`codegen draw`): every joint placed at
+/// zero joint coordinates, loops not closed (a gap shows where the spec leaves one open).
+///
+/// The spec is also loaded as [`load`] does, and its diagnostics come back with the pose:
+/// they may hold errors (a loop too far open, a wrong mobility) when the geometry could still
+/// be placed, which is when a picture helps most. `Err` when the spec cannot be read or some
+/// joint cannot be placed (an unknown body, a cycle). Pure, and never panics.
+pub fn home_pose(file_name: &str, source: &str) -> Result<(HomePose, Diagnostics), Diagnostics> {
+    let mut diags = match load(file_name, source, &SceneOverrides::default()) {
+        Ok(l) => l.warnings,
+        Err(d) => d,
+    };
+    if source.len() > MAX_SOURCE_BYTES {
+        return Err(diags);
+    }
+    let placed = std::panic::catch_unwind(|| {
+        let mut d = Diagnostics::new(file_name, source);
+        read_ir(file_name, source, &mut d).and_then(|s| home::home_pose(&s))
+    });
+    match placed {
+        Ok(Some(home)) => Ok((home, diags)),
+        Ok(None) => {
+            if !diags.has_errors() {
+                diags.push(Diagnostic::error(
+                    "the home pose could not be placed: some joint is not reached from the base",
+                ));
+            }
+            Err(diags)
+        }
+        Err(_) => {
+            diags.push(
+                Diagnostic::error("internal error: placing the home pose panicked")
+                    .with_hint("this is a bug in nocdyn; please report it with the input file"),
+            );
+            Err(diags)
         }
     }
 }
