@@ -11,6 +11,7 @@
 //! This is the only module that knows TOML or XML.
 
 mod angle;
+mod child_frame;
 mod closed;
 mod expr;
 mod fix;
@@ -306,6 +307,7 @@ fn read_ir(file_name: &str, source: &str, d: &mut Diagnostics) -> Option<ir::Spe
         None => read_toml::read(source, d),
     };
     spec.filter(|s| check_size(s, d))
+        .map(|s| child_frame::apply(s, d))
 }
 
 /// The home pose of a spec as written, for drawing it (`codegen draw`): every joint placed at
