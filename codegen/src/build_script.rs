@@ -109,8 +109,9 @@ impl Builder {
         self
     }
 
-    /// Add every `.toml` and `.urdf` file of a directory (sorted by name). A directory that
-    /// cannot be read makes [`Builder::compile`] fail with [`Error::Io`].
+    /// Add every `.toml` and `.urdf` file of a directory (sorted by name), but not the
+    /// `*.scene.toml` scene files (see [`Builder::compile`]). A directory that cannot be read
+    /// makes [`Builder::compile`] fail with [`Error::Io`].
     pub fn specs_in(&mut self, dir: impl AsRef<Path>) -> &mut Self {
         let dir = dir.as_ref();
         println!("cargo:rerun-if-changed={}", dir.display());
@@ -122,7 +123,7 @@ impl Builder {
                         matches!(
                             p.extension().and_then(|e| e.to_str()),
                             Some("toml" | "urdf")
-                        )
+                        ) && !is_scene_file(p)
                     })
                     .collect();
                 found.sort();
@@ -223,7 +224,19 @@ impl Builder {
             // where cargo runs build scripts), as cargo's own messages do.
             let name = p.to_string_lossy();
             let src = crate::spec::source_text(&name, bytes).map_err(Error::Spec)?;
-            let g = compile(&name, &src, &self.config).map_err(Error::Spec)?;
+            // A URDF's `[scene]`, when it has one.
+            let mut config = self.config.clone();
+            if let Some(beside) = scene_beside(p) {
+                println!("cargo:rerun-if-changed={}", beside.display());
+                let bytes = read_spec(&beside).map_err(|e| Error::Io(beside.clone(), e))?;
+                let side_name = beside.to_string_lossy().into_owned();
+                let text = crate::spec::source_text(&side_name, bytes).map_err(Error::Spec)?;
+                config.scene.sidecar = Some(crate::spec::SceneFile {
+                    name: side_name,
+                    text,
+                });
+            }
+            let g = compile(&name, &src, &config).map_err(Error::Spec)?;
             // Warnings (e.g. `snap`'s changes) reach the user as cargo warnings.
             if self.warnings && !g.warnings.is_empty() {
                 for line in g.warnings.render().lines() {
@@ -236,6 +249,23 @@ impl Builder {
         }
         Ok(written)
     }
+}
+
+/// A URDF's `[scene]` file: `ROBOT.scene.toml` beside `ROBOT.urdf`, when it exists (the CLI,
+/// [`Builder`] and the `mechanism!` macro use it alike; docs/scene.md, "A scene for a URDF").
+pub fn scene_beside(spec: &Path) -> Option<PathBuf> {
+    let urdf = spec
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"));
+    let beside = spec.with_extension("scene.toml");
+    (urdf && beside.is_file()).then_some(beside)
+}
+
+/// `ROBOT.scene.toml`: a URDF's `[scene]`, not a spec.
+fn is_scene_file(p: &Path) -> bool {
+    p.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.ends_with(".scene.toml"))
 }
 
 fn module_name(p: &Path, all: &[PathBuf]) -> String {

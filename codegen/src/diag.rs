@@ -144,6 +144,13 @@ impl Diagnostics {
         self.list.extend(other.list);
     }
 
+    /// Removes and returns the diagnostics for which `pred` holds, keeping the others.
+    pub fn take_if(&mut self, pred: impl Fn(&Diagnostic) -> bool) -> Vec<Diagnostic> {
+        let (taken, kept) = std::mem::take(&mut self.list).into_iter().partition(pred);
+        self.list = kept;
+        taken
+    }
+
     /// `true` when at least one diagnostic is an error.
     pub fn has_errors(&self) -> bool {
         self.list.iter().any(Diagnostic::is_error)

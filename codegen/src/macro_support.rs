@@ -23,7 +23,7 @@ pub fn resolve(manifest_dir: &Path, spec: &str) -> PathBuf {
 }
 
 /// Read the spec [`resolve`]`(manifest_dir, spec)` and generate its module: the items' source
-/// text, exactly [`compile`]'s `code`.
+/// text, exactly [`compile`]'s `code`. A URDF's `ROBOT.scene.toml` beside it is its `[scene]`.
 ///
 /// # Errors
 ///
@@ -37,7 +37,19 @@ pub fn expand(manifest_dir: &Path, spec: &str, cfg: &Config) -> Result<String, S
     let bytes =
         crate::build_script::read_spec(&path).map_err(|e| format!("cannot read {spec}: {e}"))?;
     let source = crate::spec::source_text(spec, bytes).map_err(|d| d.render())?;
-    compile(spec, &source, cfg)
+    let mut cfg = cfg.clone();
+    if let Some(beside) = crate::build_script::scene_beside(&path) {
+        // Named as the spec is: as the literal wrote it.
+        let name = Path::new(spec)
+            .with_extension("scene.toml")
+            .to_string_lossy()
+            .into_owned();
+        let bytes = crate::build_script::read_spec(&beside)
+            .map_err(|e| format!("cannot read {name}: {e}"))?;
+        let text = crate::spec::source_text(&name, bytes).map_err(|d| d.render())?;
+        cfg.scene.sidecar = Some(crate::spec::SceneFile { name, text });
+    }
+    compile(spec, &source, &cfg)
         .map(|generated| generated.code)
         .map_err(|diagnostics| diagnostics.render())
 }

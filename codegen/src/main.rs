@@ -89,6 +89,10 @@ struct Cli {
     /// and offsets within TOL (m) of 0 as exact, listing each change (as `[scene] snap`).
     #[arg(long, value_name = "TOL", value_parser = snap_tolerance, allow_negative_numbers = true)]
     snap: Option<f64>,
+    /// A `[scene]` for a spec that has none (a URDF): a TOML file with a `[scene]` table.
+    /// Without it, `ROBOT.scene.toml` beside `ROBOT.urdf` is used when it exists.
+    #[arg(long, value_name = "SCENE.toml")]
+    scene: Option<PathBuf>,
 }
 
 /// `--snap`: the bounds of `[scene] snap`.
@@ -153,8 +157,18 @@ fn main() -> ExitCode {
         Ok(r) => r,
         Err(code) => return code,
     };
+    let sidecar = match cli::sidecar(spec, cli.scene.as_deref()) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
     if cli.check {
-        return match codegen::spec::load_mechanism(&name, &source) {
+        let overrides = codegen::spec::SceneOverrides {
+            sidecar: sidecar.clone(),
+            ..Default::default()
+        };
+        return match codegen::spec::load(&name, &source, &overrides)
+            .map(|l| (l.mechanism, l.warnings))
+        {
             Ok((mechanism, warnings)) => {
                 if !warnings.is_empty() {
                     eprint!("{}", warnings.render());
@@ -212,6 +226,7 @@ fn main() -> ExitCode {
                 friction: cli.friction,
                 rotor_inertia: cli.rotor_inertia,
                 snap: cli.snap,
+                sidecar: sidecar.clone(),
             },
             implement: cli.implement.then(|| cli.runtime_path.clone()),
         },
@@ -226,7 +241,7 @@ fn main() -> ExitCode {
         eprint!("{}", out.warnings.render());
     }
     if cli.snap.is_none()
-        && let Some(note) = snap_note(&name, &source, &cfg_for_snap(&cli), &out)
+        && let Some(note) = snap_note(&name, &source, &cfg_for_snap(&cli, sidecar), &out)
     {
         eprintln!("{note}");
     }
@@ -251,7 +266,7 @@ fn main() -> ExitCode {
 const SUGGESTED_SNAP: f64 = 1e-4;
 
 /// The generation options of `cli` with `--snap` at [`SUGGESTED_SNAP`].
-fn cfg_for_snap(cli: &Cli) -> Config {
+fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config {
     Config {
         math: MathBackend::Libm,
         float: match cli.float {
@@ -262,6 +277,7 @@ fn cfg_for_snap(cli: &Cli) -> Config {
             friction: cli.friction,
             rotor_inertia: cli.rotor_inertia,
             snap: Some(SUGGESTED_SNAP),
+            sidecar,
         },
         implement: None,
     }
@@ -281,7 +297,7 @@ fn snap_note(
         source,
         &codegen::spec::SceneOverrides {
             snap: None,
-            ..snapped.scene
+            ..snapped.scene.clone()
         },
     )
     .ok()?;

@@ -251,6 +251,8 @@ impl Args {
             friction: self.friction.as_ref().is_some_and(LitBool::value),
             rotor_inertia: self.rotor_inertia.as_ref().is_some_and(LitBool::value),
             snap,
+            // A URDF's `ROBOT.scene.toml` beside it is read by `macro_support::expand`.
+            sidecar: None,
         };
         if let Some(p) = &self.implement
             && syn::parse_str::<syn::Path>(&p.value()).is_err()

@@ -175,6 +175,26 @@ pub fn read_spec(spec: &std::path::Path) -> Result<(String, String), ExitCode> {
     Ok((name, source))
 }
 
+/// The `[scene]` sidecar of `spec`: the file `--scene` names, else `ROBOT.scene.toml` beside a
+/// `ROBOT.urdf` when it exists (with a note on standard error), else none.
+pub fn sidecar(
+    spec: &std::path::Path,
+    given: Option<&std::path::Path>,
+) -> Result<Option<codegen::spec::SceneFile>, ExitCode> {
+    let path = match given {
+        Some(p) => p.to_path_buf(),
+        None => {
+            let Some(beside) = codegen::build_script::scene_beside(spec) else {
+                return Ok(None);
+            };
+            eprintln!("note: with the scene file {}", beside.display());
+            beside
+        }
+    };
+    let (name, text) = read_spec(&path)?;
+    Ok(Some(codegen::spec::SceneFile { name, text }))
+}
+
 impl Target {
     /// Load a spec for the tools. Errors and warnings are printed; the exit code is returned.
     pub fn load(spec: &std::path::Path, space: SpaceArg) -> Result<Target, ExitCode> {

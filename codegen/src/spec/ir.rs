@@ -99,6 +99,46 @@ pub(crate) struct SceneSpec {
     /// `forearm_split`: the fraction of each forearm pair's mass lumped at the elbow (the rest
     /// on the platform), in [0, 1]; with the span of the value. Default 2/3.
     pub forearm_split: Option<(f64, Span)>,
+    /// The span of the `[scene]` header, when the spec writes one.
+    pub written: Span,
+}
+
+impl SceneSpec {
+    /// Moves every span by `by` bytes (a sidecar's spans past the spec's text, so that the
+    /// diagnostics about them can be told apart and moved to the sidecar's file).
+    pub fn shift(&mut self, by: usize) {
+        let s = |span: &mut Span| {
+            if let Some(r) = span {
+                *r = r.start + by..r.end + by;
+            }
+        };
+        let n = |named: &mut Named| {
+            if let Some(r) = &mut named.span {
+                *r = r.start + by..r.end + by;
+            }
+        };
+        self.functions.iter_mut().flatten().for_each(n);
+        self.point_mass.iter_mut().for_each(n);
+        self.massless.iter_mut().for_each(n);
+        if let Some(p) = &mut self.payload {
+            n(&mut p.body);
+        }
+        self.locked.iter_mut().for_each(|(named, _)| n(named));
+        s(&mut self.runtime_params_span);
+        if let Some((r, span)) = &mut self.runtime_inertia {
+            s(span);
+            if let RuntimeInertia::Bodies(b) = r {
+                b.iter_mut().for_each(n);
+            }
+        }
+        if let Some(span) = &mut self.codourey {
+            s(span);
+        }
+        if let Some((_, span)) = &mut self.forearm_split {
+            s(span);
+        }
+        s(&mut self.written);
+    }
 }
 
 /// The value of `[scene] runtime_inertia`.
@@ -144,6 +184,7 @@ impl Default for SceneSpec {
             runtime_bodies: Vec::new(),
             codourey: None,
             forearm_split: None,
+            written: None,
         }
     }
 }

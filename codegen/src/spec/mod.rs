@@ -47,7 +47,7 @@ pub use input::{
 pub(crate) use input::{SNAP_HINT, in_range, name_too_long};
 use input::{check_size, too_large};
 pub(crate) use names::{is_module_name, sanitize_name, suggest_hint};
-pub use scene::{RuntimeBody, RuntimeParams, Scene, SceneOverrides, body_names};
+pub use scene::{RuntimeBody, RuntimeParams, Scene, SceneFile, SceneOverrides, body_names};
 use scene::{check_scene_functions, no_drive, prepare, runtime_params};
 
 /// The hint of a number out of [`in_range`].
@@ -175,9 +175,37 @@ fn load_any(
         diags.push(too_large(source.len(), true));
         return (None, diags, None);
     }
+    // A sidecar's spans are moved past the spec's text; what points there goes to its file.
+    let offset = source.len() + 1;
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let mut d = Diagnostics::new(file_name, source);
-        let spec = read_ir(file_name, source, &mut d).map(|mut s| {
+        let mut side = overrides
+            .sidecar
+            .as_ref()
+            .map(|f| Diagnostics::new(&f.name, &f.text));
+        let spec = read_ir(file_name, source, &mut d).and_then(|mut s| {
+            if let (Some(f), Some(sd)) = (&overrides.sidecar, side.as_mut()) {
+                if s.scene.written.is_some() {
+                    sd.push(
+                        Diagnostic::error(format!(
+                            "{file_name} has its own [scene] table, and a scene file is given too"
+                        ))
+                        .with_hint(
+                            "give the scene once: in the spec's [scene] table or in the scene file",
+                        ),
+                    );
+                    return None;
+                }
+                let scene = read_toml::read_scene(&f.text, sd, &mut s.gravity)?;
+                if sd.has_errors() {
+                    return None;
+                }
+                s.scene = scene;
+                s.scene.shift(offset);
+            }
+            Some(s)
+        });
+        let spec = spec.map(|mut s| {
             prepare(&mut s, overrides, &mut d);
             if s.scene.runtime_params
                 && s.platform.is_none()
@@ -272,12 +300,31 @@ fn load_any(
             };
             (m, Scene { functions, params })
         });
-        (read, d, platform)
+        (read, d, platform, side)
     }));
     match result {
-        Ok((mechanism, d, platform)) => {
+        Ok((mechanism, d, platform, side)) => {
             diags.extend(d);
-            (mechanism, diags, platform)
+            let Some(mut side) = side else {
+                return (mechanism, diags, platform);
+            };
+            for mut m in diags.take_if(|m| m.span.as_ref().is_some_and(|s| s.start >= offset)) {
+                m.span = m.span.map(|s| s.start - offset..s.end - offset);
+                side.push(m);
+            }
+            if side.has_errors() {
+                // The scene file's errors first; the spec's own, if any, once it reads.
+                side.sort_by_position();
+                (None, side, platform)
+            } else {
+                // Its warnings, without a place in the spec's text.
+                for mut m in side.take_if(|_| true) {
+                    m.message = format!("{}: {}", side.file_name(), m.message);
+                    m.span = None;
+                    diags.push(m);
+                }
+                (mechanism, diags, platform)
+            }
         }
         Err(_) => {
             diags.push(

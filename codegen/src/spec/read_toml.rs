@@ -52,6 +52,52 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
     Some(r.spec(&root))
 }
 
+/// Reads a `[scene]` sidecar: `[scene]` and optionally `[parameters]`, nothing else; `gravity`
+/// is the spec's, replaced when the scene gives one. `None` when it could not be read.
+pub(crate) fn read_scene(
+    source: &str,
+    diags: &mut Diagnostics,
+    gravity: &mut runtime::model::Vec3,
+) -> Option<SceneSpec> {
+    let (root, errors) = DeTable::parse_recoverable(source);
+    if !errors.is_empty() {
+        syntax::report(source, errors, diags);
+        return None;
+    }
+    let root = root.into_inner();
+    let mut r = Reader {
+        diags,
+        joints_incomplete: false,
+        params: Vec::new(),
+        declared: Vec::new(),
+        copy: None,
+    };
+    r.unknown_keys(&root, &["scene", "parameters"], "");
+    if let Some(v) = get(&root, "parameters")
+        && let Some(t) = r.table(v, "parameters")
+    {
+        r.parameter_table(t, "parameters");
+    }
+    let mut scene = SceneSpec::default();
+    match get(&root, "scene") {
+        Some(v) => {
+            scene.written = key_span(&root, "scene");
+            if let Some(t) = r.table(v, "scene") {
+                r.scene(t, &mut scene, gravity);
+            }
+        }
+        None => {
+            r.err(
+                "a scene file holds a [scene] table, and this one has none",
+                "scene",
+                0..0,
+            )
+            .hint = Some("write the scene's keys under a [scene] header (docs/scene.md)".into());
+        }
+    }
+    Some(scene)
+}
+
 /// The walk's state. Entries with bad values are kept with placeholder values (the error is
 /// already reported and lowering stops before using them), so that names still resolve and one
 /// mistake does not cascade into "unknown body" errors.
@@ -92,7 +138,10 @@ impl Reader<'_> {
             let span = key_span(root, "platform").unwrap_or(v.span());
             self.platform(v, span)
         });
-        let mut scene = SceneSpec::default();
+        let mut scene = SceneSpec {
+            written: key_span(root, "scene"),
+            ..SceneSpec::default()
+        };
         if let Some(v) = get(root, "scene")
             && let Some(t) = self.table(v, "scene")
         {

@@ -21,8 +21,11 @@ pub struct Scene {
 /// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect
 /// on in addition to what the spec's `[scene]` says (a URDF has no `[scene]`; its
 /// `<dynamics damping friction>` apply only with `friction`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct SceneOverrides {
+    /// A `[scene]` sidecar: a TOML file holding only `[scene]` (and `[parameters]`) for a spec
+    /// that has none, a URDF's in particular (docs/scene.md, "A scene for a URDF").
+    pub sidecar: Option<SceneFile>,
     /// Apply the joints' viscous (`damping`) and Coulomb (`friction`) friction.
     pub friction: bool,
     /// Apply the joints' reflected rotor inertia (`armature`).
@@ -30,6 +33,15 @@ pub struct SceneOverrides {
     /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
     /// replaces the spec's value). Out of (0, [`MAX_SNAP`]] it is an error.
     pub snap: Option<f64>,
+}
+
+/// A `[scene]` sidecar file: its name (for messages) and text.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneFile {
+    /// The file's name as diagnostics show it.
+    pub name: String,
+    /// Its text.
+    pub text: String,
 }
 
 /// An error when joint `j`, which `role` (e.g. "closes a loop"), has a drive: friction and rotor
