@@ -1019,7 +1019,7 @@ pub(crate) fn emit(name: &str, code: &str, single: bool) -> Result<CCrate, Strin
                         meaning(a, kind, &f.name).replace("NAME", name)
                     ));
                     reads.push(format!(
-                        "    // SAFETY: not null (checked); the caller passes a valid `{name}_params_t *`.\n    let {a} = params(unsafe {{ &{a}.read() }});"
+                        "    // SAFETY: not null (checked); the caller passes a valid `{name}_params_t *`.\n    let {a} = params(&unsafe {{ {a}.read() }});"
                     ));
                 }
                 Ty::Array(..) | Ty::Real => {
