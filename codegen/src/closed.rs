@@ -225,6 +225,7 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         dof: n,
         warnings: crate::diag::Diagnostics::new("", ""),
         per: "DOF",
+        c_crate: None,
     })
 }
 

@@ -33,6 +33,7 @@
 #![allow(clippy::needless_range_loop)] // index loops read like the equations
 
 pub mod build_script;
+pub mod c_api;
 pub mod closed;
 pub mod diag;
 pub mod draw;
@@ -80,6 +81,18 @@ pub enum Float {
     F32,
 }
 
+/// What a generation produces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Emit {
+    /// The Rust module (default).
+    #[default]
+    Rust,
+    /// The Rust module and a crate that wraps it for C ([`Generated::c_crate`], see
+    /// [`c_api`]): a `no_std` `staticlib` of `extern "C"` functions and its header. Needs
+    /// the `libm` math backend and no `implement`.
+    C,
+}
+
 /// Generation options.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
@@ -94,6 +107,8 @@ pub struct Config {
     /// `"runtime"`), so that code over modules of every kind is written once (see
     /// `runtime::Dynamics`). `None` (default): free functions only.
     pub implement: Option<String>,
+    /// What to produce: the module only, or also its C wrapper crate.
+    pub emit: Emit,
 }
 
 impl Default for Config {
@@ -103,6 +118,7 @@ impl Default for Config {
             float: Float::F64,
             scene: spec::SceneOverrides::default(),
             implement: None,
+            emit: Emit::Rust,
         }
     }
 }
@@ -120,6 +136,9 @@ pub struct Generated {
     pub warnings: diag::Diagnostics,
     /// What the op-count table divides by: `"joint"` (trees) or `"DOF"` (parallel mechanisms).
     pub per: &'static str,
+    /// With [`Emit::C`]: the C wrapper crate of [`Generated::code`] (its files by relative
+    /// path); `None` otherwise.
+    pub c_crate: Option<c_api::CCrate>,
 }
 
 impl Generated {
@@ -159,6 +178,12 @@ pub fn generate(
     if cfg.implement.is_some() {
         implement::check(mechanism, scene)?;
     }
+    if cfg.emit == Emit::C && (cfg.math != MathBackend::Libm || cfg.implement.is_some()) {
+        return Err(
+            "the C wrapper crate (`emit c`) takes the `libm` math backend and no `implement`"
+                .into(),
+        );
+    }
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || match mechanism {
             spec::Mechanism::Tree(model) => Ok(tree::generate(model, scene, cfg)),
@@ -166,6 +191,15 @@ pub fn generate(
             spec::Mechanism::Closed(model) => closed::generate(model, scene, cfg),
         })
     }));
+    let generated = generated.and_then(|out| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let mut out = out?;
+            if cfg.emit == Emit::C {
+                out.c_crate = Some(c_api::emit(mechanism.name(), &out.code, single)?);
+            }
+            Ok(out)
+        }))
+    });
     match generated {
         Ok(out) => out,
         Err(_) => {

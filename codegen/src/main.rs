@@ -55,9 +55,17 @@ struct Cli {
     /// Mechanism spec: `.toml` (nocdyn spec) or `.urdf`.
     #[arg(required = true)]
     spec: Option<PathBuf>,
-    /// Write the module here (default: standard output).
-    #[arg(short, long, value_name = "OUT.rs")]
+    /// Write the module here (default: standard output); with `--emit c`, the directory of the
+    /// C wrapper crate (required).
+    #[arg(short, long, value_name = "OUT.rs|DIR")]
     output: Option<PathBuf>,
+    /// What to write: the Rust module (`rust`), or a crate for C and C++ firmware (`c`): in the
+    /// `-o` directory, `Cargo.toml` (a `no_std` `staticlib`), `src/` (the module and one
+    /// `extern "C"` function per public function, status codes for failures) and
+    /// `include/NAME.h`. `cargo build --release` there gives `target/release/libNAME_c.a`;
+    /// link it with `-lm` (docs/firmware.md, "From C").
+    #[arg(long, value_enum, default_value = "rust")]
+    emit: EmitArg,
     /// Validate the spec only; generate nothing.
     #[arg(long)]
     check: bool,
@@ -106,6 +114,14 @@ fn snap_tolerance(s: &str) -> Result<f64, String> {
             codegen::spec::MAX_SNAP
         ))
     }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum EmitArg {
+    /// The Rust module (default).
+    Rust,
+    /// A C header and a Rust `staticlib` crate wrapping the module (needs `-o DIR`).
+    C,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -208,6 +224,16 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    if cli.emit == EmitArg::C {
+        if cli.output.is_none() {
+            eprintln!("error: --emit c writes a crate: give its directory with -o DIR");
+            return ExitCode::from(2);
+        }
+        if cli.implement || !matches!(cli.math, Math::Libm) {
+            eprintln!("error: --emit c takes the default math backend (libm) and no --implement");
+            return ExitCode::from(2);
+        }
+    }
     let math = match cli.math {
         Math::Libm => MathBackend::Libm,
         Math::Std => MathBackend::Std,
@@ -229,6 +255,10 @@ fn main() -> ExitCode {
                 sidecar: sidecar.clone(),
             },
             implement: cli.implement.then(|| cli.runtime_path.clone()),
+            emit: match cli.emit {
+                EmitArg::Rust => codegen::Emit::Rust,
+                EmitArg::C => codegen::Emit::C,
+            },
         },
     ) {
         Ok(o) => o,
@@ -248,6 +278,23 @@ fn main() -> ExitCode {
     // The table goes to stderr: the module always goes where it would without `--stats`.
     if cli.stats {
         eprintln!("{}", out.stats_table().join("\n"));
+    }
+    if let (Some(c), Some(dir)) = (&out.c_crate, &cli.output) {
+        for (rel, text) in &c.files {
+            let path = dir.join(rel);
+            let written = path
+                .parent()
+                .map_or(Ok(()), std::fs::create_dir_all)
+                .map_err(|e| format!("{}: {e}", path.display()))
+                .and_then(|()| {
+                    codegen::build_script::write_if_changed(&path, text).map_err(|e| e.to_string())
+                });
+            if let Err(e) = written {
+                eprintln!("error: {e}");
+                return ExitCode::from(1);
+            }
+        }
+        return ExitCode::SUCCESS;
     }
     let text = out.code;
     match &cli.output {
@@ -280,6 +327,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
             sidecar,
         },
         implement: None,
+        emit: codegen::Emit::Rust,
     }
 }
 

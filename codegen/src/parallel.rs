@@ -303,6 +303,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         dof: n,
         warnings: crate::diag::Diagnostics::new("", ""),
         per: "DOF",
+        c_crate: None,
     })
 }
 

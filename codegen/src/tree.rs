@@ -247,6 +247,7 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
         dof: n,
         warnings: diag::Diagnostics::new("", ""),
         per: "joint",
+        c_crate: None,
     }
 }
 

@@ -699,3 +699,61 @@ fn rounded_angles_get_a_snap_note() {
         assert!(!stderr(&o).contains("note:"), "{quiet}: {}", stderr(&o));
     }
 }
+
+/// `--emit c -o DIR` writes the C wrapper crate: its module is the plain output byte for byte,
+/// a second run changes nothing, and without `-o`, or with another math backend, it refuses.
+#[test]
+fn emit_c_writes_a_crate() {
+    let dir = scratch("emit_c");
+    let out = dir.join("puma");
+    let o = run(&[
+        "../mechanisms/specs/puma560.toml",
+        "--emit",
+        "c",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let files = [
+        "Cargo.toml",
+        "src/lib.rs",
+        "src/puma560.rs",
+        "include/puma560.h",
+    ];
+    let first: Vec<Vec<u8>> = files
+        .iter()
+        .map(|f| std::fs::read(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}")))
+        .collect();
+    let plain = run(&[PUMA]);
+    assert_eq!(
+        plain.stdout, first[2],
+        "the crate's module is the plain output"
+    );
+    let header = String::from_utf8(first[3].clone()).unwrap();
+    assert!(header.contains("#ifndef PUMA560_H") && header.contains("extern \"C\" {"));
+    assert!(header.contains("int32_t puma560_forward_dynamics(const double *q, const double *qd, const double *tau, double *qdd, puma560_error_t *err);"));
+    let o = run(&[PUMA, "--emit", "c", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success());
+    for (f, before) in files.iter().zip(&first) {
+        assert_eq!(&std::fs::read(out.join(f)).unwrap(), before, "{f} changed");
+    }
+    let o = run(&[PUMA, "--emit", "c"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-o DIR"), "{}", stderr(&o));
+    let o = run(&[
+        PUMA,
+        "--emit",
+        "c",
+        "--math",
+        "std",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&[BAD, "--emit", "c", "-o", dir.join("bad").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        !dir.join("bad").exists(),
+        "nothing written for an invalid spec"
+    );
+}

@@ -74,6 +74,7 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
         float,
         scene: Default::default(),
         implement: None,
+        emit: codegen::Emit::Rust,
     };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))

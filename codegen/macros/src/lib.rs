@@ -267,6 +267,7 @@ impl Args {
             float,
             scene,
             implement: self.implement.as_ref().map(LitStr::value),
+            emit: codegen::Emit::Rust,
         })
     }
 }

@@ -1,0 +1,1193 @@
+//! `Config::emit = Emit::C`: a generated module wrapped for C and C++ firmware, as a crate
+//! of its own. [`CCrate`] holds its files: `Cargo.toml` (a `staticlib`, `panic = "abort"`,
+//! the `libm` crate, its own `[workspace]`), `src/lib.rs` (`#![no_std]`, the module
+//! included, one `extern "C"` function per public function of the module), `src/NAME.rs`
+//! (the module itself) and `include/NAME.h` (the C header).
+//!
+//! The wrappers are read off the module's own items, as [`crate::implement`] does: each
+//! public function's arguments and result, the variants of its `Site`, `Stop` and
+//! `IndexError`, the fields of `Params` and `InertiaIndices`, the public constants. So the
+//! C interface follows the kinds' templates without a second copy of their rules.
+//!
+//! The C calling convention, the same for every function: inputs are `const T *` to fixed-size
+//! arrays (matrices flat, row-major), outputs `T *` after them, `const NAME_params_t *p` last
+//! among the inputs when the module has run-time parameters, and `NAME_error_t *err` (may be
+//! `NULL`) last when the function can fail. Every function returns an `int32_t` status: `0`
+//! on success, a distinct negative code per failure (a `NULL` argument, each `Site` of
+//! `Singular`, each `Stop` of forward kinematics, each `IndexError`). Inputs are read by value
+//! before anything is written, so an output may alias an input; outputs are written only on
+//! success, and `*err` (when given) always.
+
+use std::fmt::Write as _;
+
+/// The files of a C wrapper crate, by path relative to its root (`Cargo.toml`, `src/lib.rs`,
+/// `src/NAME.rs`, `include/NAME.h`), in a fixed order.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CCrate {
+    /// The package and library name (`NAME_c`; the static library is `libNAME_c.a`).
+    pub package: String,
+    /// `(relative path, contents)`.
+    pub files: Vec<(String, String)>,
+}
+
+/// The status codes that mean the same thing in every module (the rest are numbered after
+/// them): `(Rust enum, variant, code)`.
+const CODES: &[(&str, &str, i32)] = &[
+    ("Site", "MassMatrix", -10),
+    ("Site", "Leg", -11),
+    ("Site", "Reach", -12),
+    ("Site", "Actuation", -13),
+    ("Site", "Platform", -14),
+    ("Site", "Closure", -15),
+    ("Site", "Constraint", -16),
+    ("Site", "Spring", -17),
+    ("Site", "Input", -18),
+    ("Stop", "Input", -20),
+    ("Stop", "Guess", -21),
+    ("Stop", "Singular", -22),
+    ("Stop", "Stalled", -23),
+    ("Stop", "Iterations", -24),
+    ("Stop", "Branch", -25),
+    ("IndexError", "NotFinite", -30),
+    ("IndexError", "NotSymmetric", -31),
+    ("IndexError", "NotPositiveDefinite", -32),
+    ("IndexError", "NoConvergence", -33),
+    ("IndexError", "Overflow", -34),
+];
+
+/// The C prefix of each error enum's codes.
+fn code_prefix(enum_name: &str) -> &'static str {
+    match enum_name {
+        "Site" => "SINGULAR",
+        "Stop" => "NO_CONVERGENCE",
+        _ => "INDEX",
+    }
+}
+
+/// A dimension of an array type: its Rust text (`DOF`, `3`) and value.
+#[derive(Clone, Debug)]
+struct Dim {
+    rust: String,
+    n: usize,
+}
+
+/// The types a generated module's public items use.
+#[derive(Clone, Debug)]
+enum Ty {
+    Real,
+    Usize,
+    Str,
+    Array(Box<Ty>, Dim),
+    Tuple(Vec<Ty>),
+    /// A struct of the module (`Params`, `InertiaIndices`).
+    Named(String),
+    /// `Result<T, E>`, `E` the error type's name.
+    Result(Box<Ty>, String),
+}
+
+impl Ty {
+    /// Dimensions of nested arrays, outermost first, and the element.
+    fn dims(&self) -> (Vec<&Dim>, &Ty) {
+        match self {
+            Ty::Array(e, d) => {
+                let (mut ds, el) = e.dims();
+                ds.insert(0, d);
+                (ds, el)
+            }
+            t => (Vec::new(), t),
+        }
+    }
+
+    /// Number of scalars of an array of reals (1 for a real).
+    fn len(&self) -> usize {
+        self.dims().0.iter().map(|d| d.n).product()
+    }
+
+    /// The Rust type, dimensions as numbers, `R` the scalar.
+    fn rust(&self, real: &str) -> String {
+        match self {
+            Ty::Real => real.into(),
+            Ty::Usize => "usize".into(),
+            Ty::Str => "&str".into(),
+            Ty::Array(e, d) => format!("[{}; {}]", e.rust(real), d.n),
+            Ty::Tuple(v) => format!(
+                "({})",
+                v.iter()
+                    .map(|t| t.rust(real))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            Ty::Named(n) => format!("m::{n}"),
+            Ty::Result(t, e) => format!("Result<{}, m::{e}>", t.rust(real)),
+        }
+    }
+}
+
+/// One variant of an error enum: its name, doc, and its fields (`None`: a unit variant; an
+/// empty name: a tuple field).
+struct Variant {
+    name: String,
+    doc: String,
+    fields: Option<Vec<String>>,
+}
+
+/// One field of a struct.
+struct Field {
+    name: String,
+    doc: String,
+    ty: Ty,
+}
+
+/// One public function.
+struct Func {
+    name: String,
+    doc: String,
+    args: Vec<(String, Ty)>,
+    ret: Ty,
+}
+
+/// One public constant that C can use.
+struct Const {
+    name: String,
+    doc: String,
+    ty: Ty,
+    /// Its values as C literals, flattened; `None` for a form C cannot take.
+    values: Option<Vec<String>>,
+}
+
+/// What the wrappers need of the module.
+struct Module {
+    consts: Vec<Const>,
+    usizes: Vec<(String, usize)>,
+    structs: Vec<(String, Vec<Field>)>,
+    enums: Vec<(String, Vec<Variant>)>,
+    fns: Vec<Func>,
+}
+
+impl Module {
+    fn struct_fields(&self, name: &str) -> Option<&[Field]> {
+        self.structs
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, f)| f.as_slice())
+    }
+
+    fn variants(&self, name: &str) -> &[Variant] {
+        self.enums
+            .iter()
+            .find(|(n, _)| n == name)
+            .map_or(&[], |(_, v)| v.as_slice())
+    }
+
+    fn has_const(&self, name: &str) -> bool {
+        self.usizes.iter().any(|(n, _)| n == name)
+    }
+}
+
+/// The doc comment of `attrs`, its lines joined, trimmed.
+fn doc(attrs: &[syn::Attribute]) -> String {
+    let mut lines = Vec::new();
+    for a in attrs {
+        if let syn::Meta::NameValue(nv) = &a.meta
+            && nv.path.is_ident("doc")
+            && let syn::Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Str(s),
+                ..
+            }) = &nv.value
+        {
+            for l in s.value().lines() {
+                lines.push(l.strip_prefix(' ').unwrap_or(l).trim_end().to_string());
+            }
+        }
+    }
+    while lines.first().is_some_and(|l| l.is_empty()) {
+        lines.remove(0);
+    }
+    while lines.last().is_some_and(|l| l.is_empty()) {
+        lines.pop();
+    }
+    lines.join("\n")
+}
+
+/// The value of an integer expression: a literal or a known `usize` constant.
+fn usize_value(e: &syn::Expr, usizes: &[(String, usize)]) -> Result<usize, String> {
+    match e {
+        syn::Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) => i.base10_parse().map_err(|e| e.to_string()),
+        syn::Expr::Path(p) => {
+            let name = p
+                .path
+                .get_ident()
+                .map(|i| i.to_string())
+                .unwrap_or_default();
+            usizes
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, v)| *v)
+                .ok_or_else(|| format!("unknown length `{name}`"))
+        }
+        _ => Err("an array length that is not a constant".into()),
+    }
+}
+
+fn ty(t: &syn::Type, usizes: &[(String, usize)]) -> Result<Ty, String> {
+    Ok(match t {
+        syn::Type::Reference(r) => match &*r.elem {
+            syn::Type::Path(p) if p.path.is_ident("str") => Ty::Str,
+            e => ty(e, usizes)?,
+        },
+        syn::Type::Array(a) => {
+            let n = usize_value(&a.len, usizes)?;
+            let rust = match &a.len {
+                syn::Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
+                _ => None,
+            }
+            .unwrap_or_else(|| n.to_string());
+            Ty::Array(Box::new(ty(&a.elem, usizes)?), Dim { rust, n })
+        }
+        syn::Type::Tuple(t) => Ty::Tuple(
+            t.elems
+                .iter()
+                .map(|e| ty(e, usizes))
+                .collect::<Result<_, _>>()?,
+        ),
+        syn::Type::Path(p) => {
+            let Some(seg) = p.path.segments.last() else {
+                return Err("an empty type path".into());
+            };
+            match seg.ident.to_string().as_str() {
+                "f64" | "f32" => Ty::Real,
+                "usize" => Ty::Usize,
+                "Result" => {
+                    let syn::PathArguments::AngleBracketed(args) = &seg.arguments else {
+                        return Err("`Result` without arguments".into());
+                    };
+                    let tys: Vec<&syn::Type> = args
+                        .args
+                        .iter()
+                        .filter_map(|a| match a {
+                            syn::GenericArgument::Type(t) => Some(t),
+                            _ => None,
+                        })
+                        .collect();
+                    let [ok, err] = tys[..] else {
+                        return Err("`Result` without two types".into());
+                    };
+                    let Ty::Named(e) = ty(err, usizes)? else {
+                        return Err("an error type that is not a named type".into());
+                    };
+                    Ty::Result(Box::new(ty(ok, usizes)?), e)
+                }
+                other => Ty::Named(other.to_string()),
+            }
+        }
+        _ => return Err("an unsupported type".into()),
+    })
+}
+
+fn read(code: &str, single: bool) -> Result<Module, String> {
+    let file = syn::parse_file(code).map_err(|e| format!("the module does not parse: {e}"))?;
+    let public = |v: &syn::Visibility| matches!(v, syn::Visibility::Public(_));
+    let mut m = Module {
+        consts: Vec::new(),
+        usizes: Vec::new(),
+        structs: Vec::new(),
+        enums: Vec::new(),
+        fns: Vec::new(),
+    };
+    // `usize` constants first: array lengths refer to them.
+    for item in &file.items {
+        if let syn::Item::Const(c) = item
+            && public(&c.vis)
+            && matches!(&*c.ty, syn::Type::Path(p) if p.path.is_ident("usize"))
+        {
+            let v = usize_value(&c.expr, &m.usizes)?;
+            m.usizes.push((c.ident.to_string(), v));
+        }
+    }
+    for item in &file.items {
+        match item {
+            syn::Item::Const(c) if public(&c.vis) => {
+                // A constant of a type C has no use for (e.g. a `Params`) is left out.
+                if let Ok(t) = ty(&c.ty, &m.usizes) {
+                    m.consts.push(Const {
+                        name: c.ident.to_string(),
+                        doc: doc(&c.attrs),
+                        values: c_values(&c.expr, &t, &m.usizes, single),
+                        ty: t,
+                    });
+                }
+            }
+            syn::Item::Struct(s) if public(&s.vis) => {
+                let mut fields = Vec::new();
+                for f in &s.fields {
+                    let Some(name) = &f.ident else { continue };
+                    let t = ty(&f.ty, &m.usizes)?;
+                    fields.push(Field {
+                        name: name.to_string(),
+                        doc: doc(&f.attrs),
+                        ty: t,
+                    });
+                }
+                m.structs.push((s.ident.to_string(), fields));
+            }
+            syn::Item::Enum(e) if public(&e.vis) => {
+                let variants = e
+                    .variants
+                    .iter()
+                    .map(|v| Variant {
+                        name: v.ident.to_string(),
+                        doc: doc(&v.attrs),
+                        fields: match &v.fields {
+                            syn::Fields::Unit => None,
+                            fs => Some(
+                                fs.iter()
+                                    .map(|f| {
+                                        f.ident.as_ref().map(|i| i.to_string()).unwrap_or_default()
+                                    })
+                                    .collect(),
+                            ),
+                        },
+                    })
+                    .collect();
+                m.enums.push((e.ident.to_string(), variants));
+            }
+            syn::Item::Fn(f) if public(&f.vis) => {
+                let mut args = Vec::new();
+                for a in &f.sig.inputs {
+                    let syn::FnArg::Typed(pt) = a else {
+                        return Err("a method among the functions".into());
+                    };
+                    let syn::Pat::Ident(id) = &*pt.pat else {
+                        return Err("an argument that is not a name".into());
+                    };
+                    args.push((id.ident.to_string(), ty(&pt.ty, &m.usizes)?));
+                }
+                let ret = match &f.sig.output {
+                    syn::ReturnType::Type(_, t) => ty(t, &m.usizes)?,
+                    syn::ReturnType::Default => Ty::Tuple(Vec::new()),
+                };
+                m.fns.push(Func {
+                    name: f.sig.ident.to_string(),
+                    doc: doc(&f.attrs),
+                    args,
+                    ret,
+                });
+            }
+            _ => {}
+        }
+    }
+    Ok(m)
+}
+
+/// `MassMatrix` → `MASS_MATRIX`.
+fn screaming(camel: &str) -> String {
+    let mut s = String::new();
+    for (i, c) in camel.chars().enumerate() {
+        if c.is_ascii_uppercase() && i > 0 {
+            s.push('_');
+        }
+        s.push(c.to_ascii_uppercase());
+    }
+    s
+}
+
+/// A C block comment of `text`, each line prefixed by `indent`; `*/` cannot end it early.
+fn c_comment(text: &str, indent: &str) -> String {
+    let text = text.replace("*/", "* /");
+    let lines: Vec<&str> = text.lines().collect();
+    if lines.len() == 1 {
+        return format!("{indent}/** {} */\n", lines[0]);
+    }
+    let mut out = format!("{indent}/**\n");
+    for l in lines {
+        if l.is_empty() {
+            out.push_str(&format!("{indent} *\n"));
+        } else {
+            out.push_str(&format!("{indent} * {l}\n"));
+        }
+    }
+    out.push_str(&format!("{indent} */\n"));
+    out
+}
+
+/// A real as a C literal (`f` suffix in single precision).
+fn c_real(v: f64, single: bool) -> String {
+    let mut s = if single {
+        format!("{:?}", v as f32)
+    } else {
+        format!("{v:?}")
+    };
+    if !s.contains(['.', 'e', 'E']) {
+        s.push_str(".0");
+    }
+    if single {
+        s.push('f');
+    }
+    s
+}
+
+fn real_value(e: &syn::Expr) -> Option<f64> {
+    match e {
+        syn::Expr::Lit(syn::ExprLit { lit, .. }) => match lit {
+            syn::Lit::Float(f) => f.base10_parse().ok(),
+            syn::Lit::Int(i) => i.base10_parse::<i64>().ok().map(|v| v as f64),
+            _ => None,
+        },
+        syn::Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => real_value(&u.expr).map(|v| -v),
+        _ => None,
+    }
+}
+
+/// The values of a constant as C literals, flattened, or `None` for a form C cannot take.
+fn c_values(
+    e: &syn::Expr,
+    t: &Ty,
+    usizes: &[(String, usize)],
+    single: bool,
+) -> Option<Vec<String>> {
+    match (t, e) {
+        (Ty::Array(el, d), syn::Expr::Array(a)) if a.elems.len() == d.n => {
+            let mut v = Vec::new();
+            for x in &a.elems {
+                v.extend(c_values(x, el, usizes, single)?);
+            }
+            Some(v)
+        }
+        (Ty::Array(el, d), syn::Expr::Repeat(r)) => {
+            let one = c_values(&r.expr, el, usizes, single)?;
+            Some((0..d.n).flat_map(|_| one.clone()).collect())
+        }
+        (Ty::Real, e) => real_value(e).map(|v| vec![c_real(v, single)]),
+        (Ty::Usize, e) => usize_value(e, usizes).ok().map(|v| vec![v.to_string()]),
+        (
+            Ty::Str,
+            syn::Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Str(s),
+                ..
+            }),
+        ) => {
+            let mut out = String::from("\"");
+            for c in s.value().chars() {
+                match c {
+                    '"' => out.push_str("\\\""),
+                    '\\' => out.push_str("\\\\"),
+                    c if c.is_ascii_graphic() || c == ' ' => out.push(c),
+                    c => {
+                        let mut b = [0; 4];
+                        for byte in c.encode_utf8(&mut b).bytes() {
+                            // Octal escapes end after three digits, whatever follows.
+                            let _ = write!(out, "\\{byte:03o}");
+                        }
+                    }
+                }
+            }
+            out.push('"');
+            Some(vec![out])
+        }
+        _ => None,
+    }
+}
+
+/// What an argument or output name means, by name and kind of module.
+fn meaning(name: &str, kind: Kind, func: &str) -> &'static str {
+    match (kind, name) {
+        (Kind::Tree, "q") => "joint positions (rad or m)",
+        (Kind::Tree, "qd") => "joint rates (rad/s or m/s)",
+        (Kind::Tree, "qdd") => "joint accelerations (rad/s² or m/s²)",
+        (Kind::Tree, "tau") => "joint efforts (N·m or N)",
+        (Kind::Parallel, "x") => "platform position coordinates (m, rad; see the module's NX)",
+        (Kind::Closed, "x") => "the spanning tree's joint positions (rad or m, JOINT_NAMES order)",
+        (Kind::Parallel, "u") => "platform speeds (m/s, rad/s)",
+        (Kind::Closed, "u") => "the actuated joints' rates (rad/s or m/s)",
+        (Kind::Parallel, "ud") => "platform accelerations (m/s², rad/s²)",
+        (Kind::Closed, "ud") => "the actuated joints' accelerations (rad/s² or m/s²)",
+        (_, "tau") => "actuator efforts (N·m or N, ACTUATOR_NAMES order)",
+        (_, "q") => "actuated joint positions (rad or m, ACTUATOR_NAMES order)",
+        (_, "qd") => "actuated joint rates (rad/s or m/s)",
+        (_, "guess") => "where Newton's method starts (e.g. the HOME initializer)",
+        (_, "m") if func == "inertia_indices" => {
+            "a symmetric positive definite matrix, row-major (e.g. from mass_matrix)"
+        }
+        (_, "m") => "the generalized inertia, row-major (kg·m², kg)",
+        (_, "pose") => "the platform's pose",
+        (_, "xd") => "every tree joint's rate (rad/s or m/s, JOINT_NAMES order)",
+        (_, "p") => "run-time parameters (NAME_params_default gives the spec's values)",
+        (_, "dtau_dq") => "∂τ/∂q, row-major",
+        (_, "dtau_dqd") => "∂τ/∂q̇, row-major",
+        (_, "dqdd_dq") => "∂q̈/∂q, row-major",
+        (_, "dqdd_dqd") => "∂q̈/∂q̇, row-major",
+        (_, "minv") => "the inverse of the mass matrix, row-major",
+        (_, "qdd") => "joint accelerations (rad/s² or m/s²)",
+        (_, "indices") => "the indices",
+        _ => "the result",
+    }
+}
+
+/// The names of a function's outputs, one per element of its (successful) result.
+fn output_names(f: &Func, kind: Kind, n: usize) -> Vec<String> {
+    let names: &[&str] = match (f.name.as_str(), kind) {
+        ("mass_matrix" | "actuator_mass_matrix", _) => &["m"],
+        ("inverse_dynamics" | "gravity" | "coriolis" | "friction", _) => &["tau"],
+        ("forward_dynamics", Kind::Tree) => &["qdd"],
+        ("forward_dynamics", _) => &["ud"],
+        ("inverse_dynamics_derivatives", _) => &["dtau_dq", "dtau_dqd"],
+        ("forward_dynamics_derivatives", _) => &["dqdd_dq", "dqdd_dqd", "minv"],
+        ("actuator_rates", _) => &["qd"],
+        ("joint_rates", _) => &["xd"],
+        ("inverse_kinematics", _) => &["q"],
+        ("forward_kinematics", _) => &["x"],
+        ("platform_pose", _) => &["pose"],
+        ("inertia_indices", _) => &["indices"],
+        _ => &[],
+    };
+    if names.len() == n {
+        names.iter().map(|s| s.to_string()).collect()
+    } else if n == 1 {
+        vec!["out".into()]
+    } else {
+        (0..n).map(|k| format!("out{k}")).collect()
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Tree,
+    Parallel,
+    Closed,
+}
+
+/// One status code: its C name, value and doc.
+struct Code {
+    c: String,
+    value: i32,
+    doc: String,
+}
+
+/// The codes of one error enum of the module, in its variant order.
+fn enum_codes(m: &Module, enum_name: &str, upper: &str) -> Vec<(String, Code)> {
+    let mut next = match enum_name {
+        "Site" => -40,
+        "Stop" => -50,
+        _ => -60,
+    };
+    m.variants(enum_name)
+        .iter()
+        .map(|v| {
+            let value = CODES
+                .iter()
+                .find(|(e, n, _)| *e == enum_name && *n == v.name)
+                .map(|c| c.2)
+                .unwrap_or_else(|| {
+                    next -= 1;
+                    next + 1
+                });
+            let c = format!("{upper}_{}_{}", code_prefix(enum_name), screaming(&v.name));
+            (
+                v.name.clone(),
+                Code {
+                    c,
+                    value,
+                    doc: v.doc.clone(),
+                },
+            )
+        })
+        .collect()
+}
+
+/// The C type of a struct field (`double name[3][3]`).
+fn c_field(f: &Field, upper: &str, real: &str) -> String {
+    let (dims, el) = f.ty.dims();
+    let base = match el {
+        Ty::Usize => "int32_t",
+        _ => real,
+    };
+    let mut s = format!("{base} {}", f.name);
+    for d in dims {
+        let _ = write!(s, "[{}]", c_dim(d, upper));
+    }
+    s
+}
+
+fn c_dim(d: &Dim, upper: &str) -> String {
+    if d.rust.chars().all(|c| c.is_ascii_digit()) {
+        d.rust.clone()
+    } else {
+        format!("{upper}_{}", d.rust)
+    }
+}
+
+/// The number of scalars of an array as a C expression (`NAME_DOF * NAME_DOF`).
+fn c_len(t: &Ty, upper: &str) -> String {
+    let (dims, _) = t.dims();
+    if dims.is_empty() {
+        return "1".into();
+    }
+    dims.iter()
+        .map(|d| c_dim(d, upper))
+        .collect::<Vec<_>>()
+        .join(" * ")
+}
+
+/// The wrapper crate of the module `code` (generated for the mechanism `name`).
+pub(crate) fn emit(name: &str, code: &str, single: bool) -> Result<CCrate, String> {
+    let m = read(code, single)?;
+    let upper = name.to_ascii_uppercase();
+    let real_c = if single { "float" } else { "double" };
+    let real_r = if single { "f32" } else { "f64" };
+    let kind = if !m.has_const("NX") {
+        Kind::Tree
+    } else if m.consts.iter().any(|c| c.name == "INDEPENDENT") {
+        Kind::Closed
+    } else {
+        Kind::Parallel
+    };
+    let params = m.struct_fields("Params");
+    let indices = m.struct_fields("InertiaIndices");
+    let singular_fields: Vec<&str> = m
+        .struct_fields("Singular")
+        .unwrap_or(&[])
+        .iter()
+        .map(|f| f.name.as_str())
+        .collect();
+    let tree_pivot = singular_fields.contains(&"pivot");
+
+    // Status codes.
+    let null = Code {
+        c: format!("{upper}_NULL_ARGUMENT"),
+        value: -1,
+        doc: "A pointer argument (other than `err`) is NULL: nothing was computed or written."
+            .into(),
+    };
+    let mut site_codes = enum_codes(&m, "Site", &upper);
+    if tree_pivot {
+        // A tree's `Singular { pivot, .. }`: a pivot of the mass matrix's LDLᵀ, or `DOF` for a
+        // non-finite input or result.
+        site_codes = vec![
+            (
+                "MassMatrix".into(),
+                Code {
+                    c: format!("{upper}_SINGULAR_MASS_MATRIX"),
+                    value: -10,
+                    doc: "Pivot `index` of the mass matrix's LDLᵀ is not above its tolerance."
+                        .into(),
+                },
+            ),
+            (
+                "Input".into(),
+                Code {
+                    c: format!("{upper}_SINGULAR_INPUT"),
+                    value: -18,
+                    doc: "An input is NaN or infinite, or a result overflowed.".into(),
+                },
+            ),
+        ];
+    }
+    let stop_codes = enum_codes(&m, "Stop", &upper);
+    let index_codes = enum_codes(&m, "IndexError", &upper);
+
+    // Which error each function can return.
+    let uses = |e: &str| {
+        m.fns
+            .iter()
+            .any(|f| matches!(&f.ret, Ty::Result(_, x) if x == e))
+    };
+    let mut all_codes: Vec<&Code> = vec![&null];
+    if uses("Singular") {
+        all_codes.extend(site_codes.iter().map(|(_, c)| c));
+    }
+    if uses("NoConvergence") {
+        all_codes.extend(stop_codes.iter().map(|(_, c)| c));
+    }
+    if uses("IndexError") {
+        all_codes.extend(index_codes.iter().map(|(_, c)| c));
+    }
+
+    let mut h = String::new();
+    let mut r = String::new();
+    let header_line = code
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .trim_start_matches("// ");
+    let guard = format!("{upper}_H");
+
+    // ---- header preamble
+    let _ = writeln!(h, "/* {header_line} */");
+    let _ = writeln!(
+        h,
+        "/* C interface of the generated module `{name}` (built by the crate `{name}_c` beside this header:\n   link `lib{name}_c.a` and `-lm`). Units: SI (m, kg, s, rad, N, N·m). Arrays are fixed-size, matrices\n   flat and row-major. Inputs are read before any output is written, so an output may alias an\n   input; outputs are written only on success (status {upper}_OK). */"
+    );
+    let _ = writeln!(
+        h,
+        "#ifndef {guard}\n#define {guard}\n\n#include <stdint.h>\n"
+    );
+    let _ = writeln!(h, "#ifdef __cplusplus\nextern \"C\" {{\n#endif\n");
+
+    // ---- constants
+    if kind == Kind::Tree {
+        let _ = writeln!(
+            h,
+            "/** Number of position coordinates `x`: a tree's joint positions, NX = DOF. */\n#define {upper}_NX {}",
+            m.usizes.iter().find(|(n, _)| n == "DOF").map_or(0, |c| c.1)
+        );
+    }
+    for c in &m.consts {
+        let Some(values) = &c.values else {
+            continue;
+        };
+        h.push_str(&c_comment(
+            &if matches!(c.ty, Ty::Array(..)) {
+                format!(
+                    "{}\n(An initializer: `T v[] = {upper}_{};`.)",
+                    c.doc, c.name
+                )
+            } else {
+                c.doc.clone()
+            },
+            "",
+        ));
+        if matches!(c.ty, Ty::Array(..)) {
+            let _ = writeln!(h, "#define {upper}_{} {{ {} }}", c.name, values.join(", "));
+        } else if let [v] = &values[..] {
+            let v = if v.starts_with('-') {
+                format!("({v})")
+            } else {
+                v.clone()
+            };
+            let _ = writeln!(h, "#define {upper}_{} {v}", c.name);
+        }
+    }
+    h.push('\n');
+
+    // ---- status codes
+    let _ = writeln!(
+        h,
+        "/** Status codes: every function returns one; 0 is success, every failure its own negative code. */\nenum {name}_status {{"
+    );
+    let _ = writeln!(
+        h,
+        "    /** Success: the outputs are written. */\n    {upper}_OK = 0,"
+    );
+    for c in &all_codes {
+        h.push_str(&c_comment(&c.doc, "    "));
+        let _ = writeln!(h, "    {} = {},", c.c, c.value);
+    }
+    let _ = writeln!(h, "}};\n");
+
+    // ---- error struct
+    let _ = writeln!(
+        h,
+        "/** Why a function failed, for the functions that take `err` (which may be NULL). */\ntypedef struct {name}_error {{\n    /** The status the function returned. */\n    int32_t status;\n    /** The leg, joint, pivot, equation or matrix row of the failure; -1 when the site has none. */\n    int32_t index;\n    /** The matrix column of an `inertia_indices` entry; -1 otherwise. */\n    int32_t column;\n    /** Newton iterations made (`forward_kinematics`); 0 otherwise. */\n    int32_t iterations;\n    /** The determinant, pivot or value that failed its test; the last residual of `forward_kinematics`. */\n    {real_c} value;\n    /** Condition-number estimate of the matrix involved (infinity if unknown). */\n    {real_c} condition_estimate;\n}} {name}_error_t;\n"
+    );
+    // ---- mirrored structs
+    let mirror = |h: &mut String, rust: &str, c: &str, doc: &str, fields: &[Field]| {
+        h.push_str(&c_comment(doc, ""));
+        let _ = writeln!(h, "typedef struct {name}_{c} {{");
+        for f in fields {
+            h.push_str(&c_comment(&f.doc, "    "));
+            let _ = writeln!(h, "    {};", c_field(f, &upper, real_c));
+        }
+        let _ = writeln!(h, "}} {name}_{c}_t;\n");
+        let _ = rust;
+    };
+    if let Some(p) = params {
+        mirror(
+            &mut h,
+            "Params",
+            "params",
+            "The run-time parameters (`[scene] parameters = \"runtime\"`), SI units.",
+            p,
+        );
+    }
+    if let Some(ix) = indices {
+        mirror(
+            &mut h,
+            "InertiaIndices",
+            "inertia_indices",
+            "Dynamic performance indices of an inertia matrix (see nocdyn's docs/indices.md).",
+            ix,
+        );
+    }
+
+    // ---- Rust preamble
+    let _ = writeln!(
+        r,
+        "//! {header_line}\n//!\n//! The C interface of the module `{name}` (`include/{name}.h`): one `extern \"C\"` function per\n//! public function, no std, no alloc, no panic.\n#![no_std]\n#![allow(clippy::all, unused_unsafe)]\n\n#[allow(clippy::all, dead_code, unused_imports, unused_variables, unused_mut)]\nmod m {{\n    include!(\"{name}.rs\");\n}}\n"
+    );
+    let _ = writeln!(
+        r,
+        "/// The one panic handler of the static library (nothing in it can panic).\n#[cfg(not(test))]\n#[panic_handler]\nfn panic(_: &core::panic::PanicInfo) -> ! {{\n    loop {{}}\n}}\n"
+    );
+    let _ = writeln!(
+        r,
+        "/// `{name}_error_t`.\n#[repr(C)]\n#[derive(Clone, Copy)]\npub struct Error {{\n    pub status: i32,\n    pub index: i32,\n    pub column: i32,\n    pub iterations: i32,\n    pub value: {real_r},\n    pub condition_estimate: {real_r},\n}}\n\nconst fn failure(status: i32) -> Error {{\n    Error {{ status, index: -1, column: -1, iterations: 0, value: 0.0, condition_estimate: {real_r}::INFINITY }}\n}}\n\n/// Writes `e` to `err` (when not null) and returns its status.\nfn report(err: *mut Error, e: Error) -> i32 {{\n    if !err.is_null() {{\n        // SAFETY: the caller passes NULL or a valid `{name}_error_t *`.\n        unsafe {{ err.write(e) }};\n    }}\n    e.status\n}}\n\nfn index(k: usize) -> i32 {{\n    i32::try_from(k).unwrap_or(i32::MAX)\n}}\n"
+    );
+    let struct_conv = |r: &mut String, rust: &str, c: &str, fields: &[Field]| {
+        let _ = writeln!(
+            r,
+            "/// `{name}_{c}_t`.\n#[repr(C)]\n#[derive(Clone, Copy)]\npub struct C{rust} {{"
+        );
+        for f in fields {
+            let t = match f.ty.dims().1 {
+                Ty::Usize => f.ty.rust(real_r).replace("usize", "i32"),
+                _ => f.ty.rust(real_r),
+            };
+            let _ = writeln!(r, "    pub {}: {t},", f.name);
+        }
+        let _ = writeln!(r, "}}\n");
+    };
+    if let Some(p) = params {
+        struct_conv(&mut r, "Params", "params", p);
+        let _ = writeln!(
+            r,
+            "fn params(p: &CParams) -> m::Params {{\n    m::Params {{"
+        );
+        for f in p {
+            let _ = writeln!(r, "        {0}: p.{0},", f.name);
+        }
+        let _ = writeln!(r, "    }}\n}}\n");
+        let _ = writeln!(
+            r,
+            "/// `{name}_params_default`.\n///\n/// # Safety\n///\n/// `p` is NULL or points to a `{name}_params_t`.\n#[unsafe(no_mangle)]\npub unsafe extern \"C\" fn {name}_params_default(p: *mut CParams) -> i32 {{\n    if p.is_null() {{\n        return {};\n    }}\n    let d = m::Params::DEFAULT;\n    let c = CParams {{",
+            null.value
+        );
+        for f in p {
+            let _ = writeln!(r, "        {0}: d.{0},", f.name);
+        }
+        let _ = writeln!(
+            r,
+            "    }};\n    // SAFETY: `p` is not null; the caller passes a valid `{name}_params_t *`.\n    unsafe {{ p.write(c) }};\n    0\n}}\n"
+        );
+        h.push_str(&c_comment(
+            &format!(
+                "Writes the spec's values of the run-time parameters to `*p`.\n\np: out, one {name}_params_t.\nReturns {upper}_OK, or {upper}_NULL_ARGUMENT when `p` is NULL."
+            ),
+            "",
+        ));
+        let _ = writeln!(h, "int32_t {name}_params_default({name}_params_t *p);\n");
+    }
+    if let Some(ix) = indices {
+        struct_conv(&mut r, "InertiaIndices", "inertia_indices", ix);
+        let _ = writeln!(
+            r,
+            "fn inertia_indices(i: &m::InertiaIndices) -> CInertiaIndices {{\n    CInertiaIndices {{"
+        );
+        for f in ix {
+            let _ = writeln!(r, "        {0}: i.{0},", f.name);
+        }
+        let _ = writeln!(r, "    }}\n}}\n");
+    }
+    // Error conversions.
+    let conv = |r: &mut String, err: &str, codes: &[(String, Code)]| {
+        let inf = format!("{real_r}::INFINITY");
+        let (value, cond, iterations) = match err {
+            "Singular" => (
+                "e.value".to_string(),
+                "e.condition_estimate".to_string(),
+                "0",
+            ),
+            "NoConvergence" => ("e.residual".to_string(), inf, "index(e.iterations)"),
+            _ => (String::new(), String::new(), "0"),
+        };
+        let enum_name = match err {
+            "Singular" => "Site",
+            "NoConvergence" => "Stop",
+            _ => "IndexError",
+        };
+        let _ = writeln!(
+            r,
+            "fn from_{}(e: &m::{err}) -> Error {{",
+            screaming(err).to_ascii_lowercase()
+        );
+        if err == "Singular" && tree_pivot {
+            let _ = writeln!(
+                r,
+                "    let (status, index) = if e.pivot < m::DOF {{ ({}, index(e.pivot)) }} else {{ ({}, -1) }};\n    Error {{ status, index, column: -1, iterations: 0, value: e.value, condition_estimate: e.condition_estimate }}\n}}\n",
+                codes[0].1.value, codes[1].1.value
+            );
+            return;
+        }
+        let scrutinee = match err {
+            "Singular" => "e.site",
+            "NoConvergence" => "e.stop",
+            _ => "*e",
+        };
+        let _ = writeln!(r, "    let f = match {scrutinee} {{");
+        for v in m.variants(enum_name) {
+            let code = codes
+                .iter()
+                .find(|(n, _)| *n == v.name)
+                .map_or(-1, |c| c.1.value);
+            let arm = match &v.fields {
+                None => format!("m::{enum_name}::{} => failure({code}),", v.name),
+                Some(fs) if fs.iter().all(|f| f.is_empty()) => {
+                    let binds: Vec<String> = (0..fs.len()).map(|k| format!("k{k}")).collect();
+                    format!(
+                        "m::{enum_name}::{}({}) => Error {{ index: index(k0), ..failure({code}) }},",
+                        v.name,
+                        binds.join(", ")
+                    )
+                }
+                Some(fs) => {
+                    let mut sets = Vec::new();
+                    for f in fs {
+                        match f.as_str() {
+                            "row" | "pivot" => sets.push(format!("index: index({f})")),
+                            "col" => sets.push(format!("column: index({f})")),
+                            "value" => sets.push("value".to_string()),
+                            _ => {}
+                        }
+                    }
+                    let binds: Vec<String> = fs
+                        .iter()
+                        .map(|f| {
+                            if matches!(f.as_str(), "row" | "pivot" | "col" | "value") {
+                                f.clone()
+                            } else {
+                                format!("{f}: _")
+                            }
+                        })
+                        .collect();
+                    format!(
+                        "m::{enum_name}::{} {{ {} }} => Error {{ {}{}..failure({code}) }},",
+                        v.name,
+                        binds.join(", "),
+                        sets.join(", "),
+                        if sets.is_empty() { "" } else { ", " }
+                    )
+                }
+            };
+            let _ = writeln!(r, "        {arm}");
+        }
+        let _ = writeln!(r, "    }};");
+        if err == "IndexError" {
+            let _ = writeln!(r, "    f\n}}\n");
+        } else {
+            let _ = writeln!(
+                r,
+                "    Error {{ value: {value}, condition_estimate: {cond}, iterations: {iterations}, ..f }}\n}}\n"
+            );
+        }
+    };
+    if uses("Singular") {
+        conv(&mut r, "Singular", &site_codes);
+    }
+    if uses("NoConvergence") {
+        conv(&mut r, "NoConvergence", &stop_codes);
+    }
+    if uses("IndexError") {
+        conv(&mut r, "IndexError", &index_codes);
+    }
+
+    // ---- one wrapper per function
+    h.push_str("/* ---- functions ---- */\n\n");
+    for f in &m.fns {
+        let (ok, err) = match &f.ret {
+            Ty::Result(t, e) => ((**t).clone(), Some(e.as_str())),
+            t => (t.clone(), None),
+        };
+        let outs: Vec<Ty> = match ok {
+            Ty::Tuple(v) => v,
+            t => vec![t],
+        };
+        let out_names: Vec<String> = output_names(f, kind, outs.len())
+            .into_iter()
+            .map(|o| {
+                if f.args.iter().any(|(a, _)| *a == o) || o == "err" {
+                    format!("out_{o}")
+                } else {
+                    o
+                }
+            })
+            .collect();
+        let mut c_params = Vec::new();
+        let mut r_params = Vec::new();
+        let mut docs = Vec::new();
+        let mut null_checks = Vec::new();
+        let mut reads = Vec::new();
+        let mut call_args = Vec::new();
+        for (a, t) in &f.args {
+            match t {
+                Ty::Named(n) if n == "Params" => {
+                    c_params.push(format!("const {name}_params_t *{a}"));
+                    r_params.push(format!("{a}: *const CParams"));
+                    docs.push(format!(
+                        "{a}: in, one {name}_params_t: {}",
+                        meaning(a, kind, &f.name).replace("NAME", name)
+                    ));
+                    reads.push(format!(
+                        "    // SAFETY: not null (checked); the caller passes a valid `{name}_params_t *`.\n    let {a} = params(&unsafe {{ {a}.read() }});"
+                    ));
+                }
+                Ty::Array(..) | Ty::Real => {
+                    c_params.push(format!("const {real_c} *{a}"));
+                    r_params.push(format!("{a}: *const {real_r}"));
+                    docs.push(format!(
+                        "{a}: in, {} entries: {}",
+                        c_len(t, &upper),
+                        meaning(a, kind, &f.name)
+                    ));
+                    reads.push(format!(
+                        "    // SAFETY: not null (checked); the caller passes {} readable entries.\n    let {a} = unsafe {{ {a}.cast::<{}>().read() }};",
+                        t.len(),
+                        t.rust(real_r)
+                    ));
+                }
+                _ => return Err(format!("`{}`: an argument C cannot take", f.name)),
+            }
+            null_checks.push(format!("{a}.is_null()"));
+            call_args.push(format!("&{a}"));
+        }
+        let mut writes = Vec::new();
+        for (o, t) in out_names.iter().zip(&outs) {
+            match t {
+                Ty::Named(n) if n == "InertiaIndices" => {
+                    c_params.push(format!("{name}_inertia_indices_t *{o}"));
+                    r_params.push(format!("{o}: *mut CInertiaIndices"));
+                    docs.push(format!(
+                        "{o}: out, one {name}_inertia_indices_t: {}",
+                        meaning(o, kind, &f.name)
+                    ));
+                    writes.push(format!(
+                        "        // SAFETY: not null (checked); the caller passes a writable `{name}_inertia_indices_t *`.\n        unsafe {{ {o}.write(inertia_indices(&v_{o})) }};"
+                    ));
+                }
+                Ty::Array(..) | Ty::Real => {
+                    c_params.push(format!("{real_c} *{o}"));
+                    r_params.push(format!("{o}: *mut {real_r}"));
+                    docs.push(format!(
+                        "{o}: out, {} entries: {}",
+                        c_len(t, &upper),
+                        meaning(o, kind, &f.name)
+                    ));
+                    writes.push(format!(
+                        "        // SAFETY: not null (checked); the caller passes {} writable entries.\n        unsafe {{ {o}.cast::<{}>().write(v_{o}) }};",
+                        t.len(),
+                        t.rust(real_r)
+                    ));
+                }
+                _ => return Err(format!("`{}`: a result C cannot take", f.name)),
+            }
+            null_checks.push(format!("{o}.is_null()"));
+        }
+        if err.is_some() {
+            c_params.push(format!("{name}_error_t *err"));
+            r_params.push("err: *mut Error".into());
+            docs.push("err: out, may be NULL: why it failed (the status, the site's index, the value and condition estimate)".into());
+        } else {
+            r_params.push("err: *mut Error".into());
+        }
+        let mut statuses = vec![format!("{upper}_OK"), null.c.clone()];
+        match err {
+            Some("Singular") => statuses.extend(site_codes.iter().map(|(_, c)| c.c.clone())),
+            Some("NoConvergence") => statuses.extend(stop_codes.iter().map(|(_, c)| c.c.clone())),
+            Some("IndexError") => statuses.extend(index_codes.iter().map(|(_, c)| c.c.clone())),
+            _ => {}
+        }
+        let cname = format!("{name}_{}", f.name);
+        let mut d = if f.doc.is_empty() {
+            format!("`{}` of the module.", f.name)
+        } else {
+            f.doc.clone()
+        };
+        d.push_str("\n\n");
+        for l in &docs {
+            d.push_str(l);
+            d.push('\n');
+        }
+        let _ = write!(d, "Returns {}.", statuses.join(", "));
+        h.push_str(&c_comment(&d, ""));
+        let _ = writeln!(h, "int32_t {cname}({});\n", c_params.join(", "));
+
+        // Rust: `err` is a real argument only for fallible functions.
+        if err.is_none() {
+            r_params.pop();
+        }
+        let _ = writeln!(
+            r,
+            "/// `{cname}` of `include/{name}.h`.\n///\n/// # Safety\n///\n/// Each pointer is NULL (a status, nothing written) or points to as many values as the\n/// header says.\n#[unsafe(no_mangle)]\npub unsafe extern \"C\" fn {cname}({}) -> i32 {{",
+            r_params.join(", ")
+        );
+        let err_arg = if err.is_some() {
+            "err"
+        } else {
+            "core::ptr::null_mut()"
+        };
+        let _ = writeln!(
+            r,
+            "    if {} {{\n        return report({err_arg}, failure({}));\n    }}",
+            if null_checks.is_empty() {
+                "false".to_string()
+            } else {
+                null_checks.join(" || ")
+            },
+            null.value
+        );
+        for l in &reads {
+            let _ = writeln!(r, "{l}");
+        }
+        let binds = if out_names.len() == 1 {
+            format!("v_{}", out_names[0])
+        } else {
+            format!(
+                "({})",
+                out_names
+                    .iter()
+                    .map(|o| format!("v_{o}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        let call = format!("m::{}({})", f.name, call_args.join(", "));
+        match err {
+            Some(e) => {
+                let _ = writeln!(
+                    r,
+                    "    match {call} {{\n        Ok({binds}) => {{\n{}\n            report(err, failure(0))\n        }}\n        Err(e) => report(err, from_{}(&e)),\n    }}\n}}\n",
+                    writes
+                        .iter()
+                        .map(|w| format!("    {}", w.replace('\n', "\n    ")))
+                        .collect::<Vec<_>>()
+                        .join("\n"),
+                    screaming(e).to_ascii_lowercase()
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    r,
+                    "    let {binds} = {call};\n{}\n    0\n}}\n",
+                    writes
+                        .iter()
+                        .map(|w| w
+                            .replacen("        ", "    ", 1)
+                            .replace("\n        ", "\n    "))
+                        .collect::<Vec<_>>()
+                        .join("\n")
+                );
+            }
+        }
+    }
+    let _ = writeln!(h, "#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */");
+
+    // Format the Rust through syn and prettyplease, as the module is.
+    let parsed = syn::parse_file(&r)
+        .map_err(|e| format!("internal error: the C wrappers do not parse: {e}"))?;
+    let lib = prettyplease::unparse(&parsed);
+
+    let package = format!("{name}_c");
+    let cargo = format!(
+        "# {header_line}\n# The C interface of `{name}`: `cargo build --release` writes\n# target/release/lib{package}.a (link it with -lm); include/{name}.h declares its functions.\n[package]\nname = \"{package}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"staticlib\"]\ntest = false\ndoctest = false\nbench = false\n\n[dependencies]\n# The math backend of the generated module (sin, cos, sqrt, atan2), no_std.\nlibm = \"0.2\"\n\n# No unwinding: a panic (there is none to reach) stops in the library's own handler.\n[profile.dev]\npanic = \"abort\"\n\n# The library to link: fat LTO also drops the precompiled core's references to the\n# unwinder, which a dev build keeps (its archive does not link without a Rust runtime).\n[profile.release]\npanic = \"abort\"\nlto = true\ncodegen-units = 1\n\n# A workspace of its own: the crate builds where it is written, inside another workspace or not.\n[workspace]\n"
+    );
+    Ok(CCrate {
+        package,
+        files: vec![
+            ("Cargo.toml".into(), cargo),
+            ("src/lib.rs".into(), lib),
+            (format!("src/{name}.rs"), code.to_string()),
+            (format!("include/{name}.h"), h),
+        ],
+    })
+}
