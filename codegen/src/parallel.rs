@@ -328,6 +328,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         PlatformMotion::Translation { .. } => {
             "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"
         }
+        PlatformMotion::Schoenflies { .. } => {
+            "`x = [px, py, pz, θ]` (the carrier frame's origin, m, base frame, its orientation fixed at home; θ the tool's angle about base z, rad, 0 at home); `u = [vx, vy, vz, ω]` (m/s of the carrier, rad/s of the tool about z)"
+        }
     }
 }
 

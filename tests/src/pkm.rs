@@ -66,6 +66,9 @@ pub fn random_state(
             } else if plan.motion.parasitic() {
                 // A 1T2R platform's x = [pz, α, β].
                 i >= 1
+            } else if plan.motion.schoenflies() {
+                // A Schönflies platform's x = [px, py, pz, θ].
+                i == 3
             } else {
                 i < 3 && !planar
             };

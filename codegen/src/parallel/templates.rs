@@ -190,7 +190,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
         | PlatformMotion::PlanarPose { .. }
-        | PlatformMotion::HeaveTilt { .. } => (0usize, false),
+        | PlatformMotion::HeaveTilt { .. }
+        | PlatformMotion::Schoenflies { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -200,12 +201,15 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
     // A planar pose's [px, py, φ] ⊕ [δx, δy, δφ] is a sum too.
-    let retract =
-        if plan.motion.translates() || plan.motion.planar_pose() || plan.motion.parasitic() {
-            sp.items(RETRACT_SUM, &["retract"])
-        } else {
-            sp.items(RETRACT_QUATERNION, &["retract"])
-        };
+    let retract = if plan.motion.translates()
+        || plan.motion.planar_pose()
+        || plan.motion.parasitic()
+        || plan.motion.schoenflies()
+    {
+        sp.items(RETRACT_SUM, &["retract"])
+    } else {
+        sp.items(RETRACT_QUATERNION, &["retract"])
+    };
     let rest = sp.items(NEWTON, &["fk_residual", "forward_kinematics"]);
     quote!(#retract #rest)
 }

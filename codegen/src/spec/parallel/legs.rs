@@ -35,6 +35,16 @@ const SUPPORTED_UPU: &[&[JointKind]] = &[&[
     JointKind::Revolute,
     JointKind::Prismatic,
 ]];
+const SUPPORTED_SHAFT: &[&[JointKind]] = &[&[
+    JointKind::Revolute,
+    JointKind::Revolute,
+    JointKind::Revolute,
+    JointKind::Prismatic,
+    JointKind::Revolute,
+    JointKind::Revolute,
+]];
+/// The hint of an unsupported leg of a Schönflies platform.
+pub(super) const SUPPORTED_SCHOENFLIES_HINT: &str = "supported legs for coordinates = \"schoenflies\" (a 4-axis Delta): three Delta legs (a revolute crank carrying a [[parallelogram]] to the carrier) and one telescopic shaft R-U-P-U from a motor about z on the base to the tool, whose revolute about z into the carrier closes it (the shaft along the motor axis at home, the two universal joints in phase)";
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
 const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
     &[JointKind::Revolute, JointKind::Revolute],
@@ -212,7 +222,12 @@ fn build_leg(
     let end = match j.kind {
         // A planar platform: the revolute joint about z at the point ties the point (the
         // platform's rotation is its own coordinate, or idle for a planar point).
-        Kind::Revolute if matches!(motion, Coordinates::Planar | Coordinates::PlanarPose) => {
+        Kind::Revolute
+            if matches!(
+                motion,
+                Coordinates::Planar | Coordinates::PlanarPose | Coordinates::Schoenflies
+            ) =>
+        {
             LegEnd::Spherical {
                 on_leg: frame.translation,
                 on_platform: child_origin.translation,
@@ -305,7 +320,8 @@ fn check_leg_type(
     let supported = match motion {
         // A universal joint into a translational platform ends a U-P leg (Tsai's 3-UPU).
         Coordinates::Translation if j.kind == Kind::Universal => SUPPORTED_UPU,
-        Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
+        Coordinates::Schoenflies if j.kind == Kind::Revolute => SUPPORTED_SHAFT,
+        Coordinates::Pose | Coordinates::Translation | Coordinates::Schoenflies => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
         Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE,
         Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT,
@@ -327,6 +343,7 @@ fn check_leg_type(
             .with_hint(match motion {
                 Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE_HINT,
                 Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT_HINT,
+                Coordinates::Schoenflies => SUPPORTED_SCHOENFLIES_HINT,
                 _ => SUPPORTED_HINT,
             }),
         );

@@ -7,7 +7,10 @@
 use runtime::model::{Transform, Vec3, mat_mul, mat_vec};
 use runtime::parallel::{GEOMETRY_TOLERANCE, LegEnd, ParallelModel, PlatformMotion};
 
-use super::legs::{SUPPORTED_HEAVE_TILT_HINT, SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
+use super::legs::{
+    SUPPORTED_HEAVE_TILT_HINT, SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT,
+    SUPPORTED_SCHOENFLIES_HINT, Tree,
+};
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
 use crate::spec::ir::{Coordinates, Kind, PlatformSpec, Spec};
@@ -321,6 +324,8 @@ fn validate_diagnostic(
         SUPPORTED_PLANAR_POSE_HINT
     } else if ps.coordinates == Some(Coordinates::HeaveTilt) {
         SUPPORTED_HEAVE_TILT_HINT
+    } else if ps.coordinates == Some(Coordinates::Schoenflies) {
+        SUPPORTED_SCHOENFLIES_HINT
     } else {
         SUPPORTED_HINT
     };
