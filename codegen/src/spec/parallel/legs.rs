@@ -247,6 +247,9 @@ fn build_leg(
             on_platform: child_origin.translation,
         },
     };
+    if motion == Coordinates::Schoenflies && j.kind == Kind::Revolute {
+        check_tool_axis(tree, axes, c, path, diags);
+    }
     let (actuated, actuated_name) = act.unwrap_or((usize::MAX, String::new()));
     Leg {
         name: j.name.clone(),
@@ -255,6 +258,44 @@ fn build_leg(
         actuated,
         actuated_name,
         end,
+    }
+}
+
+/// A Schönflies platform's tool joint `c` (a revolute into the carrier, closing the shaft's
+/// leg along `path`) turns about the base `z` at home: `θ` is the tool's angle about `z`, and
+/// the homokinetic shaft turns the tool about the motor's axis, which the leg's checks hold to
+/// `z`.
+fn check_tool_axis(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    c: usize,
+    path: &[usize],
+    diags: &mut Diagnostics,
+) {
+    let (spec, model) = (tree.spec, &tree.built.model);
+    let j = &spec.joints[c];
+    let mut tip = Transform::IDENTITY;
+    for &k in path {
+        tip = compose(&tip, &model.joints[k].origin);
+    }
+    let frame = compose(&tip, &tree.frame_in_tip(c));
+    let e = axes[c].first().copied().unwrap_or([0.0, 0.0, 1.0]);
+    let a = mat_vec(&frame.rotation, &e);
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if a[0].abs() > 1e-9 * n || a[1].abs() > 1e-9 * n {
+        let at = j.axes.first();
+        diags.push(
+            Diagnostic::error(format!(
+                "the tool's joint \"{}\" into the carrier turns about [{:.4}, {:.4}, {:.4}] at home, not about the base z axis",
+                j.name,
+                a[0] / n,
+                a[1] / n,
+                a[2] / n
+            ))
+            .with_key(at.map_or_else(|| format!("{}.axis", j.key), |a| a.key.clone()))
+            .with_span(at.map_or(j.span.clone(), |a| a.span.clone()))
+            .with_hint("with coordinates = \"schoenflies\" the tool turns on the carrier about the vertical z (θ is its angle about z), parallel to its shaft's motor axis; give the joint the axis that is the base z at home"),
+        );
     }
 }
 
