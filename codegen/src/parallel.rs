@@ -272,6 +272,13 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     let layout = Layout::of(params);
     let want = |name: &str| scene.functions.wants(Kind::Parallel, name);
     let plan = Plan::new(model)?;
+    if layout.drives() && plan.legs.iter().any(|l| l.shaft.is_some()) {
+        // The run-time drives sit three to a leg; a shaft has six joints.
+        return Err(
+            "a Schönflies platform's drives cannot be run-time parameters yet (its shaft has six joints, the run-time layout three per leg): use [scene] parameters = \"constants\" or leave friction and rotor inertia off"
+                .into(),
+        );
+    }
     let k = kernels_with(&plan, &layout).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;

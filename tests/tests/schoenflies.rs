@@ -178,3 +178,95 @@ fn schoenflies_against_lagrange_multipliers() {
     assert!(worst <= 1e-10, "{worst:e}");
     assert!(worst_rt <= 1e-10, "{worst_rt:e}");
 }
+
+/// With drives (`[scene] friction = true`, `rotor_inertia = true`) on the fourth motor, the
+/// telescope and motor 1 (viscous, Coulomb and rotor inertia), the task form (the shaft's
+/// closed form with its joints' drives, leg 1 on the generic route) agrees with the joint
+/// coordinates, which apply the same drives at the same joints: inverse dynamics, `A⁻ᵀ I A⁻¹`
+/// and forward dynamics; and the split `gravity + coriolis + friction + inertial` sums to the
+/// inverse dynamics.
+#[test]
+fn schoenflies_with_drives_matches_joint_coordinates() {
+    let load = |file: &str, before: &str| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let drive = "damping = 3.0\nfriction = 0.7\narmature = 0.02\n";
+        let src = src
+            .replacen(
+                before,
+                &format!("[scene]\nfriction = true\nrotor_inertia = true\n\n{before}"),
+                1,
+            )
+            .replace(
+                "name = \"motor4\"\n",
+                &format!("name = \"motor4\"\n{drive}"),
+            )
+            .replace(
+                "name = \"telescope\"\n",
+                "name = \"telescope\"\ndamping = 5.0\nfriction = 1.5\narmature = 0.3\n",
+            )
+            .replace(
+                "name = \"motor1\"\n",
+                &format!("name = \"motor1\"\n{drive}"),
+            );
+        assert_eq!(src.matches("damping = ").count(), 3);
+        codegen::spec::load_mechanism(&path.to_string_lossy(), &src)
+            .unwrap_or_else(|d| panic!("{d}"))
+    };
+    let (codegen::spec::Mechanism::Parallel(pm), _) =
+        load("../mechanisms/specs/delta4_rl5.toml", "[platform]")
+    else {
+        panic!("not a parallel mechanism")
+    };
+    let (codegen::spec::Mechanism::Closed(jm), _) = load("data/delta4_rl5_joints.toml", "[[body]]")
+    else {
+        panic!("not a closed-loop mechanism")
+    };
+    let pplan = Plan::new(&pm).unwrap();
+    assert!(pplan.has_friction());
+    let jplan = cnoc::Plan::new(&jm).unwrap();
+    let home = pm.home_x();
+    let mut rng = tests::rng(0xd41e);
+    let mut worst = [0.0f64; 4];
+    let mut x_j = vec![0.0; jplan.nx()];
+    for _ in 0..100 {
+        let (p, v, a) = random_state(&pplan, &home, &mut rng, 3.0, 0.2 * pm.size());
+        let q = noc::inverse_kinematics(&pplan, &p).unwrap();
+        x_j = cnoc::forward_kinematics(&jplan, &q, &x_j).unwrap();
+        let amat = noc::actuation(&pplan, &p).unwrap();
+        let qd = mat_vec(&amat, &v);
+        let qdd = actuator_accelerations(&pplan, &p, &v, &a);
+        let tp = noc::inverse_dynamics(&pplan, &p, &v, &a).unwrap();
+        let tj = cnoc::inverse_dynamics(&jplan, &x_j, &qd, &qdd).unwrap();
+        let mp = noc::actuator_mass_matrix(&pplan, &p).unwrap();
+        let mj = cnoc::mass_matrix(&jplan, &x_j).unwrap();
+        let tau: Vec<f64> = tp.iter().map(|t| t + 2.0).collect();
+        let ap = noc::forward_dynamics(&pplan, &p, &v, &tau).unwrap();
+        let qdd_p = actuator_accelerations(&pplan, &p, &v, &ap);
+        let qdd_j = cnoc::forward_dynamics(&jplan, &x_j, &qd, &tau).unwrap();
+        // The split: τ = gravity + coriolis + friction + M q̈ (q̈ = A u̇ + Ȧ u, in actuator
+        // space the inertial part is τ(x, u, u̇) − τ(x, u, 0)).
+        let g = noc::gravity(&pplan, &p).unwrap();
+        let c = noc::coriolis(&pplan, &p, &v).unwrap();
+        let f = noc::friction(&pplan, &p, &v).unwrap();
+        let zero = vec![0.0; 4];
+        let still = noc::inverse_dynamics(&pplan, &p, &v, &zero).unwrap();
+        let sum: Vec<f64> = (0..4).map(|i| g[i] + c[i] + f[i]).collect();
+        let e = [
+            rel(&tp, &tj),
+            rel(&mp.concat(), &mj.concat()),
+            rel(&qdd_p, &qdd_j),
+            rel(&sum, &still),
+        ];
+        for (w, e) in worst.iter_mut().zip(e) {
+            *w = w.max(e);
+        }
+    }
+    println!(
+        "delta4_rl5 with drives on motor4, telescope and motor1: task vs joint coordinates, 100 states, worst relative error (∞-norm): ID {:.1e}, A⁻ᵀIA⁻¹ {:.1e}, FD {:.1e}; gravity + coriolis + friction vs τ(x, u, 0) {:.1e}",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    for w in worst {
+        assert!(w <= 1e-12, "{worst:?}");
+    }
+}
