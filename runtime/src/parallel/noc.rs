@@ -86,9 +86,9 @@ pub use crate::payload::Payload;
 pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, Stop, check_finite, solve_spd};
 
 pub use api::{
-    actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics, friction,
-    generalized_effort, gravity, inverse_dynamics, inverse_kinematics, leg_joint_positions,
-    leg_joint_rates, mass_matrix, platform_pose, potential_energy,
+    JointRates, actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics,
+    friction, generalized_effort, gravity, inverse_dynamics, inverse_kinematics,
+    leg_joint_positions, leg_joint_rates, mass_matrix, platform_pose, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
 pub use delta::{DeltaKin, DeltaPlan};

@@ -73,6 +73,9 @@ pub fn leg_joint_positions(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sing
         .collect())
 }
 
+/// One leg's joint rates and accelerations `(θ̇, θ̈)`.
+pub type JointRates = (Vec<f64>, Vec<f64>);
+
 /// Every leg's joint rates and accelerations `(θ̇, θ̈)` (rad/s or m/s, and per s²; the spec's
 /// joint order after U expansion) at `(x, u, u̇)`: the actuated ones are `q̇ = A u` and
 /// `q̈ = A u̇ + Ȧ u`.
@@ -81,7 +84,7 @@ pub fn leg_joint_rates(
     x: &[f64],
     u: &[f64],
     ud: &[f64],
-) -> Result<Vec<(Vec<f64>, Vec<f64>)>, Singular> {
+) -> Result<Vec<JointRates>, Singular> {
     check_finite(&[x, u, ud])?;
     let (pl, legs) = kinematics(plan, x)?;
     let out = leg_rates(plan, &pl, &legs, u, ud);
