@@ -34,7 +34,9 @@ pub fn generalized_force<R: Real>(
 }
 
 /// [`generalized_force`] with the leg joints' drives from `drives` instead of the plan (closed-form
-/// UPS legs then take the generic route, where the joint efforts are formed).
+/// UPS legs then take the generic route, where the joint efforts are formed). A Schönflies
+/// shaft keeps its plan's drives (`drives` holds three joints per leg; the generator refuses
+/// run-time drives on such a platform).
 pub fn generalized_force_with<R: Real>(
     plan: &Plan,
     pl: &Platform<R>,
