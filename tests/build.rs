@@ -117,6 +117,10 @@ fn main() {
     let joints = "data/tsai_3upu_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "upu_joints", Path::new(joints), |_| {});
+    // The 4-axis Delta in joint coordinates, likewise.
+    let joints = "data/delta4_rl5_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(&out, "delta4_joints", Path::new(joints), |_| {});
     // The 3-PRS tripod of mechanisms/specs/tripod_3prs.toml in task coordinates (heave_tilt),
     // for the bench against its joint-coordinate form.
     let task = "data/tripod_3prs_task.toml";

@@ -272,6 +272,13 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     let layout = Layout::of(params);
     let want = |name: &str| scene.functions.wants(Kind::Parallel, name);
     let plan = Plan::new(model)?;
+    if layout.drives() && plan.legs.iter().any(|l| l.shaft.is_some()) {
+        // The run-time drives sit three to a leg; a shaft has six joints.
+        return Err(
+            "a Schönflies platform's drives cannot be run-time parameters yet (its shaft has six joints, the run-time layout three per leg): use [scene] parameters = \"constants\" or leave friction and rotor inertia off"
+                .into(),
+        );
+    }
     let k = kernels_with(&plan, &layout).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
@@ -328,6 +335,9 @@ fn coordinates_doc(motion: &PlatformMotion) -> &'static str {
         }
         PlatformMotion::Translation { .. } => {
             "`x = [px, py, pz]` (platform frame origin, m, base frame; the orientation stays at home); `u = v` (m/s of the platform frame origin, base-frame components)"
+        }
+        PlatformMotion::Schoenflies { .. } => {
+            "`x = [px, py, pz, θ]` (the carrier frame's origin, m, base frame, its orientation fixed at home; θ the tool's angle about base z, rad, 0 at home); `u = [vx, vy, vz, ω]` (m/s of the carrier, rad/s of the tool about z)"
         }
     }
 }

@@ -1048,11 +1048,14 @@ pub fn platform_pose(motion: PlatformMotion, x: &[f64]) -> Transform {
             rotation: quaternion_matrix([1.0, 0.0, 0.0, 0.0]),
             translation: [x[0], x[1], height],
         },
-        // The origin; the orientation stays fixed.
-        PlatformMotion::Translation { rotation } => Transform {
-            rotation,
-            translation: [x[0], x[1], x[2]],
-        },
+        // The origin; the orientation stays fixed (a Schönflies carrier's too: the tool is the
+        // shaft leg's last body).
+        PlatformMotion::Translation { rotation } | PlatformMotion::Schoenflies { rotation } => {
+            Transform {
+                rotation,
+                translation: [x[0], x[1], x[2]],
+            }
+        }
         // The origin in the plane z = height; the home rotation turned by φ about z.
         PlatformMotion::PlanarPose { height, rotation } => {
             let (s, c) = x[2].sin_cos();
@@ -1132,7 +1135,8 @@ pub fn from_parallel(model: &ParallelModel, leg_q: &[Vec<f64>], x: &[f64]) -> CS
                     | PlatformMotion::PlanarPoint { .. }
                     | PlatformMotion::Translation { .. }
                     | PlatformMotion::PlanarPose { .. }
-                    | PlatformMotion::HeaveTilt { .. } => plat.translation,
+                    | PlatformMotion::HeaveTilt { .. }
+                    | PlatformMotion::Schoenflies { .. } => plat.translation,
                 };
                 (
                     CJointKind::Revolute { axis },

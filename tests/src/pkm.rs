@@ -7,7 +7,7 @@ use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 /// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 9] = [
+pub const PARALLEL: [&str; 10] = [
     "gough_stewart",
     "sliding_hexapod",
     "rus_hexapod",
@@ -17,6 +17,7 @@ pub const PARALLEL: [&str; 9] = [
     "planar_3rrr",
     "tsai_3upu",
     "prs_head",
+    "delta4_rl5",
 ];
 
 /// The spec file of a bundled mechanism.
@@ -66,6 +67,9 @@ pub fn random_state(
             } else if plan.motion.parasitic() {
                 // A 1T2R platform's x = [pz, α, β].
                 i >= 1
+            } else if plan.motion.schoenflies() {
+                // A Schönflies platform's x = [px, py, pz, θ].
+                i == 3
             } else {
                 i < 3 && !planar
             };

@@ -117,6 +117,14 @@ pub mod upu_joints {
         "/variants/upu_joints/tsai_3upu_joints.rs"
     ));
 }
+/// The 4-axis Delta of `mechanisms/specs/delta4_rl5.toml` in joint coordinates (`tests/data/
+/// delta4_rl5_joints.toml`, the closed-loop route), for the bench against its task form.
+pub mod delta4_joints {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/delta4_joints/delta4_rl5_joints.rs"
+    ));
+}
 /// The 3-PRS tripod of `mechanisms/specs/tripod_3prs.toml` in task coordinates `[pz, α, β]`
 /// (`tests/data/tripod_3prs_task.toml`, `coordinates = "heave_tilt"`), for the bench against its
 /// joint-coordinate form.

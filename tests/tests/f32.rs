@@ -82,7 +82,8 @@ macro_rules! parallel {
                 runtime::parallel::PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
                 runtime::parallel::PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
                 runtime::parallel::PlatformMotion::PlanarPose { .. }
-                | runtime::parallel::PlatformMotion::HeaveTilt { .. } => (0.1, 0.02 * model.size()),
+                | runtime::parallel::PlatformMotion::HeaveTilt { .. }
+                | runtime::parallel::PlatformMotion::Schoenflies { .. } => (0.1, 0.02 * model.size()),
             };
             let mut rng = tests::rng(22);
             let mut worst: f64 = 0.0;
@@ -119,7 +120,8 @@ fn parallel_mechanisms_in_single_precision() {
         delta_rl5,
         planar_3rrr,
         tsai_3upu,
-        prs_head
+        prs_head,
+        delta4_rl5
     );
 }
 

@@ -304,6 +304,7 @@ fn parallel_guards_match_the_runtime_tests() {
         "planar_3rrr",
         "tsai_3upu",
         "prs_head",
+        "delta4_rl5",
     ] {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();

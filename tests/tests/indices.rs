@@ -377,6 +377,10 @@ fn rotate_x(m: &ParallelModel, r: &Mat3, x: &[f64]) -> Vec<f64> {
         }
         // Not turned (the tilts are about base axes): the same coordinates.
         PlatformMotion::HeaveTilt { .. } => x.to_vec(),
+        PlatformMotion::Schoenflies { .. } => {
+            let p = mat_vec(r, &[x[0], x[1], x[2]]);
+            vec![p[0], p[1], p[2], x[3]]
+        }
     }
 }
 

@@ -68,9 +68,9 @@ fn states(name: &str) -> Vec<State> {
                 PlatformMotion::Orientation { .. } => (0.3, 0.0),
                 PlatformMotion::PlanarPoint { .. } => (0.0, 0.03),
                 PlatformMotion::Translation { .. } => (0.0, 0.02 * model.size()),
-                PlatformMotion::PlanarPose { .. } | PlatformMotion::HeaveTilt { .. } => {
-                    (0.1, 0.02 * model.size())
-                }
+                PlatformMotion::PlanarPose { .. }
+                | PlatformMotion::HeaveTilt { .. }
+                | PlatformMotion::Schoenflies { .. } => (0.1, 0.02 * model.size()),
             };
             let n = plan.dof();
             let mut rng = tests::rng(0xa110c ^ n as u64);

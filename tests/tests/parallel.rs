@@ -31,6 +31,7 @@ fn amplitudes(m: &ParallelModel) -> (f64, f64) {
         PlatformMotion::Translation { .. } => (0.0, 0.05 * m.size()),
         PlatformMotion::PlanarPose { .. } => (0.15, 0.03 * m.size()),
         PlatformMotion::HeaveTilt { .. } => (0.2, 0.03 * m.size()),
+        PlatformMotion::Schoenflies { .. } => (1.0, 0.05 * m.size()),
     }
 }
 
@@ -128,6 +129,7 @@ generated_vs_runtime!(delta_rl5);
 generated_vs_runtime!(planar_3rrr);
 generated_vs_runtime!(tsai_3upu);
 generated_vs_runtime!(prs_head);
+generated_vs_runtime!(delta4_rl5);
 
 macro_rules! power_balance {
     ($test:ident, $name:ident) => {
@@ -199,6 +201,7 @@ power_balance!(power_balance_delta_rl5, delta_rl5);
 power_balance!(power_balance_planar_3rrr, planar_3rrr);
 power_balance!(power_balance_tsai_3upu, tsai_3upu);
 power_balance!(power_balance_prs_head, prs_head);
+power_balance!(power_balance_delta4_rl5, delta4_rl5);
 
 /// Home is where every leg joint is zero (the spec's placements), and the loops close there.
 #[test]
@@ -269,6 +272,10 @@ macro_rules! against_lagrange {
                     PlatformMotion::Translation { .. } => unreachable!("see tests/tests/delta.rs"),
                     // A 1T2R platform's reference is in tests/tests/prs.rs (as a pose).
                     PlatformMotion::HeaveTilt { .. } => unreachable!("see tests/tests/prs.rs"),
+                    // A 4-axis Delta's reference is in tests/tests/schoenflies.rs.
+                    PlatformMotion::Schoenflies { .. } => {
+                        unreachable!("see tests/tests/schoenflies.rs")
+                    }
                     // t = S u: ω = (0, 0, u₂), the platform origin's velocity (u₀, u₁, 0).
                     PlatformMotion::PlanarPose { height, .. } => (
                         Prescribed::Pose {

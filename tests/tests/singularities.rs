@@ -97,6 +97,11 @@ fn coords(m: &ParallelModel, p: [f64; 3], q: [f64; 4]) -> Vec<f64> {
             vec![p[0], p[1], phi]
         }
         // The tilts of R = Rz(γ)·Ry(β)·Rx(α) (home rotation the identity): α, β.
+        // The tool's angle: the quaternion's turn about z.
+        PlatformMotion::Schoenflies { .. } => {
+            let theta = 2.0 * q[3].atan2(q[0]);
+            vec![p[0], p[1], p[2], theta]
+        }
         PlatformMotion::HeaveTilt { .. } => {
             let [w, a, b, c] = q;
             let n = w * w + a * a + b * b + c * c;
@@ -200,6 +205,7 @@ generated_routes!(delta_rl5);
 generated_routes!(planar_3rrr);
 generated_routes!(tsai_3upu);
 generated_routes!(prs_head);
+generated_routes!(delta4_rl5);
 
 fn generated(name: &str) -> &'static [(&'static str, Route)] {
     match name {
@@ -212,6 +218,7 @@ fn generated(name: &str) -> &'static [(&'static str, Route)] {
         "planar_3rrr" => &planar_3rrr::ROUTES,
         "tsai_3upu" => &tsai_3upu::ROUTES,
         "prs_head" => &prs_head::ROUTES,
+        "delta4_rl5" => &delta4_rl5::ROUTES,
         _ => panic!("no generated module {name}"),
     }
 }
@@ -515,6 +522,7 @@ fn reference_agrees_with_runtime_at_generic_states() {
         "agile_eye",
         "delta_rl5",
         "planar_3rrr",
+        "delta4_rl5",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -814,6 +822,135 @@ fn delta_type_two(y: f64) {
     finish(&bad);
 }
 
+/// 4-axis Delta (`delta4_rl5`): the Delta's leg 1 (its first Delta leg; leg 0 is the shaft)
+/// stretched as in `delta_stretched_leg_singularity`, the tool turned by 40°: `Leg(1)`, then
+/// `Reach(1)`.
+#[test]
+fn delta4_stretched_leg_singularity() {
+    let m = model("delta4_rl5");
+    let plan = plan(&m);
+    let (o, p0): ([f64; 3], [f64; 3]) = ([0.33, 0.0, 0.0], [0.125, 0.0, -1.0]);
+    let dir = [p0[0] - o[0], 0.0, p0[2] - o[2]];
+    let n = (dir[0] * dir[0] + dir[2] * dir[2]).sqrt();
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| {
+            let r = 0.42 + 1.055 - d;
+            Point {
+                delta: d,
+                x: vec![
+                    o[0] + r * dir[0] / n - 0.125,
+                    0.0,
+                    o[2] + r * dir[2] / n,
+                    40f64.to_radians(),
+                ],
+            }
+        })
+        .collect();
+    let bad = walk_report(
+        "4-axis Delta, |P₁ − O₁| = 1.475 m − δ (leg 1 stretched)",
+        &plan,
+        &walk,
+        &states(4, 0xd4),
+        Some(generated_id("delta4_rl5")),
+        &[
+            |s| matches!(s, Site::Leg(1)),
+            |s| matches!(s, Site::Reach(1)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
+    );
+    finish(&bad);
+}
+
+/// 4-axis Delta (`delta4_rl5`): the Delta's type-II singularity (the rods coplanar) at
+/// `y = 0.1 m`, `z = −0.6 m`, `x* − δ`, the tool turned by −70°: the shaft's row `(0, 0, 0, 1)`
+/// of `A` does not help, `Actuation(_)`.
+#[test]
+fn delta4_parallel_singularity() {
+    let m = model("delta4_rl5");
+    let plan = plan(&m);
+    let (y, th) = (0.1, (-70f64).to_radians());
+    // The Delta legs' 3 × 3 block of A (rows 1..4, columns 0..3).
+    let det = |x: f64| {
+        let a = noc::actuation(&plan, &[x, y, -0.6, th]).unwrap();
+        let b = |r: usize, c: usize| a[r + 1][c];
+        b(0, 0) * (b(1, 1) * b(2, 2) - b(1, 2) * b(2, 1))
+            - b(0, 1) * (b(1, 0) * b(2, 2) - b(1, 2) * b(2, 0))
+            + b(0, 2) * (b(1, 0) * b(2, 1) - b(1, 1) * b(2, 0))
+    };
+    let (mut lo, mut hi) = (1.0, 1.04);
+    assert!(det(lo) * det(hi) < 0.0, "no sign change of det A");
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if det(mid) * det(lo) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let xs = lo;
+    println!("4-axis Delta: det A changes sign at x* = {xs} m (y = {y} m, z = -0.6 m)");
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![xs - d, y, -0.6, th],
+        })
+        .collect();
+    let bad = walk_report(
+        "4-axis Delta, x = x* − δ (rods coplanar)",
+        &plan,
+        &walk,
+        &states(4, 0xd5),
+        Some(generated_id("delta4_rl5")),
+        &[|s| matches!(s, Site::Actuation(_))],
+    );
+    finish(&bad);
+}
+
+/// 4-axis Delta (`delta4_rl5`): the shaft's upper U at its gimbal lock, the tube levelled out
+/// along the U's first axis (the tube at right angles to the motor axis: `cos θ₂ → 0`). The
+/// carrier at `(0.3, 0, −0.15 − δ)`, `θ = 0`, puts the lower U's centre at the height of the
+/// upper one. This lies far outside the Delta's reach (its legs would answer `Reach`), but the
+/// shaft is leg 0 and its test comes first: `Reach(1)` while the shaft is regular, `Leg(0)` at
+/// the lock (`cos² θ₂ ≤ SHAFT_TOLERANCE`, δ ≲ 3e-5 m).
+#[test]
+fn delta4_shaft_gimbal_lock() {
+    let m = model("delta4_rl5");
+    let plan = plan(&m);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: vec![0.3, 0.0, -0.15 - d, 0.0],
+        })
+        .collect();
+    let bad = walk_report(
+        "4-axis Delta, carrier at (0.3, 0, −0.15 − δ) (the shaft's U at its gimbal lock)",
+        &plan,
+        &walk,
+        &states(4, 0xd6),
+        Some(generated_id("delta4_rl5")),
+        &[
+            |s| matches!(s, Site::Leg(0)),
+            |s| matches!(s, Site::Reach(1)),
+        ],
+    );
+    finish(&bad);
+    for (u, ud) in states(4, 0xd6) {
+        let e = noc::inverse_dynamics(&plan, &[0.3, 0.0, -0.15, 0.0], &u, &ud).unwrap_err();
+        assert_eq!(e.site, Site::Leg(0));
+        let g = generated_id("delta4_rl5")(&[0.3, 0.0, -0.15, 0.0], &u, &ud).unwrap_err();
+        assert_eq!(g.site, Site::Leg(0));
+    }
+    // The tube's length to zero (the carrier's tool point at the upper U): `Reach(0)`.
+    let e = noc::inverse_kinematics(&plan, &[0.0, 0.0, -0.15, 0.0]).unwrap_err();
+    assert_eq!(e.site, Site::Reach(0));
+}
+
 /// Planar 3-RRR (`planar_3rrr`, task coordinates `[px, py, φ]`): leg 0's boundary, its
 /// proximal and distal links in one line (stretched, `|B₀ − A₀| = l₁ + l₂`): the leg Jacobian's
 /// determinant vanishes, a leg (type-I) singularity. The platform keeps its home rotation
@@ -1104,6 +1241,7 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
         "agile_eye",
         "delta_rl5",
         "planar_3rrr",
+        "delta4_rl5",
     ] {
         let m = model(name);
         let plan = plan(&m);
@@ -1212,9 +1350,10 @@ fn probe_inputs(values: &[(f64, &str)]) -> Vec<String> {
 /// which tests `value > 0` instead of `|value| > 0` before dividing.
 #[test]
 fn out_of_reach() {
-    let cases: [(&str, [f64; 3]); 5] = [
+    let cases: [(&str, [f64; 3]); 6] = [
         ("rus_hexapod", [0.0, 0.0, 10.0]),
         ("delta_rl5", [3.0, 0.0, 0.0]),
+        ("delta4_rl5", [3.0, 0.0, 0.0]),
         ("planar_3rrr", [3.0, 0.0, 0.0]),
         ("sliding_hexapod", [10.0, 0.0, 0.0]),
         ("sliding_hexapod", [0.0, -10.0, 2.0]),

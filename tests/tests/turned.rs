@@ -68,6 +68,10 @@ fn turn_parallel(m: &ParallelModel, t: &Transform) -> ParallelModel {
             height,
             rotation: runtime::model::mat_mul(&t.rotation, &rotation),
         },
+        // Turned about z: the carrier's rotation turns, θ stays relative to it.
+        PlatformMotion::Schoenflies { rotation } => PlatformMotion::Schoenflies {
+            rotation: runtime::model::mat_mul(&t.rotation, &rotation),
+        },
         other => other,
     };
     out
@@ -113,6 +117,11 @@ fn turn_state(motion: PlatformMotion, r: &Mat3, x: &[f64], u: &[f64]) -> (Vec<f6
             (vec![p[0], p[1], x[2]], vec![v[0], v[1], u[2]])
         }
         PlatformMotion::HeaveTilt { .. } => unreachable!("not turned"),
+        PlatformMotion::Schoenflies { .. } => {
+            let p = rv(r, &[x[0], x[1], x[2]]);
+            let v = rv(r, &[u[0], u[1], u[2]]);
+            (vec![p[0], p[1], p[2], x[3]], vec![v[0], v[1], v[2], u[3]])
+        }
     }
 }
 
@@ -155,9 +164,10 @@ fn turned_platforms_are_accepted_with_the_same_efforts() {
             continue;
         }
         let t = match m.motion {
-            PlatformMotion::PlanarPoint { .. } | PlatformMotion::PlanarPose { .. } => {
-                turn_about_z()
-            }
+            // (A Schönflies tool turns about z: its motor axis must stay along z.)
+            PlatformMotion::PlanarPoint { .. }
+            | PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::Schoenflies { .. } => turn_about_z(),
             _ => generic_turn(),
         };
         let plan = pnoc::Plan::new(&m).unwrap();

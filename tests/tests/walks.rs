@@ -331,7 +331,8 @@ parallel_routes!(
     delta_rl5,
     planar_3rrr,
     tsai_3upu,
-    prs_head
+    prs_head,
+    delta4_rl5
 );
 
 fn parallel_runtime(plan: &ParallelPlan, x: &[f64], u: &[f64], ud: &[f64]) -> Vec<Verdict> {
@@ -423,6 +424,13 @@ fn turned(m: &ParallelModel, axis: usize, deg: f64, dp: [f64; 3]) -> Vec<f64> {
             home[1] + dp[1],
             home[2] + if axis == 2 { deg.to_radians() } else { 0.0 },
         ],
+        // Moved by dp, the tool turned about z.
+        PlatformMotion::Schoenflies { .. } => vec![
+            home[0] + dp[0],
+            home[1] + dp[1],
+            home[2] + dp[2],
+            home[3] + if axis == 2 { deg.to_radians() } else { 0.0 },
+        ],
         // Heave dz, tilted about x (α) or y (β).
         PlatformMotion::HeaveTilt { .. } => vec![
             home[0] + dp[2],
@@ -445,6 +453,7 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
         "planar_3rrr",
         "tsai_3upu",
         "prs_head",
+        "delta4_rl5",
     ] {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
@@ -548,6 +557,47 @@ fn parallel_generated_and_runtime_agree_toward_singularities() {
                         format!("dz {dz}"),
                         &mut bad,
                     );
+                }
+            }
+            PlatformMotion::Schoenflies { .. } => {
+                // The Delta's walks (out of the workspace sideways and down, up toward the
+                // base), the tool turned all the way round, and the carrier raised toward the
+                // shaft's upper U off the axis (the tube levels out: its U's gimbal lock) and on
+                // it (the tube's length to zero).
+                let dirs = [
+                    [1.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                    [0.0, 0.0, -1.0],
+                    [0.0, 0.0, 1.0],
+                    [0.6, 0.0, 0.8],
+                ];
+                for d in dirs {
+                    for s in 0..=800 {
+                        let t = 1.2 * s as f64 / 800.0;
+                        at(
+                            turned(&m, 2, 30.0, [d[0] * t, d[1] * t, d[2] * t]),
+                            format!("{t} m along {d:?}"),
+                            &mut bad,
+                        );
+                    }
+                }
+                for s in 0..=720 {
+                    let deg = -360.0 + 720.0 * s as f64 / 720.0;
+                    at(
+                        turned(&m, 2, deg, [0.1, 0.0, 0.0]),
+                        format!("{deg}° about z"),
+                        &mut bad,
+                    );
+                }
+                for (dx, label) in [(0.3, "off the axis"), (0.0, "on the axis")] {
+                    for s in 0..=800 {
+                        let dz = 1.0 * s as f64 / 800.0;
+                        at(
+                            turned(&m, 2, 10.0, [dx, 0.0, dz]),
+                            format!("raised {dz} m {label}"),
+                            &mut bad,
+                        );
+                    }
                 }
             }
             PlatformMotion::Translation { .. } => {

@@ -32,7 +32,7 @@ pub(super) fn templates(
     want: &dyn Fn(&str) -> bool,
     params: bool,
 ) -> TokenStream {
-    let types = error_types(plan.motion.parasitic());
+    let types = error_types(plan.motion.parasitic(), plan.motion.schoenflies());
     let lu_solve = lu_fn(
         cfg,
         plan,
@@ -99,13 +99,20 @@ pub(super) fn templates(
 
 /// `Site` (its leg and actuation variants documented with the tolerances), `Singular` and
 /// `NoConvergence`.
-fn error_types(parasitic: bool) -> TokenStream {
+fn error_types(parasitic: bool, schoenflies: bool) -> TokenStream {
     let tol = crate::scalar::tolerance;
     let leg_tol = tol(noc::LEG_TOLERANCE);
     let act_tol = tol(noc::ACTUATION_TOLERANCE);
-    let leg_doc = format!(
+    let mut leg_doc = format!(
         " Leg `k`'s Jacobian is singular: `|det J| ≤ {leg_tol:e} · ∏‖columns‖` (a leg, type-I, singularity)."
     );
+    if schoenflies {
+        // The shaft's Jacobian columns are orthogonal: its test is the U's bend.
+        let shaft_tol = tol(noc::SHAFT_TOLERANCE);
+        leg_doc.push_str(&format!(
+            " For the tool's R-U-P-U shaft: its universal joint at gimbal lock, `cos² θ ≤ {shaft_tol:e}` (the tube at right angles to the motor axis)."
+        ));
+    }
     let act_doc = format!(
         " Pivot `i` of the actuation matrix `A` (each column scaled by the largest norm of its unit group, partial pivoting) is `≤ {act_tol:e}` times the larger of 1 and the largest pivot: a parallel (type-II) singularity."
     );
@@ -190,7 +197,8 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
         | PlatformMotion::PlanarPose { .. }
-        | PlatformMotion::HeaveTilt { .. } => (0usize, false),
+        | PlatformMotion::HeaveTilt { .. }
+        | PlatformMotion::Schoenflies { .. } => (0usize, false),
     };
     let sp = Specialize::new(cfg)
         .constant("QUATERNION", Literal::usize_unsuffixed(quaternion))
@@ -200,12 +208,15 @@ fn kinematics(cfg: &Config, plan: &Plan) -> TokenStream {
         .doc("FK_TOLERANCE", format!("{fk_tol:e}"))
         .doc("FK_MAX_ITERATIONS", fk_max.to_string());
     // A planar pose's [px, py, φ] ⊕ [δx, δy, δφ] is a sum too.
-    let retract =
-        if plan.motion.translates() || plan.motion.planar_pose() || plan.motion.parasitic() {
-            sp.items(RETRACT_SUM, &["retract"])
-        } else {
-            sp.items(RETRACT_QUATERNION, &["retract"])
-        };
+    let retract = if plan.motion.translates()
+        || plan.motion.planar_pose()
+        || plan.motion.parasitic()
+        || plan.motion.schoenflies()
+    {
+        sp.items(RETRACT_SUM, &["retract"])
+    } else {
+        sp.items(RETRACT_QUATERNION, &["retract"])
+    };
     let rest = sp.items(NEWTON, &["fk_residual", "forward_kinematics"]);
     quote!(#retract #rest)
 }

@@ -243,6 +243,9 @@ pub(crate) enum Coordinates {
     /// Three DOF with parasitic motion (1T2R): heave and two tilts, `x = [pz, α, β]`; the
     /// parasitic `(px, py, γ)` follow from the legs (a 3-PRS or 3-RPS head).
     HeaveTilt,
+    /// Four DOF, the Schönflies motions: a translating carrier `[px, py, pz]` and a tool that
+    /// turns on it about `z` by `θ` (a 4-axis Delta with a telescopic R-U-P-U shaft).
+    Schoenflies,
 }
 
 /// The `[platform]` table of a parallel mechanism. Entries that could not be read are `None`

@@ -78,6 +78,8 @@ fn end_map(motion: PlatformMotion, lk: &LegKin<f64>) -> DMatrix<f64> {
         PlatformMotion::Orientation { .. } => DMatrix::identity(3, 3),
         PlatformMotion::PlanarPoint { .. } => DMatrix::identity(3, 2),
         PlatformMotion::Translation { .. } => DMatrix::identity(3, 3),
+        // A Schönflies carrier's Delta legs (`terms` does not take the shaft).
+        PlatformMotion::Schoenflies { .. } => DMatrix::identity(3, 4),
         // v_end = v + ω × arm, ω = (0, 0, u₂): columns e_x, e_y, e_z × arm.
         PlatformMotion::PlanarPose { .. } => {
             let mut g = DMatrix::zeros(3, 3);
@@ -105,7 +107,9 @@ fn end_motion(motion: PlatformMotion, lk: &LegKin<f64>, u: &[f64], ud: &[f64]) -
         }
         PlatformMotion::Orientation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
         PlatformMotion::PlanarPoint { .. } => ([u[0], u[1], 0.0], [ud[0], ud[1], 0.0]),
-        PlatformMotion::Translation { .. } => ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]]),
+        PlatformMotion::Translation { .. } | PlatformMotion::Schoenflies { .. } => {
+            ([u[0], u[1], u[2]], [ud[0], ud[1], ud[2]])
+        }
         PlatformMotion::PlanarPose { .. } => {
             let (w, wd) = (v3([0.0, 0.0, u[2]]), v3([0.0, 0.0, ud[2]]));
             let (v, a) = (v3([u[0], u[1], 0.0]), v3([ud[0], ud[1], 0.0]));
@@ -140,7 +144,18 @@ fn body_count(plan: &Plan) -> usize {
 }
 
 /// `T`, `Ṫ u`, `M`, `W`, `w^G`, `L`, `L̇ u` and `A` at `(x, u)`.
+///
+/// A Schönflies platform (its six-joint shaft) is not taken: `Err` with `Site::Platform` and
+/// an infinite condition estimate (tests/tests/schoenflies.rs checks it against the joint
+/// coordinates and Lagrange's multipliers instead).
 pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
+    if plan.motion.schoenflies() {
+        return Err(Singular {
+            site: Site::Platform,
+            value: 0.0,
+            condition_estimate: f64::INFINITY,
+        });
+    }
     check_finite(&[x, u])?;
     let n = plan.dof();
     let (pl, legs) = noc::kinematics(plan, x)?;
@@ -216,7 +231,7 @@ pub fn terms(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Terms, Singular> {
             t[(6 * b + 4, 1)] = 1.0;
             put_body(&mut m, &mut gravity, b, Matrix3::zeros(), mass, g_world);
         }
-        PlatformMotion::Translation { .. } => {
+        PlatformMotion::Translation { .. } | PlatformMotion::Schoenflies { .. } => {
             // T_P = S = [0; 1₃]: ω = 0 and every point moves with u, so Ṫ u = 0.
             t.view_mut((6 * b + 3, 0), (3, 3))
                 .copy_from(&Matrix3::identity());

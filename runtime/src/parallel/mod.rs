@@ -89,6 +89,19 @@ pub enum PlatformMotion {
         /// The platform origin's home `(px, py)` (base frame, m): the Newton steps' start.
         xy: [f64; 2],
     },
+    /// Four DOF, the Schönflies motions (x, y, z and a turn about the vertical `z`): a 4-axis
+    /// Delta (ABB IRB 360 FlexPicker, Codian D4). The platform (the *carrier*) translates, its
+    /// rotation fixed at `rotation`, carried by three Delta legs; a tool turns on it about the
+    /// base `z` axis, driven by a fourth motor on the base through a telescopic R–U–P–U shaft
+    /// (a [`LegKind::Shaft`] leg whose last body is the tool). `x = [px, py, pz, θ]`: the carrier
+    /// frame's origin (m) and the tool's angle about `z` (rad, `0` at home); `u = [vx, vy, vz,
+    /// ω]`, so that `x ⊕ δu` is a sum. The carrier's twist is `[0; v]`, the tool's `[ω e_z; v]`
+    /// (at its axis); the shaft's double Cardan is homokinetic, so the motor turns with the tool
+    /// (docs/method.md, "Schönflies motion").
+    Schoenflies {
+        /// The carrier's fixed rotation (platform → base).
+        rotation: crate::model::Mat3,
+    },
 }
 
 impl PlatformMotion {
@@ -101,6 +114,7 @@ impl PlatformMotion {
             PlatformMotion::Translation { .. }
             | PlatformMotion::PlanarPose { .. }
             | PlatformMotion::HeaveTilt { .. } => 3,
+            PlatformMotion::Schoenflies { .. } => 4,
         }
     }
     /// Number of speeds `u` (the degrees of freedom, and the number of actuators).
@@ -112,6 +126,7 @@ impl PlatformMotion {
             PlatformMotion::Translation { .. }
             | PlatformMotion::PlanarPose { .. }
             | PlatformMotion::HeaveTilt { .. } => 3,
+            PlatformMotion::Schoenflies { .. } => 4,
         }
     }
     /// The unit group of each speed (`u`'s columns of the actuation matrix `A`): speeds of one
@@ -126,7 +141,12 @@ impl PlatformMotion {
             PlatformMotion::PlanarPoint { .. } => &[0, 0],
             PlatformMotion::PlanarPose { .. } => &[0, 0, 1],
             PlatformMotion::HeaveTilt { .. } => &[0, 1, 1],
+            PlatformMotion::Schoenflies { .. } => &[0, 0, 0, 1],
         }
+    }
+    /// Whether the platform is a Schönflies carrier with a turning tool (`Schoenflies`).
+    pub fn schoenflies(&self) -> bool {
+        matches!(self, PlatformMotion::Schoenflies { .. })
     }
     /// Whether the platform has parasitic motion (`HeaveTilt`): its pose follows from `x` by
     /// the legs' constraints, and `x ⊕ δu` is a sum.
@@ -229,6 +249,16 @@ pub enum LegKind {
     /// A revolute about the plane normal, then a prismatic joint along the line from it to a
     /// point of a planar platform: the R-P leg of a 3-RPR (angle and length of that line).
     PlanarRp,
+    /// The telescopic shaft of a Schönflies platform ([`PlatformMotion::Schoenflies`]): a
+    /// revolute on the base whose axis is the base `z` (the fourth motor), a U (two
+    /// perpendicular revolutes, the first perpendicular to the motor axis, meeting on it), a
+    /// prismatic tube along the motor axis at home, a second U whose tube-side axis is parallel
+    /// to the first U's tube-side axis and whose other axis is parallel to the first U's first
+    /// axis (the yokes in phase), its centre on the motor axis at home; its last body is the
+    /// tool, which meets the carrier in a revolute about `z` on the same line (a spherical
+    /// [`LegEnd`] point: the shaft fixes the tool's angle). The double Cardan is homokinetic:
+    /// the motor's angle is the tool's.
+    Shaft,
     /// Any other chain of three one-DOF joints (revolute or prismatic, any axes) ending in a
     /// spherical joint at a 6-DOF platform: inverse kinematics by a fixed number of Newton
     /// steps from the home configuration (`noc::GENERIC_IK_ITERATIONS`), checked against
@@ -247,6 +277,7 @@ impl LegKind {
             LegKind::PlanarRr => "planar RR",
             LegKind::PlanarPr => "planar PR",
             LegKind::PlanarRp => "planar RP",
+            LegKind::Shaft => "R-U-P-U shaft",
             LegKind::Generic => "generic (Newton)",
         }
     }
@@ -282,6 +313,10 @@ impl ParallelModel {
                 alloc::vec![self.home.translation[0], self.home.translation[1], 0.0]
             }
             PlatformMotion::HeaveTilt { .. } => alloc::vec![self.home.translation[2], 0.0, 0.0],
+            PlatformMotion::Schoenflies { .. } => {
+                let t = self.home.translation;
+                alloc::vec![t[0], t[1], t[2], 0.0]
+            }
         }
     }
 
@@ -468,6 +503,18 @@ fn classify(m: &ParallelModel, leg: &Leg, tol: f64) -> Result<LegKind, String> {
         (PlatformMotion::Translation { .. }, LegEnd::Spherical { .. }, [_, _, _]) => {
             LegKind::Generic
         }
+        // A Schönflies carrier: three Delta legs (as a translational platform's) and the shaft.
+        (PlatformMotion::Schoenflies { .. }, LegEnd::Spherical { .. }, [R, R, R]) if meet(1, 2) => {
+            LegKind::Rus
+        }
+        (PlatformMotion::Schoenflies { .. }, LegEnd::Spherical { .. }, [R, R, R, P, R, R]) => {
+            shaft_leg(leg, &ax, tol)?
+        }
+        (PlatformMotion::Schoenflies { .. }, _, _) => {
+            return Err(format!(
+                "leg {name}: a Schönflies platform's legs are Delta legs (a revolute crank, then the parallelogram's U and S) and one R-U-P-U shaft from a motor about z to the tool"
+            ));
+        }
         (PlatformMotion::Orientation { centre }, LegEnd::Revolute { .. }, [R, R]) => {
             for (k, (e, p)) in ax.iter().enumerate() {
                 let off = cross(&sub(&centre, p), e);
@@ -619,6 +666,76 @@ fn heave_tilt_leg(
         }
     }
     Ok(kind)
+}
+
+/// The telescopic R-U-P-U shaft of a Schönflies platform ([`LegKind::Shaft`]): the motor axis
+/// along the base `z`, the U axes perpendicular to each other and to the motor axis, meeting on
+/// it, the tube along it, the second U in phase with the first (its tube-side axis parallel to
+/// the first U's tube-side axis, its other axis to the first U's first axis) with its centre on
+/// the motor axis, and the tool's point on the same line: the conditions under which the double
+/// Cardan is homokinetic and the tool turns with the motor.
+fn shaft_leg(leg: &Leg, ax: &[(Vec3, Vec3)], tol: f64) -> Result<LegKind, String> {
+    let name = &leg.name;
+    let jn = |k: usize| leg.joints[k].name.as_str();
+    let par = |a: &Vec3, b: &Vec3| norm(&cross(a, b)) <= 1e-9;
+    let perp = |a: &Vec3, b: &Vec3| dot(a, b).abs() <= 1e-9;
+    let on_line = |p: &Vec3| norm(&cross(&sub(p, &ax[0].1), &ax[0].0)) <= tol;
+    let e0 = ax[0].0;
+    if e0[0].abs() > 1e-9 || e0[1].abs() > 1e-9 {
+        return Err(format!(
+            "leg {name}: its motor joint {} does not turn about the base z axis (the tool's angle θ is about z)",
+            jn(0)
+        ));
+    }
+    if !(perp(&ax[1].0, &e0) && perp(&ax[2].0, &e0) && perp(&ax[1].0, &ax[2].0)) {
+        return Err(format!(
+            "leg {name}: its universal joint's axes {} and {} are not perpendicular to each other and to the motor axis {} at home (the shaft hangs along the motor axis at home)",
+            jn(1),
+            jn(2),
+            jn(0)
+        ));
+    }
+    if !(on_line(&ax[1].1) && on_line(&ax[2].1) && norm(&sub(&ax[1].1, &ax[2].1)) <= tol) {
+        return Err(format!(
+            "leg {name}: its universal joint {}/{} is not centred on the motor axis {}",
+            jn(1),
+            jn(2),
+            jn(0)
+        ));
+    }
+    if !par(&ax[3].0, &e0) {
+        return Err(format!(
+            "leg {name}: its telescopic joint {} does not slide along the motor axis {} at home",
+            jn(3),
+            jn(0)
+        ));
+    }
+    if !(par(&ax[4].0, &ax[2].0) && par(&ax[5].0, &ax[1].0)) {
+        return Err(format!(
+            "leg {name}: its universal joints are not in phase (the tool-side joint's axes {} and {} must be parallel to {} and {} at home), so the double Cardan is not homokinetic and the tool would not turn with the motor",
+            jn(4),
+            jn(5),
+            jn(2),
+            jn(1)
+        ));
+    }
+    let tip = leg_tip_home(leg);
+    if !(on_line(&ax[4].1) && norm(&sub(&ax[4].1, &ax[5].1)) <= tol && on_line(&tip)) {
+        return Err(format!(
+            "leg {name}: its second universal joint {}/{} and the tool's joint are not centred on the motor axis {} at home",
+            jn(4),
+            jn(5),
+            jn(0)
+        ));
+    }
+    if norm(&sub(&ax[4].1, &ax[1].1)) <= tol {
+        return Err(format!(
+            "leg {name}: its universal joints {} and {} coincide (the tube has no length)",
+            jn(1),
+            jn(4)
+        ));
+    }
+    Ok(LegKind::Shaft)
 }
 
 /// The leg's end point at home in the base frame (spherical end), or the last body's origin.

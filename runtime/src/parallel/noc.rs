@@ -41,6 +41,9 @@
 //! * `parasitic.rs`: step 1 of a 1T2R platform (`HeaveTilt`): the parasitic components by
 //!   the legs' constraints, the twist map `t = S(x) u` and its rate ([`Parasitic`]); every
 //!   later step runs as for a 6-DOF pose with `t`, `ṫ`, then projects by `Sᵀ`.
+//! * `shaft.rs`: a Schönflies platform's telescopic R–U–P–U shaft to the tool ([`ShaftPlan`]):
+//!   its closed-form inverse kinematics, the map of its joint rates from `u`, its force and
+//!   inertia (the homokinetic double Cardan: the motor turns with the tool).
 //! * `subproblems.rs`: the Paden–Kahan subproblems of step 2.
 //! * `legs.rs`: steps 2–3, [`leg_kinematics`] ([`LegKin`]) and [`kinematics`] of every leg;
 //!   step 6's [`actuation_matrix`].
@@ -75,6 +78,7 @@ mod motion;
 mod parasitic;
 mod plan;
 mod pose;
+mod shaft;
 mod subproblems;
 mod ups;
 
@@ -82,14 +86,14 @@ pub use crate::payload::Payload;
 pub use crate::solve::{NoConvergence, PIVOT_TOLERANCE, Stop, check_finite, solve_spd};
 
 pub use api::{
-    actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics, friction,
-    generalized_effort, gravity, inverse_dynamics, inverse_kinematics, leg_joint_positions,
-    mass_matrix, platform_pose, potential_energy,
+    JointRates, actuation, actuator_mass_matrix, actuator_rates, coriolis, forward_dynamics,
+    friction, generalized_effort, gravity, inverse_dynamics, inverse_kinematics,
+    leg_joint_positions, leg_joint_rates, mass_matrix, platform_pose, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
 pub use delta::{DeltaKin, DeltaPlan};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
-pub use force::{generalized_force, generalized_force_with, payload_force};
+pub use force::{generalized_force, generalized_force_with, leg_rates, payload_force};
 pub use generic_leg::{GENERIC_IK_ITERATIONS, GENERIC_IK_TOLERANCE};
 pub use inertia::{
     generalized_inertia, generalized_inertia_by_columns, generalized_inertia_with, payload_inertia,
@@ -104,6 +108,7 @@ pub use parasitic::{
 };
 pub use plan::{LegPlan, Plan};
 pub use pose::{Platform, platform};
+pub use shaft::{SHAFT_TOLERANCE, ShaftPlan};
 pub use ups::{UpsBody, UpsKin, UpsPlan};
 
 #[cfg(doc)]

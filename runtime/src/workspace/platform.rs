@@ -64,6 +64,7 @@ impl Workspace for Platform {
             PlatformMotion::Translation { .. } => &["px", "py", "pz"],
             PlatformMotion::PlanarPose { .. } => &["px", "py", "phi"],
             PlatformMotion::HeaveTilt { .. } => &["pz", "alpha", "beta"],
+            PlatformMotion::Schoenflies { .. } => &["px", "py", "pz", "theta"],
         };
         names.iter().map(|n| String::from(*n)).collect()
     }
@@ -78,6 +79,9 @@ impl Workspace for Platform {
             }
             PlatformMotion::HeaveTilt { .. } => {
                 vec![Speed::Translation, Speed::Rotation, Speed::Rotation]
+            }
+            PlatformMotion::Schoenflies { .. } => {
+                [[Speed::Translation; 3].as_slice(), &[Speed::Rotation]].concat()
             }
         }
     }
@@ -128,6 +132,17 @@ impl Workspace for Platform {
                     revolute: true,
                 },
             ],
+            // θ is a coordinate of x: stepped as a joint angle.
+            PlatformMotion::Schoenflies { .. } => vec![
+                pos(0),
+                pos(1),
+                pos(2),
+                Axis::Joint {
+                    name: "theta".into(),
+                    index: 3,
+                    revolute: true,
+                },
+            ],
         }
     }
     fn quaternion(&self) -> Option<usize> {
@@ -137,7 +152,8 @@ impl Workspace for Platform {
             PlatformMotion::PlanarPoint { .. }
             | PlatformMotion::Translation { .. }
             | PlatformMotion::PlanarPose { .. }
-            | PlatformMotion::HeaveTilt { .. } => None,
+            | PlatformMotion::HeaveTilt { .. }
+            | PlatformMotion::Schoenflies { .. } => None,
         }
     }
     fn inertia(&self, x: &[f64], space: Space) -> Result<DMatrix<f64>, EvalError> {
@@ -169,9 +185,9 @@ impl Workspace for Platform {
                         ("kg", "m/s^2 per unit effort")
                     }
                     PlatformMotion::Pose => ("kg m^2 | kg m | kg (mixed)", "mixed"),
-                    PlatformMotion::PlanarPose { .. } | PlatformMotion::HeaveTilt { .. } => {
-                        ("kg | kg m | kg m^2 (mixed)", "mixed")
-                    }
+                    PlatformMotion::PlanarPose { .. }
+                    | PlatformMotion::HeaveTilt { .. }
+                    | PlatformMotion::Schoenflies { .. } => ("kg | kg m | kg m^2 (mixed)", "mixed"),
                 };
                 InertiaWords {
                     matrix: "generalized inertia I in platform speeds u (mass_matrix), efforts tau = A^-T I u'",
@@ -190,9 +206,9 @@ impl Workspace for Platform {
             PlatformMotion::Orientation { .. } => (0.3, 0.0),
             PlatformMotion::PlanarPoint { .. } => (0.0, 0.05),
             PlatformMotion::Translation { .. } => (0.0, 0.02 * self.model.size()),
-            PlatformMotion::PlanarPose { .. } | PlatformMotion::HeaveTilt { .. } => {
-                (0.1, 0.02 * self.model.size())
-            }
+            PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. }
+            | PlatformMotion::Schoenflies { .. } => (0.1, 0.02 * self.model.size()),
         };
         self.speeds()
             .iter()

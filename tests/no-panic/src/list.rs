@@ -34,6 +34,7 @@ macro_rules! for_each_mechanism {
             planar_3rrr,
             tsai_3upu,
             prs_head,
+            delta4_rl5,
             // Closed loops in joint coordinates.
             four_bar,
             five_bar_joints,

@@ -88,7 +88,8 @@ export_parallel!(
     delta_rl5,
     planar_3rrr,
     tsai_3upu,
-    prs_head
+    prs_head,
+    delta4_rl5
 );
 
 macro_rules! export_closed {

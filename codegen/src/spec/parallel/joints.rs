@@ -137,11 +137,14 @@ fn check_closing_joint(
             Coordinates::Translation => (Kind::Spherical, "translation"),
             Coordinates::PlanarPose => (Kind::Revolute, "planar_pose"),
             Coordinates::HeaveTilt => (Kind::Spherical, "heave_tilt"),
+            Coordinates::Schoenflies => (Kind::Spherical, "schoenflies"),
         };
         // Tsai's 3-UPU: a universal joint into a translational platform (its cross is massless
         // and, with ω = 0, its angles follow from the leg's; docs/spec.md).
         let upu = coords == Coordinates::Translation && j.kind == Kind::Universal;
-        if j.kind != want && !upu {
+        // A Schönflies carrier: the tool's revolute about z ends the shaft's leg.
+        let tool = coords == Coordinates::Schoenflies && j.kind == Kind::Revolute;
+        if j.kind != want && !upu && !tool {
             diags.push(
                 Diagnostic::error(format!(
                     "the platform \"{pname}\" is the child of {} joint \"{}\", but with coordinates = \"{word}\" a joint into the platform must be {}",

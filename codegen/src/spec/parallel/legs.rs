@@ -35,6 +35,16 @@ const SUPPORTED_UPU: &[&[JointKind]] = &[&[
     JointKind::Revolute,
     JointKind::Prismatic,
 ]];
+const SUPPORTED_SHAFT: &[&[JointKind]] = &[&[
+    JointKind::Revolute,
+    JointKind::Revolute,
+    JointKind::Revolute,
+    JointKind::Prismatic,
+    JointKind::Revolute,
+    JointKind::Revolute,
+]];
+/// The hint of an unsupported leg of a Schönflies platform.
+pub(super) const SUPPORTED_SCHOENFLIES_HINT: &str = "supported legs for coordinates = \"schoenflies\" (a 4-axis Delta): three Delta legs (a revolute crank carrying a [[parallelogram]] to the carrier) and one telescopic shaft R-U-P-U from a motor about z on the base to the tool, whose revolute about z into the carrier closes it (the shaft along the motor axis at home, the two universal joints in phase)";
 const SUPPORTED_ORIENTATION: &[&[JointKind]] = &[&[JointKind::Revolute, JointKind::Revolute]];
 const SUPPORTED_PLANAR_POSE: &[&[JointKind]] = &[
     &[JointKind::Revolute, JointKind::Revolute],
@@ -212,7 +222,12 @@ fn build_leg(
     let end = match j.kind {
         // A planar platform: the revolute joint about z at the point ties the point (the
         // platform's rotation is its own coordinate, or idle for a planar point).
-        Kind::Revolute if matches!(motion, Coordinates::Planar | Coordinates::PlanarPose) => {
+        Kind::Revolute
+            if matches!(
+                motion,
+                Coordinates::Planar | Coordinates::PlanarPose | Coordinates::Schoenflies
+            ) =>
+        {
             LegEnd::Spherical {
                 on_leg: frame.translation,
                 on_platform: child_origin.translation,
@@ -232,6 +247,9 @@ fn build_leg(
             on_platform: child_origin.translation,
         },
     };
+    if motion == Coordinates::Schoenflies && j.kind == Kind::Revolute {
+        check_tool_axis(tree, axes, c, path, diags);
+    }
     let (actuated, actuated_name) = act.unwrap_or((usize::MAX, String::new()));
     Leg {
         name: j.name.clone(),
@@ -240,6 +258,44 @@ fn build_leg(
         actuated,
         actuated_name,
         end,
+    }
+}
+
+/// A Schönflies platform's tool joint `c` (a revolute into the carrier, closing the shaft's
+/// leg along `path`) turns about the base `z` at home: `θ` is the tool's angle about `z`, and
+/// the homokinetic shaft turns the tool about the motor's axis, which the leg's checks hold to
+/// `z`.
+fn check_tool_axis(
+    tree: &Tree<'_>,
+    axes: &Axes,
+    c: usize,
+    path: &[usize],
+    diags: &mut Diagnostics,
+) {
+    let (spec, model) = (tree.spec, &tree.built.model);
+    let j = &spec.joints[c];
+    let mut tip = Transform::IDENTITY;
+    for &k in path {
+        tip = compose(&tip, &model.joints[k].origin);
+    }
+    let frame = compose(&tip, &tree.frame_in_tip(c));
+    let e = axes[c].first().copied().unwrap_or([0.0, 0.0, 1.0]);
+    let a = mat_vec(&frame.rotation, &e);
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if a[0].abs() > 1e-9 * n || a[1].abs() > 1e-9 * n {
+        let at = j.axes.first();
+        diags.push(
+            Diagnostic::error(format!(
+                "the tool's joint \"{}\" into the carrier turns about [{:.4}, {:.4}, {:.4}] at home, not about the base z axis",
+                j.name,
+                a[0] / n,
+                a[1] / n,
+                a[2] / n
+            ))
+            .with_key(at.map_or_else(|| format!("{}.axis", j.key), |a| a.key.clone()))
+            .with_span(at.map_or(j.span.clone(), |a| a.span.clone()))
+            .with_hint("with coordinates = \"schoenflies\" the tool turns on the carrier about the vertical z (θ is its angle about z), parallel to its shaft's motor axis; give the joint the axis that is the base z at home"),
+        );
     }
 }
 
@@ -305,7 +361,8 @@ fn check_leg_type(
     let supported = match motion {
         // A universal joint into a translational platform ends a U-P leg (Tsai's 3-UPU).
         Coordinates::Translation if j.kind == Kind::Universal => SUPPORTED_UPU,
-        Coordinates::Pose | Coordinates::Translation => SUPPORTED_POSE,
+        Coordinates::Schoenflies if j.kind == Kind::Revolute => SUPPORTED_SHAFT,
+        Coordinates::Pose | Coordinates::Translation | Coordinates::Schoenflies => SUPPORTED_POSE,
         Coordinates::Orientation | Coordinates::Planar => SUPPORTED_ORIENTATION,
         Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE,
         Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT,
@@ -327,6 +384,7 @@ fn check_leg_type(
             .with_hint(match motion {
                 Coordinates::PlanarPose => SUPPORTED_PLANAR_POSE_HINT,
                 Coordinates::HeaveTilt => SUPPORTED_HEAVE_TILT_HINT,
+                Coordinates::Schoenflies => SUPPORTED_SCHOENFLIES_HINT,
                 _ => SUPPORTED_HINT,
             }),
         );

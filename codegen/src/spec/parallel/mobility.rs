@@ -23,6 +23,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Translation => (6, 3, "spatial, λ = 6"),
         Coordinates::PlanarPose => (3, 3, "planar, λ = 3"),
         Coordinates::HeaveTilt => (6, 3, "spatial, λ = 6"),
+        Coordinates::Schoenflies => (6, 4, "spatial, λ = 6"),
     };
     // A parallelogram is counted as what it is, two rods with a ball joint at each end
     // (2 bodies, 4 S joints), not as its expansion (the equivalent rod, a U and an S: 1 body,
@@ -53,6 +54,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
         Coordinates::Translation => "translation",
         Coordinates::PlanarPose => "planar_pose",
         Coordinates::HeaveTilt => "heave_tilt",
+        Coordinates::Schoenflies => "schoenflies",
     };
     if m != dof {
         diags.push(
@@ -70,6 +72,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
                     Coordinates::Translation => ": each leg of a Delta is a revolute crank carrying a [[parallelogram]] (two ball–ball rods, their idle spins not counted)",
                     Coordinates::PlanarPose => ": each leg of a planar 3-DOF platform is R-R, P-R or R-P in the plane, joined to the platform by a revolute about z",
                     Coordinates::HeaveTilt => ": each leg of a 1T2R platform is P-R-S or R-P-S (5 DOF, one constraint each)",
+                    Coordinates::Schoenflies => ": a 4-axis Delta's carrier has three Delta legs (a revolute crank carrying a [[parallelogram]]) and its tool a telescopic R-U-P-U shaft from a fourth motor, closed by the tool's revolute into the carrier",
                 }
             )),
         );

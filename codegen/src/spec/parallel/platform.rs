@@ -35,7 +35,8 @@ pub(super) fn check_platform(
             Coordinates::Pose
             | Coordinates::Translation
             | Coordinates::PlanarPose
-            | Coordinates::HeaveTilt,
+            | Coordinates::HeaveTilt
+            | Coordinates::Schoenflies,
         ) if ps.centre.is_some() => {
             diags.push(
                 Diagnostic::error("`centre` is only for coordinates = \"orientation\"")
@@ -205,6 +206,9 @@ pub(super) fn assemble(
         },
         Coordinates::PlanarPose => PlatformMotion::PlanarPose {
             height: ps.home.translation[2],
+            rotation: ps.home.rotation,
+        },
+        Coordinates::Schoenflies => PlatformMotion::Schoenflies {
             rotation: ps.home.rotation,
         },
         Coordinates::HeaveTilt => PlatformMotion::HeaveTilt {

@@ -129,6 +129,13 @@ fn declared(motion: &PlatformMotion, size: f64) -> Option<Declared> {
             "translation",
             "holds its orientation fixed",
         )),
+        // The carrier translates (the tool's turn is the shaft leg's own, past the tool's
+        // revolute: that leg constrains the carrier in nothing).
+        PlatformMotion::Schoenflies { .. } => Some((
+            (0..3).map(|i| prismatic(&e(i))).collect(),
+            "schoenflies",
+            "holds the carrier's orientation fixed",
+        )),
         // A point platform has no orientation: its legs end in revolutes about the plane normal
         // at the point, whose spin of the "platform" is idle, and a point's motion is not a
         // rigid body's twist. The planar five-bar's legs are checked by their type instead

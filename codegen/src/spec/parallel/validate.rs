@@ -7,7 +7,10 @@
 use runtime::model::{Transform, Vec3, mat_mul, mat_vec};
 use runtime::parallel::{GEOMETRY_TOLERANCE, LegEnd, ParallelModel, PlatformMotion};
 
-use super::legs::{SUPPORTED_HEAVE_TILT_HINT, SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT, Tree};
+use super::legs::{
+    SUPPORTED_HEAVE_TILT_HINT, SUPPORTED_HINT, SUPPORTED_PLANAR_POSE_HINT,
+    SUPPORTED_SCHOENFLIES_HINT, Tree,
+};
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
 use crate::spec::ir::{Coordinates, Kind, PlatformSpec, Spec};
@@ -321,10 +324,37 @@ fn validate_diagnostic(
         SUPPORTED_PLANAR_POSE_HINT
     } else if ps.coordinates == Some(Coordinates::HeaveTilt) {
         SUPPORTED_HEAVE_TILT_HINT
+    } else if ps.coordinates == Some(Coordinates::Schoenflies) {
+        SUPPORTED_SCHOENFLIES_HINT
     } else {
         SUPPORTED_HINT
     };
-    let d = Diagnostic::error(msg).with_hint(hint);
+    // A Schönflies shaft's message names the joint at fault (a U joint's expanded revolutes
+    // as `<name>_1`, `<name>_2`): the diagnostic points at it.
+    let named = (ps.coordinates == Some(Coordinates::Schoenflies))
+        .then(|| {
+            spec.joints
+                .iter()
+                .filter(|j| !closing.iter().any(|&c| spec.joints[c].name == j.name))
+                .filter_map(|j| {
+                    [
+                        format!(" {} ", j.name),
+                        format!(" {}_1", j.name),
+                        format!(" {}_2", j.name),
+                    ]
+                    .iter()
+                    .filter_map(|p| msg.find(p.as_str()))
+                    .min()
+                    .map(|at| (at, j))
+                })
+                .min_by_key(|(at, _)| *at)
+                .map(|(_, j)| j)
+        })
+        .flatten();
+    let d = Diagnostic::error(msg.clone()).with_hint(hint);
+    if let Some(j) = named {
+        return d.with_key(j.key.clone()).with_span(j.span.clone());
+    }
     match leg {
         Some(j) => d.with_key(j.key.clone()).with_span(j.span.clone()),
         None => d.with_key("platform").with_span(ps.span.clone()),

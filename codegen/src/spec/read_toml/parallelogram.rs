@@ -230,7 +230,10 @@ impl Reader<'_> {
     ) -> Option<(BodySpec, [JointSpec; 2])> {
         let key = |k: &str| format!("{}.{k}", pg.path);
         let ps = spec.platform.as_ref()?;
-        if ps.coordinates != Some(Coordinates::Translation) {
+        if !matches!(
+            ps.coordinates,
+            Some(Coordinates::Translation | Coordinates::Schoenflies)
+        ) {
             self.err(
                 "a parallelogram needs a translational platform",
                 &pg.path,

@@ -67,7 +67,7 @@ impl Reader<'_> {
     }
 
     /// `platform.coordinates`: `"pose"`, `"orientation"`, `"planar"`, `"translation"` or
-    /// `"planar_pose"` or `"heave_tilt"`.
+    /// `"planar_pose"`, `"heave_tilt"` or `"schoenflies"`.
     fn coordinates(&mut self, c: &Val<'_>) -> Option<Coordinates> {
         let s = self.string(c, "platform.coordinates")?;
         match s.as_str() {
@@ -77,6 +77,7 @@ impl Reader<'_> {
             "translation" => Some(Coordinates::Translation),
             "planar_pose" => Some(Coordinates::PlanarPose),
             "heave_tilt" => Some(Coordinates::HeaveTilt),
+            "schoenflies" => Some(Coordinates::Schoenflies),
             other => {
                 let hint = suggest_hint(
                     &other.to_ascii_lowercase(),
@@ -87,10 +88,11 @@ impl Reader<'_> {
                         "translation",
                         "planar_pose",
                         "heave_tilt",
+                        "schoenflies",
                     ],
                 )
                 .unwrap_or_else(|| {
-                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF), \"translation\" (position, orientation fixed, 3 DOF) \"planar_pose\" (position in a plane and rotation about its normal, 3 DOF) or \"heave_tilt\" (heave and two tilts with parasitic motion, 3 DOF: a 3-PRS or 3-RPS head)".into()
+                    "coordinates is \"pose\" (position and orientation, 6 DOF), \"orientation\" (rotation about a fixed centre, 3 DOF), \"planar\" (a point in a plane, 2 DOF), \"translation\" (position, orientation fixed, 3 DOF) \"planar_pose\" (position in a plane and rotation about its normal, 3 DOF) \"heave_tilt\" (heave and two tilts with parasitic motion, 3 DOF: a 3-PRS or 3-RPS head) or \"schoenflies\" (a translating carrier and a tool turning about z, 4 DOF: a 4-axis Delta)".into()
                 });
                 self.err(
                     format!("unknown platform coordinates {other:?}"),

@@ -7,7 +7,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::dynamics::forward_dynamics_generic;
-use super::force::generalized_force;
+use super::force::{generalized_force, leg_rates};
 use super::inertia::generalized_inertia;
 use super::legs::{JointPos, actuated_positions, actuation_matrix, kinematics, positions};
 use super::lu::solve_dyn;
@@ -71,6 +71,27 @@ pub fn leg_joint_positions(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sing
                 .collect()
         })
         .collect())
+}
+
+/// One leg's joint rates and accelerations `(θ̇, θ̈)`.
+pub type JointRates = (Vec<f64>, Vec<f64>);
+
+/// Every leg's joint rates and accelerations `(θ̇, θ̈)` (rad/s or m/s, and per s²; the spec's
+/// joint order after U expansion) at `(x, u, u̇)`: the actuated ones are `q̇ = A u` and
+/// `q̈ = A u̇ + Ȧ u`.
+pub fn leg_joint_rates(
+    plan: &Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+) -> Result<Vec<JointRates>, Singular> {
+    check_finite(&[x, u, ud])?;
+    let (pl, legs) = kinematics(plan, x)?;
+    let out = leg_rates(plan, &pl, &legs, u, ud);
+    for (a, b) in &out {
+        check_finite(&[a, b])?;
+    }
+    Ok(out)
 }
 
 /// The actuation matrix `A` at `x` (`q̇ = A u`).

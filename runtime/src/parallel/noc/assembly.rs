@@ -40,7 +40,8 @@ pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
         PlatformMotion::PlanarPoint { .. }
         | PlatformMotion::Translation { .. }
         | PlatformMotion::PlanarPose { .. }
-        | PlatformMotion::HeaveTilt { .. } => {
+        | PlatformMotion::HeaveTilt { .. }
+        | PlatformMotion::Schoenflies { .. } => {
             return x.iter().zip(du).map(|(a, b)| a + b).collect();
         }
     };

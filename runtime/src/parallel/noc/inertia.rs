@@ -10,6 +10,7 @@ use super::force::generalized_force;
 use super::legs::LegKin;
 use super::plan::{LegPlan, Plan};
 use super::pose::Platform;
+use super::shaft::shaft_inertia;
 use super::ups::ups_inertia;
 use crate::algebra::{M, V, add, cross, cv, dot, inertia_quad, mtv, mv, scale, sub, zero3};
 use crate::drive::DriveInputs;
@@ -72,8 +73,8 @@ fn payload_inertia_in<R: Real>(
     let n = motion.dof();
     let z = R::c(0.0);
     let mut out = vec![vec![z; n]; n];
-    if motion.translates() {
-        for (i, row) in out.iter_mut().enumerate() {
+    if motion.translates() || motion.schoenflies() {
+        for (i, row) in out.iter_mut().enumerate().take(3) {
             row[i] = payload.mass;
         }
         return out;
@@ -166,6 +167,16 @@ fn inertia_in<R: Real>(
                 (a != 0.0).then(|| R::c(a))
             }),
         };
+        if let Some(sp) = &lp.shaft {
+            // The shaft to the tool (shaft.rs): its own 4 × 4.
+            let m = shaft_inertia(lp, sp, lk);
+            for i in 0..4 {
+                for j in 0..4 {
+                    out[i][j] = out[i][j] + m[i][j];
+                }
+            }
+            continue;
+        }
         let lam = match (&lp.ups, &lk.ups, &lp.delta, &lk.delta, drives) {
             (Some(up), Some(uk), _, _, None) => ups_inertia(up, uk),
             (_, _, Some(dp), Some(dk), None) => delta_inertia(dp, dk, &lk.frame),
@@ -203,18 +214,18 @@ fn inertia_in<R: Real>(
             out[1][2] = out[1][2] + lc2[1];
             out[2][2] = out[2][2] + dot(c2, lc2);
         } else {
-            // Orientation (u = ω), planar point (u = in-plane velocity) or translation (u = v):
-            // I += Λ's block.
-            for i in 0..n {
-                for j in 0..n {
+            // Orientation (u = ω), planar point (u = in-plane velocity) or translation (u = v;
+            // a Schönflies carrier's v): I += Λ's block.
+            for i in 0..n.min(3) {
+                for j in 0..n.min(3) {
                     out[i][j] = out[i][j] + lam[i][j];
                 }
             }
         }
     }
-    if motion.translates() {
+    if motion.translates() || motion.schoenflies() {
         let (mass, _, _) = plan.platform;
-        for i in 0..n {
+        for i in 0..n.min(3) {
             out[i][i] = out[i][i] + R::c(mass);
         }
         return out;

@@ -13,6 +13,7 @@ use super::delta::{DeltaKin, delta_kin};
 use super::generic_leg::generic_ik;
 use super::plan::{LegPlan, Plan, cross3, dot3, sub3};
 use super::pose::{Platform, platform};
+use super::shaft::{shaft_ik, shaft_row};
 use super::subproblems::{one_axis, rus_crank, two_axes};
 use super::ups::{UpsKin, UpsPlan};
 use crate::algebra::{M, V, add, cm, cross, cv, dot, ident, mm, mtv, mv, rot, scale, sub, zero3};
@@ -72,7 +73,10 @@ pub fn leg_kinematics<R: Real>(
     // The end target in L.
     let (target, arm, end_base) = end_target(lp, pl, &fr, ft);
     // Closed-form inverse kinematics.
-    let (q, ups) = closed_form_ik(lp, k, &fr, target, end_base)?;
+    let (q, ups) = match (&lp.shaft, pl.tool) {
+        (Some(sp), Some(tool)) => (shaft_ik(lp, sp, k, target, tool)?, None),
+        _ => closed_form_ik(lp, k, &fr, target, end_base)?,
+    };
     // Product of exponentials from the home configuration.
     let chain = chain_pose(lp, &q);
     let end = match lp.kind {
@@ -140,7 +144,9 @@ fn closed_form_ik<R: Real>(
         LegKind::PlanarPr => Ok((planar_pr_ik(lp, k, target)?, None)),
         LegKind::PlanarRp => Ok((planar_rp_ik(lp, k, target)?, None)),
         LegKind::SphericalRr => Ok((spherical_rr_ik(lp, k, target)?, None)),
-        LegKind::Generic => Ok((generic_ik(lp, target, k)?, None)),
+        // (A shaft has its own closed form, which needs the tool's angle: `shaft_ik`; without
+        // it, Newton's steps would not know the motor's angle either.)
+        LegKind::Generic | LegKind::Shaft => Ok((generic_ik(lp, target, k)?, None)),
     }
 }
 
@@ -432,6 +438,13 @@ fn jacobian_inverse<R: Real>(
         // The same virtual column (the revolute's axis is the plane normal).
         LegKind::PlanarPr => vec![e[0], cross(e[1], sub(end, o[1])), e[1]],
         LegKind::PlanarRp => vec![cross(e[0], sub(end, o[0])), e[1], e[0]],
+        // A shaft: the tube's U and prismatic joint at the second U's centre T = o₄ (the
+        // motor's column is known from ω; shaft.rs).
+        LegKind::Shaft => vec![
+            cross(e[1], sub(o[4], o[1])),
+            cross(e[2], sub(o[4], o[2])),
+            e[3],
+        ],
         _ => (0..n)
             .map(|j| match lp.joints[j] {
                 JointKind::Revolute => cross(e[j], sub(end, o[j])),
@@ -444,7 +457,8 @@ fn jacobian_inverse<R: Real>(
     let r2 = cross(cols[0], cols[1]);
     let det = dot(cols[0], r0);
     let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
-    let det = if jacobian && lp.ups.is_none() && lp.delta.is_none() {
+    // (A shaft's columns are orthogonal: its own test is the U's gimbal lock, in `shaft_ik`.)
+    let det = if jacobian && lp.ups.is_none() && lp.delta.is_none() && lp.shaft.is_none() {
         R::check(
             det,
             R::c(R::tolerance(LEG_TOLERANCE)) * hn,
@@ -513,6 +527,9 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, pl: &Platform<R>, legs: &[LegKin<R
             // q̇_a = (row_a of J⁻¹) · Lᵀ v_end = g · v_end with g = L · row_a; for a
             // closed-form UPS leg the prismatic rate is ±ρ̇ = ±s·v_end.
             // a Delta leg's crank rate is q̇ = (d/s)·v_end.
+            if let Some(sp) = &lp.shaft {
+                return shaft_row(lp, sp, lk);
+            }
             let g = match (&lk.ups, &lk.delta) {
                 (Some(uk), _) => scale(R::c(lp.sigma_first), uk.s),
                 (None, Some(dk)) => mv(&lk.frame, scale(dk.inv_s, dk.d)),
@@ -526,6 +543,8 @@ pub fn actuation_matrix<R: Real>(plan: &Plan, pl: &Platform<R>, legs: &[LegKin<R
                 PlatformMotion::Orientation { .. } => vec![g[0], g[1], g[2]],
                 PlatformMotion::PlanarPoint { .. } => vec![g[0], g[1]],
                 PlatformMotion::Translation { .. } => vec![g[0], g[1], g[2]],
+                // A Delta leg of a Schönflies carrier: the tool's ω does not move it.
+                PlatformMotion::Schoenflies { .. } => vec![g[0], g[1], g[2], R::c(0.0)],
                 // v_end = v + ω × arm with ω = (0, 0, u₂): q̇ = g·v + (arm × g)_z ω.
                 PlatformMotion::PlanarPose { .. } => {
                     vec![g[0], g[1], lk.arm[0] * g[1] - lk.arm[1] * g[0]]

@@ -14,18 +14,18 @@ use crate::scalar::Real;
 /// material point at the joint point `o_k` (velocities of points are not needed: the
 /// accelerations carry them in their `ω × (ω × r)` and Coriolis terms).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct BodyMotion<R> {
+pub struct BodyMotion<R> {
     /// Angular velocity.
-    pub(crate) w: V<R>,
+    pub w: V<R>,
     /// Angular acceleration.
-    pub(crate) alpha: V<R>,
+    pub alpha: V<R>,
     /// Acceleration of the material point at the joint point `o_k`.
-    pub(crate) a: V<R>,
+    pub a: V<R>,
 }
 
 impl<R: Real> BodyMotion<R> {
     /// Acceleration of the body's material point at `x`, knowing it at `o`.
-    pub(crate) fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
+    pub fn accel_at(&self, o: V<R>, x: V<R>) -> V<R> {
         let r = sub(x, o);
         add(
             add(self.a, cross(self.alpha, r)),
@@ -38,7 +38,12 @@ impl<R: Real> BodyMotion<R> {
 /// with axis `e` through `o_j`, `ω_j = ω_{j−1} + θ̇ e`, `ω̇_j = ω̇_{j−1} + θ̈ e + θ̇ ω_{j−1} × e`
 /// (R), and `a_j(o_j) = a_{j−1}(o_j) + θ̈ e + 2 θ̇ ω_{j−1} × e` (P). `qdd = None`: θ̈ = 0 (the
 /// bias `J̇ θ̇`).
-fn chain<R: Real>(lp: &LegPlan, lk: &LegKin<R>, qd: &[R], qdd: Option<&[R]>) -> Vec<BodyMotion<R>> {
+pub(super) fn chain<R: Real>(
+    lp: &LegPlan,
+    lk: &LegKin<R>,
+    qd: &[R],
+    qdd: Option<&[R]>,
+) -> Vec<BodyMotion<R>> {
     let n = lp.joints.len();
     let mut out: Vec<BodyMotion<R>> = Vec::with_capacity(n);
     for j in 0..n {

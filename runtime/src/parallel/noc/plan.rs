@@ -8,6 +8,7 @@ use alloc::vec::Vec;
 
 use super::api::inverse_dynamics;
 use super::delta::{DeltaPlan, delta_plan};
+use super::shaft::{ShaftPlan, shaft_plan};
 use super::subproblems::rus_crank;
 use super::ups::{UpsPlan, ups_plan};
 use crate::model::{JointKind, Mat3, Transform, Vec3, mat_vec};
@@ -55,6 +56,9 @@ pub struct LegPlan {
     /// The closed form of a Delta leg (see [`DeltaPlan`]): a RUS leg of a translational
     /// platform whose rod has no spin inertia; `None` otherwise.
     pub delta: Option<DeltaPlan>,
+    /// The shaft of a Schönflies platform (see [`ShaftPlan`]): `Some` for a
+    /// [`LegKind::Shaft`] leg, `None` otherwise.
+    pub shaft: Option<ShaftPlan>,
 }
 
 /// The constant data of a whole mechanism: what the evaluators need, prepared once.
@@ -107,6 +111,14 @@ impl Plan {
     /// Prepare `model` (validating it first).
     pub fn new(model: &ParallelModel) -> Result<Plan, alloc::string::String> {
         let kinds = model.validate()?;
+        if model.motion.schoenflies() {
+            let shafts = kinds.iter().filter(|k| **k == LegKind::Shaft).count();
+            if shafts != 1 {
+                return Err(alloc::format!(
+                    "a Schönflies platform needs three Delta legs and one R-U-P-U shaft to the tool; there are {shafts} shafts"
+                ));
+            }
+        }
         let mut legs = Vec::with_capacity(model.legs.len());
         for (leg, kind) in model.legs.iter().zip(kinds) {
             let first = leg.joints[0].origin;
@@ -142,6 +154,8 @@ impl Plan {
                     meet(&points[0], &axes[0], &points[1], &axes[1])
                 }
                 LegKind::Pus | LegKind::Rus => meet(&points[1], &axes[1], &points[2], &axes[2]),
+                // The shaft's first U centre.
+                LegKind::Shaft => points[1],
                 // The elbow of a planar RR leg.
                 LegKind::PlanarRr | LegKind::PlanarPr => points[1],
                 // The revolute's point (the line to the platform point starts on its axis).
@@ -156,7 +170,7 @@ impl Plan {
                 | LegKind::PlanarPr
                 | LegKind::PlanarRp
                 | LegKind::Generic => (0, 1),
-                LegKind::Pus | LegKind::Rus => (1, 2),
+                LegKind::Pus | LegKind::Rus | LegKind::Shaft => (1, 2),
             };
             let (e1, e2) = (axes[ui], axes[uj]);
             let k = cross3(&e1, &e2);
@@ -182,6 +196,7 @@ impl Plan {
                 sigma_first: 1.0,
                 ups: None,
                 delta: None,
+                shaft: None,
             };
             match kind {
                 LegKind::Ups => {
@@ -215,7 +230,10 @@ impl Plan {
                     }
                     plan.sigma_first = best.1;
                     if kind == LegKind::Rus
-                        && matches!(model.motion, PlatformMotion::Translation { .. })
+                        && matches!(
+                            model.motion,
+                            PlatformMotion::Translation { .. } | PlatformMotion::Schoenflies { .. }
+                        )
                     {
                         plan.delta = delta_plan(&plan);
                     }
@@ -241,6 +259,12 @@ impl Plan {
                     ];
                     plan.length = libm::sqrt(dot3(&h, &h));
                     plan.sigma_first = sign(dot3(&h, &axes[1]));
+                }
+                LegKind::Shaft => {
+                    let sp = shaft_plan(&plan);
+                    plan.length = sp.length;
+                    plan.sigma_u = sign(dot3(&sp.dir, &k));
+                    plan.shaft = Some(sp);
                 }
                 LegKind::Generic => {
                     // The leg's size: the reach from its first joint to the S centre at home.
@@ -297,6 +321,8 @@ impl Plan {
         for leg in &mut p.legs {
             leg.ups = None;
             leg.delta = None;
+            // (The shaft keeps its closed form: it has no other route; its bodies are
+            // massless here, its drives the friction's.)
             for b in &mut leg.bodies {
                 *b = (0.0, b.1, none);
             }

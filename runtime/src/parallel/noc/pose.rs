@@ -17,6 +17,9 @@ pub struct Platform<R> {
     /// A 1T2R platform's parasitic components and twist map `t = S u` (`HeaveTilt`); `None`
     /// for every other motion, whose `u` shapes the twist directly.
     pub parasitic: Option<Parasitic<R>>,
+    /// A Schönflies platform's tool angle `(sin θ, cos θ)` (`Schoenflies`); `None` for every
+    /// other motion.
+    pub tool: Option<(R, R)>,
 }
 
 /// The platform pose from `x` (`Pose`: `[p; q]`, `Orientation`: `q`, `Translation`: `p` with
@@ -32,6 +35,7 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
                 rot: ident(),
                 origin: [x[0], x[1], R::c(height)],
                 parasitic: None,
+                tool: None,
             });
         }
         PlatformMotion::Translation { rotation } => {
@@ -39,6 +43,7 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
                 rot: cm(&rotation),
                 origin: [x[0], x[1], x[2]],
                 parasitic: None,
+                tool: None,
             });
         }
         PlatformMotion::PlanarPose { height, rotation } => {
@@ -58,6 +63,16 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
                 rot,
                 origin: [x[0], x[1], R::c(height)],
                 parasitic: None,
+                tool: None,
+            });
+        }
+        PlatformMotion::Schoenflies { rotation } => {
+            // The carrier translates; the tool's angle goes to the shaft.
+            return Ok(Platform {
+                rot: cm(&rotation),
+                origin: [x[0], x[1], x[2]],
+                parasitic: None,
+                tool: Some(x[3].sin_cos()),
             });
         }
         PlatformMotion::HeaveTilt { .. } => {
@@ -66,6 +81,7 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
                 rot,
                 origin,
                 parasitic: Some(par),
+                tool: None,
             });
         }
     };
@@ -103,5 +119,6 @@ pub fn platform<R: Real>(plan: &Plan, x: &[R]) -> Result<Platform<R>, Singular> 
         rot,
         origin,
         parasitic: None,
+        tool: None,
     })
 }
