@@ -125,6 +125,7 @@ pub fn gough_stewart_at_yaw(yaw: f64) -> ParallelModel {
             ],
             actuated: 2,
             actuated_name: format!("p{i}"),
+            actuated_home: 0.0,
             end: LegEnd::Spherical {
                 on_leg: [0.0, 0.0, len],
                 on_platform: p[i],

@@ -645,6 +645,7 @@ fn hexapod() -> Hexapod {
             bodies: vec![massless("cross"), cyl, rod],
             actuated: 2,
             actuated_name: "j2".into(),
+            actuated_home: 0.0,
             end: LegEnd::Spherical {
                 on_leg: [0.0, 0.0, len],
                 on_platform: p,
@@ -951,6 +952,7 @@ fn spherical() -> Spherical {
             bodies: vec![proximal, distal],
             actuated: 0,
             actuated_name: "j0".into(),
+            actuated_home: 0.0,
             end: LegEnd::Revolute {
                 on_leg: c,
                 on_platform: c,

@@ -16,6 +16,31 @@ pub(crate) fn rot_z(a: f64) -> Transform {
     Transform::from_xyz_rpy([0.0; 3], [0.0, 0.0, a])
 }
 
+/// Rotation by `a` about the unit `axis`, exact (correctly rounded) at multiples of 15°
+/// (`spec::expr::sin_cos`).
+pub(crate) fn rotation(axis: &Vec3, a: f64) -> Mat3 {
+    let (s, c) = super::expr::sin_cos(a);
+    let e = axis;
+    let k = 1.0 - c;
+    [
+        [
+            c + e[0] * e[0] * k,
+            e[0] * e[1] * k - e[2] * s,
+            e[0] * e[2] * k + e[1] * s,
+        ],
+        [
+            e[1] * e[0] * k + e[2] * s,
+            c + e[1] * e[1] * k,
+            e[1] * e[2] * k - e[0] * s,
+        ],
+        [
+            e[2] * e[0] * k - e[1] * s,
+            e[2] * e[1] * k + e[0] * s,
+            c + e[2] * e[2] * k,
+        ],
+    ]
+}
+
 /// Pure translation.
 pub(crate) fn trans(t: Vec3) -> Transform {
     Transform {

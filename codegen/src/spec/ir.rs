@@ -359,6 +359,11 @@ pub(crate) struct JointSpec {
     pub child_origin: Option<Transform>,
     /// Span of the `child_origin` key, when written.
     pub child_origin_span: Span,
+    /// `home`: the joint's coordinate at home (rad or m), so that generated functions take and
+    /// return absolute coordinates; 0 by default (docs/spec.md, "Coordinates at home").
+    pub home: f64,
+    /// Span of the `home` value, when written.
+    pub home_span: Span,
     /// Friction and rotor inertia as written (applied only when `[scene]` says so).
     pub drive: DriveSpec,
 }

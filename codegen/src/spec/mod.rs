@@ -20,6 +20,7 @@ mod geom;
 mod home;
 mod input;
 mod ir;
+mod joint_home;
 mod lower;
 mod names;
 mod parallel;
@@ -355,6 +356,7 @@ fn read_ir(file_name: &str, source: &str, d: &mut Diagnostics) -> Option<ir::Spe
     };
     spec.filter(|s| check_size(s, d))
         .map(|s| child_frame::apply(s, d))
+        .map(|s| joint_home::apply(s, d))
 }
 
 /// The home pose of a spec as written, for drawing it (`codegen draw`): every joint placed at

@@ -497,6 +497,8 @@ fn joint(
         actuated_span: None,
         child_origin: None,
         child_origin_span: None,
+        home: 0.0,
+        home_span: None,
         // `<dynamics damping friction>`: applied only when a scene turns friction on (a URDF
         // has no scene, so never from the file alone). Negative values are not friction.
         drive: DriveSpec {

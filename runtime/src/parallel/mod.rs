@@ -204,6 +204,10 @@ pub struct Leg {
     pub actuated: usize,
     /// Name of the actuated joint (as in the spec).
     pub actuated_name: String,
+    /// The actuated joint's coordinate at home (rad or m; the spec's `home`, 0 by default):
+    /// `inverse_kinematics` returns, and `forward_kinematics` takes, `home` plus the joint's
+    /// displacement from its home frame, so that the actuators' coordinates are absolute.
+    pub actuated_home: f64,
     /// How the last body meets the platform.
     pub end: LegEnd,
 }

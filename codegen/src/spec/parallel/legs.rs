@@ -204,6 +204,7 @@ fn build_leg(
         })
         .collect();
     let leg_bodies = path.iter().map(|&k| model.bodies[k].clone()).collect();
+    let actuated_spec = actuated.first().copied();
     let act = actuated.first().and_then(|&a| {
         let name = &spec.joints[a].name;
         path.iter()
@@ -251,12 +252,14 @@ fn build_leg(
         check_tool_axis(tree, axes, c, path, diags);
     }
     let (actuated, actuated_name) = act.unwrap_or((usize::MAX, String::new()));
+    let actuated_home = actuated_spec.map_or(0.0, |a| spec.joints[a].home);
     Leg {
         name: j.name.clone(),
         joints: leg_joints,
         bodies: leg_bodies,
         actuated,
         actuated_name,
+        actuated_home,
         end,
     }
 }

@@ -68,6 +68,8 @@ impl Reader<'_> {
         let drive = self.joint_drive(e);
         let child_origin_span = key_span(t, "child_origin");
         let child_origin = self.joint_child_origin(e);
+        let home_span = e.get("home").map(|v| v.span());
+        let home = self.joint_home(e, kind);
         let (Some((parent, parent_span)), Some((child, child_span))) = (parent, child) else {
             self.joints_incomplete = true;
             return None;
@@ -88,8 +90,39 @@ impl Reader<'_> {
             actuated_span,
             child_origin,
             child_origin_span,
+            home,
+            home_span,
             drive,
         })
+    }
+
+    /// `home`: the coordinate at home, an angle (revolute) or a length (prismatic); 0 when not
+    /// written.
+    fn joint_home(&mut self, e: Entry<'_, '_>, kind: Option<Kind>) -> f64 {
+        let Some(v) = e.get("home") else {
+            return 0.0;
+        };
+        let key = e.key("home");
+        match kind {
+            Some(Kind::Revolute) => self.angle(v, &key).unwrap_or(0.0),
+            Some(Kind::Prismatic) => self.number(v, &key).unwrap_or(0.0),
+            Some(k) => {
+                self.err(
+                    format!(
+                        "`home` is for revolute and prismatic joints, not {}",
+                        k.word()
+                    ),
+                    &key,
+                    v.span(),
+                )
+                .hint = Some(
+                    "a joint of one coordinate may carry its value at home; remove `home` here"
+                        .into(),
+                );
+                0.0
+            }
+            None => 0.0,
+        }
     }
 
     /// `kind` (required).

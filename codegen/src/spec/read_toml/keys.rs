@@ -84,6 +84,7 @@ pub(super) const JOINT_KEYS: &[&str] = &[
     "mdh",
     "actuated",
     "child_origin",
+    "home",
     "damping",
     "friction",
     "armature",

@@ -413,6 +413,8 @@ impl Reader<'_> {
             actuated_span: None,
             child_origin: None,
             child_origin_span: None,
+            home: 0.0,
+            home_span: None,
             drive: DriveSpec::default(),
         };
         let mut u = joint(

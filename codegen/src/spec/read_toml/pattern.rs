@@ -11,13 +11,13 @@
 
 use std::ops::Range;
 
-use runtime::model::{Mat3, Transform, Vec3, mat_mul, mat_vec};
+use runtime::model::{Mat3, Transform, mat_mul, mat_vec};
 use toml::de::{DeTable, DeValue};
 
 use super::keys::PATTERN_KEYS;
 use super::parallelogram::ParallelogramSpec;
 use super::{Reader, get, key_span};
-use crate::spec::expr::{self, Value};
+use crate::spec::expr::Value;
 use crate::spec::ir::{BodySpec, JointSpec, Placement, SpringSpec};
 
 /// The largest number of copies (a typo such as `copies = 30000` fails fast).
@@ -39,30 +39,6 @@ pub(super) struct Copies {
     pub joints: Vec<JointSpec>,
     pub springs: Vec<SpringSpec>,
     pub parallelograms: Vec<ParallelogramSpec>,
-}
-
-/// Rotation by `a` about the unit `axis`, exact at multiples of 15°.
-fn turn(axis: Vec3, a: f64) -> Mat3 {
-    let (s, c) = expr::sin_cos(a);
-    let e = axis;
-    let k = 1.0 - c;
-    [
-        [
-            c + e[0] * e[0] * k,
-            e[0] * e[1] * k - e[2] * s,
-            e[0] * e[2] * k + e[1] * s,
-        ],
-        [
-            e[1] * e[0] * k + e[2] * s,
-            c + e[1] * e[1] * k,
-            e[1] * e[2] * k - e[0] * s,
-        ],
-        [
-            e[2] * e[0] * k - e[1] * s,
-            e[2] * e[1] * k + e[0] * s,
-            c + e[2] * e[2] * k,
-        ],
-    ]
 }
 
 fn turned(r: &Mat3, t: &Transform) -> Transform {
@@ -176,7 +152,7 @@ impl Reader<'_> {
             self.copy = Some(Copy {
                 index,
                 params: Vec::new(),
-                turn: turn(axis, step * (index - 1) as f64),
+                turn: crate::spec::geom::rotation(&axis, step * (index - 1) as f64),
                 members: Vec::new(),
             });
             if let Some(p) = params {

@@ -500,14 +500,23 @@ fn kinematics_of<R: Real>(
     Ok((pl, legs))
 }
 
-/// Actuated joint positions (rad or m) of the legs, in leg order.
+/// Actuated joint positions (rad or m) of the legs, in leg order: each leg's coordinate at
+/// home ([`LegPlan::actuated_home`], 0 unless the spec says) plus the joint's displacement from
+/// its home frame.
 pub fn actuated_positions<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<R> {
     plan.legs
         .iter()
         .zip(legs)
-        .map(|(lp, lk)| match lk.q[lp.actuated] {
-            JointPos::R(s, c) => s.atan2(c),
-            JointPos::P(d) => d,
+        .map(|(lp, lk)| {
+            let q = match lk.q[lp.actuated] {
+                JointPos::R(s, c) => s.atan2(c),
+                JointPos::P(d) => d,
+            };
+            if lp.actuated_home == 0.0 {
+                q
+            } else {
+                q + R::c(lp.actuated_home)
+            }
         })
         .collect()
 }

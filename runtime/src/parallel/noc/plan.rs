@@ -36,6 +36,8 @@ pub struct LegPlan {
     pub bodies: Vec<(f64, Vec3, Mat3)>,
     /// Index of the actuated joint.
     pub actuated: usize,
+    /// The actuated joint's coordinate at home ([`crate::parallel::Leg::actuated_home`]).
+    pub actuated_home: f64,
     /// Friction and rotor inertia of each leg joint (actuated or passive).
     pub drives: Vec<crate::model::Drive>,
     /// Spherical end: the S centre at home (`L`); revolute end: the end axis at home (`L`).
@@ -187,6 +189,7 @@ impl Plan {
                     .map(|b| (b.mass, b.com, b.inertia))
                     .collect(),
                 actuated: leg.actuated,
+                actuated_home: leg.actuated_home,
                 drives: leg.joints.iter().map(|j| j.drive).collect(),
                 end_home,
                 end_platform,
