@@ -426,6 +426,14 @@ fn items(
             })
         })
         .collect();
+    let home = plan.home();
+    // All zero (the default) as before: `[0.0; NX]`.
+    let home_value = if home.iter().all(|&h| h == 0.0) {
+        quote! { [0.0; NX] }
+    } else {
+        let h = home.iter().map(|&h| crate::emit::float_lit(h));
+        quote! { [#(#h),*] }
+    };
     let items = templates(cfg, !plan.springs.is_empty());
     let spring_names = spring_names(plan);
     let params = runtime_params(model, params, layout);
@@ -441,9 +449,10 @@ fn items(
         /// Index in `x` of each independent coordinate.
         pub const INDEPENDENT: [usize; DOF] = [#(#indep),*];
         #spring_names
-        /// The spec's home configuration (every tree joint at zero, where the spec's geometry
-        /// closes the loops in its declared branch): a guess for `forward_kinematics` near home.
-        pub const HOME: [#real; NX] = [0.0; NX];
+        /// The spec's home configuration (every tree joint at its `home` value, zero unless the
+        /// spec gives one, where the spec's geometry closes the loops in its declared branch): a
+        /// guess for `forward_kinematics` near home.
+        pub const HOME: [#real; NX] = #home_value;
         /// The largest move of each independent coordinate per stage of `forward_kinematics`
         /// (rad, or m: a fraction of the mechanism's size).
         const STEP: [#real; DOF] = [#(#step),*];

@@ -3,7 +3,8 @@
 //! the tree without, at `q` (by the runtime's spatial-algebra RNEA, a route independent of the
 //! spec reader); a parallel platform's `inverse_kinematics` returns the actuated joints' home
 //! values plus their displacements (the Gough–Stewart's leg lengths, worked out here from
-//! Tsai's published points), and `forward_kinematics` takes them.
+//! Tsai's published points), and `forward_kinematics` takes them; closed loops assemble to the
+//! same configurations shifted by their homes, with the same efforts.
 
 use codegen::spec::{Mechanism, load_mechanism};
 use runtime::model::Model;
@@ -186,18 +187,59 @@ fn a_platform_returns_absolute_leg_lengths() {
 }
 
 #[test]
+fn closed_loops_take_absolute_coordinates() {
+    let plain_src = bundled("four_bar");
+    let h = [0.3, -1.2, 2.0];
+    let homed_src = with_homes(
+        &plain_src,
+        &[
+            ("crank_joint", "0.3"),
+            ("coupler_joint", "-1.2"),
+            ("rocker_joint", "2.0"),
+        ],
+    );
+    let plan = |src: &str| match load_mechanism("f.toml", src) {
+        Ok((Mechanism::Closed(m), _)) => runtime::closed::noc::Plan::new(&m).unwrap(),
+        Ok(_) => panic!("not closed loops"),
+        Err(d) => panic!("{d}"),
+    };
+    let (p0, p1) = (plan(&plain_src), plan(&homed_src));
+    assert_eq!(p1.home(), h.to_vec());
+    // Configurations assembled from the crank angle, in both coordinates.
+    let mut r = Stream(11);
+    for _ in 0..50 {
+        let crank = 0.5 * r.next();
+        let x0 = runtime::closed::noc::newton_assembly(&p0, &[crank], &[0.0; 3]).unwrap();
+        let x1 = runtime::closed::noc::newton_assembly(&p1, &[crank + h[0]], &h).unwrap();
+        for i in 0..3 {
+            assert!((x1[i] - x0[i] - h[i]).abs() < 1e-12, "{x0:?} {x1:?}");
+        }
+        let (u, ud) = ([r.next()], [r.next()]);
+        let a = runtime::closed::noc::inverse_dynamics(&p0, &x0, &u, &ud).unwrap();
+        let b = runtime::closed::noc::inverse_dynamics(&p1, &x1, &u, &ud).unwrap();
+        assert!(
+            (a[0] - b[0]).abs() < 1e-12 * a[0].abs().max(1.0),
+            "{a:?} {b:?}"
+        );
+    }
+    // The generated module's HOME holds them.
+    let g = codegen::compile("f.toml", &homed_src, &codegen::Config::default()).unwrap();
+    assert!(
+        g.code
+            .contains("pub const HOME: [f64; NX] = [0.3, -1.2, 2.0];")
+    );
+}
+
+#[test]
 fn home_is_refused_where_it_has_no_meaning() {
     let e = load_mechanism(
         "f.toml",
-        &with_homes(&bundled("four_bar"), &[("crank_joint", "0.3")]),
+        &with_homes(&bundled("four_bar"), &[("tip", "0.3")]),
     )
     .map(|_| ())
     .unwrap_err()
     .to_string();
-    assert!(
-        e.contains("closed loops in joint coordinates do not take yet"),
-        "{e}"
-    );
+    assert!(e.contains("closes a loop, and has no coordinate"), "{e}");
     let e = load_mechanism(
         "g.toml",
         &bundled("gough_stewart").replace("kind = \"S\"\n", "kind = \"S\"\nhome = 0.1\n"),

@@ -291,7 +291,8 @@ impl Workspace for Loops {
         &self.model.name
     }
     fn home(&self) -> Vec<f64> {
-        vec![0.0; self.plan.dof()]
+        let home = self.plan.home();
+        self.plan.independent.iter().map(|&i| home[i]).collect()
     }
     fn coordinate_names(&self) -> Vec<String> {
         self.independent().map(|j| j.name.clone()).collect()
@@ -336,7 +337,7 @@ impl Workspace for Loops {
         }
     }
     fn home_state(&self) -> Vec<f64> {
-        vec![0.0; self.plan.nx()]
+        self.plan.home()
     }
     fn sample_widths(&self) -> Vec<f64> {
         vec![0.5; self.plan.dof()]

@@ -52,12 +52,23 @@ pub(crate) fn lower_closed_attached(
     if diags.has_errors() {
         return None;
     }
+    // Each tree joint's coordinate at home (`home`, docs/spec.md "Coordinates at home").
+    let home: Vec<f64> = built
+        .spec_joint
+        .iter()
+        .map(|&s| spec.joints[s].home)
+        .collect();
     let mut closed = ClosedModel {
         name: spec.name.clone(),
         tree: model,
         cuts,
         independent,
         springs,
+        home: if home.iter().all(|&h| h == 0.0) {
+            Vec::new()
+        } else {
+            home
+        },
     };
     close_at_home(spec, &mut closed, diags);
     check_spring_lengths(spec, &closed, diags);

@@ -9,14 +9,18 @@
 //!   `inverse_kinematics` returns and expected by `forward_kinematics`
 //!   (`runtime::parallel::Leg::actuated_home`, set by the lowering); the legs' other joints are
 //!   internal to the module, and their `home` changes nothing.
-//! - Closed loops in joint coordinates measure every joint from home: `home` is refused there.
+//! - In closed loops in joint coordinates the frames stay as written (the spec's home closes
+//!   the loops); the tree joints' homes are `runtime::closed::ClosedModel::home`, which the
+//!   evaluator subtracts before it turns a joint (generated and runtime alike) and `HOME`
+//!   holds. A loop-closing joint has no coordinate: `home` is an error there.
 
 use super::closed;
 use super::geom::{compose, rotation, trans};
 use super::ir::{Kind, Placement, Spec};
 use crate::diag::{Diagnostic, Diagnostics};
 
-/// Applies the trees' `home` values to the joint frames; refuses them in closed loops.
+/// Applies the trees' `home` values to the joint frames (closed loops keep theirs for the
+/// lowering; a loop-closing joint's is an error).
 pub(crate) fn apply(mut spec: Spec, diags: &mut Diagnostics) -> Spec {
     if spec.platform.is_some() {
         return spec;
@@ -28,15 +32,20 @@ pub(crate) fn apply(mut spec: Spec, diags: &mut Diagnostics) -> Spec {
             continue;
         }
         if loops {
-            diags.push(
-                Diagnostic::error(format!(
-                    "joint \"{}\" gives its coordinate at home, which closed loops in joint coordinates do not take yet",
-                    j.name
-                ))
-                .with_key(format!("{}.home", j.key))
-                .with_span(j.home_span.clone().or(j.span.clone()))
-                .with_hint("closed loops measure every joint from its home frame: remove `home` (trees and parallel platforms take it)"),
-            );
+            // The loop-closing joints have no coordinate; the tree joints' homes go to
+            // `ClosedModel::home` (spec/closed.rs), the frames staying where the spec closes
+            // the loops.
+            if j.child_origin.is_some() {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "joint \"{}\" closes a loop, and has no coordinate to give at home",
+                        j.name
+                    ))
+                    .with_key(format!("{}.home", j.key))
+                    .with_span(j.home_span.clone().or(j.span.clone()))
+                    .with_hint("the loop-closing joint's angle follows from the tree joints: remove `home` here"),
+                );
+            }
             continue;
         }
         let axis = j.axes.first().map_or([0.0, 0.0, 1.0], |a| {

@@ -125,6 +125,10 @@ pub struct ClosedModel {
     pub independent: Vec<usize>,
     /// Spring-dampers (applied forces, with gravity in the generalized force).
     pub springs: Vec<Spring>,
+    /// Each tree joint's coordinate at home (rad or m; the spec's `home`), empty for all zero:
+    /// every function takes absolute coordinates, tree joint `i` being turned (or moved) by
+    /// `x_i − home_i` from its frame at home (docs/spec.md, "Coordinates at home").
+    pub home: Vec<f64>,
 }
 
 /// Length tolerance of the closure check at home, relative to the mechanism's size.

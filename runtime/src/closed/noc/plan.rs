@@ -49,6 +49,9 @@ pub struct JointPlan {
     pub body: (f64, Vec3, Mat3),
     /// Friction and rotor inertia at this joint (actuated or passive).
     pub drive: crate::model::Drive,
+    /// The coordinate at home ([`super::super::ClosedModel::home`]): the joint moves by
+    /// `x − home` from `origin`.
+    pub home: f64,
 }
 
 /// One cut joint's constant data.
@@ -106,7 +109,10 @@ impl Plan {
         model.validate()?;
         let tree = &model.tree;
         let n = tree.dof();
-        let joints = joint_plans(tree);
+        let mut joints = joint_plans(tree);
+        for (j, &h) in joints.iter_mut().zip(&model.home) {
+            j.home = h;
+        }
         let cuts = cut_plans(model);
         let candidates = candidate_rows(model);
         let independent = model.independent.clone();
@@ -124,7 +130,7 @@ impl Plan {
             size: model.size(),
             springs: model.springs.clone(),
         };
-        let x0 = vec![0.0; n];
+        let x0 = plan.home();
         let jac = home_jacobian(&plan, &candidates, &x0);
         let tol = RANK_TOLERANCE * norm(&jac.concat());
         check_mobility(&plan, n, &jac, tol)?;
@@ -209,6 +215,10 @@ impl Plan {
     pub fn dof(&self) -> usize {
         self.independent.len()
     }
+    /// The joint coordinates at home (absolute: [`JointPlan::home`]).
+    pub fn home(&self) -> Vec<f64> {
+        self.joints.iter().map(|j| j.home).collect()
+    }
     /// The rows of `Φ_d`'s LU: the kept loop equations, then the spare ones.
     pub fn system_rows(&self) -> impl Iterator<Item = &Row> {
         self.rows.iter().chain(&self.spare)
@@ -227,6 +237,7 @@ fn joint_plans(tree: &crate::model::Model) -> Vec<JointPlan> {
             axis: j.axis,
             body: (b.mass, b.com, b.inertia),
             drive: j.drive,
+            home: 0.0,
         })
         .collect()
 }

@@ -38,12 +38,18 @@ pub fn kinematics<R: Real>(plan: &Plan, x: &[R]) -> Kin<R> {
         let r0 = mm(&rp, &cm(&j.origin.rotation));
         let o = add(pp, mv(&rp, cv(&j.origin.translation)));
         let e = mv(&r0, cv(&j.axis));
+        // The displacement from the joint's frame at home.
+        let xi = if j.home == 0.0 {
+            x[i]
+        } else {
+            x[i] - R::c(j.home)
+        };
         let (r, p) = match j.kind {
             JointKind::Revolute => {
-                let (s, c) = x[i].sin_cos();
+                let (s, c) = xi.sin_cos();
                 (mm(&r0, &rot(&j.axis, s, c)), o)
             }
-            JointKind::Prismatic => (r0, add(o, scale(x[i], e))),
+            JointKind::Prismatic => (r0, add(o, scale(xi, e))),
         };
         k.rot.push(r);
         k.pos.push(p);
