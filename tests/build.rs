@@ -47,6 +47,7 @@ fn spec_file(variant: &str) -> &'static str {
         v if v.starts_with("iiwa") => "iiwa14.urdf",
         v if v.starts_with("gs") => "gough_stewart.toml",
         v if v.starts_with("closed") => "spherical_five_bar.toml",
+        v if v.starts_with("delta") => "delta_rl5.toml",
         _ => "puma560.toml",
     }
 }
@@ -104,6 +105,10 @@ fn main() {
     generate(&out, "gs_point_legs", &p, |_| {});
     let p = with_scene(&out, gs, "gs_id_only", "functions = [\"inverse_dynamics\"]");
     generate(&out, "gs_id_only", &p, |_| {});
+    // Codourey's simplified Delta, for the speed/accuracy chart beside the exact model.
+    let delta = "../mechanisms/specs/delta_rl5.toml";
+    let p = with_scene(&out, delta, "delta_codourey", "delta_model = \"codourey\"");
+    generate(&out, "delta_codourey", &p, |_| {});
     // The Delta in joint coordinates (the closed-loop route), for the bench against its
     // platform form.
     let joints = "data/delta_rl5_joints.toml";

@@ -92,6 +92,15 @@ pub mod iiwa_rounded {
 pub mod iiwa_snapped {
     include!(concat!(env!("OUT_DIR"), "/variants/iiwa_snapped/iiwa14.rs"));
 }
+/// Codourey's simplified Delta (`[scene] delta_model = "codourey"`) of
+/// `mechanisms/specs/delta_rl5.toml`, for the speed/accuracy chart.
+pub mod delta_codourey {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/delta_codourey/delta_rl5.rs"
+    ));
+}
+
 /// The Delta of `mechanisms/specs/delta_rl5.toml` in joint coordinates (`tests/data/
 /// delta_rl5_joints.toml`, the closed-loop route), for the bench against its platform form.
 pub mod delta_joints {

@@ -1,5 +1,6 @@
 //! Speed against accuracy, measured in one run: for the PUMA 560 (a
-//! tree), the Gough–Stewart platform (a parallel mechanism), the five-bar in joint
+//! tree), the Gough–Stewart platform (a parallel mechanism), the Delta (exact and Codourey's
+//! simplified model, a scene level), the five-bar in joint
 //! coordinates (closed loops) and a URDF with rounded angles (the iiwa 14, as written and
 //! snapped), every way nocdyn offers to compute the inverse dynamics — including fidelity
 //! levels and the `libm` math backend (modules from `tests/build.rs`) — timed
@@ -241,6 +242,79 @@ fn gough_stewart(points: &mut Vec<Point>) {
             .efforts
     };
     add("Newton–Euler + Lagrange multipliers", &lag);
+}
+
+/// The Delta (`delta_rl5`, translational platform coordinates): the exact model and Codourey's
+/// simplified one (`[scene] delta_model = "codourey"`, rod masses lumped 2/3 at the elbows and
+/// 1/3 on the platform), both against the double-double evaluation of the exact model, so the
+/// simplified level's error is the model error it makes (docs/scene.md). States within ±0.3 m of
+/// home per coordinate.
+fn delta(points: &mut Vec<Point>) {
+    use mechanisms::delta_rl5 as g;
+    use mechanisms::f32::delta_rl5 as s;
+    use runtime::parallel::noc;
+    use tests::variants::delta_codourey as c;
+    let model = tests::pkm::model("delta_rl5");
+    let plan = noc::Plan::new(&model).unwrap();
+    let home = model.home_x();
+    let mut rng = tests::rng(33);
+    let states: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..STATES)
+        .map(|_| {
+            let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 0.0, 0.3);
+            let r = |v: Vec<f64>| v.iter().map(|&a| a as f32 as f64).collect::<Vec<_>>();
+            (r(x), r(u), r(ud))
+        })
+        .collect();
+    let reference: Vec<Vec<f64>> = states
+        .iter()
+        .map(|(x, u, ud)| references::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .collect();
+    let m = "Delta (RL5)";
+    let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
+        points.push(Point {
+            mechanism: m,
+            candidate,
+            ns: time(|i| f(black_box(i))[0]),
+            error: worst(f, &reference),
+        });
+    };
+    let arr = |i: usize| -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let (x, u, ud) = &states[i];
+        (
+            x.clone().try_into().unwrap(),
+            u.clone().try_into().unwrap(),
+            ud.clone().try_into().unwrap(),
+        )
+    };
+    let g64 = |i: usize| {
+        let (x, u, ud) = arr(i);
+        g::inverse_dynamics(&x, &u, &ud).unwrap().to_vec()
+    };
+    add("generated f64", &g64);
+    let s32 = |i: usize| {
+        let (x, u, ud) = arr(i);
+        let (x, u, ud) = (
+            x.map(|v| v as f32),
+            u.map(|v| v as f32),
+            ud.map(|v| v as f32),
+        );
+        s::inverse_dynamics(&x, &u, &ud)
+            .unwrap()
+            .iter()
+            .map(|&v| v as f64)
+            .collect::<Vec<_>>()
+    };
+    add("generated f32", &s32);
+    let cod = |i: usize| {
+        let (x, u, ud) = arr(i);
+        c::inverse_dynamics(&x, &u, &ud).unwrap().to_vec()
+    };
+    add("generated f64, Codourey's simplified Delta", &cod);
+    let rt = |i: usize| {
+        let (x, u, ud) = &states[i];
+        noc::inverse_dynamics(&plan, x, u, ud).unwrap()
+    };
+    add("runtime (leg-wise, f64)", &rt);
 }
 
 /// A URDF with its quarter and half turns rounded to 5 digits (`1.5708`, `3.1416`), as many
@@ -531,6 +605,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut points = Vec::new();
     puma(&mut points);
     gough_stewart(&mut points);
+    delta(&mut points);
     five_bar(&mut points);
     iiwa(&mut points);
     let mut csv = String::from("mechanism,candidate,ns_per_call,max_relative_error\n");
@@ -581,10 +656,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
-    let colours = [RED, BLUE, GREEN, MAGENTA];
+    let colours = [RED, BLUE, GREEN, MAGENTA, CYAN];
     let mechs = [
         "PUMA 560",
         "Gough–Stewart",
+        "Delta (RL5)",
         "five-bar (joint coordinates)",
         "iiwa 14 (URDF angles to 5 digits)",
     ];
