@@ -36,6 +36,16 @@ type Val<'i> = Spanned<DeValue<'i>>;
 
 /// Reads a TOML spec. `None` when the file could not be read far enough to validate it.
 pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
+    parsed(source, diags, |r, root| r.spec(root))
+}
+
+/// Parses `source` and walks its root table with a fresh [`Reader`]; `None` after a syntax
+/// error (reported).
+fn parsed<T>(
+    source: &str,
+    diags: &mut Diagnostics,
+    walk: impl FnOnce(&mut Reader<'_>, &DeTable<'_>) -> T,
+) -> Option<T> {
     let (root, errors) = DeTable::parse_recoverable(source);
     if !errors.is_empty() {
         syntax::report(source, errors, diags);
@@ -49,7 +59,7 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
         declared: Vec::new(),
         copy: None,
     };
-    Some(r.spec(&root))
+    Some(walk(&mut r, &root))
 }
 
 /// Reads a `[scene]` sidecar: `[scene]` and optionally `[parameters]`, nothing else; `gravity`
@@ -59,43 +69,33 @@ pub(crate) fn read_scene(
     diags: &mut Diagnostics,
     gravity: &mut runtime::model::Vec3,
 ) -> Option<SceneSpec> {
-    let (root, errors) = DeTable::parse_recoverable(source);
-    if !errors.is_empty() {
-        syntax::report(source, errors, diags);
-        return None;
-    }
-    let root = root.into_inner();
-    let mut r = Reader {
-        diags,
-        joints_incomplete: false,
-        params: Vec::new(),
-        declared: Vec::new(),
-        copy: None,
-    };
-    r.unknown_keys(&root, &["scene", "parameters"], "");
-    if let Some(v) = get(&root, "parameters")
-        && let Some(t) = r.table(v, "parameters")
-    {
-        r.parameter_table(t, "parameters");
-    }
-    let mut scene = SceneSpec::default();
-    match get(&root, "scene") {
-        Some(v) => {
-            scene.written = key_span(&root, "scene");
-            if let Some(t) = r.table(v, "scene") {
-                r.scene(t, &mut scene, gravity);
+    parsed(source, diags, |r, root| {
+        r.unknown_keys(root, &["scene", "parameters"], "");
+        if let Some(v) = get(root, "parameters")
+            && let Some(t) = r.table(v, "parameters")
+        {
+            r.parameter_table(t, "parameters");
+        }
+        let mut scene = SceneSpec::default();
+        match get(root, "scene") {
+            Some(v) => {
+                scene.written = key_span(root, "scene");
+                if let Some(t) = r.table(v, "scene") {
+                    r.scene(t, &mut scene, gravity);
+                }
+            }
+            None => {
+                r.err(
+                    "a scene file holds a [scene] table, and this one has none",
+                    "scene",
+                    0..0,
+                )
+                .hint =
+                    Some("write the scene's keys under a [scene] header (docs/scene.md)".into());
             }
         }
-        None => {
-            r.err(
-                "a scene file holds a [scene] table, and this one has none",
-                "scene",
-                0..0,
-            )
-            .hint = Some("write the scene's keys under a [scene] header (docs/scene.md)".into());
-        }
-    }
-    Some(scene)
+        scene
+    })
 }
 
 /// The walk's state. Entries with bad values are kept with placeholder values (the error is

@@ -152,26 +152,41 @@ fn puma(points: &mut Vec<Point>) {
     add("Newton–Euler + Lagrange multipliers", &lag);
 }
 
+/// A platform state: `x`, `u`, `u̇`.
+type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// `STATES` random regular states of a platform (rounded to `f32`, so that the single-precision
+/// module sees the same inputs; turns up to `angle`, moves up to `reach` from home) and the
+/// double-double inverse dynamics at each.
+fn platform_states(
+    model: &runtime::parallel::ParallelModel,
+    seed: u64,
+    angle: f64,
+    reach: f64,
+) -> (runtime::parallel::noc::Plan, Vec<State>, Vec<Vec<f64>>) {
+    let plan = runtime::parallel::noc::Plan::new(model).unwrap();
+    let home = model.home_x();
+    let mut rng = tests::rng(seed);
+    let states: Vec<State> = (0..STATES)
+        .map(|_| {
+            let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, angle, reach);
+            let r = |v: Vec<f64>| v.iter().map(|&a| a as f32 as f64).collect::<Vec<_>>();
+            (r(x), r(u), r(ud))
+        })
+        .collect();
+    let reference = states
+        .iter()
+        .map(|(x, u, ud)| references::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
+        .collect();
+    (plan, states, reference)
+}
+
 fn gough_stewart(points: &mut Vec<Point>) {
     use mechanisms::f32::gough_stewart as s;
     use mechanisms::gough_stewart as g;
     use runtime::parallel::noc;
     let model = tests::pkm::model("gough_stewart");
-    let plan = noc::Plan::new(&model).unwrap();
-    let home = model.home_x();
-    let mut rng = tests::rng(32);
-    let states: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..STATES)
-        .map(|_| {
-            let (x, u, ud) =
-                tests::pkm::random_state(&plan, &home, &mut rng, 0.1, 0.02 * model.size());
-            let r = |v: Vec<f64>| v.iter().map(|&a| a as f32 as f64).collect::<Vec<_>>();
-            (r(x), r(u), r(ud))
-        })
-        .collect();
-    let reference: Vec<Vec<f64>> = states
-        .iter()
-        .map(|(x, u, ud)| references::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
-        .collect();
+    let (plan, states, reference) = platform_states(&model, 32, 0.1, 0.02 * model.size());
     let m = "Gough–Stewart";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {
@@ -255,20 +270,7 @@ fn delta(points: &mut Vec<Point>) {
     use runtime::parallel::noc;
     use tests::variants::delta_codourey as c;
     let model = tests::pkm::model("delta_rl5");
-    let plan = noc::Plan::new(&model).unwrap();
-    let home = model.home_x();
-    let mut rng = tests::rng(33);
-    let states: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..STATES)
-        .map(|_| {
-            let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 0.0, 0.3);
-            let r = |v: Vec<f64>| v.iter().map(|&a| a as f32 as f64).collect::<Vec<_>>();
-            (r(x), r(u), r(ud))
-        })
-        .collect();
-    let reference: Vec<Vec<f64>> = states
-        .iter()
-        .map(|(x, u, ud)| references::dd::inverse_dynamics_dd(&plan, x, u, ud).unwrap())
-        .collect();
+    let (plan, states, reference) = platform_states(&model, 33, 0.0, 0.3);
     let m = "Delta (RL5)";
     let mut add = |candidate, f: &dyn Fn(usize) -> Vec<f64>| {
         points.push(Point {

@@ -422,7 +422,7 @@ impl Reader<'_> {
     }
 
     /// `{ axis = [x, y, z], angle = … }`: a rotation by `angle` (rad, or an angle string) about
-    /// `axis` (normalized; not zero).
+    /// `axis` (normalized; not zero), exact at multiples of 15° (`geom::rotation`).
     fn axis_angle(&mut self, v: &Val<'_>, key: &str) -> Option<Mat3> {
         let t = self.table(v, key)?;
         self.unknown_keys(t, &["axis", "angle"], key);
@@ -462,25 +462,7 @@ impl Reader<'_> {
             return None;
         }
         let e = [axis[0] / n, axis[1] / n, axis[2] / n];
-        let (s, c) = runtime::model::exact_sin_cos(angle);
-        let k = 1.0 - c;
-        Some([
-            [
-                c + e[0] * e[0] * k,
-                e[0] * e[1] * k - e[2] * s,
-                e[0] * e[2] * k + e[1] * s,
-            ],
-            [
-                e[1] * e[0] * k + e[2] * s,
-                c + e[1] * e[1] * k,
-                e[1] * e[2] * k - e[0] * s,
-            ],
-            [
-                e[2] * e[0] * k - e[1] * s,
-                e[2] * e[1] * k + e[0] * s,
-                c + e[2] * e[2] * k,
-            ],
-        ])
+        Some(crate::spec::geom::rotation(&e, angle))
     }
 
     /// An array of `n` numbers.
