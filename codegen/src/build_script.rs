@@ -311,6 +311,15 @@ pub fn write_if_changed(path: &Path, content: &str) -> Result<(), Error> {
     }
     let err = |e: std::io::Error| Error::Io(path.to_path_buf(), e);
     let target = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    // A device, FIFO or socket (`-o /dev/null`, `-o /dev/stdout`) is written into, never
+    // replaced: a rename would put a regular file in its place.
+    if std::fs::metadata(&target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        let mut f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&target)
+            .map_err(err)?;
+        return f.write_all(content.as_bytes()).map_err(err);
+    }
     let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -342,6 +351,22 @@ pub fn write_if_changed(path: &Path, content: &str) -> Result<(), Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `-o /dev/null` writes into the device and leaves it a device (a rename would replace
+    /// it with a regular file, and every later reader of `/dev/null` would read what it holds).
+    #[cfg(unix)]
+    #[test]
+    fn a_device_is_written_into_not_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let null = Path::new("/dev/null");
+        if !std::fs::metadata(null).is_ok_and(|m| m.file_type().is_char_device()) {
+            return; // no /dev/null device here to check against
+        }
+        write_if_changed(null, "pub fn f() {}\n").unwrap();
+        let m = std::fs::metadata(null).unwrap();
+        assert!(m.file_type().is_char_device(), "/dev/null was replaced");
+        assert_eq!(std::fs::read(null).unwrap().len(), 0);
+    }
 
     /// A fresh, empty directory under the system's temporary directory.
     fn scratch(test: &str) -> PathBuf {
