@@ -4,7 +4,7 @@
 //! included, one `extern "C"` function per public function of the module), `src/NAME.rs`
 //! (the module itself) and `include/NAME.h` (the C header).
 //!
-//! The wrappers are read off the module's own items, as [`crate::implement`] does: each
+//! The wrappers are read off the module's own items, as `implement.rs` does: each
 //! public function's arguments and result, the variants of its `Site`, `Stop` and
 //! `IndexError`, the fields of `Params` and `InertiaIndices`, the public constants. So the
 //! C interface follows the kinds' templates without a second copy of their rules.

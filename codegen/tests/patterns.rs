@@ -22,7 +22,7 @@ fn model(path: &Path) -> String {
 #[test]
 fn rewritten_specs_give_the_models_written_out() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    for name in ["delta_rl5", "planar_3rrr", "gough_stewart"] {
+    for name in ["delta_rl5", "planar_3rrr", "gough_stewart", "delta4_rl5"] {
         let new = model(&root.join(format!("mechanisms/specs/{name}.toml")));
         let old = model(&root.join(format!("codegen/tests/data/expanded/{name}.toml")));
         assert!(split(&new).0.len() > 100, "{name}");

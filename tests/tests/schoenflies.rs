@@ -214,7 +214,9 @@ fn schoenflies_with_drives_matches_joint_coordinates() {
             .unwrap_or_else(|d| panic!("{d}"))
     };
     let (codegen::spec::Mechanism::Parallel(pm), _) =
-        load("../mechanisms/specs/delta4_rl5.toml", "[platform]")
+        // The written-out form (its Delta legs one by one, not a pattern): a drive on motor1
+        // alone.
+        load("../codegen/tests/data/expanded/delta4_rl5.toml", "[platform]")
     else {
         panic!("not a parallel mechanism")
     };
