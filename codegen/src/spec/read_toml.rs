@@ -110,7 +110,7 @@ struct Reader<'d> {
     /// reference to one whose value failed is not reported again, and hints suggest them.
     declared: Vec<String>,
     /// The pattern copy being read, if any.
-    copy: Option<pattern::Copy>,
+    copy: Option<pattern::PatternCopy>,
 }
 
 fn get<'t, 'i>(t: &'t DeTable<'i>, k: &str) -> Option<&'t Val<'i>> {

@@ -25,7 +25,7 @@ const MAX_COPIES: usize = 64;
 
 /// The copy being read: its number (from 1), its own parameters, its turn and the names of
 /// its bodies (after `{i}` is replaced).
-pub(super) struct Copy {
+pub(super) struct PatternCopy {
     pub index: usize,
     pub params: Vec<(String, Value)>,
     turn: Mat3,
@@ -48,7 +48,7 @@ fn turned(r: &Mat3, t: &Transform) -> Transform {
     }
 }
 
-impl Copy {
+impl PatternCopy {
     fn outside(&self, body: &str) -> bool {
         !self.members.iter().any(|m| m == body)
     }
@@ -149,7 +149,7 @@ impl Reader<'_> {
         }
         for index in 1..=copies {
             let errors = self.diags.error_count();
-            self.copy = Some(Copy {
+            self.copy = Some(PatternCopy {
                 index,
                 params: Vec::new(),
                 turn: crate::spec::geom::rotation(&axis, step * (index - 1) as f64),
