@@ -20,7 +20,7 @@ use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount};
 use crate::spec::{Kind, RuntimeBody, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
-use crate::{Config, Generated, MathBackend, VERSION};
+use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
 mod templates;
 
@@ -50,6 +50,11 @@ pub struct Kernels {
     pub coriolis: Kernel,
     /// The joints' friction and the springs' damping; `None` without either.
     pub friction: Option<Kernel>,
+    /// `∂τ/∂x` then `∂τ/∂u` of `inverse_dynamics`, row-major, the derivative in `x` along the
+    /// constraint manifold (`ẋ = S u`, [`crate::tangent`]).
+    pub inverse_dynamics_derivatives: Kernel,
+    /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
+    pub forward_dynamics_derivatives: Kernel,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -170,7 +175,52 @@ fn build(
             })?),
             None => None,
         },
+        // The derivatives, last again: along `S`'s columns, the speeds and the efforts.
+        inverse_dynamics_derivatives: configured(&|c| {
+            let f = ids(&noc::generalized_force_with(
+                plan, c, &u, &ud, true, &extras,
+            ));
+            [
+                tangent::jacobian(&f, &along_manifold(plan, c)),
+                tangent::jacobian(&f, &tangent::along_inputs(Arg::U, d)),
+            ]
+            .concat()
+        })?,
+        // Forward dynamics solves `f(x, u, u̇) = τ`: `B = 1`.
+        forward_dynamics_derivatives: kernel(&|| {
+            let fd = noc::forward_dynamics_with(plan, &x, &u, &tau, &extras)?;
+            let c = noc::configuration(plan, &x, true)?;
+            let f = noc::generalized_force_with(plan, &c, &u, &ud, true, &extras);
+            let b: Vec<Vec<Sx>> = (0..d)
+                .map(|r| (0..d).map(|k| Sx::c(f64::from(u8::from(r == k)))).collect())
+                .collect();
+            tangent::ImplicitForward {
+                fd: &fd,
+                f: &f,
+                inertia: &noc::generalized_inertia_with(plan, &c, &extras),
+                b_rate: &[],
+                b: &b,
+            }
+            .derivatives(&along_manifold(plan, &c), &tangent::along_inputs(Arg::U, d))
+        })?,
     })
+}
+
+/// The tangent directions of the constraint manifold at the configuration `c`: `ẋ = S e_j`,
+/// the joint rates per unit independent speed.
+fn along_manifold(plan: &Plan, c: &noc::Config<Sx>) -> Vec<tangent::Direction> {
+    let d = plan.dof();
+    let columns: Vec<Vec<Sx>> = (0..d)
+        .map(|j| {
+            let e: Vec<Sx> = (0..d).map(|k| Sx::c(f64::from(u8::from(k == j)))).collect();
+            noc::joint_rates_generic(plan, c, &e)
+        })
+        .collect();
+    // `nx × d`, column `j` the rates of direction `j`.
+    let s: Vec<Vec<Sx>> = (0..plan.nx())
+        .map(|k| columns.iter().map(|col| col[k]).collect())
+        .collect();
+    tangent::along_coordinates(&s)
 }
 
 /// Generate the module of a closed-loop mechanism for `scene`: only the functions it selects
@@ -286,6 +336,24 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
             fns.with_p(vec![Arg::X, Arg::U, Arg::Tau]),
             &k.forward_dynamics,
             fallible(&[Part::Vector]),
+            true,
+        ),
+        fns.make(
+            "inverse_dynamics_derivatives",
+            vec![format!(
+                "`(∂τ/∂x, ∂τ/∂u)` of `inverse_dynamics` at `(x, u, ud)`; element `[i][j] = ∂τ_i/∂x_j`. The derivative in `x` is taken along the constraint manifold: column `j` is the rate of `τ` while the mechanism moves with the independent speed `u_j` alone (the joints at `ẋ = S e_j`, `joint_rates(x, e_j)`), so it is the derivative with respect to the independent coordinate `x[INDEPENDENT[j]]` with the others following. `∂τ/∂u̇` is `mass_matrix(x)`. The same guards and errors as `inverse_dynamics`. {coords}."
+            )],
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Ud]),
+            &k.inverse_dynamics_derivatives,
+            fallible(&[Part::Matrix, Part::Matrix]),
+            true,
+        ),
+        fns.make(
+            "forward_dynamics_derivatives",
+            vec!["`(∂u̇/∂x, ∂u̇/∂u, ∂u̇/∂τ)` of `forward_dynamics`; element `[i][j] = ∂u̇_i/∂x_j`, the derivative in `x` along the constraint manifold as in `inverse_dynamics_derivatives`; `∂u̇/∂τ = I⁻¹`. The same guards and errors as `forward_dynamics`.".into()],
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Tau]),
+            &k.forward_dynamics_derivatives,
+            fallible(&[Part::Hidden(n), Part::Matrix, Part::Matrix, Part::Matrix]),
             true,
         ),
         fns.make(

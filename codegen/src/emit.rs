@@ -35,6 +35,9 @@ pub enum Part {
     Vector,
     /// `[[f64; DOF]; DOF]`, row-major.
     Matrix,
+    /// `[[[f64; DOF]; DOF]; DOF]`, `DOF` row-major matrices one after the other (a platform's
+    /// `∂A/∂x_j`, `j` first).
+    Matrices,
     /// `[f64; NX]` with `NX` given (closed loops: all joint coordinates).
     Coords(usize),
     /// `[f64; N]` with the literal length `N` (a 1T2R platform's full pose, `N = 7`).
@@ -51,6 +54,7 @@ impl Part {
         match self {
             Part::Vector => dof,
             Part::Matrix => dof * dof,
+            Part::Matrices => dof * dof * dof,
             Part::Coords(n) | Part::Array(n) | Part::Hidden(n) => n,
             Part::Scalar => 1,
         }
@@ -60,6 +64,7 @@ impl Part {
         match self {
             Part::Vector => quote!([#real; DOF]),
             Part::Matrix => quote!([[#real; DOF]; DOF]),
+            Part::Matrices => quote!([[[#real; DOF]; DOF]; DOF]),
             Part::Coords(_) => quote!([#real; NX]),
             Part::Array(n) => {
                 let n = proc_macro2::Literal::usize_unsuffixed(n);
@@ -379,10 +384,13 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
             Part::Vector | Part::Coords(_) | Part::Array(_) => quote!([#(#now),*]),
             Part::Scalar => quote!(#(#now)*),
             Part::Hidden(_) => continue,
-            Part::Matrix => {
-                let rows: Vec<TokenStream> =
-                    now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
-                quote!([#(#rows),*])
+            Part::Matrix => matrix_tokens(now, n),
+            Part::Matrices => {
+                let m: Vec<TokenStream> = now
+                    .chunks((n * n).max(1))
+                    .map(|m| matrix_tokens(m, n))
+                    .collect();
+                quote!([#(#m),*])
             }
         });
     }
@@ -391,6 +399,12 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
     } else {
         quote!((#(#items),*))
     }
+}
+
+/// A row-major `n × n` matrix of outputs.
+fn matrix_tokens(outs: &[TokenStream], n: usize) -> TokenStream {
+    let rows: Vec<TokenStream> = outs.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
+    quote!([#(#rows),*])
 }
 
 /// Statements per block beyond which a function body is split into blocks.

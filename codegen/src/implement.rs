@@ -192,7 +192,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
                 -> Option<Result<[#real; DOF], Singular>>
         },
     );
-    let id_derivatives = optional(
+    let id_derivatives = fallible(
         "inverse_dynamics_derivatives",
         quote!(x, u, ud),
         quote! {
@@ -202,7 +202,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
                 x: &[#real; #nx],
                 u: &[#real; DOF],
                 ud: &[#real; DOF],
-            ) -> Option<([[#real; DOF]; DOF], [[#real; DOF]; DOF])>
+            ) -> Option<Result<([[#real; DOF]; DOF], [[#real; DOF]; DOF]), Singular>>
         },
     );
     let fd_derivatives = optional(

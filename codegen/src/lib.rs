@@ -50,6 +50,7 @@ pub mod scalar;
 pub mod schedule;
 pub mod spec;
 pub mod sym;
+mod tangent;
 mod template;
 pub mod tree;
 

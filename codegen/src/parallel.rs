@@ -24,7 +24,7 @@ use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount};
 use crate::spec::{Kind, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
-use crate::{Config, Generated, MathBackend, VERSION};
+use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
 mod templates;
 
@@ -58,6 +58,11 @@ pub struct Kernels {
     /// A 1T2R platform's full pose `[px, py, pz, qw, qx, qy, qz]` (`platform_pose`: the
     /// parasitic components); `None` for the other motions.
     pub platform_pose: Option<Kernel>,
+    /// `A`, `f`, then `∂A/∂x_j` (one matrix per speed `j`), `∂f/∂x` and `∂f/∂u` (`[i][j]`),
+    /// the derivatives along the tangent of `x` ([`crate::tangent`]).
+    pub idd_parts: Kernel,
+    /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
+    pub forward_dynamics_derivatives: Kernel,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -120,6 +125,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     // in the DAG, and the `LDLᵀ` of `I`).
     let (fd, fd_guards) =
         guarded(|| noc::forward_dynamics_with(plan, &x, &u, &tau, &payloads, drives.as_ref()));
+    let fd = fd?;
     let cat = |a: Vec<ExprId>, b: Vec<ExprId>| a.into_iter().chain(b).collect::<Vec<_>>();
     // The split of the efforts, built last so that the nodes of the functions above stay as
     // they were without it.
@@ -132,6 +138,48 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
     } else {
         None
     };
+    // The derivatives along the tangent of `x`, the speeds and the efforts: last again.
+    let along_x = tangent::along_coordinates(&noc::tangent(plan.motion, &x));
+    let along_u = tangent::along_inputs(Arg::U, n);
+    let da = tangent::jacobian(&flat(&a), &along_x);
+    // `[r][c][j]` → `[j][r][c]`: one matrix per direction.
+    let da: Vec<ExprId> = (0..n * n * n)
+        .map(|k| da[(k % (n * n)) * n + k / (n * n)])
+        .collect();
+    let idd_parts = with_kin(
+        [
+            flat(&a),
+            ids(&f),
+            da.clone(),
+            tangent::jacobian(&ids(&f), &along_x),
+            tangent::jacobian(&ids(&f), &along_u),
+        ]
+        .concat(),
+    );
+    // Forward dynamics solves `f(x, u, u̇) = Aᵀ τ`: `B = Aᵀ`, `∂(B τ)/∂x_j = (∂A/∂x_j)ᵀ τ`.
+    let b: Vec<Vec<Sx>> = (0..n).map(|r| (0..n).map(|c| a[c][r]).collect()).collect();
+    let b_rate: Vec<Vec<Sx>> = (0..n)
+        .map(|j| {
+            (0..n)
+                .map(|c| {
+                    (0..n).fold(Sx::c(0.0), |s, r| {
+                        s + Sx(da[j * n * n + r * n + c]) * tau[r]
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let (fdd, fdd_guards) = guarded(|| {
+        tangent::ImplicitForward {
+            fd: &fd,
+            f: &f,
+            inertia: &i,
+            b_rate: &b_rate,
+            b: &b,
+        }
+        .derivatives(&along_x, &along_u)
+    });
+    let fdd = fdd?;
     Ok(Kernels {
         graph: Graph::new(),
         inverse_kinematics: Kernel::new(ids(&q), pos_guards),
@@ -139,12 +187,14 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         id_parts: with_kin(cat(flat(&a), ids(&f))),
         mass_matrix: with_kin(flat(&i)),
         inertia_parts: with_kin(cat(flat(&a), flat(&i))),
-        forward_dynamics: Kernel::new(ids(&fd?), fd_guards),
+        forward_dynamics: Kernel::new(ids(&fd), fd_guards.clone()),
         fk_parts: with_kin(cat(ids(&q), flat(&a))),
         gravity_parts: split_kernel(fg),
         coriolis_parts: split_kernel(fc),
         friction_parts: ffr.map(split_kernel),
         platform_pose,
+        idd_parts,
+        forward_dynamics_derivatives: Kernel::new(fdd, tangent::union(fd_guards, fdd_guards)),
     })
 }
 
@@ -245,6 +295,17 @@ pub fn lu_inverse_ops(n: usize, groups: &[usize]) -> OpCount {
     let tri = n * (n + 1) / 2;
     c.mul += n * n * n + tri * n;
     c.add += (n * n + tri) * (n - 1);
+    c
+}
+
+/// Operation count of `inverse_dynamics_derivatives` beyond its kernel: `lu_inverse`, then
+/// `τ = A⁻ᵀ f` and, for each of the `2n` columns, its right-hand side (`∂f/∂x_j − (∂A/∂x_j)ᵀ τ`
+/// or `∂f/∂u_j`) and its product with `A⁻ᵀ`.
+pub fn idd_solve_ops(n: usize, groups: &[usize]) -> OpCount {
+    let mut c = lu_many_ops(n, n, groups);
+    // `A⁻ᵀ` times `2n + 1` vectors, and `n` products `(∂A/∂x_j)ᵀ τ` subtracted.
+    c.mul += (2 * n + 1) * n * n + n * n * n;
+    c.add += (2 * n + 1) * n * (n - 1) + n * n * n;
     c
 }
 
@@ -426,6 +487,24 @@ fn functions(
             true,
         ),
         fns.make(
+            "idd_parts",
+            vec!["Kernel of `inverse_dynamics_derivatives`: `A`, `f = I u̇ + C u − γ`, then `∂A/∂x_j` (one matrix per speed `j`), `∂f/∂x` and `∂f/∂u`, the derivatives in `x` along the tangent `x ⊕ δu`.".into()],
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Ud]),
+            &k.idd_parts,
+            fallible(&[Part::Matrix, Part::Vector, Part::Matrices, Part::Matrix, Part::Matrix]),
+            false,
+        ),
+        fns.make(
+            "forward_dynamics_derivatives",
+            vec![
+                "`(∂u̇/∂x, ∂u̇/∂u, ∂u̇/∂τ)` of `forward_dynamics`; element `[i][j] = ∂u̇_i/∂x_j`, the derivative in `x` along the tangent `x ⊕ δu` (column `j`: `x` moved as by the speed `u_j`; see `inverse_dynamics_derivatives`). The same guards and errors as `forward_dynamics`.".into(),
+            ],
+            fns.with_p(vec![Arg::X, Arg::U, Arg::Tau]),
+            &k.forward_dynamics_derivatives,
+            fallible(&[Part::Hidden(n), Part::Matrix, Part::Matrix, Part::Matrix]),
+            true,
+        ),
+        fns.make(
             "fk_parts",
             vec!["Kernel of `forward_kinematics`: `q(x)` and `A(x)`.".into()],
             vec![Arg::X],
@@ -466,6 +545,7 @@ fn functions(
         .filter(|f| {
             want(match f.name {
                 "id_parts" => "inverse_dynamics",
+                "idd_parts" => "inverse_dynamics_derivatives",
                 "inertia_parts" => "actuator_mass_matrix",
                 n => n.strip_suffix("_parts").unwrap_or(n),
             })
@@ -502,6 +582,14 @@ fn stats(
             plus(ops("inertia_parts"), lu_inverse_ops(n, groups), 1),
         ),
         ("forward_dynamics".into(), ops("forward_dynamics")),
+        (
+            "inverse_dynamics_derivatives".into(),
+            plus(ops("idd_parts"), idd_solve_ops(n, groups), 1),
+        ),
+        (
+            "forward_dynamics_derivatives".into(),
+            ops("forward_dynamics_derivatives"),
+        ),
         (
             "forward_kinematics (per Newton step)".into(),
             plus(ops("fk_parts"), lu, 1),

@@ -78,3 +78,61 @@ pub fn actuator_mass_matrix(x: &[f64; NX], p: &Params) -> Result<[[f64; DOF]; DO
     }
     Ok(out)
 }
+
+/// `(∂τ/∂x, ∂τ/∂u)` of `inverse_dynamics` at `(x, u, ud)`; element `[i][j] = ∂τ_i/∂x_j`.
+/// The derivative in `x` is taken along the tangent `x ⊕ δu` of the speeds: column `j` is the
+/// rate of `τ` while `x` moves as the speed `u_j` moves it (a quaternion `q̇ = ½ (0, ω) ⊗ q`
+/// with `ω` in the base frame, a position `ṗ = v`; for every other motion `x ⊕ δu` is the
+/// sum and this is `∂τ/∂x`). `∂τ/∂u̇` is `actuator_mass_matrix(x)·A(x)`. From `Aᵀ τ = f`:
+/// `∂τ = A⁻ᵀ (∂f − (∂A)ᵀ τ)`, with the one LU of `A` that `inverse_dynamics` uses, so it fails
+/// where `inverse_dynamics` does.
+#[allow(clippy::all)]
+pub fn inverse_dynamics_derivatives(
+    x: &[f64; NX],
+    u: &[f64; DOF],
+    ud: &[f64; DOF],
+    p: &Params,
+) -> Result<([[f64; DOF]; DOF], [[f64; DOF]; DOF]), Singular> {
+    let (a, f, da, dfx, dfu) = idd_parts(x, u, ud, p)?;
+    let ai = lu_inverse(&a)?;
+    // `A⁻ᵀ b`: row `r` of the result is column `r` of `A⁻¹` against `b`.
+    let solve_t = |b: &[f64; DOF]| -> [f64; DOF] {
+        let mut out = [0.0; DOF];
+        for r in 0..DOF {
+            let mut s = 0.0;
+            for k in 0..DOF {
+                s += ai[k][r] * b[k];
+            }
+            out[r] = s;
+        }
+        out
+    };
+    let tau = solve_t(&f);
+    let mut dx = [[0.0; DOF]; DOF];
+    let mut du = [[0.0; DOF]; DOF];
+    for j in 0..DOF {
+        let mut bx = [0.0; DOF];
+        let mut bu = [0.0; DOF];
+        for i in 0..DOF {
+            let mut s = dfx[i][j];
+            for k in 0..DOF {
+                s -= da[j][k][i] * tau[k];
+            }
+            bx[i] = s;
+            bu[i] = dfu[i][j];
+        }
+        let (cx, cu) = (solve_t(&bx), solve_t(&bu));
+        for i in 0..DOF {
+            if !(cx[i].is_finite() && cu[i].is_finite()) {
+                return Err(Singular {
+                    site: Site::Input,
+                    value: if cx[i].is_finite() { cu[i] } else { cx[i] },
+                    condition_estimate: f64::INFINITY,
+                });
+            }
+            dx[i][j] = cx[i];
+            du[i][j] = cu[i];
+        }
+    }
+    Ok((dx, du))
+}

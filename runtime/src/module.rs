@@ -144,21 +144,27 @@ pub trait Dynamics<const NX: usize, const DOF: usize> {
         None
     }
 
-    /// Trees: `(∂τ/∂q, ∂τ/∂q̇)` of `inverse_dynamics`, element `[i][j] = ∂τ_i/∂x_j`
-    /// (`inverse_dynamics_derivatives`). `None` elsewhere (for now).
+    /// `(∂τ/∂x, ∂τ/∂u)` of `inverse_dynamics`, element `[i][j] = ∂τ_i/∂x_j`
+    /// (`inverse_dynamics_derivatives`): a tree's `(∂τ/∂q, ∂τ/∂q̇)`, always `Ok`; a platform's
+    /// and a closed loop's with the derivative in `x` along the tangent of its coordinates
+    /// (column `j`: `x` moved as the speed `u_j` moves it). `None` where the module was
+    /// generated without it.
     #[allow(clippy::type_complexity)]
     fn inverse_dynamics_derivatives(
         &self,
         x: &[Self::Scalar; NX],
         u: &[Self::Scalar; DOF],
         ud: &[Self::Scalar; DOF],
-    ) -> Option<([[Self::Scalar; DOF]; DOF], [[Self::Scalar; DOF]; DOF])> {
+    ) -> Option<Result<([[Self::Scalar; DOF]; DOF], [[Self::Scalar; DOF]; DOF]), Self::Singular>>
+    {
         let _ = (x, u, ud);
         None
     }
 
-    /// Trees: `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of `forward_dynamics`, with its pivots and errors
-    /// (`forward_dynamics_derivatives`). `None` elsewhere (for now).
+    /// `(∂u̇/∂x, ∂u̇/∂u, ∂u̇/∂τ)` of `forward_dynamics`, with its pivots and errors
+    /// (`forward_dynamics_derivatives`; a tree's `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)`), the derivative in `x`
+    /// as in [`Dynamics::inverse_dynamics_derivatives`]. `None` where the module was generated
+    /// without it.
     #[allow(clippy::type_complexity)]
     fn forward_dynamics_derivatives(
         &self,

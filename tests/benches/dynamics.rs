@@ -392,9 +392,53 @@ task_vs_joints!(
     [1.0, 0.5, -2.0, 5.0]
 );
 
+/// The derivative functions beside `inverse_dynamics`, generated, through `runtime::Dynamics`
+/// (the module's own functions, forwarded): `{name}/derivatives/{function}` at a state near
+/// home (the actuated coordinates moved by 0.01, speeds and rates fixed numbers).
+fn derivatives_of<M: runtime::Dynamics<NX, N, Scalar = f64>, const NX: usize, const N: usize>(
+    c: &mut Criterion,
+    m: &M,
+) {
+    let q0 = m.inverse_kinematics(&M::HOME).expect("home is regular");
+    let q: [f64; N] = core::array::from_fn(|i| q0[i] + 0.01 * (i as f64 + 1.0));
+    let x = m.forward_kinematics(&q, &M::HOME).expect("assembles");
+    let u: [f64; N] = core::array::from_fn(|i| 0.3 - 0.1 * i as f64);
+    let ud: [f64; N] = core::array::from_fn(|i| 1.0 - 0.4 * i as f64);
+    let tau = m.inverse_dynamics(&x, &u, &ud).expect("regular");
+    assert!(
+        m.inverse_dynamics_derivatives(&x, &u, &ud)
+            .is_some_and(|r| r.is_ok())
+    );
+    assert!(
+        m.forward_dynamics_derivatives(&x, &u, &tau)
+            .is_some_and(|r| r.is_ok())
+    );
+    let mut g = c.benchmark_group(format!("{}/derivatives", M::NAME));
+    g.bench_function("inverse_dynamics", |b| {
+        b.iter(|| m.inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("inverse_dynamics_derivatives", |b| {
+        b.iter(|| m.inverse_dynamics_derivatives(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("forward_dynamics_derivatives", |b| {
+        b.iter(|| m.forward_dynamics_derivatives(black_box(&x), black_box(&u), black_box(&tau)))
+    });
+    g.finish();
+}
+
+/// The derivatives of the five: two arms, a 6-DOF platform, a spherical platform and
+/// Andrews' squeezer (a closed loop).
+fn derivatives(c: &mut Criterion) {
+    derivatives_of(c, &mechanisms::puma560::Module);
+    derivatives_of(c, &mechanisms::chain7::Module);
+    derivatives_of(c, &mechanisms::gough_stewart::Module);
+    derivatives_of(c, &mechanisms::agile_eye::Module);
+    derivatives_of(c, &mechanisms::andrews_squeezer::Module);
+}
+
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, prs_task_vs_joints, delta4_rl5, delta4_task_vs_joints, five_bar_joints, spherical_five_bar
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, prs_task_vs_joints, delta4_rl5, delta4_task_vs_joints, five_bar_joints, spherical_five_bar, derivatives
 }
 criterion_main!(benches);

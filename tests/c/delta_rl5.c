@@ -24,6 +24,7 @@ int main(void) {
     double asym[N * N];
     delta_rl5_inertia_indices_t ix;
     delta_rl5_error_t err;
+    double d1[N * N], d2[N * N], d3[N * N], d[3 * N * N];
     int32_t s;
 
     input("x", x, NX);
@@ -39,6 +40,15 @@ int main(void) {
     output("mass_matrix", delta_rl5_mass_matrix(x, m, &err), m, N * N);
     output("actuator_mass_matrix", delta_rl5_actuator_mass_matrix(x, am, &err), am, N * N);
     output("forward_dynamics", delta_rl5_forward_dynamics(x, u, tau, a, &err), a, N);
+    s = delta_rl5_inverse_dynamics_derivatives(x, u, ud, d1, d2, &err);
+    memcpy(d, d1, sizeof d1);
+    memcpy(d + N * N, d2, sizeof d2);
+    output("inverse_dynamics_derivatives", s, d, 2 * N * N);
+    s = delta_rl5_forward_dynamics_derivatives(x, u, tau, d1, d2, d3, &err);
+    memcpy(d, d1, sizeof d1);
+    memcpy(d + N * N, d2, sizeof d2);
+    memcpy(d + 2 * N * N, d3, sizeof d3);
+    output("forward_dynamics_derivatives", s, d, 3 * N * N);
     /* Forward kinematics from home back to x. */
     output("forward_kinematics", delta_rl5_forward_kinematics(q, home, fk, &err), fk, NX);
     s = delta_rl5_inertia_indices(am, &ix, &err);

@@ -23,6 +23,7 @@ int main(void) {
     double bad[N * N];
     four_bar_inertia_indices_t ix;
     four_bar_error_t err;
+    double d1[N * N], d2[N * N], d3[N * N], d[3 * N * N];
     int32_t s;
 
     /* Assemble the loop at the crank angle, then evaluate there. */
@@ -38,6 +39,15 @@ int main(void) {
     output("inverse_dynamics", four_bar_inverse_dynamics(x, u, ud, t, &err), t, N);
     output("mass_matrix", four_bar_mass_matrix(x, m, NULL), m, N * N);
     output("forward_dynamics", four_bar_forward_dynamics(x, u, tau, a, &err), a, N);
+    s = four_bar_inverse_dynamics_derivatives(x, u, ud, d1, d2, &err);
+    memcpy(d, d1, sizeof d1);
+    memcpy(d + N * N, d2, sizeof d2);
+    output("inverse_dynamics_derivatives", s, d, 2 * N * N);
+    s = four_bar_forward_dynamics_derivatives(x, u, tau, d1, d2, d3, &err);
+    memcpy(d, d1, sizeof d1);
+    memcpy(d + N * N, d2, sizeof d2);
+    memcpy(d + 2 * N * N, d3, sizeof d3);
+    output("forward_dynamics_derivatives", s, d, 3 * N * N);
     output("gravity", four_bar_gravity(x, g, &err), g, N);
     output("coriolis", four_bar_coriolis(x, u, c, &err), c, N);
     output("actuator_mass_matrix", four_bar_actuator_mass_matrix(x, am, &err), am, N * N);

@@ -2,6 +2,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod closed;
+pub mod dual;
 
 pub mod pkm;
 pub mod routes;

@@ -101,6 +101,22 @@ impl Printed {
     }
 }
 
+/// The two derivative functions of a platform or closed-loop module `g`, as C printed them.
+macro_rules! check_derivatives {
+    ($p:ident, $g:ident, $x:ident, $u:ident, $ud:ident, $tau:ident) => {
+        let (a, b) = $g::inverse_dynamics_derivatives(&$x, &$u, &$ud).unwrap();
+        $p.check(
+            "inverse_dynamics_derivatives",
+            &[flat(&a), flat(&b)].concat(),
+        );
+        let (a, b, c) = $g::forward_dynamics_derivatives(&$x, &$u, &$tau).unwrap();
+        $p.check(
+            "forward_dynamics_derivatives",
+            &[flat(&a), flat(&b), flat(&c)].concat(),
+        );
+    };
+}
+
 fn flat<const N: usize>(m: &[[f64; N]]) -> Vec<f64> {
     m.iter().flatten().copied().collect()
 }
@@ -389,6 +405,7 @@ fn delta_rl5_from_c() {
         "forward_dynamics",
         &g::forward_dynamics(&x, &u, &tau).unwrap(),
     );
+    check_derivatives!(p, g, x, u, ud, tau);
     p.check(
         "forward_kinematics",
         &g::forward_kinematics(&q, &g::HOME).unwrap(),
@@ -459,6 +476,7 @@ fn four_bar_from_c() {
         "forward_dynamics",
         &g::forward_dynamics(&x, &u, &tau).unwrap(),
     );
+    check_derivatives!(p, g, x, u, ud, tau);
     p.check("gravity", &g::gravity(&x).unwrap());
     p.check("coriolis", &g::coriolis(&x, &u).unwrap());
     let am = g::actuator_mass_matrix(&x).unwrap();

@@ -205,6 +205,21 @@ mod actuation {
         Ok((a_of(x), [u[0], 0.0, -u[2]]))
     }
     type Matrix = [[f64; DOF]; DOF];
+    /// `A`, `f`, `∂A/∂x_j`, `∂f/∂x = 0` and `∂f/∂u`, by hand from `a_of` and `f_of`.
+    #[allow(clippy::type_complexity)]
+    fn idd_parts(
+        x: &[f64; NX],
+        u: &[f64; DOF],
+        ud: &[f64; DOF],
+        _p: &Params,
+    ) -> Result<(Matrix, [f64; DOF], [Matrix; DOF], Matrix, Matrix), Singular> {
+        let mut da = [[[0.0; DOF]; DOF]; DOF];
+        da[0][0][0] = 1.0;
+        da[1][1][2] = 0.4;
+        da[2][2][2] = 2.0 * x[2];
+        let dfu = [[0.0, 1.0, 0.0], [-2.0, 0.0, 0.0], [0.0; DOF]];
+        Ok((a_of(x), f_of(u, ud), da, [[0.0; DOF]; DOF], dfu))
+    }
     fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
         Ok((a_of(x), i_of(x, p)))
     }
@@ -376,6 +391,38 @@ fn platform_actuation_solves_with_a_transposed() {
         for j in 0..DOF {
             assert!((got[i][j] - want[(i, j)]).abs() < 1e-13 * want.amax());
             assert_eq!(got[i][j], got[j][i]);
+        }
+    }
+}
+
+#[test]
+fn platform_inverse_dynamics_derivatives_match_differences() {
+    use actuation::*;
+    let p = Params { scale: 1.0 };
+    let (x, u, ud) = ([0.3, -0.7, 0.4], [0.5, -1.2, 0.8], [0.1, 0.9, -0.6]);
+    let (dx, du) = inverse_dynamics_derivatives(&x, &u, &ud, &p).expect("regular");
+    let h = 1e-6;
+    for j in 0..DOF {
+        let moved = |v: &[f64; DOF], s: f64| {
+            let mut w = *v;
+            w[j] += s;
+            w
+        };
+        let tx = |s| inverse_dynamics(&moved(&x, s), &u, &ud, &p).unwrap();
+        let tu = |s| inverse_dynamics(&x, &moved(&u, s), &ud, &p).unwrap();
+        let (xp, xm, up, um) = (tx(h), tx(-h), tu(h), tu(-h));
+        for i in 0..DOF {
+            let (fx, fu) = ((xp[i] - xm[i]) / (2.0 * h), (up[i] - um[i]) / (2.0 * h));
+            assert!(
+                (dx[i][j] - fx).abs() < 1e-7,
+                "∂τ{i}/∂x{j}: {} vs {fx}",
+                dx[i][j]
+            );
+            assert!(
+                (du[i][j] - fu).abs() < 1e-7,
+                "∂τ{i}/∂u{j}: {} vs {fu}",
+                du[i][j]
+            );
         }
     }
 }

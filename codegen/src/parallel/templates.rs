@@ -13,7 +13,8 @@ use runtime::parallel::noc::{self, Plan};
 use crate::template::Specialize;
 use crate::{Config, emit, lu};
 
-/// `inverse_dynamics` and `actuator_mass_matrix` around the kernels and the LU solves.
+/// `inverse_dynamics`, `actuator_mass_matrix` and `inverse_dynamics_derivatives` around the
+/// kernels and the LU solves.
 const ACTUATION: &str = include_str!("../../templates/platform_actuation.rs");
 /// `retract` of coordinates that hold a quaternion.
 const RETRACT_QUATERNION: &str = include_str!("../../templates/platform_retract_quaternion.rs");
@@ -66,7 +67,17 @@ pub(super) fn templates(
     } else {
         quote!()
     };
-    let amm_wrapper = if want("inertia") {
+    let inverse: Vec<&str> = [
+        ("inertia", "actuator_mass_matrix"),
+        ("idd", "inverse_dynamics_derivatives"),
+    ]
+    .into_iter()
+    .filter(|(kernel, _)| want(kernel))
+    .map(|(_, f)| f)
+    .collect();
+    let amm_wrapper = if inverse.is_empty() {
+        quote!()
+    } else {
         let lu_inverse = lu_fn(
             cfg,
             plan,
@@ -75,10 +86,8 @@ pub(super) fn templates(
             false,
             lu::Rhs::Identity,
         );
-        let f = actuation.items(ACTUATION, &["actuator_mass_matrix"]);
+        let f = actuation.items(ACTUATION, &inverse);
         quote!(#lu_inverse #f)
-    } else {
-        quote!()
     };
     let kinematics = kinematics(cfg, plan);
     quote! {

@@ -21,10 +21,10 @@ use std::collections::HashMap;
 
 use super::{Arg, ExprId, Graph, Node};
 
-/// The derivatives of nodes with respect to one input, memoized per node.
+/// The derivatives of nodes along one direction of the inputs, memoized per node.
 pub struct Derivative {
-    arg: Arg,
-    index: u16,
+    /// The direction: each seeded input's derivative (`None`: 1); every other input's is 0.
+    seeds: Vec<(Arg, u16, Option<ExprId>)>,
     memo: HashMap<ExprId, ExprId>,
 }
 
@@ -32,8 +32,19 @@ impl Derivative {
     /// Differentiation with respect to `arg[index]`.
     pub fn new(arg: Arg, index: usize) -> Derivative {
         Derivative {
-            arg,
-            index: index as u16,
+            seeds: vec![(arg, index as u16, None)],
+            memo: HashMap::new(),
+        }
+    }
+
+    /// The derivative along a direction of the inputs given by nodes: `arg[index]` moves at
+    /// the rate `rate` (a tangent of the coordinates' manifold, say), every other input stays.
+    pub fn along(direction: &[(Arg, usize, ExprId)]) -> Derivative {
+        Derivative {
+            seeds: direction
+                .iter()
+                .map(|&(a, i, r)| (a, i as u16, Some(r)))
+                .collect(),
             memo: HashMap::new(),
         }
     }
@@ -76,13 +87,11 @@ impl Derivative {
         let zero = g.zero();
         match g.node(id) {
             Node::Const(_) => zero,
-            Node::Input(a, i) => {
-                if a == self.arg && i == self.index {
-                    g.constant(1.0)
-                } else {
-                    zero
-                }
-            }
+            Node::Input(a, i) => match self.seeds.iter().find(|s| (s.0, s.1) == (a, i)) {
+                Some(&(_, _, Some(rate))) => rate,
+                Some(&(_, _, None)) => g.constant(1.0),
+                None => zero,
+            },
             Node::Add(a, b) => g.add(d(a), d(b)),
             Node::Sub(a, b) => g.sub(d(a), d(b)),
             Node::Neg(a) => g.neg(d(a)),

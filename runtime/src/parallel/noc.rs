@@ -90,7 +90,7 @@ pub use api::{
     friction, generalized_effort, gravity, inverse_dynamics, inverse_kinematics,
     leg_joint_positions, leg_joint_rates, mass_matrix, platform_pose, potential_energy,
 };
-pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract};
+pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract, tangent};
 pub use delta::{DeltaKin, DeltaPlan};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
 pub use force::{generalized_force, generalized_force_with, leg_rates, payload_force};

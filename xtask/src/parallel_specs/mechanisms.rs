@@ -125,6 +125,7 @@ pub fn sliding_hexapod(dir: &Path) -> std::io::Result<()> {
             },
         );
     }
+    lean_scene(&mut s);
     s.write(dir, "sliding_hexapod.toml")?;
     println!("  cond(A) {}", g(plucker_condition(&points, &dirs), 3));
     Ok(())
@@ -231,6 +232,7 @@ pub fn rus_hexapod(dir: &Path) -> std::io::Result<()> {
             },
         );
     }
+    lean_scene(&mut s);
     s.write(dir, "rus_hexapod.toml")?;
     println!(
         "  home height {height:.6} m, cond(A) {}",
@@ -316,4 +318,21 @@ pub fn agile_eye(dir: &Path) -> std::io::Result<()> {
         );
     }
     s.write(dir, "agile_eye.toml")
+}
+
+/// A `[scene]` without the two derivative functions: with a full inertia on every leg body their
+/// forward-mode derivatives run to ten times `inverse_dynamics`' operations, and the bundled
+/// crate compiles every module twice (`f64` and `f32`).
+fn lean_scene(s: &mut Spec) {
+    s.comment(
+        "Every function but the two derivative ones (ten times inverse_dynamics' operations at 6 DOF",
+    );
+    s.comment("with full leg inertias): delete this table to have them.");
+    s.table(
+        "[scene]",
+        &[(
+            "functions",
+            r#"["actuator_rates", "inverse_dynamics", "mass_matrix", "actuator_mass_matrix", "forward_dynamics", "gravity", "coriolis"]"#.into(),
+        )],
+    );
 }

@@ -10,6 +10,7 @@ use super::lu::solve_dyn;
 use super::plan::Plan;
 use crate::model::JointKind;
 use crate::parallel::PlatformMotion;
+use crate::scalar::Real;
 use crate::solve::{NoConvergence, Stop, check_finite};
 
 /// Newton iterations of [`forward_kinematics`] at most.
@@ -69,6 +70,43 @@ pub fn retract(motion: PlatformMotion, x: &[f64], du: &[f64]) -> Vec<f64> {
         }
     }
     out
+}
+
+/// The tangent of [`retract`] at `du = 0`: the `nx × n` matrix `E(x)` with `ẋ = E(x) u`, so
+/// that a function's derivative along the speed `u_j` is `Σ_k ∂f/∂x_k E_kj`. A quaternion `q`
+/// moves as `q̇ = ½ (0, ω) ⊗ q` (`ω` in the base frame, on the left as in [`retract`]), a
+/// position as `ṗ = v`; every other motion's `x ⊕ δu` is a sum, `E = 1`.
+pub fn tangent<R: Real>(motion: PlatformMotion, x: &[R]) -> Vec<Vec<R>> {
+    let (qi, pi) = match motion {
+        PlatformMotion::Pose => (3, Some(0)),
+        PlatformMotion::Orientation { .. } => (0, None),
+        _ => {
+            return (0..x.len())
+                .map(|k| {
+                    (0..x.len())
+                        .map(|j| R::c(f64::from(u8::from(k == j))))
+                        .collect()
+                })
+                .collect();
+        }
+    };
+    let n = if pi.is_some() { 6 } else { 3 };
+    let mut e = vec![vec![R::c(0.0); n]; x.len()];
+    let half = R::c(0.5);
+    let [w, a, b, c] = [x[qi], x[qi + 1], x[qi + 2], x[qi + 3]];
+    // ½ (0, e_j) ⊗ (w, a, b, c) for the unit rotation rates e_0, e_1, e_2.
+    let columns = [[-a, w, -c, b], [-b, c, w, -a], [-c, -b, a, w]];
+    for (j, col) in columns.iter().enumerate() {
+        for (k, &v) in col.iter().enumerate() {
+            e[qi + k][j] = half * v;
+        }
+    }
+    if let Some(p) = pi {
+        for i in 0..3 {
+            e[p + i][3 + i] = R::c(1.0);
+        }
+    }
+    e
 }
 
 /// Forward kinematics: the platform coordinates `x` whose actuated joint positions are `q`, by
