@@ -439,7 +439,15 @@ fn tree_functions(g: &Graph, specs: Vec<Spec>, scene: &Scene, n: usize) -> Vec<F
 fn base_parameter_items(base: &dynamics::Base) -> TokenStream {
     let real = crate::emit::real();
     let nbp = Literal::usize_unsuffixed(base.values.len());
-    let values = base.values.iter().map(|&v| emit::float_lit(v));
+    // In single precision, the values rounded to `f32` (as many digits as the type holds).
+    let values = base.values.iter().map(|&v| {
+        if crate::scalar::single() {
+            let lit = Literal::f32_unsuffixed((v as f32).abs());
+            if v < 0.0 { quote!(-#lit) } else { quote!(#lit) }
+        } else {
+            emit::float_lit(v)
+        }
+    });
     let names = base.names.iter();
     quote! {
         /// Number of base (identifiable) parameters: the rank of the standard regressor over
