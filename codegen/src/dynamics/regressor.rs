@@ -58,8 +58,9 @@ pub fn body_standard_parameters(mass: f64, com: &Vec3, inertia: &Mat3) -> [f64; 
 }
 
 /// Which drive columns a model has: `(FV and FC, IA)`. Friction (`[scene] friction`, some
-/// joint with a viscous or Coulomb coefficient) brings all three per joint; rotor inertia
-/// alone brings `IA`.
+/// joint with a viscous or Coulomb coefficient) brings all three per joint (`FC` only where the
+/// joint has a Coulomb speed scale `v_s`, i.e. a Coulomb level); rotor inertia alone brings
+/// `IA`.
 fn drive_columns(model: &Model) -> (bool, bool) {
     let friction = model
         .joints
