@@ -132,6 +132,15 @@ fn main() {
     println!("cargo:rerun-if-changed={task}");
     generate(&out, "tripod_task", Path::new(task), |_| {});
 
+    // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
+    let p = with_scene(
+        &out,
+        puma,
+        "puma_drives",
+        "friction = true\nrotor_inertia = true",
+    );
+    generate(&out, "puma_drives", &p, |_| {});
+
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
     let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE}");

@@ -63,9 +63,13 @@
 //!   by differentiating the inverse-dynamics DAG and solving with forward dynamics' factors;
 //! * `drives`: joint friction and rotor inertia;
 //! * `runtime_params`: the run-time parameter layout ([`param_index`]) and the run-time bodies'
-//!   inertial parameters.
+//!   inertial parameters;
+//! * `regressor`: the standard regressor, one column per standard inertial or drive parameter;
+//! * `base_parameters`: the base (identifiable) parameters found from it, and [`regressor`], the
+//!   regressor over them.
 
 mod algebra;
+mod base_parameters;
 mod choice;
 mod composite;
 mod derivatives;
@@ -75,17 +79,20 @@ mod forward;
 mod frames;
 mod inverse;
 mod links;
+mod regressor;
 mod regroup;
 mod runtime_params;
 
 use crate::sym::ExprId;
 
+pub use base_parameters::{Base, Regressor, regressor};
 pub use composite::mass_matrix;
 pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives};
 pub use drives::{add_drive_efforts, friction_effort};
 pub use forward::{PIVOT_TOLERANCE, forward_dynamics};
 pub use inverse::{Terms, inverse_dynamics};
 pub use links::Tree;
+pub use regressor::{BODY_PARAMETERS, Standard, body_standard_parameters};
 pub use runtime_params::{ParamKind, body_param_index, param_count, param_count_with, param_index};
 
 /// A symbolic 3-vector.

@@ -26,6 +26,8 @@ pub enum Shape {
     Fallible(Vec<Part>),
     /// A tuple of parts, in output order (no [`Part::Hidden`]).
     Tuple(Vec<Part>),
+    /// `[[f64; NBP]; DOF]`, outputs row-major (a tree's `regressor`).
+    Regressor,
 }
 
 /// One part of a [`Shape::Fallible`] result.
@@ -370,6 +372,11 @@ fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
             quote!(Ok(#v))
         }
         Shape::Tuple(ref parts) => parts_tokens(parts, f.dof, outs),
+        Shape::Regressor => {
+            let k = outs.len() / f.dof.max(1);
+            let rows: Vec<TokenStream> = outs.chunks(k.max(1)).map(|r| quote!([#(#r),*])).collect();
+            quote!([#(#rows),*])
+        }
     }
 }
 
@@ -541,6 +548,7 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
             quote!(Result<#t, Singular>)
         }
         Shape::Tuple(parts) => parts_type(parts),
+        Shape::Regressor => quote!([[#real; NBP]; DOF]),
     };
     let docs = f.doc.iter().map(|d| {
         let d = format!(" {d}");

@@ -40,6 +40,8 @@ pub struct Symbolic {
     /// `q̈` (checked, not returned), then `∂q̈/∂q`, `∂q̈/∂q̇` and `I⁻¹ = ∂q̈/∂τ`, each
     /// row-major; under `forward_dynamics_guards`.
     pub forward_dynamics_derivatives: Vec<sym::ExprId>,
+    /// The regressor over the base parameters (`None` with run-time parameters).
+    pub regressor: Option<dynamics::Regressor>,
 }
 
 /// Build the symbolic dynamics of a validated model.
@@ -111,6 +113,10 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         forward_dynamics_guards,
         "the derivatives test what forward dynamics tests"
     );
+    // With run-time parameters the base parameters' values would be inputs: left out.
+    let regressor = params
+        .is_none()
+        .then(|| dynamics::regressor(&mut g, &tree, model));
     Symbolic {
         graph: g,
         dof: tree.dof(),
@@ -123,6 +129,7 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         friction,
         inverse_dynamics_derivatives,
         forward_dynamics_derivatives,
+        regressor,
     }
 }
 
@@ -218,17 +225,22 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
     let params = scene.params.as_ref();
     let parts = symbolic_with(model, params);
     let n = parts.dof;
+    let base = parts.regressor.as_ref().map(|r| r.base.clone());
     let (g, specs) = tree_specs(parts, params.is_some());
     let functions = tree_functions(&g, specs, scene, n);
+    let base = base.filter(|_| functions.iter().any(|f| f.name == "regressor"));
     let stats: Vec<(String, OpCount)> = functions
         .iter()
         .map(|f| (f.name.to_string(), f.schedule.ops))
         .collect();
     let header = tree_header(model, n, cfg, &stats);
     let joint_names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
-    let extra = params
+    let mut extra = params
         .map(|rp| params_template(model, rp))
         .unwrap_or_default();
+    if let Some(base) = &base {
+        extra.extend(base_parameter_items(base));
+    }
     let items = items(n, &joint_names, &functions, extra);
     let code = module::render(
         &ModulePlan {
@@ -269,6 +281,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
         friction,
         inverse_dynamics_derivatives: idd,
         forward_dynamics_derivatives: fdd,
+        regressor,
     } = parts;
     let n = fd.len();
     let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
@@ -375,6 +388,22 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Vector,
         ));
     }
+    if let Some(r) = regressor {
+        specs.push((
+            "regressor",
+            vec![
+                "The regressor over the base parameters: `inverse_dynamics(q, q̇, q̈) = \
+                 regressor(q, q̇, q̈) · BASE_PARAMETERS`, element `[i][k]` the effort of joint \
+                 `i` per unit of base parameter `k` (`BASE_PARAMETER_NAMES[k]`: the standard \
+                 parameters it groups). Linear in the parameters, for identification from \
+                 measured efforts."
+                    .into(),
+            ],
+            vec![Arg::Q, Arg::Qd, Arg::Qdd],
+            k(r.outputs),
+            Shape::Regressor,
+        ));
+    }
     if runtime_params {
         for spec in &mut specs {
             spec.2.push(Arg::P);
@@ -404,6 +433,36 @@ fn tree_functions(g: &Graph, specs: Vec<Spec>, scene: &Scene, n: usize) -> Vec<F
             }
         })
         .collect()
+}
+
+/// `NBP`, `BASE_PARAMETERS` and `BASE_PARAMETER_NAMES`, emitted with `regressor`.
+fn base_parameter_items(base: &dynamics::Base) -> TokenStream {
+    let real = crate::emit::real();
+    let nbp = Literal::usize_unsuffixed(base.values.len());
+    // In single precision, the values rounded to `f32` (as many digits as the type holds).
+    let values = base.values.iter().map(|&v| {
+        if crate::scalar::single() {
+            let lit = Literal::f32_unsuffixed((v as f32).abs());
+            if v < 0.0 { quote!(-#lit) } else { quote!(#lit) }
+        } else {
+            emit::float_lit(v)
+        }
+    });
+    let names = base.names.iter();
+    quote! {
+        /// Number of base (identifiable) parameters: the rank of the standard regressor over
+        /// generic states (docs/method.md, "Identification: the regressor and base parameters").
+        pub const NBP: usize = #nbp;
+        /// The spec's values of the base parameters, so that
+        /// `regressor(q, q̇, q̈) · BASE_PARAMETERS = inverse_dynamics(q, q̇, q̈)`.
+        pub const BASE_PARAMETERS: [#real; NBP] = [#(#values),*];
+        /// What each base parameter is: the linear combination of standard parameters it
+        /// groups. Standard parameters (Khalil's convention) per body, in its body frame about
+        /// its origin: `XX, XY, XZ, YY, YZ, ZZ` (inertia tensor entries), `MX, MY, MZ` (mass
+        /// times mass centre), `M`, written `XX_<body>`; per joint with drives `FV_<joint>`
+        /// (viscous), `FC_<joint>` (Coulomb level), `IA_<joint>` (rotor inertia).
+        pub const BASE_PARAMETER_NAMES: [&str; NBP] = [#(#names),*];
+    }
 }
 
 /// The module's header: provenance, degrees of freedom, math backend, operation counts.

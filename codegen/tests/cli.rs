@@ -124,7 +124,8 @@ fn stats_prints_the_table_to_stderr_beside_the_module() {
             "inverse_dynamics",
             "forward_dynamics",
             "inverse_dynamics_derivatives",
-            "forward_dynamics_derivatives"
+            "forward_dynamics_derivatives",
+            "regressor"
         ]
     );
     assert!(!t.contains("pub fn"), "--stats printed code");

@@ -1,6 +1,7 @@
 //! The generated dynamics of nocdyn's bundled mechanisms: one module per spec in `specs/`, each
 //! with its constants and free functions (trees: `DOF`, `JOINT_NAMES`, `mass_matrix`,
-//! `coriolis`, `gravity`, `inverse_dynamics`, `forward_dynamics`; parallel platforms and closed
+//! `coriolis`, `gravity`, `inverse_dynamics`, `forward_dynamics`, their derivatives, and
+//! `regressor` with `NBP`, `BASE_PARAMETERS`, `BASE_PARAMETER_NAMES`; parallel platforms and closed
 //! loops: `NX`, `DOF`, `HOME`, kinematics and dynamics, `gravity` and `coriolis` among them; see the generated headers for op
 //! counts), and a unit struct `Module` that implements [`Dynamics`] by calling them, so that
 //! code over every kind of module is written once.

@@ -17,6 +17,7 @@ int main(void) {
     double m[N * N], c[N], g[N], t[N], a[N];
     double d1[N * N], d2[N * N], d3[N * N], d[5 * N * N];
     double asym[N * N];
+    double y[N * PUMA560_NBP];
     puma560_inertia_indices_t ix;
     puma560_error_t err;
     int32_t s;
@@ -40,6 +41,7 @@ int main(void) {
     memcpy(d + N * N, d2, sizeof d2);
     memcpy(d + 2 * N * N, d3, sizeof d3);
     output("forward_dynamics_derivatives", s, d, 3 * N * N);
+    output("regressor", puma560_regressor(q, qd, qdd, y), y, N * PUMA560_NBP);
     s = puma560_inertia_indices(m, &ix, &err);
     output("inertia_indices", s, ix.eigenvalues, N);
     printf("indices %.17g %.17g %.17g\n", ix.condition, ix.manipulability, ix.isotropic_acceleration);

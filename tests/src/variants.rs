@@ -27,6 +27,10 @@ pub mod gs_point_legs {
         "/variants/gs_point_legs/gough_stewart.rs"
     ));
 }
+/// The PUMA 560 with friction and rotor inertia (`[scene] friction`, `rotor_inertia`).
+pub mod puma_drives {
+    include!(concat!(env!("OUT_DIR"), "/variants/puma_drives/puma560.rs"));
+}
 /// The PUMA 560 with a tool and run-time parameters (`src/params_scene.toml`).
 pub mod puma_params {
     include!(concat!(env!("OUT_DIR"), "/variants/puma_params/puma560.rs"));

@@ -331,6 +331,12 @@ fn puma560_from_c() {
         "forward_dynamics_derivatives",
         &[flat(&a), flat(&b), flat(&c)].concat(),
     );
+    let y: Vec<f64> = g::regressor(&q, &qd, &qdd)
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
+    p.check("regressor", &y);
     let ix = g::inertia_indices(&m).unwrap();
     p.check("inertia_indices", &ix.eigenvalues);
     close(

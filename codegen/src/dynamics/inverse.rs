@@ -49,13 +49,13 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
 }
 
 /// Twists and their rates per body, from the forward sweep.
-struct Motion {
+pub(super) struct Motion {
     /// `ω_i`, body frame.
-    omega: Vec<V3>,
+    pub(super) omega: Vec<V3>,
     /// `ω̇_i`, body frame.
-    omegad: Vec<V3>,
+    pub(super) omegad: Vec<V3>,
     /// Acceleration of the body-frame origin, body frame.
-    acc: Vec<V3>,
+    pub(super) acc: Vec<V3>,
     /// ω resolved in the joint frame (the body frame before the joint's own rotation).
     omega_j: Vec<V3>,
     /// ω̇ resolved in the joint frame.
@@ -113,7 +113,7 @@ pub(super) fn inverse_dynamics_sunk(
 
 /// Forward sweep: twists t_i = T_i q̇ and their rates ṫ_i = T_i q̈ + Ṫ_i q̇ (eqs. 25–26, 33),
 /// resolved in body frames; `acc` is the acceleration of the body-frame origin.
-fn forward_sweep(s: &mut Sym<'_>, qd: &[ExprId], qdd: &[ExprId], a0: V3) -> Motion {
+pub(super) fn forward_sweep(s: &mut Sym<'_>, qd: &[ExprId], qdd: &[ExprId], a0: V3) -> Motion {
     let tree = s.tree;
     let n = tree.dof();
     let mut m = Motion {

@@ -292,6 +292,18 @@ fn load_any(
         let read = mechanism.map(|(m, params)| {
             if let Some(fs) = &functions {
                 check_scene_functions(&m, fs, &mut d);
+                // The base parameters' values would be inputs: no regressor with run-time
+                // parameters (docs/method.md, "Identification").
+                if params.is_some() && matches!(m, Mechanism::Tree(_)) {
+                    for f in fs.iter().filter(|f| f.name == "regressor") {
+                        d.push(
+                            Diagnostic::error("a module with run-time parameters has no regressor")
+                                .with_key(f.key.clone())
+                                .with_span(f.span.clone())
+                                .with_hint("the base parameters' values would depend on the run-time parameters: generate the regressor from a scene with constants (remove `parameters = \"runtime\"`)"),
+                        );
+                    }
+                }
             }
             let functions = match &functions {
                 None => FunctionSet::all(),

@@ -30,7 +30,8 @@ macro_rules! export {
                         Ok((_, _, minv)) => minv[0][0],
                         Err(e) => e.value,
                     };
-                    m[0][0] + c[0] + gr[0] + t[0] + a + dq[0][0] + d
+                    let y = g::regressor(q, qd, x);
+                    m[0][0] + c[0] + gr[0] + t[0] + a + dq[0][0] + d + y[0][0]
                 }
             }
         )*
