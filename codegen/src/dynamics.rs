@@ -62,6 +62,8 @@
 //! * `derivatives`: [`inverse_dynamics_derivatives`] and [`forward_dynamics_derivatives`],
 //!   by differentiating the inverse-dynamics DAG and solving with forward dynamics' factors;
 //! * `drives`: joint friction and rotor inertia;
+//! * `kinematics`: [`frame_kinematics`], the pose, Jacobian and `J̇ q̇` of the frames
+//!   `[scene] frames` names;
 //! * `runtime_params`: the run-time parameter layout ([`param_index`]) and the run-time bodies'
 //!   inertial parameters.
 
@@ -74,6 +76,7 @@ mod flops;
 mod forward;
 mod frames;
 mod inverse;
+mod kinematics;
 mod links;
 mod regroup;
 mod runtime_params;
@@ -85,6 +88,7 @@ pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives
 pub use drives::{add_drive_efforts, friction_effort};
 pub use forward::{PIVOT_TOLERANCE, forward_dynamics};
 pub use inverse::{Terms, inverse_dynamics};
+pub use kinematics::{FramePart, frame_kinematics};
 pub use links::Tree;
 pub use runtime_params::{ParamKind, body_param_index, param_count, param_count_with, param_index};
 

@@ -41,6 +41,10 @@ pub enum Part {
     Array(usize),
     /// `f64`.
     Scalar,
+    /// `[[f64; 3]; 3]`, row-major (a rotation matrix).
+    Rotation,
+    /// `[[f64; DOF]; 6]`, row-major (a frame's Jacobian).
+    Jacobian,
     /// This many outputs that are checked for finiteness but not returned (a tree's
     /// `forward_dynamics_derivatives`: its `q̈`, so that it fails where `forward_dynamics` does).
     Hidden(usize),
@@ -53,6 +57,8 @@ impl Part {
             Part::Matrix => dof * dof,
             Part::Coords(n) | Part::Array(n) | Part::Hidden(n) => n,
             Part::Scalar => 1,
+            Part::Rotation => 9,
+            Part::Jacobian => 6 * dof,
         }
     }
     fn ty(self) -> TokenStream {
@@ -66,6 +72,8 @@ impl Part {
                 quote!([#real; #n])
             }
             Part::Scalar => quote!(#real),
+            Part::Rotation => quote!([[#real; 3]; 3]),
+            Part::Jacobian => quote!([[#real; DOF]; 6]),
             Part::Hidden(_) => quote!(()),
         }
     }
@@ -379,9 +387,13 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
             Part::Vector | Part::Coords(_) | Part::Array(_) => quote!([#(#now),*]),
             Part::Scalar => quote!(#(#now)*),
             Part::Hidden(_) => continue,
-            Part::Matrix => {
+            Part::Matrix | Part::Jacobian => {
                 let rows: Vec<TokenStream> =
                     now.chunks(n.max(1)).map(|r| quote!([#(#r),*])).collect();
+                quote!([#(#rows),*])
+            }
+            Part::Rotation => {
+                let rows: Vec<TokenStream> = now.chunks(3).map(|r| quote!([#(#r),*])).collect();
                 quote!([#(#rows),*])
             }
         });

@@ -23,6 +23,8 @@ pub enum Function {
     InverseDynamicsDerivatives,
     /// `forward_dynamics_derivatives`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹)` (trees).
     ForwardDynamicsDerivatives,
+    /// `frames`: the pose, Jacobian and `J̇ q̇` of each frame `[scene] frames` names (trees).
+    Frames,
     /// `joint_rates`: every tree joint's rate (closed loops).
     JointRates,
     /// `actuator_rates`: `q̇ = A u`.
@@ -37,7 +39,7 @@ pub enum Function {
 
 impl Function {
     /// Every function, in the order of the enum.
-    pub const ALL: [Function; 13] = [
+    pub const ALL: [Function; 14] = [
         Function::MassMatrix,
         Function::Coriolis,
         Function::Gravity,
@@ -46,6 +48,7 @@ impl Function {
         Function::Friction,
         Function::InverseDynamicsDerivatives,
         Function::ForwardDynamicsDerivatives,
+        Function::Frames,
         Function::JointRates,
         Function::ActuatorRates,
         Function::ActuatorMassMatrix,
@@ -64,6 +67,7 @@ impl Function {
             Function::Friction => "friction",
             Function::InverseDynamicsDerivatives => "inverse_dynamics_derivatives",
             Function::ForwardDynamicsDerivatives => "forward_dynamics_derivatives",
+            Function::Frames => "frames",
             Function::JointRates => "joint_rates",
             Function::ActuatorRates => "actuator_rates",
             Function::ActuatorMassMatrix => "actuator_mass_matrix",
@@ -111,6 +115,7 @@ impl Kind {
                 InverseDynamicsDerivatives,
                 ForwardDynamicsDerivatives,
                 Friction,
+                Frames,
             ],
             Kind::Parallel => &[
                 ActuatorRates,

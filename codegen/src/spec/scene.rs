@@ -16,6 +16,9 @@ pub struct Scene {
     pub functions: FunctionSet,
     /// The run-time parameters (`[scene] parameters = "runtime"`; `None`: constants).
     pub params: Option<RuntimeParams>,
+    /// The frames whose kinematics a tree module offers (`[scene] frames`, by default the
+    /// leaf bodies; empty for the other kinds).
+    pub frames: Vec<super::Frame>,
 }
 
 /// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect
