@@ -4,7 +4,7 @@
 //!
 //! A frame is any spec body's own frame: a body a joint moves, or one attached by fixed joints
 //! (a URDF link behind a fixed joint, a TOML body fixed to another, a body behind a locked
-//! joint). Fixed joints are merged before the dynamics, so the placement kept here is where
+//! joint), or `"base"` (the fixed world; a URDF's root link). Fixed joints are merged before the dynamics, so the placement kept here is where
 //! such a frame sits on the moving body it became part of. Without the key, the module offers
 //! the tips: every leaf body (one that is no joint's parent) that some joint moves, in file
 //! order; `frames = []` offers none.
@@ -88,11 +88,15 @@ pub(super) fn resolve(
     let names: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
     let mut frames: Vec<Frame> = Vec::new();
     for (n, written) in named {
-        let Some(at) = names
-            .iter()
-            .position(|b| *b == n.name)
-            .and_then(|b| attach.get(b).copied().flatten())
-        else {
+        let base = Attach {
+            target: None,
+            pose: Transform::IDENTITY,
+        };
+        let found = match names.iter().position(|b| *b == n.name) {
+            Some(b) => attach.get(b).copied().flatten(),
+            None => (n.name == ir::BASE).then_some(base),
+        };
+        let Some(at) = found else {
             let mut d = Diagnostic::error(format!("unknown frame {:?}", n.name))
                 .with_key(n.key.clone())
                 .with_span(n.span.clone());
