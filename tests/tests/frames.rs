@@ -26,10 +26,15 @@ const STATES: usize = 200;
 /// A frame's functions, from a compiled module or the interpreter: `pose(q)` as `R` row-major
 /// then `p`, `jacobian(q)` 6 × n row-major, `jdot(q, q̇)`.
 struct Fns<'a> {
-    pose: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>,
-    jacobian: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>,
-    jdot: Box<dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a>,
+    pose: Of<'a>,
+    jacobian: Of<'a>,
+    jdot: OfTwo<'a>,
 }
+
+/// A function of `q` and `q̇`.
+type OfTwo<'a> = Box<dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a>;
+/// A function of `q`.
+type Of<'a> = Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>;
 
 fn load(file: &str, src: &str, scene: Option<&str>) -> codegen::spec::Loaded {
     let mut overrides = codegen::spec::SceneOverrides::default();
