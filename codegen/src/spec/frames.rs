@@ -24,9 +24,11 @@ pub struct Frame {
     /// Its identifier in generated code ([`frame_ident`]): the functions `<ident>_pose`,
     /// `<ident>_jacobian` and `<ident>_jacobian_dot_qd`.
     pub ident: String,
-    /// The model body it is fixed to (`None`: the base).
+    /// The model body it is fixed to (`None`: the base; a parallel mechanism's frames are all
+    /// `None`, fixed to the platform).
     pub body: Option<usize>,
-    /// Its pose in that body's frame (in the base frame when `body` is `None`).
+    /// Its pose in that body's frame (in the base frame when `body` is `None` in a tree; in
+    /// the platform frame in a parallel mechanism).
     pub placement: Transform,
 }
 
@@ -162,17 +164,100 @@ fn leaves(spec: &ir::Spec, attach: &[Option<Attach>]) -> Vec<usize> {
         .collect()
 }
 
-/// An error when a spec that is not a tree has a `[scene] frames` key: for now only trees
-/// offer frames.
-pub(super) fn only_trees(spec: &ir::Spec, what: &str, diags: &mut Diagnostics) {
+/// The frames of a parallel spec: the platform or bodies fixed to it (`placement`: the pose
+/// in the platform frame; `body` is `None`). No default: without the key, none. Errors at the
+/// names: an unknown body (with a suggestion), a body that is not the platform or fixed to it,
+/// a frame named twice, two names with one identifier, the identifier `platform` beside a 1T2R
+/// platform's own `platform_pose`; a planar-point platform (no orientation) takes none.
+pub(super) fn resolve_platform(spec: &ir::Spec, diags: &mut Diagnostics) -> Vec<Frame> {
+    let Some((names, span)) = &spec.scene.frames else {
+        return Vec::new();
+    };
+    let coordinates = spec.platform.as_ref().and_then(|p| p.coordinates);
+    if coordinates == Some(ir::Coordinates::Planar) && !names.is_empty() {
+        diags.push(
+            Diagnostic::error(
+                "a planar-point platform offers no frames: its orientation is not a coordinate",
+            )
+            .with_key("scene.frames")
+            .with_span(span.clone())
+            .with_hint("remove `frames` (the point's position is `x`)"),
+        );
+        return Vec::new();
+    }
+    let bodies: Vec<&str> = spec.bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut frames: Vec<Frame> = Vec::new();
+    for n in names {
+        let error = |message: String, hint: String| {
+            Diagnostic::error(message)
+                .with_key(n.key.clone())
+                .with_span(n.span.clone())
+                .with_hint(hint)
+        };
+        let Some(placement) = super::parallel::pose_on_platform(spec, &n.name) else {
+            let d = if bodies.contains(&n.name.as_str()) {
+                error(
+                    format!("frame {:?} is not the platform or fixed to it", n.name),
+                    "a parallel module offers frames fixed to the platform: name the platform body or a body attached to it by fixed joints".into(),
+                )
+            } else {
+                error(
+                    format!("unknown frame {:?}", n.name),
+                    match suggest_hint(&n.name, &bodies) {
+                        Some(h) => format!("{h} (a frame is a body's name)"),
+                        None => "a frame is the platform's name or a body's fixed to it".into(),
+                    },
+                )
+            };
+            diags.push(d);
+            continue;
+        };
+        if frames.iter().any(|f| f.name == n.name) {
+            diags.push(error(
+                format!("frame {:?} is named twice", n.name),
+                "name each frame once".into(),
+            ));
+            continue;
+        }
+        let ident = frame_ident(&n.name);
+        if let Some(other) = frames.iter().find(|f| f.ident == ident) {
+            diags.push(error(
+                format!(
+                    "frames {:?} and {:?} both become the identifier `{ident}` (functions `{ident}_pose`, …)",
+                    other.name, n.name
+                ),
+                "frame identifiers are the names in lower snake case (docs/spec.md, `[scene] frames`); name only one of them, or rename a body".into(),
+            ));
+            continue;
+        }
+        if ident == "platform" && coordinates == Some(ir::Coordinates::HeaveTilt) {
+            diags.push(error(
+                format!("frame {:?} would make a second `platform_pose`", n.name),
+                "a 1T2R module already has `platform_pose` (the full pose with the parasitic motion); rename the platform body, or name a body fixed to it".into(),
+            ));
+            continue;
+        }
+        frames.push(Frame {
+            name: n.name.clone(),
+            ident,
+            body: None,
+            placement,
+        });
+    }
+    frames
+}
+
+/// An error when a closed-loop spec has a `[scene] frames` key: for now only trees and
+/// platforms offer frames.
+pub(super) fn not_closed(spec: &ir::Spec, diags: &mut Diagnostics) {
     if let Some((names, span)) = &spec.scene.frames
         && !names.is_empty()
     {
         diags.push(
-            Diagnostic::error(format!("`frames` is offered for trees only, and this spec describes {what}"))
+            Diagnostic::error("`frames` is offered for trees and parallel platforms, and this spec describes closed loops in joint coordinates")
                 .with_key("scene.frames")
                 .with_span(span.clone())
-                .with_hint("remove `frames` (or write `frames = []`); frame kinematics of platforms and closed loops are not generated yet"),
+                .with_hint("remove `frames` (or write `frames = []`); the kinematics of closed loops' bodies are not generated yet"),
         );
     }
 }

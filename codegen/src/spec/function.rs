@@ -23,7 +23,8 @@ pub enum Function {
     InverseDynamicsDerivatives,
     /// `forward_dynamics_derivatives`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹)` (trees).
     ForwardDynamicsDerivatives,
-    /// `frames`: the pose, Jacobian and `J̇ q̇` of each frame `[scene] frames` names (trees).
+    /// `frames`: the pose, Jacobian and `J̇ q̇` (`J̇ u`) of each frame `[scene] frames` names
+    /// (trees, parallel platforms).
     Frames,
     /// `joint_rates`: every tree joint's rate (closed loops).
     JointRates,
@@ -126,6 +127,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Frames,
             ],
             Kind::Closed => &[
                 JointRates,

@@ -278,13 +278,13 @@ fn load_any(
             // Lowered once; where each spec body went places the run-time bodies.
             let mut frames = Vec::new();
             let (mechanism, attach) = if s.platform.is_some() {
-                frames::only_trees(&s, "a parallel mechanism", &mut d);
+                frames = frames::resolve_platform(&s, &mut d);
                 (
                     Mechanism::Parallel(parallel::lower_parallel(&s, &mut d)?),
                     None,
                 )
             } else if closed::is_closed(&s) {
-                frames::only_trees(&s, "closed loops", &mut d);
+                frames::not_closed(&s, &mut d);
                 let (m, attach) = closed::lower_closed_attached(&s, &mut d)?;
                 (Mechanism::Closed(m), Some(attach))
             } else {
