@@ -63,7 +63,8 @@ pub(crate) fn frame_ident(name: &str) -> String {
     }
 }
 
-/// The frames of a tree spec (`attach`: where each spec body ended up). Errors at their
+/// The frames of a tree spec, or of closed loops in joint coordinates (any body of the
+/// spanning tree, no default) (`attach`: where each spec body ended up). Errors at their
 /// names' spans: an unknown body (with a suggestion), a name given twice, two names with one
 /// identifier. Among the default frames (the key absent) a later one whose identifier is
 /// taken is left out with a warning.
@@ -74,6 +75,8 @@ pub(super) fn resolve(
 ) -> Vec<Frame> {
     let named: Vec<(Named, bool)> = match &spec.scene.frames {
         Some((names, _)) => names.iter().map(|n| (n.clone(), true)).collect(),
+        // Closed loops in joint coordinates: none by default.
+        None if super::closed::is_closed(spec) => Vec::new(),
         None => leaves(spec, attach)
             .into_iter()
             .map(|b| {
@@ -245,21 +248,6 @@ pub(super) fn resolve_platform(spec: &ir::Spec, diags: &mut Diagnostics) -> Vec<
         });
     }
     frames
-}
-
-/// An error when a closed-loop spec has a `[scene] frames` key: for now only trees and
-/// platforms offer frames.
-pub(super) fn not_closed(spec: &ir::Spec, diags: &mut Diagnostics) {
-    if let Some((names, span)) = &spec.scene.frames
-        && !names.is_empty()
-    {
-        diags.push(
-            Diagnostic::error("`frames` is offered for trees and parallel platforms, and this spec describes closed loops in joint coordinates")
-                .with_key("scene.frames")
-                .with_span(span.clone())
-                .with_hint("remove `frames` (or write `frames = []`); the kinematics of closed loops' bodies are not generated yet"),
-        );
-    }
 }
 
 #[cfg(test)]

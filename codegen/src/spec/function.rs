@@ -137,6 +137,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Frames,
             ],
         }
     }

@@ -276,21 +276,21 @@ fn load_any(
                 return None;
             }
             // Lowered once; where each spec body went places the run-time bodies.
-            let mut frames = Vec::new();
-            let (mechanism, attach) = if s.platform.is_some() {
-                frames = frames::resolve_platform(&s, &mut d);
+            let (mechanism, attach, frames) = if s.platform.is_some() {
+                let frames = frames::resolve_platform(&s, &mut d);
                 (
                     Mechanism::Parallel(parallel::lower_parallel(&s, &mut d)?),
                     None,
+                    frames,
                 )
             } else if closed::is_closed(&s) {
-                frames::not_closed(&s, &mut d);
                 let (m, attach) = closed::lower_closed_attached(&s, &mut d)?;
-                (Mechanism::Closed(m), Some(attach))
+                let frames = frames::resolve(&s, &attach, &mut d);
+                (Mechanism::Closed(m), Some(attach), frames)
             } else {
                 let built = lower::lower_built(&s, &mut d)?;
-                frames = frames::resolve(&s, &built.attach, &mut d);
-                (Mechanism::Tree(built.model), Some(built.attach))
+                let frames = frames::resolve(&s, &built.attach, &mut d);
+                (Mechanism::Tree(built.model), Some(built.attach), frames)
             };
             let params = runtime_params(&s, attach.as_deref());
             Some((mechanism, params, frames))
