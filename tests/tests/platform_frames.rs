@@ -68,12 +68,15 @@ fn rotation_difference(a: &[f64], b: &[f64]) -> [f64; 3] {
     ]
 }
 
+/// The generated `(pose, J, J̇ u)` of frame `k` at `(x, u)`.
+type Generated<'a> = dyn Fn(usize, &[f64], &[f64]) -> [Vec<f64>; 3] + 'a;
+
 /// Worst errors: generated against runtime (pose, J, J̇ u), J by differences, J̇ u by
 /// differences.
 fn check(
     model: &ParallelModel,
     frames: &[Frame],
-    generated: &dyn Fn(usize, &[f64], &[f64]) -> [Vec<f64>; 3],
+    generated: &Generated<'_>,
     seed: u64,
 ) -> [f64; 5] {
     let plan = Plan::new(model).unwrap();

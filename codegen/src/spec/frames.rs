@@ -1,4 +1,5 @@
-//! `[scene] frames`: the frames whose kinematics (pose, Jacobian, `J̇ q̇`) a tree module offers,
+//! `[scene] frames`: the frames whose kinematics a module offers (a tree's pose, Jacobian and
+//! `J̇ q̇`; the same for frames fixed to a parallel platform; a closed loop's body poses),
 //! resolved to the model body each is fixed to and its placement there, and the identifiers
 //! their functions take.
 //!
@@ -16,7 +17,7 @@ use super::lower::Attach;
 use super::suggest_hint;
 use crate::diag::{Diagnostic, Diagnostics};
 
-/// A frame whose kinematics a tree module offers.
+/// A frame whose kinematics a module offers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     /// The name as the spec writes it (the body's).

@@ -24,7 +24,7 @@ pub enum Function {
     /// `forward_dynamics_derivatives`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹)` (trees).
     ForwardDynamicsDerivatives,
     /// `frames`: the pose, Jacobian and `J̇ q̇` (`J̇ u`) of each frame `[scene] frames` names
-    /// (trees, parallel platforms).
+    /// (trees, parallel platforms; a closed loop's body poses).
     Frames,
     /// `joint_rates`: every tree joint's rate (closed loops).
     JointRates,

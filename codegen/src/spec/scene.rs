@@ -16,8 +16,8 @@ pub struct Scene {
     pub functions: FunctionSet,
     /// The run-time parameters (`[scene] parameters = "runtime"`; `None`: constants).
     pub params: Option<RuntimeParams>,
-    /// The frames whose kinematics a tree module offers (`[scene] frames`, by default the
-    /// leaf bodies; empty for the other kinds).
+    /// The frames whose kinematics the module offers (`[scene] frames`; a tree's default is
+    /// its leaf bodies, the other kinds have none by default).
     pub frames: Vec<super::Frame>,
 }
 
