@@ -22,8 +22,8 @@ use crate::diag::{Diagnostic, Diagnostics};
 pub struct Frame {
     /// The name as the spec writes it (the body's).
     pub name: String,
-    /// Its identifier in generated code ([`frame_ident`]): the functions `<ident>_pose`,
-    /// `<ident>_jacobian` and `<ident>_jacobian_dot_qd`.
+    /// Its identifier in generated code (the name in lower snake case): the functions
+    /// `<ident>_pose`, `<ident>_jacobian` and `<ident>_jacobian_dot_qd` (a tree's).
     pub ident: String,
     /// The model body it is fixed to (`None`: the base; a parallel mechanism's frames are all
     /// `None`, fixed to the platform).
