@@ -214,6 +214,11 @@ fn meaning(name: &str, kind: Kind, func: &str) -> &'static str {
         (_, "y") => "the regressor over the base parameters, DOF × NBP, row-major",
         (_, "qdd") => "joint accelerations (rad/s² or m/s²)",
         (_, "indices") => "the indices",
+        (_, "rotation") => "the rotation base ← frame, row-major",
+        (_, "position") => "the frame's origin in the base frame (m)",
+        (_, "jacobian") => "the frame's Jacobian, 6 × DOF row-major: rows ω then v (base frame)",
+        (_, "jdot_qd") => "J̇ q̇: ω̇ then p̈ at q̈ = 0 (base frame)",
+        (_, "jdot_u") => "J̇ u: ω̇ then p̈ at u̇ = 0 (base frame)",
         _ => "the result",
     }
 }
@@ -236,6 +241,10 @@ fn output_names(f: &Func, kind: Kind, n: usize) -> Vec<String> {
         ("forward_kinematics", _) => &["x"],
         ("platform_pose", _) => &["pose"],
         ("inertia_indices", _) => &["indices"],
+        (f, Kind::Tree) if f.ends_with("_jacobian_dot_qd") => &["jdot_qd"],
+        (f, Kind::Parallel) if f.ends_with("_jacobian_dot_u") => &["jdot_u"],
+        (f, Kind::Tree | Kind::Parallel) if f.ends_with("_jacobian") => &["jacobian"],
+        (f, Kind::Tree | Kind::Parallel) if f.ends_with("_pose") => &["rotation", "position"],
         _ => &[],
     };
     if names.len() == n {

@@ -18,7 +18,7 @@ use crate::module::{self, ModulePlan};
 use crate::params::{Layout, drive_inputs, params_items, payload_inputs, payload_inputs_at};
 use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::schedule::{Kernel, OpCount};
-use crate::spec::{Kind, RuntimeBody, RuntimeParams, Scene};
+use crate::spec::{Frame, Kind, RuntimeBody, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
@@ -55,6 +55,8 @@ pub struct Kernels {
     pub inverse_dynamics_derivatives: Kernel,
     /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
     pub forward_dynamics_derivatives: Kernel,
+    /// Per frame of [`kernels_with_frames`]: its pose at `x` (`R` row-major, then `p`).
+    pub frames: Vec<Kernel>,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -72,7 +74,18 @@ pub fn kernels_with(
     payload_body: Option<usize>,
     bodies: &[usize],
 ) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body, bodies));
+    kernels_with_frames(plan, layout, payload_body, bodies, &[])
+}
+
+/// [`kernels_with`] and the poses of `frames` (`[scene] frames`: each fixed to a tree body).
+pub fn kernels_with_frames(
+    plan: &Plan,
+    layout: &Layout,
+    payload_body: Option<usize>,
+    bodies: &[usize],
+    frames: &[Frame],
+) -> Result<Kernels, Singular> {
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body, bodies, frames));
     r.map(|k| Kernels { graph, ..k })
 }
 
@@ -81,6 +94,7 @@ fn build(
     layout: &Layout,
     payload_body: Option<usize>,
     bodies: &[usize],
+    frames: &[Frame],
 ) -> Result<Kernels, Singular> {
     let d = plan.dof();
     let x = inputs(Arg::X, plan.nx());
@@ -203,6 +217,15 @@ fn build(
             }
             .derivatives(&along_manifold(plan, &c), &tangent::along_inputs(Arg::U, d))
         })?,
+        // Last of all.
+        frames: frames
+            .iter()
+            .map(|f| {
+                let (r, p) = noc::frame_pose(plan, &x, f.body, &f.placement);
+                let out: Vec<Sx> = r.into_iter().flatten().chain(p).collect();
+                Kernel::new(ids(&out), Vec::new())
+            })
+            .collect(),
     })
 }
 
@@ -235,14 +258,41 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     let payload = params.and_then(|p| p.payload);
     let bodies = params.map_or(&[][..], |p| &p.bodies[..]);
     let body_links: Vec<usize> = bodies.iter().map(|b| b.body).collect();
-    let k = kernels_with(&plan, &layout, payload.map(|p| p.0), &body_links).map_err(|e| {
-        format!("the mechanism is singular for every input ({e}); check the loop geometry")
-    })?;
+    let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
+    let frames: &[Frame] = if wanted("frames") { &scene.frames } else { &[] };
+    let k = kernels_with_frames(&plan, &layout, payload.map(|p| p.0), &body_links, frames)
+        .map_err(|e| {
+            format!("the mechanism is singular for every input ({e}); check the loop geometry")
+        })?;
     let n = plan.dof();
     let functions = functions(&k, &plan, &layout);
-    let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
-    let stats = stats(&functions, &wanted);
-    let functions: Vec<Function<'_>> = functions.into_iter().filter(|f| wanted(f.name)).collect();
+    let mut stats = stats(&functions, &wanted);
+    let mut functions: Vec<Function<'_>> =
+        functions.into_iter().filter(|f| wanted(f.name)).collect();
+    let names: Vec<String> = frames
+        .iter()
+        .map(|f| format!("{}_pose_at", f.ident))
+        .collect();
+    for ((f, name), kernel) in frames.iter().zip(&names).zip(&k.frames) {
+        functions.push(Function {
+            name,
+            doc: vec![format!(
+                "Pose of frame `{}` at the tree joint positions `x` (`JOINT_NAMES` order; not checked for closure): `(R, p)`, the rotation base ← frame and its origin in the base frame (m). `{}_pose` assembles `x` first.",
+                f.name, f.ident
+            )],
+            args: vec![Arg::X],
+            outputs: kernel.outputs.clone(),
+            shape: Shape::Tuple(vec![Part::Rotation, Part::Array(3)]),
+            dof: n,
+            schedule: crate::schedule::schedule(&k.graph, kernel),
+            public: true,
+            sites: false,
+        });
+        stats.push((
+            name.clone(),
+            functions.last().map(|f| f.schedule.ops).unwrap_or_default(),
+        ));
+    }
     let joint_names: Vec<String> = model.tree.joints.iter().map(|j| j.name.clone()).collect();
     let act_names: Vec<String> = plan
         .independent
@@ -258,6 +308,8 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     } else {
         quote!()
     };
+    let mut after = actuator_mass_matrix;
+    after.extend(frame_wrappers(frames));
     let code = module::render(
         &ModulePlan {
             name: &model.name,
@@ -265,7 +317,7 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
             items,
             graph: &k.graph,
             functions,
-            after: actuator_mass_matrix,
+            after,
         },
         cfg,
     );
@@ -277,6 +329,39 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         per: "DOF",
         c_crate: None,
     })
+}
+
+/// `NF`, `FRAME_NAMES` and per frame `F_pose(q)`: the loops assembled from `HOME`
+/// (`forward_kinematics`), then `F_pose_at`.
+fn frame_wrappers(frames: &[Frame]) -> TokenStream {
+    if frames.is_empty() {
+        return quote!();
+    }
+    let real = crate::emit::real();
+    let nf = Literal::usize_unsuffixed(frames.len());
+    let names = frames.iter().map(|f| f.name.as_str());
+    let wrappers = frames.iter().map(|f| {
+        let pose = quote::format_ident!("{}_pose", f.ident);
+        let at = quote::format_ident!("{}_pose_at", f.ident);
+        let doc = format!(
+            " Pose of frame `{}` at the independent coordinates `q`: the loops assembled by `forward_kinematics(q, &HOME)`, then `{at}`; `Err` where the assembly fails.",
+            f.name
+        );
+        quote! {
+            #[doc = #doc]
+            pub fn #pose(q: &[#real; DOF]) -> Result<([[#real; 3]; 3], [#real; 3]), NoConvergence> {
+                forward_kinematics(q, &HOME).map(|x| #at(&x))
+            }
+        }
+    });
+    quote! {
+        /// Number of frames whose poses the module offers (`[scene] frames`).
+        pub const NF: usize = #nf;
+        /// The frames' names as the spec writes them; frame `F`'s functions are `F_pose` and
+        /// `F_pose_at`, with `F` the name in lower snake case (docs/spec.md).
+        pub const FRAME_NAMES: [&str; NF] = [#(#names),*];
+        #(#wrappers)*
+    }
 }
 
 /// The DAG kernels as the module's scheduled functions, in emission order (all of them; the

@@ -62,6 +62,8 @@
 //! * `derivatives`: [`inverse_dynamics_derivatives`] and [`forward_dynamics_derivatives`],
 //!   by differentiating the inverse-dynamics DAG and solving with forward dynamics' factors;
 //! * `drives`: joint friction and rotor inertia;
+//! * `kinematics`: [`frame_kinematics`], the pose, Jacobian and `J̇ q̇` of the frames
+//!   `[scene] frames` names;
 //! * `runtime_params`: the run-time parameter layout ([`param_index`]) and the run-time bodies'
 //!   inertial parameters;
 //! * `regressor`: the standard regressor, one column per standard inertial or drive parameter;
@@ -78,6 +80,7 @@ mod flops;
 mod forward;
 mod frames;
 mod inverse;
+mod kinematics;
 mod links;
 mod regressor;
 mod regroup;
@@ -91,6 +94,7 @@ pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives
 pub use drives::{add_drive_efforts, friction_effort};
 pub use forward::{PIVOT_TOLERANCE, forward_dynamics};
 pub use inverse::{Terms, inverse_dynamics};
+pub use kinematics::{FramePart, frame_kinematics};
 pub use links::Tree;
 pub use regressor::{BODY_PARAMETERS, Standard, body_standard_parameters};
 pub use runtime_params::{ParamKind, body_param_index, param_count, param_count_with, param_index};

@@ -46,6 +46,10 @@ pub enum Part {
     Array(usize),
     /// `f64`.
     Scalar,
+    /// `[[f64; 3]; 3]`, row-major (a rotation matrix).
+    Rotation,
+    /// `[[f64; DOF]; 6]`, row-major (a frame's Jacobian).
+    Jacobian,
     /// This many outputs that are checked for finiteness but not returned (a tree's
     /// `forward_dynamics_derivatives`: its `q̈`, so that it fails where `forward_dynamics` does).
     Hidden(usize),
@@ -59,6 +63,8 @@ impl Part {
             Part::Matrices => dof * dof * dof,
             Part::Coords(n) | Part::Array(n) | Part::Hidden(n) => n,
             Part::Scalar => 1,
+            Part::Rotation => 9,
+            Part::Jacobian => 6 * dof,
         }
     }
     fn ty(self) -> TokenStream {
@@ -73,6 +79,8 @@ impl Part {
                 quote!([#real; #n])
             }
             Part::Scalar => quote!(#real),
+            Part::Rotation => quote!([[#real; 3]; 3]),
+            Part::Jacobian => quote!([[#real; DOF]; 6]),
             Part::Hidden(_) => quote!(()),
         }
     }
@@ -185,7 +193,13 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
     let checks = input_checks(f);
     let stmts: Vec<TokenStream> = checks.into_iter().chain(stmts).collect();
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| operand(g, s, o)).collect();
-    let out_check = output_check(f, &outs);
+    // Constants are finite: a result of constants only (a platform frame's constant
+    // Jacobian) needs no check (and an array of bare literals no `is_finite`).
+    let out_check = if f.outputs.iter().all(|&o| g.as_const(o).is_some()) {
+        TokenStream::new()
+    } else {
+        output_check(f, &outs)
+    };
     let ret = return_tokens(f, &outs);
     quote! { #(#stmts)* #out_check #ret }
 }
@@ -391,7 +405,7 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
             Part::Vector | Part::Coords(_) | Part::Array(_) => quote!([#(#now),*]),
             Part::Scalar => quote!(#(#now)*),
             Part::Hidden(_) => continue,
-            Part::Matrix => matrix_tokens(now, n),
+            Part::Matrix | Part::Jacobian => matrix_tokens(now, n),
             Part::Matrices => {
                 let m: Vec<TokenStream> = now
                     .chunks((n * n).max(1))
@@ -399,6 +413,7 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
                     .collect();
                 quote!([#(#m),*])
             }
+            Part::Rotation => matrix_tokens(now, 3),
         });
     }
     if items.len() == 1 {

@@ -56,7 +56,7 @@ pub mod tree;
 
 use schedule::OpCount;
 
-pub use tree::{Symbolic, symbolic, symbolic_with};
+pub use tree::{Symbolic, symbolic, symbolic_with, symbolic_with_frames};
 
 /// Where generated code takes `sin_cos` and `sqrt` from.
 #[derive(Clone, Debug, PartialEq, Eq)]

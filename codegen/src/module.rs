@@ -129,15 +129,15 @@ impl Functions<'_> {
     }
 
     /// The function `name` of `kernel`, scheduled.
-    pub fn make(
+    pub fn make<'n>(
         &self,
-        name: &'static str,
+        name: &'n str,
         doc: Vec<String>,
         args: Vec<Arg>,
         kernel: &Kernel,
         shape: Shape,
         public: bool,
-    ) -> Function<'static> {
+    ) -> Function<'n> {
         Function {
             name,
             doc,

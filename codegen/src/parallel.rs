@@ -22,7 +22,7 @@ use crate::scalar::{Sx, flat, guarded, ids, in_fresh_graph, inputs};
 use crate::emit::{self, Function, Part, Shape};
 use crate::module::{self, ModulePlan};
 use crate::schedule::{Kernel, OpCount};
-use crate::spec::{Kind, RuntimeParams, Scene};
+use crate::spec::{Frame, Kind, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
@@ -63,6 +63,9 @@ pub struct Kernels {
     pub idd_parts: Kernel,
     /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
     pub forward_dynamics_derivatives: Kernel,
+    /// Per frame of [`kernels_with_frames`] (`[scene] frames`, fixed to the platform): its
+    /// pose (`R` row-major, then `p`), its Jacobian `J` (6 × n row-major) and `J̇ u`.
+    pub frames: Vec<[Kernel; 3]>,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -75,11 +78,41 @@ pub fn kernels(plan: &Plan) -> Result<Kernels, Singular> {
 /// [`noc::payload_force`] and [`noc::payload_inertia`], the drives enter as
 /// [`runtime::drive::DriveInputs`].
 pub fn kernels_with(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, layout));
+    kernels_with_frames(plan, layout, &[])
+}
+
+/// [`kernels_with`] and the kinematics of `frames`, fixed to the platform (each frame's
+/// `placement` is its pose in the platform frame).
+pub fn kernels_with_frames(
+    plan: &Plan,
+    layout: &Layout,
+    frames: &[Frame],
+) -> Result<Kernels, Singular> {
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, frames));
     r.map(|k| Kernels { graph, ..k })
 }
 
-fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
+/// The kernels of a frame fixed to the platform: pose, `J`, `J̇ u`, each with the guards of
+/// the platform's pose.
+fn frame_kernels(plan: &Plan, x: &[Sx], u: &[Sx], f: &Frame) -> Result<[Kernel; 3], Singular> {
+    let at = &f.placement;
+    let kernel = |which: usize| -> Result<Kernel, Singular> {
+        let (out, guards) = guarded(|| {
+            noc::platform(plan, x).map(|pl| match which {
+                0 => {
+                    let (r, p) = noc::frame_pose(&pl, at);
+                    r.into_iter().flatten().chain(p).collect::<Vec<Sx>>()
+                }
+                1 => noc::frame_jacobian(plan.motion, &pl, at),
+                _ => noc::frame_jacobian_dot_u(plan.motion, &pl, at, u).to_vec(),
+            })
+        });
+        Ok(Kernel::new(ids(&out?), guards))
+    };
+    Ok([kernel(0)?, kernel(1)?, kernel(2)?])
+}
+
+fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Singular> {
     let n = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, n);
@@ -180,6 +213,10 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         .derivatives(&along_x, &along_u)
     });
     let fdd = fdd?;
+    let frames = frames
+        .iter()
+        .map(|f| frame_kernels(plan, &x, &u, f))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(Kernels {
         graph: Graph::new(),
         inverse_kinematics: Kernel::new(ids(&q), pos_guards),
@@ -195,6 +232,7 @@ fn build(plan: &Plan, layout: &Layout) -> Result<Kernels, Singular> {
         platform_pose,
         idd_parts,
         forward_dynamics_derivatives: Kernel::new(fdd, tangent::union(fd_guards, fdd_guards)),
+        frames,
     })
 }
 
@@ -340,12 +378,15 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
                 .into(),
         );
     }
-    let k = kernels_with(&plan, &layout).map_err(|e| {
+    let frames: &[Frame] = if want("frames") { &scene.frames } else { &[] };
+    let k = kernels_with_frames(&plan, &layout, frames).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
     let n = plan.dof();
-    let functions = functions(&k, &plan, &layout, &want);
-    let stats = stats(&functions, n, plan.motion.unit_groups(), &want);
+    let names = frame_names(frames);
+    let mut functions = functions(&k, &plan, &layout, &want);
+    functions.extend(frame_functions(&k, frames, &names, n));
+    let stats = stats(&functions, n, plan.motion.unit_groups(), &want, &names);
     let header = header(model, &plan, &layout, cfg, &stats);
     // The wrappers of the kernels that are emitted.
     let emitted = |name: &str| {
@@ -353,7 +394,8 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
             .iter()
             .any(|f| f.name.strip_suffix("_parts") == Some(name))
     };
-    let items = items(model, &plan, params, &layout, cfg, &emitted);
+    let mut items = items(model, &plan, params, &layout, cfg, &emitted);
+    items.extend(frame_items(frames));
     let code = module::render(
         &ModulePlan {
             name: &model.name,
@@ -553,14 +595,91 @@ fn functions(
         .collect()
 }
 
+/// The names of each frame's functions: `<ident>_pose`, `<ident>_jacobian`,
+/// `<ident>_jacobian_dot_u`.
+fn frame_names(frames: &[Frame]) -> Vec<[String; 3]> {
+    frames
+        .iter()
+        .map(|f| ["pose", "jacobian", "jacobian_dot_u"].map(|s| format!("{}_{s}", f.ident)))
+        .collect()
+}
+
+/// `NF` and `FRAME_NAMES` of a module with frames, nothing without.
+fn frame_items(frames: &[Frame]) -> TokenStream {
+    if frames.is_empty() {
+        return TokenStream::new();
+    }
+    let nf = Literal::usize_unsuffixed(frames.len());
+    let names = frames.iter().map(|f| f.name.as_str());
+    quote! {
+        /// Number of frames whose kinematics the module offers (`[scene] frames`).
+        pub const NF: usize = #nf;
+        /// The frames' names as the spec writes them; frame `F`'s functions are
+        /// `F_pose`, `F_jacobian` and `F_jacobian_dot_u`, with `F` the name in lower snake
+        /// case (docs/spec.md).
+        pub const FRAME_NAMES: [&str; NF] = [#(#names),*];
+    }
+}
+
+/// The functions of the frames fixed to the platform, scheduled.
+fn frame_functions<'a>(
+    k: &Kernels,
+    frames: &[Frame],
+    names: &'a [[String; 3]],
+    n: usize,
+) -> Vec<Function<'a>> {
+    let fns = module::Functions {
+        graph: &k.graph,
+        dof: n,
+        params: false,
+    };
+    let fallible = |parts: &[Part]| Shape::Fallible(parts.to_vec());
+    let mut out = Vec::new();
+    for ((f, [pose, jac, jdot]), kernels) in frames.iter().zip(names).zip(&k.frames) {
+        let name = &f.name;
+        out.push(fns.make(
+            pose,
+            vec![format!(
+                "Pose of frame `{name}` (fixed to the platform) at `x`: `(R, p)`, the rotation base ← frame and its origin in the base frame (m). `Err` where the platform's pose is (a zero quaternion, `Site::Platform`; a 1T2R platform's parasitic motion, as `platform_pose`)."
+            )],
+            vec![Arg::X],
+            &kernels[0],
+            fallible(&[Part::Rotation, Part::Array(3)]),
+            true,
+        ));
+        out.push(fns.make(
+            jac,
+            vec![format!(
+                "Jacobian of frame `{name}`: `J(x) u = [ω; v]`, the frame's angular velocity then the velocity of its origin, base-frame components (Pinocchio's `LOCAL_WORLD_ALIGNED`, angular first); row `r`, column `j` is `∂t_r/∂u_j`. Errors as `{pose}`."
+            )],
+            vec![Arg::X],
+            &kernels[1],
+            fallible(&[Part::Jacobian]),
+            true,
+        ));
+        out.push(fns.make(
+            jdot,
+            vec![format!(
+                "`J̇ u` of frame `{name}` (the convention of `{jac}`): its classical acceleration `[ω̇; p̈]` is `J u̇ + J̇ u`. Errors as `{pose}`."
+            )],
+            vec![Arg::X, Arg::U],
+            &kernels[2],
+            fallible(&[Part::Array(6)]),
+            true,
+        ));
+    }
+    out
+}
+
 /// The operation counts of the header's table: each public function `want` selects, a
 /// wrapper's LU (`inverse_dynamics`, `actuator_mass_matrix`, a step of `forward_kinematics`)
-/// added to its kernel's count.
+/// added to its kernel's count, then the frames' functions (`names`).
 fn stats(
     functions: &[Function<'_>],
     n: usize,
     groups: &[usize],
     want: &dyn Fn(&str) -> bool,
+    names: &[[String; 3]],
 ) -> Vec<(String, OpCount)> {
     let ops = |name: &str| {
         functions
@@ -603,11 +722,13 @@ fn stats(
         .iter()
         .any(|f| f.name == "platform_pose")
         .then(|| ("platform_pose".to_string(), ops("platform_pose")));
+    let frames = names.iter().flatten().map(|f| (f.clone(), ops(f)));
     stats
         .into_iter()
         .chain(friction)
         .chain(pose)
         .filter(|(n, _)| want(n))
+        .chain(frames)
         .collect()
 }
 

@@ -42,6 +42,9 @@ pub struct Symbolic {
     pub forward_dynamics_derivatives: Vec<sym::ExprId>,
     /// The regressor over the base parameters (`None` with run-time parameters).
     pub regressor: Option<dynamics::Regressor>,
+    /// Per frame of [`symbolic_with_frames`], in its order: `pose` (`R` row-major, then `p`),
+    /// `jacobian` (`6 × n` row-major) and `J̇ q̇` ([`dynamics::frame_kinematics`]).
+    pub frames: Vec<[Vec<sym::ExprId>; 3]>,
 }
 
 /// Build the symbolic dynamics of a validated model.
@@ -52,6 +55,15 @@ pub fn symbolic(model: &Model) -> Symbolic {
 /// [`symbolic`] with run-time parameters (`[scene] parameters = "runtime"`): every output also
 /// reads `Arg::P` (layout: [`dynamics::param_index`]).
 pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Symbolic {
+    symbolic_with_frames(model, params, &[])
+}
+
+/// [`symbolic_with`] and the kinematics of `frames` (`[scene] frames`).
+pub fn symbolic_with_frames(
+    model: &Model,
+    params: Option<&spec::RuntimeParams>,
+    frames: &[spec::Frame],
+) -> Symbolic {
     let mut tree = Tree::new(model);
     if let Some(rp) = params {
         tree = tree.with_runtime_params(rp.payload.as_ref().map(|p| p.0), rp.coulomb_velocity);
@@ -117,6 +129,18 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
     let regressor = params
         .is_none()
         .then(|| dynamics::regressor(&mut g, &tree, model));
+    // Last of all, for the same reason.
+    let frames = frames
+        .iter()
+        .map(|f| {
+            [
+                dynamics::FramePart::Pose,
+                dynamics::FramePart::Jacobian,
+                dynamics::FramePart::JacobianDotQd,
+            ]
+            .map(|part| dynamics::frame_kinematics(&mut g, &tree, f.body, &f.placement, part))
+        })
+        .collect();
     Symbolic {
         graph: g,
         dof: tree.dof(),
@@ -130,6 +154,7 @@ pub fn symbolic_with(model: &Model, params: Option<&spec::RuntimeParams>) -> Sym
         inverse_dynamics_derivatives,
         forward_dynamics_derivatives,
         regressor,
+        frames,
     }
 }
 
@@ -223,11 +248,17 @@ fn params_template(model: &Model, rp: &spec::RuntimeParams) -> proc_macro2::Toke
 /// parameters (`None`: constants).
 pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
     let params = scene.params.as_ref();
-    let parts = symbolic_with(model, params);
+    let frames: &[spec::Frame] = if scene.functions.wants(Kind::Tree, "frames") {
+        &scene.frames
+    } else {
+        &[]
+    };
+    let parts = symbolic_with_frames(model, params, frames);
     let n = parts.dof;
     let base = parts.regressor.as_ref().map(|r| r.base.clone());
-    let (g, specs) = tree_specs(parts, params.is_some());
-    let functions = tree_functions(&g, specs, scene, n);
+    let (g, specs) = tree_specs(parts, params.is_some(), frames);
+    let names: Vec<String> = specs.iter().map(|s| s.0.clone()).collect();
+    let functions = tree_functions(&g, specs, &names, scene, n);
     let base = base.filter(|_| functions.iter().any(|f| f.name == "regressor"));
     let stats: Vec<(String, OpCount)> = functions
         .iter()
@@ -241,7 +272,8 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
     if let Some(base) = &base {
         extra.extend(base_parameter_items(base));
     }
-    let items = items(n, &joint_names, &functions, extra);
+    let frame_names: Vec<&str> = frames.iter().map(|f| f.name.as_str()).collect();
+    let items = items(n, &joint_names, &frame_names, &functions, extra);
     let code = module::render(
         &ModulePlan {
             name: &model.name,
@@ -264,11 +296,12 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
 }
 
 /// One candidate function of a tree module: name, doc paragraphs, arguments, kernel, shape.
-type Spec = (&'static str, Vec<String>, Vec<Arg>, Kernel, Shape);
+type Spec = (String, Vec<String>, Vec<Arg>, Kernel, Shape);
 
 /// The graph and every function a tree module can hold, in module order (`friction` when the
-/// model has friction); each also reads `Arg::P` with `runtime_params`.
-fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
+/// model has friction, then the functions of `frames`); each dynamics function also reads
+/// `Arg::P` with `runtime_params`.
+fn tree_specs(parts: Symbolic, runtime_params: bool, frames: &[spec::Frame]) -> (Graph, Vec<Spec>) {
     let Symbolic {
         graph: g,
         dof: _,
@@ -282,12 +315,13 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
         inverse_dynamics_derivatives: idd,
         forward_dynamics_derivatives: fdd,
         regressor,
+        frames: frame_outputs,
     } = parts;
     let n = fd.len();
     let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
     let mut specs: Vec<Spec> = vec![
         (
-            "mass_matrix",
+            "mass_matrix".into(),
             vec![
                 "Generalized inertia matrix `I(q) = TᵀMT` (lecture eq. 21), symmetric positive \
                  definite away from singularities; kg·m² (revolute rows/columns), kg (prismatic)."
@@ -298,7 +332,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Matrix,
         ),
         (
-            "coriolis",
+            "coriolis".into(),
             vec![
                 "Velocity-dependent efforts `C(q, q̇) q̇` with `C = Tᵀ(MṪ + WMT)` (lecture eq. 22): \
                  Coriolis and centrifugal terms, no gravity."
@@ -309,7 +343,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Vector,
         ),
         (
-            "gravity",
+            "gravity".into(),
             vec![
                 "Efforts that hold the mechanism still against gravity, `−γ(q) = −Tᵀ w^G`; equal \
                  to `inverse_dynamics(q, 0, 0)`."
@@ -320,7 +354,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Vector,
         ),
         (
-            "inverse_dynamics",
+            "inverse_dynamics".into(),
             vec![
                 "Joint efforts (N·m for revolute, N for prismatic joints) that produce the motion: \
                  `τ = I q̈ + C q̇ − γ` (lecture eq. 24). Units: q in rad or m, q̇ in rad/s or m/s, \
@@ -332,7 +366,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Vector,
         ),
         (
-            "forward_dynamics",
+            "forward_dynamics".into(),
             vec![
                 "Joint accelerations `q̈ = I⁻¹ (τ − C q̇ + γ)`; `Err(Singular)` when a pivot of \
                  the mass matrix's factorization is not above `1e-12` times its diagonal entry \
@@ -344,7 +378,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::FallibleVector,
         ),
         (
-            "inverse_dynamics_derivatives",
+            "inverse_dynamics_derivatives".into(),
             vec![
                 "Derivatives of `inverse_dynamics`: `(∂τ/∂q, ∂τ/∂q̇)`, element `[i][j] = \
                  ∂τ_i/∂x_j`, exact (symbolic differentiation of the same expressions, friction \
@@ -356,7 +390,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             Shape::Tuple(vec![Part::Matrix, Part::Matrix]),
         ),
         (
-            "forward_dynamics_derivatives",
+            "forward_dynamics_derivatives".into(),
             vec![
                 "Derivatives of `forward_dynamics`: `(∂q̈/∂q, ∂q̈/∂q̇, I⁻¹ = ∂q̈/∂τ)`, element \
                  `[i][j] = ∂q̈_i/∂x_j`, with `∂q̈/∂x = −I⁻¹ ∂τ/∂x` at `q̈ = forward_dynamics(q, \
@@ -376,7 +410,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
     ];
     if let Some(friction) = friction {
         specs.push((
-            "friction",
+            "friction".into(),
             vec![
                 "Joint friction efforts `δ(q̇) = b q̇ + c q̇ / √(q̇² + v_s²)` (viscous and \
                  regularized Coulomb, `[scene] friction = true`); included in \
@@ -390,7 +424,7 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
     }
     if let Some(r) = regressor {
         specs.push((
-            "regressor",
+            "regressor".into(),
             vec![
                 "The regressor over the base parameters: `inverse_dynamics(q, q̇, q̈) = \
                  regressor(q, q̇, q̈) · BASE_PARAMETERS`, element `[i][k]` the effort of joint \
@@ -409,15 +443,71 @@ fn tree_specs(parts: Symbolic, runtime_params: bool) -> (Graph, Vec<Spec>) {
             spec.2.push(Arg::P);
         }
     }
+    for (f, [pose, jacobian, jdot]) in frames.iter().zip(frame_outputs) {
+        specs.extend(frame_specs(f, pose, jacobian, jdot));
+    }
     (g, specs)
 }
 
-/// The functions `scene` selects among `specs`, each scheduled on `g`.
-fn tree_functions(g: &Graph, specs: Vec<Spec>, scene: &Scene, n: usize) -> Vec<Function<'static>> {
+/// The three functions of frame `f`.
+fn frame_specs(
+    f: &spec::Frame,
+    pose: Vec<sym::ExprId>,
+    jacobian: Vec<sym::ExprId>,
+    jdot: Vec<sym::ExprId>,
+) -> [Spec; 3] {
+    let k = |outputs: Vec<sym::ExprId>| Kernel::new(outputs, Vec::new());
+    let (name, id) = (&f.name, &f.ident);
+    [
+        (
+            format!("{id}_pose"),
+            vec![format!(
+                "Pose of frame `{name}`: `(R, p)`, the rotation base ← frame (its columns are \
+                 the frame's axes in the base frame) and the position of its origin in the base \
+                 frame (m)."
+            )],
+            vec![Arg::Q],
+            k(pose),
+            Shape::Tuple(vec![Part::Rotation, Part::Array(3)]),
+        ),
+        (
+            format!("{id}_jacobian"),
+            vec![format!(
+                "Jacobian of frame `{name}`: `J q̇ = [ω; v]`, its angular velocity then the \
+                 velocity of its origin, both in base-frame components (Pinocchio's \
+                 `LOCAL_WORLD_ALIGNED`, angular first); row `r`, column `j` is `∂t_r/∂q̇_j`."
+            )],
+            vec![Arg::Q],
+            k(jacobian),
+            Shape::Tuple(vec![Part::Jacobian]),
+        ),
+        (
+            format!("{id}_jacobian_dot_qd"),
+            vec![format!(
+                "`J̇ q̇` of frame `{name}` (the convention of `{id}_jacobian`): its classical \
+                 acceleration `[ω̇; p̈]` is `J q̈ + J̇ q̇`."
+            )],
+            vec![Arg::Q, Arg::Qd],
+            k(jdot),
+            Shape::Tuple(vec![Part::Array(6)]),
+        ),
+    ]
+}
+
+/// The functions `scene` selects among `specs` (named `names`, the specs' names), each
+/// scheduled on `g`. The frames' functions are already chosen (`generate`).
+fn tree_functions<'a>(
+    g: &Graph,
+    specs: Vec<Spec>,
+    names: &'a [String],
+    scene: &Scene,
+    n: usize,
+) -> Vec<Function<'a>> {
     specs
         .into_iter()
-        .filter(|s| scene.functions.wants(Kind::Tree, s.0))
-        .map(|(name, doc, args, kernel, shape)| {
+        .zip(names)
+        .filter(|(s, _)| scene.functions.wants(Kind::Tree, &s.0))
+        .map(|((_, doc, args, kernel, shape), name)| {
             let schedule = schedule(g, &kernel);
             let outputs = kernel.outputs;
             Function {
@@ -486,11 +576,13 @@ fn tree_header(model: &Model, n: usize, cfg: &Config, stats: &[(String, OpCount)
     header
 }
 
-/// The tree module's items before its functions: `DOF`, `JOINT_NAMES`, the `Singular` error
-/// of `forward_dynamics` (when it is emitted) and `extra` (the `Params` items).
+/// The tree module's items before its functions: `DOF`, `JOINT_NAMES`, `NF` and `FRAME_NAMES`
+/// (when the module has frames), the `Singular` error of `forward_dynamics` (when it is
+/// emitted) and `extra` (the `Params` items).
 fn items(
     dof: usize,
     joint_names: &[String],
+    frame_names: &[&str],
     functions: &[Function<'_>],
     extra: TokenStream,
 ) -> TokenStream {
@@ -523,11 +615,23 @@ fn items(
             }
         }
     });
+    let frames = (!frame_names.is_empty()).then(|| {
+        let nf = Literal::usize_unsuffixed(frame_names.len());
+        quote! {
+            /// Number of frames whose kinematics the module offers (`[scene] frames`).
+            pub const NF: usize = #nf;
+            /// The frames' names as the spec writes them; frame `F`'s functions are
+            /// `F_pose`, `F_jacobian` and `F_jacobian_dot_qd`, with `F` the name in lower snake
+            /// case (docs/spec.md).
+            pub const FRAME_NAMES: [&str; NF] = [#(#frame_names),*];
+        }
+    });
     quote! {
         /// Number of degrees of freedom (joint coordinates).
         pub const DOF: usize = #dof_lit;
         /// Joint names, in coordinate order.
         pub const JOINT_NAMES: [&str; DOF] = [#(#names),*];
+        #frames
         #singular
         #extra
     }

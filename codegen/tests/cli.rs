@@ -125,7 +125,10 @@ fn stats_prints_the_table_to_stderr_beside_the_module() {
             "forward_dynamics",
             "inverse_dynamics_derivatives",
             "forward_dynamics_derivatives",
-            "regressor"
+            "regressor",
+            "link2_pose",
+            "link2_jacobian",
+            "link2_jacobian_dot_qd"
         ]
     );
     assert!(!t.contains("pub fn"), "--stats printed code");

@@ -1,5 +1,5 @@
 //! The generated dynamics of nocdyn's bundled mechanisms: one module per spec in `specs/`, each
-//! with its constants and free functions (trees: `DOF`, `JOINT_NAMES`, `mass_matrix`,
+//! with its constants and free functions (trees: `DOF`, `JOINT_NAMES`, `FRAME_NAMES` and each tip frame's `_pose`, `_jacobian`, `_jacobian_dot_qd`, `mass_matrix`,
 //! `coriolis`, `gravity`, `inverse_dynamics`, `forward_dynamics`, their derivatives, and
 //! `regressor` with `NBP`, `BASE_PARAMETERS`, `BASE_PARAMETER_NAMES`; parallel platforms and closed
 //! loops: `NX`, `DOF`, `HOME`, kinematics and dynamics, `gravity` and `coriolis` among them; see the generated headers for op

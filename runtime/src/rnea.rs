@@ -206,3 +206,33 @@ pub fn coriolis(model: &Model, q: &[f64], qd: &[f64]) -> DVector<f64> {
     let zero = alloc::vec![0.0; model.dof()];
     rnea(model, q, qd, &zero, &Vector3::zeros())
 }
+
+/// Every body's spatial velocity `[ω; v_O]` in its own coordinates (`v_O`: the velocity of the
+/// body-frame origin) and its spatial acceleration `[ω̇; a_O − ω × v_O]` (Featherstone's
+/// spatial acceleration, not the classical one), both from the RNEA's forward pass (5.7)–(5.8)
+/// without gravity: the chain recursion the generated frame kinematics are checked against.
+pub fn motion(
+    model: &Model,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+) -> (Vec<Vector6<f64>>, Vec<Vector6<f64>>) {
+    let n = model.dof();
+    assert_eq!(qd.len(), n, "q̇ has the wrong length");
+    assert_eq!(qdd.len(), n, "q̈ has the wrong length");
+    let t = tree(model, q);
+    let mut v: Vec<Vector6<f64>> = Vec::with_capacity(n);
+    let mut a: Vec<Vector6<f64>> = Vec::with_capacity(n);
+    for i in 0..n {
+        let vj = t.s[i] * qd[i];
+        let (vp, ap) = match model.joints[i].parent {
+            None => (Vector6::zeros(), Vector6::zeros()),
+            Some(p) => (v[p], a[p]),
+        };
+        let vi = t.x_up[i] * vp + vj;
+        let ai = t.x_up[i] * ap + t.s[i] * qdd[i] + crm(&vi) * vj;
+        v.push(vi);
+        a.push(ai);
+    }
+    (v, a)
+}

@@ -18,6 +18,7 @@ int main(void) {
     double d1[N * N], d2[N * N], d3[N * N], d[5 * N * N];
     double asym[N * N];
     double y[N * PUMA560_NBP];
+    double rot[9], pos[3], jac[6 * N], jdot[6], pose[12];
     puma560_inertia_indices_t ix;
     puma560_error_t err;
     int32_t s;
@@ -42,6 +43,12 @@ int main(void) {
     memcpy(d + 2 * N * N, d3, sizeof d3);
     output("forward_dynamics_derivatives", s, d, 3 * N * N);
     output("regressor", puma560_regressor(q, qd, qdd, y), y, N * PUMA560_NBP);
+    s = puma560_link6_pose(q, rot, pos);
+    memcpy(pose, rot, sizeof rot);
+    memcpy(pose + 9, pos, sizeof pos);
+    output("link6_pose", s, pose, 12);
+    output("link6_jacobian", puma560_link6_jacobian(q, jac), jac, 6 * N);
+    output("link6_jacobian_dot_qd", puma560_link6_jacobian_dot_qd(q, qd, jdot), jdot, 6);
     s = puma560_inertia_indices(m, &ix, &err);
     output("inertia_indices", s, ix.eigenvalues, N);
     printf("indices %.17g %.17g %.17g\n", ix.condition, ix.manipulability, ix.isotropic_acceleration);

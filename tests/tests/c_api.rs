@@ -337,6 +337,10 @@ fn puma560_from_c() {
         .copied()
         .collect();
     p.check("regressor", &y);
+    let (rot, pos) = g::link6_pose(&q);
+    p.check("link6_pose", &[flat(&rot), pos.to_vec()].concat());
+    p.check("link6_jacobian", &g::link6_jacobian(&q).concat());
+    p.check("link6_jacobian_dot_qd", &g::link6_jacobian_dot_qd(&q, &qd));
     let ix = g::inertia_indices(&m).unwrap();
     p.check("inertia_indices", &ix.eigenvalues);
     close(

@@ -25,6 +25,9 @@ pub enum Function {
     ForwardDynamicsDerivatives,
     /// `regressor`: `Y(q, q̇, q̈)` over the base parameters, `τ = Y · BASE_PARAMETERS` (trees).
     Regressor,
+    /// `frames`: the pose, Jacobian and `J̇ q̇` (`J̇ u`) of each frame `[scene] frames` names
+    /// (trees, parallel platforms; a closed loop's body poses).
+    Frames,
     /// `joint_rates`: every tree joint's rate (closed loops).
     JointRates,
     /// `actuator_rates`: `q̇ = A u`.
@@ -39,7 +42,7 @@ pub enum Function {
 
 impl Function {
     /// Every function, in the order of the enum.
-    pub const ALL: [Function; 14] = [
+    pub const ALL: [Function; 15] = [
         Function::MassMatrix,
         Function::Coriolis,
         Function::Gravity,
@@ -49,6 +52,7 @@ impl Function {
         Function::InverseDynamicsDerivatives,
         Function::ForwardDynamicsDerivatives,
         Function::Regressor,
+        Function::Frames,
         Function::JointRates,
         Function::ActuatorRates,
         Function::ActuatorMassMatrix,
@@ -68,6 +72,7 @@ impl Function {
             Function::InverseDynamicsDerivatives => "inverse_dynamics_derivatives",
             Function::ForwardDynamicsDerivatives => "forward_dynamics_derivatives",
             Function::Regressor => "regressor",
+            Function::Frames => "frames",
             Function::JointRates => "joint_rates",
             Function::ActuatorRates => "actuator_rates",
             Function::ActuatorMassMatrix => "actuator_mass_matrix",
@@ -116,6 +121,7 @@ impl Kind {
                 ForwardDynamicsDerivatives,
                 Friction,
                 Regressor,
+                Frames,
             ],
             Kind::Parallel => &[
                 ActuatorRates,
@@ -128,6 +134,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Frames,
             ],
             Kind::Closed => &[
                 JointRates,
@@ -139,6 +146,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Frames,
             ],
         }
     }

@@ -66,6 +66,9 @@ pub(crate) struct Named {
 pub(crate) struct SceneSpec {
     /// Emit only these public functions (trees).
     pub functions: Option<Vec<Named>>,
+    /// `frames = ["tool", …]`: the bodies whose kinematics the module offers (see
+    /// `spec::frames`), with the span of the value; `None`: the default (the leaves).
+    pub frames: Option<(Vec<Named>, Span)>,
     /// Bodies modelled as point masses at their mass centres (no rotational inertia).
     pub point_mass: Vec<Named>,
     /// Bodies modelled as massless (no mass, no inertia).
@@ -118,6 +121,10 @@ impl SceneSpec {
             }
         };
         self.functions.iter_mut().flatten().for_each(n);
+        if let Some((f, span)) = &mut self.frames {
+            f.iter_mut().for_each(n);
+            s(span);
+        }
         self.point_mass.iter_mut().for_each(n);
         self.massless.iter_mut().for_each(n);
         if let Some(p) = &mut self.payload {
@@ -170,6 +177,7 @@ impl Default for SceneSpec {
     fn default() -> Self {
         SceneSpec {
             functions: None,
+            frames: None,
             point_mass: Vec::new(),
             massless: Vec::new(),
             payload: None,

@@ -15,6 +15,7 @@ mod child_frame;
 mod closed;
 mod expr;
 mod fix;
+mod frames;
 mod function;
 mod geom;
 mod home;
@@ -39,6 +40,7 @@ use runtime::parallel::ParallelModel;
 use crate::diag::{Diagnostic, Diagnostics};
 
 pub use fix::apply_fixes;
+pub use frames::Frame;
 pub use function::{Function, FunctionSet, Kind};
 pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use input::{
@@ -274,22 +276,26 @@ fn load_any(
                 return None;
             }
             // Lowered once; where each spec body went places the run-time bodies.
-            let (mechanism, attach) = if s.platform.is_some() {
+            let (mechanism, attach, frames) = if s.platform.is_some() {
+                let frames = frames::resolve_platform(&s, &mut d);
                 (
                     Mechanism::Parallel(parallel::lower_parallel(&s, &mut d)?),
                     None,
+                    frames,
                 )
             } else if closed::is_closed(&s) {
                 let (m, attach) = closed::lower_closed_attached(&s, &mut d)?;
-                (Mechanism::Closed(m), Some(attach))
+                let frames = frames::resolve(&s, &attach, &mut d);
+                (Mechanism::Closed(m), Some(attach), frames)
             } else {
                 let built = lower::lower_built(&s, &mut d)?;
-                (Mechanism::Tree(built.model), Some(built.attach))
+                let frames = frames::resolve(&s, &built.attach, &mut d);
+                (Mechanism::Tree(built.model), Some(built.attach), frames)
             };
             let params = runtime_params(&s, attach.as_deref());
-            Some((mechanism, params))
+            Some((mechanism, params, frames))
         });
-        let read = mechanism.map(|(m, params)| {
+        let read = mechanism.map(|(m, params, frames)| {
             if let Some(fs) = &functions {
                 check_scene_functions(&m, fs, &mut d);
                 // The base parameters' values would be inputs: no regressor with run-time
@@ -311,7 +317,14 @@ fn load_any(
                     FunctionSet::only(fs.iter().filter_map(|f| f.name.parse().ok()).collect())
                 }
             };
-            (m, Scene { functions, params })
+            (
+                m,
+                Scene {
+                    functions,
+                    params,
+                    frames,
+                },
+            )
         });
         (read, d, platform, side)
     }));

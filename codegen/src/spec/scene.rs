@@ -16,6 +16,9 @@ pub struct Scene {
     pub functions: FunctionSet,
     /// The run-time parameters (`[scene] parameters = "runtime"`; `None`: constants).
     pub params: Option<RuntimeParams>,
+    /// The frames whose kinematics the module offers (`[scene] frames`; a tree's default is
+    /// its leaf bodies, the other kinds have none by default).
+    pub frames: Vec<super::Frame>,
 }
 
 /// Scene switches from outside the spec (CLI flags, [`crate::Config`]): each turns its effect

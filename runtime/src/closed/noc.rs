@@ -20,7 +20,8 @@
 //! holds the tolerances.
 //! * `plan.rs`: [`Plan`] and the choice of the kept loop equations at home.
 //! * `band.rs`: the banded order of `Φ_d`'s columns and rows.
-//! * `tree.rs`: step 1, the spanning tree's [`kinematics`].
+//! * `tree.rs`: step 1, the spanning tree's [`kinematics`]; `frames.rs`: the pose of a frame
+//!   fixed to a tree body ([`frame_pose`], `[scene] frames`).
 //! * `loop_equations.rs`: step 2, the loop equations, their Jacobian rows and bias `Φ̇ ẋ`.
 //! * `lu.rs`: step 3, [`lu_factor`] of `Φ_d`.
 //! * `config.rs`: steps 1–3 with the closure checks, [`configuration`].
@@ -40,6 +41,7 @@ mod band;
 mod config;
 mod dynamics;
 mod force;
+mod frames;
 mod inertia;
 mod loop_equations;
 mod lu;
@@ -56,6 +58,7 @@ pub use assembly::{closure_residual, forward_kinematics, newton_assembly, newton
 pub use config::{Config, configuration};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
 pub use force::{Extras, generalized_force, generalized_force_with};
+pub use frames::frame_pose;
 pub use inertia::{generalized_inertia, generalized_inertia_with};
 pub use lu::{Lu, lu_factor};
 pub use motion::{BodyMotion, motions};

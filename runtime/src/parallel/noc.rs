@@ -57,6 +57,8 @@
 //!   split of the efforts: [`gravity`], [`coriolis`], [`friction`].
 //! * `assembly.rs`: forward kinematics by Newton's method, [`forward_kinematics`], and
 //!   [`retract`].
+//! * `frames.rs`: frames fixed to the platform (`[scene] frames`): [`frame_pose`],
+//!   [`frame_jacobian`] and [`frame_jacobian_dot_u`].
 
 // Index loops read like the equations; negated float comparisons make NaN fail the test.
 #![allow(
@@ -70,6 +72,7 @@ mod assembly;
 mod delta;
 mod dynamics;
 mod force;
+mod frames;
 mod generic_leg;
 mod inertia;
 mod legs;
@@ -94,6 +97,7 @@ pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract,
 pub use delta::{DeltaKin, DeltaPlan};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
 pub use force::{generalized_force, generalized_force_with, leg_rates, payload_force};
+pub use frames::{frame_jacobian, frame_jacobian_dot_u, frame_pose, frame_twist};
 pub use generic_leg::{GENERIC_IK_ITERATIONS, GENERIC_IK_TOLERANCE};
 pub use inertia::{
     generalized_inertia, generalized_inertia_by_columns, generalized_inertia_with, payload_inertia,

@@ -230,6 +230,44 @@ macro_rules! mechanisms {
 
 for_each_mechanism!(mechanisms);
 
+/// The trees' frame functions (`[scene] frames`; not methods of `runtime::Dynamics`, their
+/// names are the frames'): one wrapper per frame calling its pose, Jacobian and `J̇ q̇`, each
+/// wrapper under its own `#[no_panic]`; `FRAMES` calls each once.
+macro_rules! frames {
+    ($($name:ident: $m:ident::{$pose:ident, $jac:ident, $jdot:ident}),* $(,)?) => {
+        $(
+            #[cfg_attr(feature = "prove", no_panic::no_panic)]
+            #[inline(never)]
+            #[allow(clippy::type_complexity)]
+            pub fn $name(
+                q: &[F; root::$m::DOF],
+                qd: &[F; root::$m::DOF],
+            ) -> (([[F; 3]; 3], [F; 3]), [[F; root::$m::DOF]; 6], [F; 6]) {
+                (root::$m::$pose(q), root::$m::$jac(q), root::$m::$jdot(q, qd))
+            }
+        )*
+        /// Every frame wrapper, with its name.
+        pub const FRAMES: &[(&str, fn(&mut u64) -> F)] = &[$((stringify!($name), |seed| {
+            let q = inputs(seed, 3.0);
+            let qd = inputs(seed, 1.0);
+            let ((r, p), j, d) = $name(&q, &qd);
+            r[2][1] + p[0] + j[5][0] + d[3]
+        })),*];
+    };
+}
+
+frames!(
+    planar_2r_link2: planar_2r::{link2_pose, link2_jacobian, link2_jacobian_dot_qd},
+    puma560_link6: puma560::{link6_pose, link6_jacobian, link6_jacobian_dot_qd},
+    puma560_urdf_link6: puma560_urdf::{link6_pose, link6_jacobian, link6_jacobian_dot_qd},
+    stanford_arm_link6: stanford_arm::{link6_pose, link6_jacobian, link6_jacobian_dot_qd},
+    gripper_tree_fa_distal: gripper_tree::{fa_distal_pose, fa_distal_jacobian, fa_distal_jacobian_dot_qd},
+    gripper_tree_fb_distal: gripper_tree::{fb_distal_pose, fb_distal_jacobian, fb_distal_jacobian_dot_qd},
+    chain7_iiwa_link_7: chain7::{iiwa_link_7_pose, iiwa_link_7_jacobian, iiwa_link_7_jacobian_dot_qd},
+    iiwa14_iiwa_link_ee: iiwa14::{iiwa_link_ee_pose, iiwa_link_ee_jacobian, iiwa_link_ee_jacobian_dot_qd},
+    iiwa14_tool: iiwa14::{tool_pose, tool_jacobian, tool_jacobian_dot_qd},
+);
+
 /// A function that can panic (index out of bounds): `--features canary` must fail to link.
 #[cfg(feature = "canary")]
 #[no_panic::no_panic]
@@ -242,7 +280,7 @@ fn main() {
     let mut seed = black_box(0x9e37_79b9_7f4a_7c15_u64);
     #[cfg(feature = "canary")]
     println!("canary: {}", canary(&black_box([1.0; 4]), black_box(7)));
-    for (name, run) in MECHANISMS {
+    for (name, run) in MECHANISMS.iter().chain(FRAMES) {
         let s = run(&mut seed);
         println!("{name}: checksum {s:e}");
     }

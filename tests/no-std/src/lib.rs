@@ -10,11 +10,11 @@ fn panic(_: &core::panic::PanicInfo) -> ! {
 }
 
 macro_rules! export {
-    ($($m:ident),* $(,)?) => {
+    ($($m:ident: [$($pose:ident, $jac:ident, $jdot:ident);*]),* $(,)?) => {
         $(
             pub mod $m {
                 use mechanisms::$m as g;
-                /// Calls every generated function once; returns a checksum.
+                /// Calls every generated function once (the frames' too); returns a checksum.
                 #[unsafe(no_mangle)]
                 pub extern "C" fn $m(q: &[f64; g::DOF], qd: &[f64; g::DOF], x: &[f64; g::DOF]) -> f64 {
                     let m = g::mass_matrix(q);
@@ -31,7 +31,12 @@ macro_rules! export {
                         Err(e) => e.value,
                     };
                     let y = g::regressor(q, qd, x);
-                    m[0][0] + c[0] + gr[0] + t[0] + a + dq[0][0] + d + y[0][0]
+                    let mut f = 0.0;
+                    $(
+                        let (r, p) = g::$pose(q);
+                        f += r[0][0] + p[2] + g::$jac(q)[5][0] + g::$jdot(q, qd)[3];
+                    )*
+                    m[0][0] + c[0] + gr[0] + t[0] + a + dq[0][0] + d + y[0][0] + f
                 }
             }
         )*
@@ -39,13 +44,19 @@ macro_rules! export {
 }
 
 export!(
-    planar_2r,
-    puma560,
-    puma560_urdf,
-    stanford_arm,
-    gripper_tree,
-    chain7,
-    iiwa14
+    planar_2r: [link2_pose, link2_jacobian, link2_jacobian_dot_qd],
+    puma560: [link6_pose, link6_jacobian, link6_jacobian_dot_qd],
+    puma560_urdf: [link6_pose, link6_jacobian, link6_jacobian_dot_qd],
+    stanford_arm: [link6_pose, link6_jacobian, link6_jacobian_dot_qd],
+    gripper_tree: [
+        fa_distal_pose, fa_distal_jacobian, fa_distal_jacobian_dot_qd;
+        fb_distal_pose, fb_distal_jacobian, fb_distal_jacobian_dot_qd
+    ],
+    chain7: [iiwa_link_7_pose, iiwa_link_7_jacobian, iiwa_link_7_jacobian_dot_qd],
+    iiwa14: [
+        iiwa_link_ee_pose, iiwa_link_ee_jacobian, iiwa_link_ee_jacobian_dot_qd;
+        tool_pose, tool_jacobian, tool_jacobian_dot_qd
+    ],
 );
 
 macro_rules! export_parallel {

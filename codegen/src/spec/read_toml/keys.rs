@@ -66,6 +66,7 @@ pub(super) const SCENE_KEYS: &[&str] = &[
     "runtime_inertia",
     "delta_model",
     "forearm_split",
+    "frames",
 ];
 pub(super) const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 pub(super) const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];

@@ -1,5 +1,6 @@
 //! The `[scene]` table: which functions, gravity, the bodies' mass overrides, the payload,
-//! drives (friction, rotor inertia), run-time parameters, snapping and locked joints.
+//! drives (friction, rotor inertia), run-time parameters, snapping, locked joints and the
+//! frames whose kinematics the module offers.
 
 use runtime::model::Vec3;
 use toml::de::{DeTable, DeValue};
@@ -57,6 +58,11 @@ impl Reader<'_> {
         }
         if let Some(v) = get(t, "forearm_split") {
             self.forearm_split(v, scene);
+        }
+        if let Some(v) = get(t, "frames")
+            && let Some(names) = self.names(v, "scene.frames")
+        {
+            scene.frames = Some((names, Some(v.span())));
         }
     }
 
