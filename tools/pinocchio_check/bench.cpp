@@ -2,6 +2,8 @@
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/aba.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <chrono>
 #include <iostream>
 #include <random>
@@ -19,6 +21,12 @@ int main(int argc, char** argv) {
     double trnea = run([&](int s){ return pinocchio::rnea(m, d, q[s], v[s], acc[s])[0]; });
     double tcrba = run([&](int s){ return pinocchio::crba(m, d, q[s])(0,0); });
     double taba = run([&](int s){ return pinocchio::aba(m, d, q[s], v[s], acc[s])[0]; });
-    std::cout << argv[a] << " nv " << m.nv << " rnea " << trnea << " ns crba " << tcrba << " ns aba " << taba << " ns\n";
+    std::cout << argv[a] << " nv " << m.nv << " rnea " << trnea << " ns crba " << tcrba << " ns aba " << taba << " ns";
+    if (m.nv <= 16) {  // the robots whose generated modules have the derivatives
+      double trd = run([&](int s){ pinocchio::computeRNEADerivatives(m, d, q[s], v[s], acc[s]); return d.dtau_dq(0,0) + d.dtau_dv(m.nv-1,m.nv-1); });
+      double tad = run([&](int s){ pinocchio::computeABADerivatives(m, d, q[s], v[s], acc[s]); return d.ddq_dq(0,0) + d.ddq_dv(m.nv-1,m.nv-1) + d.Minv(0,0); });
+      std::cout << " computeRNEADerivatives " << trd << " ns computeABADerivatives " << tad << " ns";
+    }
+    std::cout << "\n";
   }
 }

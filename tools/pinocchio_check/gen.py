@@ -5,6 +5,13 @@ for f in sorted(glob.glob("urdf/*.urdf")):
     m = pin.buildModelFromUrdf(f)
     d = m.createData()
     names = [m.names[i] for i in range(1, m.njoints)]
+    # Derivatives for the robots with <= 16 DOF (the others' modules leave them out: scenes/):
+    # the state, Pinocchio's computeRNEADerivatives (dtau_dq, dtau_dv) at (q, v, a) and
+    # computeABADerivatives (ddq_dq, ddq_dv, Minv) at (q, v, t2), row-major; derivatives in q are
+    # w.r.t. the tangent (a continuous joint's angle), as nocdyn's.
+    der = open(f"data/{name}.deriv.txt", "w") if m.nv <= 16 else None
+    if der:
+        der.write(" ".join(names) + "\n")
     with open(f"data/{name}.txt", "w") as out:
         out.write(" ".join(names) + "\n")
         for _ in range(200):
@@ -24,4 +31,14 @@ for f in sorted(glob.glob("urdf/*.urdf")):
             fd = pin.aba(m, d, q, v, t2)
             vals = np.concatenate([th, v, a, tau, M.ravel(), t2, fd])
             out.write(" ".join(repr(float(x)) for x in vals) + "\n")
+            if der:
+                dq, dv, _ = pin.computeRNEADerivatives(m, d, q, v, a)
+                dq, dv = np.array(dq), np.array(dv)
+                fq, fv, mi = pin.computeABADerivatives(m, d, q, v, t2)
+                fq, fv, mi = np.array(fq), np.array(fv), np.array(mi)
+                mi = np.triu(mi) + np.triu(mi, 1).T  # Pinocchio fills Minv's upper triangle
+                dvals = np.concatenate([th, v, a, t2, dq.ravel(), dv.ravel(), fq.ravel(), fv.ravel(), mi.ravel()])
+                der.write(" ".join(repr(float(x)) for x in dvals) + "\n")
+    if der:
+        der.close()
     print(name, m.nq, m.nv)

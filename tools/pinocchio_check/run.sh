@@ -21,6 +21,9 @@ cp "$D/tiago_description/robots/tiago.urdf" urdf/tiago.urdf
 cp "$D/anymal_b_simple_description/robots/anymal.urdf" urdf/anymal.urdf
 cp "$D/talos_data/robots/talos_full_v2.urdf" urdf/talos_full.urdf
 cp "$D/allegro_hand_description/urdf/allegro_right_hand.urdf" urdf/allegro.urdf
+# Robots above 16 DOF leave the derivatives and the regressor out (scenes/NAME.scene.toml,
+# read beside NAME.urdf by codegen::build_script).
+cp scenes/*.scene.toml urdf/
 python3 gen.py
 cargo run --release
 # Pinocchio's own timing of the same URDFs (header-only build, -O3, the defines of its CMake

@@ -79,6 +79,70 @@ macro_rules! check {
     }};
 }
 
+/// The derivatives (robots with <= 16 DOF; `data/NAME.deriv.txt` from gen.py): worst relative
+/// error of each matrix against Pinocchio's computeRNEADerivatives / computeABADerivatives over
+/// all states, and ns per call of inverse_dynamics, its derivatives and forward dynamics'
+/// derivatives (median of 31 batches over the states, as `check!`; the whole result through
+/// `black_box`).
+macro_rules! check_deriv {
+    ($m:ident) => {{
+        use robots::$m as g;
+        const N: usize = g::DOF;
+        let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".deriv.txt")).unwrap();
+        let mut lines = text.lines();
+        let pin_names: Vec<&str> = lines.next().unwrap().split(' ').collect();
+        assert_eq!(pin_names.len(), N, "{} joint count", stringify!($m));
+        let perm: Vec<usize> = pin_names.iter().map(|n| g::JOINT_NAMES.iter().position(|m| m == n).expect("name")).collect();
+        // [∂τ/∂q, ∂τ/∂q̇, ∂q̈/∂q, ∂q̈/∂q̇, M⁻¹]
+        let mut err = [0.0f64; 5];
+        let mut states: Vec<([f64; N], [f64; N], [f64; N], [f64; N])> = Vec::new();
+        for line in lines {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            let take = |k: usize| -> [f64; N] {
+                let mut o = [0.0; N];
+                for i in 0..N { o[perm[i]] = v[k * N + i]; }
+                o
+            };
+            let mat = |k: usize| -> [[f64; N]; N] {
+                let off = 4 * N + k * N * N;
+                let mut o = [[0.0; N]; N];
+                for i in 0..N { for j in 0..N { o[perm[i]][perm[j]] = v[off + i * N + j]; } }
+                o
+            };
+            let (q, qd, qdd, t2) = (take(0), take(1), take(2), take(3));
+            let (dq, dv) = g::inverse_dynamics_derivatives(&q, &qd, &qdd);
+            let (fq, fv, mi) = g::forward_dynamics_derivatives(&q, &qd, &t2).unwrap();
+            for (k, ours) in [dq, dv, fq, fv, mi].iter().enumerate() {
+                err[k] = err[k].max(rel(ours.as_flattened(), mat(k).as_flattened()));
+            }
+            states.push((q, qd, qdd, t2));
+        }
+        let time = |f: &dyn Fn(&([f64; N], [f64; N], [f64; N], [f64; N])) -> f64| {
+            let mut t: Vec<f64> = (0..31)
+                .map(|_| {
+                    let t0 = std::time::Instant::now();
+                    let mut sink = 0.0;
+                    for s in &states { sink += f(std::hint::black_box(s)); }
+                    std::hint::black_box(sink);
+                    t0.elapsed().as_nanos() as f64 / states.len() as f64
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[15]
+        };
+        // black_box on the whole result: every entry is computed, none left out by inlining.
+        let tid = time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics(q, qd, qdd))[0]);
+        let tidd = time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]);
+        let tfdd = time(&|(q, qd, _, t2)| {
+            std::hint::black_box(g::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)
+        });
+        println!(
+            "{:16} dof {:2}  dID/dq {:.1e} dID/dv {:.1e}  dFD/dq {:.1e} dFD/dv {:.1e} Minv {:.1e}  ({} states)  ns: ID {:.0} IDD {:.0} FDD {:.0}",
+            stringify!($m), N, err[0], err[1], err[2], err[3], err[4], states.len(), tid, tidd, tfdd
+        );
+    }};
+}
+
 fn main() {
     check!(ur5);
     check!(ur10);
@@ -95,4 +159,15 @@ fn main() {
     check!(anymal);
     check!(talos_full);
     check!(allegro);
+    // Derivatives: the robots with <= 16 DOF (the others' scenes leave them out).
+    check_deriv!(ur5);
+    check_deriv!(ur10);
+    check_deriv!(panda);
+    check_deriv!(z1);
+    check_deriv!(kinova);
+    check_deriv!(xarm7);
+    check_deriv!(iiwa14);
+    check_deriv!(talos_left_arm);
+    check_deriv!(anymal);
+    check_deriv!(allegro);
 }
