@@ -26,6 +26,7 @@ use crate::spec::{Frame, Kind, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
+mod derivatives;
 mod templates;
 
 use templates::templates;
@@ -172,47 +173,7 @@ fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Sing
         None
     };
     // The derivatives along the tangent of `x`, the speeds and the efforts: last again.
-    let along_x = tangent::along_coordinates(&noc::tangent(plan.motion, &x));
-    let along_u = tangent::along_inputs(Arg::U, n);
-    let da = tangent::jacobian(&flat(&a), &along_x);
-    // `[r][c][j]` → `[j][r][c]`: one matrix per direction.
-    let da: Vec<ExprId> = (0..n * n * n)
-        .map(|k| da[(k % (n * n)) * n + k / (n * n)])
-        .collect();
-    let idd_parts = with_kin(
-        [
-            flat(&a),
-            ids(&f),
-            da.clone(),
-            tangent::jacobian(&ids(&f), &along_x),
-            tangent::jacobian(&ids(&f), &along_u),
-        ]
-        .concat(),
-    );
-    // Forward dynamics solves `f(x, u, u̇) = Aᵀ τ`: `B = Aᵀ`, `∂(B τ)/∂x_j = (∂A/∂x_j)ᵀ τ`.
-    let b: Vec<Vec<Sx>> = (0..n).map(|r| (0..n).map(|c| a[c][r]).collect()).collect();
-    let b_rate: Vec<Vec<Sx>> = (0..n)
-        .map(|j| {
-            (0..n)
-                .map(|c| {
-                    (0..n).fold(Sx::c(0.0), |s, r| {
-                        s + Sx(da[j * n * n + r * n + c]) * tau[r]
-                    })
-                })
-                .collect()
-        })
-        .collect();
-    let (fdd, fdd_guards) = guarded(|| {
-        tangent::ImplicitForward {
-            fd: &fd,
-            f: &f,
-            inertia: &i,
-            b_rate: &b_rate,
-            b: &b,
-        }
-        .derivatives(&along_x, &along_u)
-    });
-    let fdd = fdd?;
+    let d = derivatives::Derivatives::of(plan, &x, &a, &f, &fd, &i, &tau)?;
     let frames = frames
         .iter()
         .map(|f| frame_kernels(plan, &x, &u, f))
@@ -230,8 +191,11 @@ fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Sing
         coriolis_parts: split_kernel(fc),
         friction_parts: ffr.map(split_kernel),
         platform_pose,
-        idd_parts,
-        forward_dynamics_derivatives: Kernel::new(fdd, tangent::union(fd_guards, fdd_guards)),
+        idd_parts: with_kin(d.idd_parts),
+        forward_dynamics_derivatives: Kernel::new(
+            d.forward_dynamics,
+            tangent::union(fd_guards, d.forward_guards),
+        ),
         frames,
     })
 }

@@ -286,6 +286,46 @@ fn dual_jacobians(
     out
 }
 
+/// One state's worst relative errors `(∂ID, ∂FD)` of module `m` against dual numbers through
+/// `id` and `fd` (the runtime's routes over `Real`), `x` moved along the columns of `e`.
+#[allow(clippy::too_many_arguments)]
+fn against_duals<M: Dynamics<NX, N, Scalar = f64>, const NX: usize, const N: usize>(
+    m: &M,
+    id: &DualFn<'_>,
+    fd: &DualFn<'_>,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+    tau: &[f64],
+    e: &[Vec<f64>],
+) -> (f64, f64) {
+    let [ix, iu, _] = dual_jacobians(id, x, u, ud, e);
+    let [fx, fu, ft] = dual_jacobians(fd, x, u, tau, e);
+    let arr = |v: &[f64]| -> [f64; NX] { core::array::from_fn(|i| v[i]) };
+    let vec = |v: &[f64]| -> [f64; N] { core::array::from_fn(|i| v[i]) };
+    let (gx, gu) = m
+        .inverse_dynamics_derivatives(&arr(x), &vec(u), &vec(ud))
+        .unwrap()
+        .unwrap();
+    let (hx, hu, ht) = m
+        .forward_dynamics_derivatives(&arr(x), &vec(u), &vec(tau))
+        .unwrap()
+        .unwrap();
+    let id_err = rel(&flat(&gx), &ix, 1e-300).max(rel(&flat(&gu), &iu, 1e-300));
+    let fd_err = rel(&flat(&hx), &fx, 1e-300)
+        .max(rel(&flat(&hu), &fu, 1e-300))
+        .max(rel(&flat(&ht), &ft, 1e-300));
+    (id_err, fd_err)
+}
+
+/// Report one module's worst errors against dual numbers; `false` above 1e-11.
+fn duals_within(name: &str, (id, fd): (f64, f64)) -> bool {
+    eprintln!(
+        "{name}: generated against dual numbers through the runtime, worst relative errors (∞-norm) over 100 states: ∂ID {id:.1e}, ∂FD {fd:.1e}"
+    );
+    id <= 1e-11 && fd <= 1e-11
+}
+
 macro_rules! platform_duals {
     ($($name:ident),* $(,)?) => {
         #[test]
@@ -306,23 +346,10 @@ macro_rules! platform_duals {
                     let tau = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
                     let fid = |x: &[Dual], u: &[Dual], w: &[Dual]| platform::inverse_dynamics(&plan, x, u, w);
                     let ffd = |x: &[Dual], u: &[Dual], w: &[Dual]| platform::forward_dynamics(&plan, x, u, w);
-                    let [ix, iu, _] = dual_jacobians(&fid, &x, &u, &ud, &e);
-                    let [fx, fu, ft] = dual_jacobians(&ffd, &x, &u, &tau, &e);
-                    let arr = |v: &[f64]| -> [f64; g::NX] { core::array::from_fn(|i| v[i]) };
-                    let vec = |v: &[f64]| -> [f64; g::DOF] { core::array::from_fn(|i| v[i]) };
-                    let (gx, gu) = g::inverse_dynamics_derivatives(&arr(&x), &vec(&u), &vec(&ud)).unwrap();
-                    let (hx, hu, ht) = g::forward_dynamics_derivatives(&arr(&x), &vec(&u), &vec(&tau)).unwrap();
-                    id = id.max(rel(&flat(&gx), &ix, 1e-300)).max(rel(&flat(&gu), &iu, 1e-300));
-                    fd = fd
-                        .max(rel(&flat(&hx), &fx, 1e-300))
-                        .max(rel(&flat(&hu), &fu, 1e-300))
-                        .max(rel(&flat(&ht), &ft, 1e-300));
+                    let (i, f) = against_duals(&g::Module, &fid, &ffd, &x, &u, &ud, &tau, &e);
+                    (id, fd) = (id.max(i), fd.max(f));
                 }
-                eprintln!(
-                    "{}: generated against dual numbers through the runtime, worst relative errors (∞-norm) over 100 states: ∂ID {id:.1e}, ∂FD {fd:.1e}",
-                    stringify!($name)
-                );
-                if !(id <= 1e-11 && fd <= 1e-11) {
+                if !duals_within(stringify!($name), (id, fd)) {
                     failed.push((stringify!($name), id, fd));
                 }
             })*
@@ -372,23 +399,10 @@ macro_rules! closed_duals {
                         noc::generalized_force_with(&plan, &c, u, w, true, &Extras::none())
                     };
                     let ffd = |x: &[Dual], u: &[Dual], w: &[Dual]| noc::forward_dynamics_generic(&plan, x, u, w).unwrap();
-                    let [ix, iu, _] = dual_jacobians(&fid, &x, &u, &ud, &e);
-                    let [fx, fu, ft] = dual_jacobians(&ffd, &x, &u, &tau, &e);
-                    let arr = |v: &[f64]| -> [f64; g::NX] { core::array::from_fn(|i| v[i]) };
-                    let vec = |v: &[f64]| -> [f64; g::DOF] { core::array::from_fn(|i| v[i]) };
-                    let (gx, gu) = g::inverse_dynamics_derivatives(&arr(&x), &vec(&u), &vec(&ud)).unwrap();
-                    let (hx, hu, ht) = g::forward_dynamics_derivatives(&arr(&x), &vec(&u), &vec(&tau)).unwrap();
-                    id = id.max(rel(&flat(&gx), &ix, 1e-300)).max(rel(&flat(&gu), &iu, 1e-300));
-                    fd = fd
-                        .max(rel(&flat(&hx), &fx, 1e-300))
-                        .max(rel(&flat(&hu), &fu, 1e-300))
-                        .max(rel(&flat(&ht), &ft, 1e-300));
+                    let (i, f) = against_duals(&g::Module, &fid, &ffd, &x, &u, &ud, &tau, &e);
+                    (id, fd) = (id.max(i), fd.max(f));
                 }
-                eprintln!(
-                    "{}: generated against dual numbers through the runtime, worst relative errors (∞-norm) over 100 states: ∂ID {id:.1e}, ∂FD {fd:.1e}",
-                    stringify!($name)
-                );
-                if !(id <= 1e-11 && fd <= 1e-11) {
+                if !duals_within(stringify!($name), (id, fd)) {
                     failed.push((stringify!($name), id, fd));
                 }
             })*
