@@ -11,7 +11,10 @@
 //! - **dual numbers through the runtime's evaluators**, which are written over `Real`
 //!   ([`tests::dual`]): `x + ε E e_j` with `E` the tangent of the platform's `retract`
 //!   (the closed loops: `S e_j`, the runtime's joint rates), `A⁻ᵀ f` and `I⁻¹ (Aᵀ τ − h)` by
-//!   the runtime's own generic LU and `LDLᵀ`. ≤ 1e-11 relative on 100 states per module.
+//!   the runtime's own generic LU and `LDLᵀ`. The trees go through the closed-loop evaluator
+//!   as a mechanism without loops (`Plan::tree`; the runtime's RNEA is `f64` only), which
+//!   shares nothing with the generator's tree recursions. ≤ 1e-11 relative on 100 states per
+//!   module.
 //!
 //! Errors are relative in the ∞-norm over the whole matrix.
 
@@ -419,4 +422,59 @@ closed_duals!(
     n_four_bar,
     tripod_3prs,
     andrews_squeezer,
+);
+
+macro_rules! tree_duals {
+    ($(($name:ident, $file:literal)),* $(,)?) => {
+        #[test]
+        fn tree_derivatives_match_dual_numbers_through_the_runtime() {
+            use runtime::closed::noc::{self, Extras, Plan};
+            let mut failed = Vec::new();
+            $({
+                use mechanisms::$name as g;
+                let path = tests::pkm::spec_path("x").with_file_name($file);
+                let src = std::fs::read_to_string(&path).unwrap();
+                let (model, _) = codegen::spec::load_tree($file, &src).unwrap_or_else(|d| panic!("{d}"));
+                let plan = Plan::tree(&model);
+                let n = g::DOF;
+                let e: Vec<Vec<f64>> = (0..n)
+                    .map(|k| (0..n).map(|j| f64::from(u8::from(k == j))).collect())
+                    .collect();
+                let mut rng = tests::rng(0x7ee ^ n as u64);
+                let (mut id, mut fd) = (0.0f64, 0.0f64);
+                for _ in 0..100 {
+                    let (q, qd, qdd) = tests::random_state(&mut rng, n);
+                    let qa: [f64; g::DOF] = core::array::from_fn(|i| q[i]);
+                    let (qda, qdda) = (
+                        core::array::from_fn(|i| qd[i]),
+                        core::array::from_fn(|i| qdd[i]),
+                    );
+                    let tau = g::inverse_dynamics(&qa, &qda, &qdda);
+                    let fid = |x: &[Dual], u: &[Dual], w: &[Dual]| {
+                        let c = noc::configuration(&plan, x, true).unwrap();
+                        noc::generalized_force_with(&plan, &c, u, w, true, &Extras::none())
+                    };
+                    let ffd = |x: &[Dual], u: &[Dual], w: &[Dual]| {
+                        noc::forward_dynamics_generic(&plan, x, u, w).unwrap()
+                    };
+                    let (i, f) = against_duals(&g::Module, &fid, &ffd, &q, &qd, &qdd, &tau, &e);
+                    (id, fd) = (id.max(i), fd.max(f));
+                }
+                if !duals_within(stringify!($name), (id, fd)) {
+                    failed.push((stringify!($name), id, fd));
+                }
+            })*
+            assert!(failed.is_empty(), "{failed:?}");
+        }
+    };
+}
+
+tree_duals!(
+    (planar_2r, "planar_2r.toml"),
+    (puma560, "puma560.toml"),
+    (puma560_urdf, "puma560.urdf"),
+    (stanford_arm, "stanford_arm.toml"),
+    (gripper_tree, "gripper_tree.toml"),
+    (chain7, "chain7.toml"),
+    (iiwa14, "iiwa14.urdf"),
 );
