@@ -11,7 +11,7 @@
 use alloc::vec::Vec;
 
 use super::pose::Platform;
-use crate::algebra::{M, V, cm, cv};
+use crate::algebra::{M, V, cm, cross, cv, mv};
 use crate::model::Transform;
 use crate::parallel::PlatformMotion;
 use crate::scalar::Real;
@@ -62,16 +62,7 @@ fn platform_twist<R: Real>(
 
 /// `ρ = R p`, the frame's origin from the platform frame's (base components).
 fn arm<R: Real>(pl: &Platform<R>, placement: &Transform) -> V<R> {
-    let p = cv::<R>(&placement.translation);
-    core::array::from_fn(|i| pl.rot[i][0] * p[0] + pl.rot[i][1] * p[1] + pl.rot[i][2] * p[2])
-}
-
-fn cross<R: Real>(a: V<R>, b: V<R>) -> V<R> {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    mv(&pl.rot, cv::<R>(&placement.translation))
 }
 
 /// The frame's twist `[ω; v]` for the speeds `u`.
