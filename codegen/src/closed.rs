@@ -51,7 +51,7 @@ pub struct Kernels {
     /// The joints' friction and the springs' damping; `None` without either.
     pub friction: Option<Kernel>,
     /// `∂τ/∂x` then `∂τ/∂u` of `inverse_dynamics`, row-major, the derivative in `x` along the
-    /// constraint manifold (`ẋ = S u`, [`crate::tangent`]).
+    /// constraint manifold (`ẋ = S u`, `codegen/src/tangent.rs`).
     pub inverse_dynamics_derivatives: Kernel,
     /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
     pub forward_dynamics_derivatives: Kernel,

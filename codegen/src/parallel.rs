@@ -60,7 +60,7 @@ pub struct Kernels {
     /// parasitic components); `None` for the other motions.
     pub platform_pose: Option<Kernel>,
     /// `A`, `f`, then `∂A/∂x_j` (one matrix per speed `j`), `∂f/∂x` and `∂f/∂u` (`[i][j]`),
-    /// the derivatives along the tangent of `x` ([`crate::tangent`]).
+    /// the derivatives along the tangent of `x` (`codegen/src/tangent.rs`).
     pub idd_parts: Kernel,
     /// `u̇` (checked, not returned), then `∂u̇/∂x`, `∂u̇/∂u` and `∂u̇/∂τ`, row-major.
     pub forward_dynamics_derivatives: Kernel,
