@@ -321,6 +321,28 @@ fn against_duals<M: Dynamics<NX, N, Scalar = f64>, const NX: usize, const N: usi
     (id_err, fd_err)
 }
 
+/// [`against_duals`] through the closed-loop evaluator of `plan` (a closed loop's, or a tree's
+/// as a mechanism without loops).
+#[allow(clippy::too_many_arguments)]
+fn through_closed_route<M: Dynamics<NX, N, Scalar = f64>, const NX: usize, const N: usize>(
+    m: &M,
+    plan: &runtime::closed::noc::Plan,
+    x: &[f64],
+    u: &[f64],
+    ud: &[f64],
+    tau: &[f64],
+    e: &[Vec<f64>],
+) -> (f64, f64) {
+    use runtime::closed::noc::{self, Extras};
+    let id = |x: &[Dual], u: &[Dual], w: &[Dual]| {
+        let c = noc::configuration(plan, x, true).unwrap();
+        noc::generalized_force_with(plan, &c, u, w, true, &Extras::none())
+    };
+    let fd =
+        |x: &[Dual], u: &[Dual], w: &[Dual]| noc::forward_dynamics_generic(plan, x, u, w).unwrap();
+    against_duals(m, &id, &fd, x, u, ud, tau, e)
+}
+
 /// Report one module's worst errors against dual numbers; `false` above 1e-11.
 fn duals_within(name: &str, (id, fd): (f64, f64)) -> bool {
     eprintln!(
@@ -377,7 +399,7 @@ macro_rules! closed_duals {
     ($($name:ident),* $(,)?) => {
         #[test]
         fn closed_loop_derivatives_match_dual_numbers_through_the_runtime() {
-            use runtime::closed::noc::{self, Extras, Plan};
+            use runtime::closed::noc::{self, Plan};
             let mut failed = Vec::new();
             $({
                 use mechanisms::$name as g;
@@ -397,12 +419,7 @@ macro_rules! closed_duals {
                         .collect();
                     let e: Vec<Vec<f64>> = (0..plan.nx()).map(|k| cols.iter().map(|c| c[k]).collect()).collect();
                     let tau = noc::inverse_dynamics(&plan, &x, &u, &ud).unwrap();
-                    let fid = |x: &[Dual], u: &[Dual], w: &[Dual]| {
-                        let c = noc::configuration(&plan, x, true).unwrap();
-                        noc::generalized_force_with(&plan, &c, u, w, true, &Extras::none())
-                    };
-                    let ffd = |x: &[Dual], u: &[Dual], w: &[Dual]| noc::forward_dynamics_generic(&plan, x, u, w).unwrap();
-                    let (i, f) = against_duals(&g::Module, &fid, &ffd, &x, &u, &ud, &tau, &e);
+                    let (i, f) = through_closed_route(&g::Module, &plan, &x, &u, &ud, &tau, &e);
                     (id, fd) = (id.max(i), fd.max(f));
                 }
                 if !duals_within(stringify!($name), (id, fd)) {
@@ -428,7 +445,7 @@ macro_rules! tree_duals {
     ($(($name:ident, $file:literal)),* $(,)?) => {
         #[test]
         fn tree_derivatives_match_dual_numbers_through_the_runtime() {
-            use runtime::closed::noc::{self, Extras, Plan};
+            use runtime::closed::noc::Plan;
             let mut failed = Vec::new();
             $({
                 use mechanisms::$name as g;
@@ -450,14 +467,7 @@ macro_rules! tree_duals {
                         core::array::from_fn(|i| qdd[i]),
                     );
                     let tau = g::inverse_dynamics(&qa, &qda, &qdda);
-                    let fid = |x: &[Dual], u: &[Dual], w: &[Dual]| {
-                        let c = noc::configuration(&plan, x, true).unwrap();
-                        noc::generalized_force_with(&plan, &c, u, w, true, &Extras::none())
-                    };
-                    let ffd = |x: &[Dual], u: &[Dual], w: &[Dual]| {
-                        noc::forward_dynamics_generic(&plan, x, u, w).unwrap()
-                    };
-                    let (i, f) = against_duals(&g::Module, &fid, &ffd, &q, &qd, &qdd, &tau, &e);
+                    let (i, f) = through_closed_route(&g::Module, &plan, &q, &qd, &qdd, &tau, &e);
                     (id, fd) = (id.max(i), fd.max(f));
                 }
                 if !duals_within(stringify!($name), (id, fd)) {
