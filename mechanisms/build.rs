@@ -1,6 +1,7 @@
 //! Generates every spec in `specs/` into `$OUT_DIR/<module>.rs` (see codegen::build_script),
 //! plus `$OUT_DIR/mechanisms.rs`, which declares one module per spec; with the `f32` feature
-//! also `$OUT_DIR/f32/<module>.rs`, declared inside `pub mod f32`.
+//! also `$OUT_DIR/f32/<module>.rs`, declared inside `pub mod f32` (without the derivatives,
+//! regressor and frame functions).
 fn main() {
     let out =
         std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
@@ -19,6 +20,17 @@ fn main() {
             .float(float)
             .implement("runtime")
             .out_dir(&dir);
+        if float == codegen::Float::F32 {
+            // Single precision keeps the dynamics and kinematics; derivatives, regressors and
+            // frames stay f64 only (they would double the crate's build time).
+            use codegen::spec::Function::*;
+            b.omit(&[
+                InverseDynamicsDerivatives,
+                ForwardDynamicsDerivatives,
+                Regressor,
+                Frames,
+            ]);
+        }
         b.compile().unwrap_or_else(|e| panic!("\n{e}"));
         if float == codegen::Float::F32 {
             list.push_str(

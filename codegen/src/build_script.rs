@@ -187,6 +187,13 @@ impl Builder {
         self
     }
 
+    /// Leave `functions` out of every module (those a module's kind does not offer are
+    /// ignored), on top of each spec's `[scene] functions`.
+    pub fn omit(&mut self, functions: &[crate::spec::Function]) -> &mut Self {
+        self.config.scene.omit = functions.to_vec();
+        self
+    }
+
     /// Print each spec's warnings (e.g. `snap`'s changes, a joint that moves only massless
     /// bodies) as `cargo:warning` lines; on by default.
     pub fn warnings(&mut self, on: bool) -> &mut Self {

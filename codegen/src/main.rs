@@ -253,6 +253,7 @@ fn main() -> ExitCode {
                 rotor_inertia: cli.rotor_inertia,
                 snap: cli.snap,
                 sidecar: sidecar.clone(),
+                omit: Vec::new(),
             },
             implement: cli.implement.then(|| cli.runtime_path.clone()),
             emit: match cli.emit {
@@ -325,6 +326,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
             rotor_inertia: cli.rotor_inertia,
             snap: Some(SUGGESTED_SNAP),
             sidecar,
+            omit: Vec::new(),
         },
         implement: None,
         emit: codegen::Emit::Rust,

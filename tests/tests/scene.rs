@@ -94,6 +94,42 @@ fn scene_functions_emit_only_what_is_asked_for() {
     assert_eq!(id(&g), id(&all));
 }
 
+/// `Config`'s `omit` (the `f32` build of the bundled mechanisms) leaves functions out on top of
+/// the spec's `[scene] functions`; names the kind does not offer are ignored.
+#[test]
+fn omitted_functions_are_left_out() {
+    use codegen::spec::Function;
+    let full = "{ ixx = 0.01, iyy = 0.05, izz = 0.05 }";
+    let mut config = codegen::Config::default();
+    config.scene.omit = vec![
+        Function::Regressor,
+        Function::Coriolis,
+        Function::ActuatorRates,
+    ];
+    let g = codegen::compile("arm.toml", &spec("", "1.0", full), &config).unwrap();
+    for f in [
+        "inverse_dynamics",
+        "mass_matrix",
+        "gravity",
+        "forward_dynamics",
+    ] {
+        assert!(g.code.contains(&format!("pub fn {f}(")), "{f} is missing");
+    }
+    for f in ["regressor", "coriolis"] {
+        assert!(!g.code.contains(&format!("pub fn {f}(")), "{f} was emitted");
+    }
+    // On top of the spec's own list.
+    let src = spec(
+        "[scene]\nfunctions = [\"inverse_dynamics\", \"coriolis\"]\n",
+        "1.0",
+        full,
+    );
+    let g = codegen::compile("arm.toml", &src, &config).unwrap();
+    assert!(g.code.contains("pub fn inverse_dynamics("));
+    assert!(!g.code.contains("pub fn coriolis("));
+    assert_eq!(g.stats.len(), 1);
+}
+
 /// A payload of 1 kg at 0.8 m on link 2 (mass centre at 0.4 m, 1 kg): together 2 kg at 0.6 m,
 /// inertia about the common centre `I + Σ m d²` = 0.05 + 2 · 1 · 0.2² = 0.13 kg·m² across the
 /// link (parallel-axis theorem, by hand), 0.01 along it.

@@ -253,6 +253,7 @@ impl Args {
             snap,
             // A URDF's `ROBOT.scene.toml` beside it is read by `macro_support::expand`.
             sidecar: None,
+            omit: Vec::new(),
         };
         if let Some(p) = &self.implement
             && syn::parse_str::<syn::Path>(&p.value()).is_err()

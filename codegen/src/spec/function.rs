@@ -179,6 +179,20 @@ impl FunctionSet {
         FunctionSet(Some(functions))
     }
 
+    /// The same set without `omit` (for a module of `kind`).
+    pub fn without(self, kind: Kind, omit: &[Function]) -> FunctionSet {
+        if omit.is_empty() {
+            return self;
+        }
+        let kept = match self.0 {
+            Some(fs) => fs,
+            None => kind.selectable().to_vec(),
+        };
+        FunctionSet(Some(
+            kept.into_iter().filter(|f| !omit.contains(f)).collect(),
+        ))
+    }
+
     /// Whether a module of `kind` emits the item named `name`: a selectable function when the
     /// set names it, anything else always.
     pub fn wants(&self, kind: Kind, name: &str) -> bool {

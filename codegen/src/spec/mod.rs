@@ -316,7 +316,8 @@ fn load_any(
                 Some(fs) => {
                     FunctionSet::only(fs.iter().filter_map(|f| f.name.parse().ok()).collect())
                 }
-            };
+            }
+            .without(m.kind(), &overrides.omit);
             (
                 m,
                 Scene {

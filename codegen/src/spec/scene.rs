@@ -36,6 +36,10 @@ pub struct SceneOverrides {
     /// Take near-exact angles and offsets as exact within this tolerance (as `[scene] snap`;
     /// replaces the spec's value). Out of (0, [`MAX_SNAP`]] it is an error.
     pub snap: Option<f64>,
+    /// Leave these functions out, on top of what `[scene] functions` selects (a name the
+    /// mechanism's kind does not offer, or always emits, is ignored): e.g. a single-precision
+    /// build without derivatives.
+    pub omit: Vec<super::Function>,
 }
 
 /// A `[scene]` sidecar file: its name (for messages) and text.
