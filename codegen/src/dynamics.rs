@@ -88,7 +88,7 @@ mod runtime_params;
 
 use crate::sym::ExprId;
 
-pub use base_parameters::{Base, Regressor, regressor};
+pub use base_parameters::{Base, Regressor, State, Stream, base_parameters_with, regressor};
 pub use composite::mass_matrix;
 pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives};
 pub use drives::{add_drive_efforts, friction_effort};

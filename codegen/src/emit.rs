@@ -50,6 +50,8 @@ pub enum Part {
     Rotation,
     /// `[[f64; DOF]; 6]`, row-major (a frame's Jacobian).
     Jacobian,
+    /// `[[f64; NBP]; DOF]`, row-major, with `NBP` given (a platform's regressor kernel).
+    Regressor(usize),
     /// This many outputs that are checked for finiteness but not returned (a tree's
     /// `forward_dynamics_derivatives`: its `q̈`, so that it fails where `forward_dynamics` does).
     Hidden(usize),
@@ -65,6 +67,7 @@ impl Part {
             Part::Scalar => 1,
             Part::Rotation => 9,
             Part::Jacobian => 6 * dof,
+            Part::Regressor(k) => dof * k,
         }
     }
     fn ty(self) -> TokenStream {
@@ -73,6 +76,7 @@ impl Part {
             Part::Vector => quote!([#real; DOF]),
             Part::Matrix => quote!([[#real; DOF]; DOF]),
             Part::Matrices => quote!([[[#real; DOF]; DOF]; DOF]),
+            Part::Regressor(_) => quote!([[#real; NBP]; DOF]),
             Part::Coords(_) => quote!([#real; NX]),
             Part::Array(n) => {
                 let n = proc_macro2::Literal::usize_unsuffixed(n);
@@ -414,6 +418,11 @@ fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
                 quote!([#(#m),*])
             }
             Part::Rotation => matrix_tokens(now, 3),
+            Part::Regressor(k) => {
+                let rows: Vec<TokenStream> =
+                    now.chunks((*k).max(1)).map(|r| quote!([#(#r),*])).collect();
+                quote!([#(#rows),*])
+            }
         });
     }
     if items.len() == 1 {

@@ -27,7 +27,12 @@ use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
 mod derivatives;
+mod op_counts;
+mod regressor;
 mod templates;
+
+use op_counts::plus;
+pub use op_counts::{idd_solve_ops, lu_inverse_ops, lu_many_ops, lu_ops};
 
 use templates::templates;
 
@@ -67,6 +72,9 @@ pub struct Kernels {
     /// Per frame of [`kernels_with_frames`] (`[scene] frames`, fixed to the platform): its
     /// pose (`R` row-major, then `p`), its Jacobian `J` (6 × n row-major) and `J̇ u`.
     pub frames: Vec<[Kernel; 3]>,
+    /// `A` then the generalized forces of the base parameters (`DOF × NBP`), with the base
+    /// parameters: [`kernels_for`] a model with constant parameters only.
+    pub regressor: Option<(Kernel, crate::dynamics::Base)>,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -89,7 +97,21 @@ pub fn kernels_with_frames(
     layout: &Layout,
     frames: &[Frame],
 ) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, layout, frames));
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, frames, None));
+    r.map(|k| Kernels { graph, ..k })
+}
+
+/// [`kernels_with_frames`] of `model` (whose plan is `plan`), with its regressor over the base
+/// parameters when `regressor` (and the parameters are constants).
+pub fn kernels_for(
+    model: &ParallelModel,
+    plan: &Plan,
+    layout: &Layout,
+    frames: &[Frame],
+    regressor: bool,
+) -> Result<Kernels, Singular> {
+    let model = (regressor && !layout.any()).then_some(model);
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, frames, model));
     r.map(|k| Kernels { graph, ..k })
 }
 
@@ -113,7 +135,12 @@ fn frame_kernels(plan: &Plan, x: &[Sx], u: &[Sx], f: &Frame) -> Result<[Kernel; 
     Ok([kernel(0)?, kernel(1)?, kernel(2)?])
 }
 
-fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Singular> {
+fn build(
+    plan: &Plan,
+    layout: &Layout,
+    frames: &[Frame],
+    model: Option<&ParallelModel>,
+) -> Result<Kernels, Singular> {
     let n = plan.dof();
     let x = inputs(Arg::X, plan.nx());
     let u = inputs(Arg::U, n);
@@ -178,6 +205,14 @@ fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Sing
         .iter()
         .map(|f| frame_kernels(plan, &x, &u, f))
         .collect::<Result<Vec<_>, _>>()?;
+    // The regressor, last of all.
+    let regressor = match model {
+        Some(m) => regressor::regressor(m, &x, &u, &ud, &a)?.map(|r| {
+            let guards = tangent::union(kin_guards.clone(), r.guards);
+            (Kernel::new(r.outputs, guards), r.base)
+        }),
+        None => None,
+    };
     Ok(Kernels {
         graph: Graph::new(),
         inverse_kinematics: Kernel::new(ids(&q), pos_guards),
@@ -197,6 +232,7 @@ fn build(plan: &Plan, layout: &Layout, frames: &[Frame]) -> Result<Kernels, Sing
             tangent::union(fd_guards, d.forward_guards),
         ),
         frames,
+        regressor,
     })
 }
 
@@ -254,76 +290,6 @@ fn split(
     (fg, fc, ffr)
 }
 
-/// Operation count of the emitted `lu_solve_many::<K>` for an `n × n` matrix: squared column
-/// norms, partial pivoting, `k` right-hand sides (`lu_solve` is `k = 1`, `lu_inverse` is
-/// `k = n`). The error paths (a square root and a division each) are not counted.
-pub fn lu_many_ops(n: usize, k: usize, groups: &[usize]) -> OpCount {
-    let mut c = OpCount::default();
-    // Squared column norms (for the scale-free pivot test), and each unit group's largest.
-    c.mul += n * n;
-    c.add += n * (n - 1);
-    let distinct = (0..n)
-        .filter(|&j| (0..j).all(|i| groups.get(i) != groups.get(j)))
-        .count();
-    c.cmp += n - distinct;
-    for p in 0..n {
-        let rows = n - p - 1;
-        // The pivot's conditional swaps (one comparison per lower row); its square and the
-        // two cross-multiplied products of the tolerance test, the tolerance's product, the
-        // test and the running maximum's comparison.
-        c.cmp += rows + 2;
-        c.mul += 4;
-        // Its reciprocal, and the updates of the columns right of it and of the right-hand
-        // sides.
-        c.div += 1;
-        c.mul += rows * (1 + (n - p - 1) + k);
-        c.add += rows * ((n - p - 1) + k);
-    }
-    // Back substitution for k right-hand sides (by the reciprocal pivots).
-    c.mul += k * (n * (n - 1) / 2) + n * k;
-    c.add += k * (n * (n - 1) / 2);
-    c
-}
-
-/// Operation count of `lu_solve` (one right-hand side).
-pub fn lu_ops(n: usize, groups: &[usize]) -> OpCount {
-    lu_many_ops(n, 1, groups)
-}
-
-/// Operation count of `lu_inverse` followed by `A⁻ᵀ I A⁻¹` (`I A⁻¹` in full, then the upper
-/// triangle of `A⁻ᵀ (I A⁻¹)`).
-pub fn lu_inverse_ops(n: usize, groups: &[usize]) -> OpCount {
-    let mut c = lu_many_ops(n, n, groups);
-    let tri = n * (n + 1) / 2;
-    c.mul += n * n * n + tri * n;
-    c.add += (n * n + tri) * (n - 1);
-    c
-}
-
-/// Operation count of `inverse_dynamics_derivatives` beyond its kernel: `lu_inverse`, then
-/// `τ = A⁻ᵀ f` and, for each of the `2n` columns, its right-hand side (`∂f/∂x_j − (∂A/∂x_j)ᵀ τ`
-/// or `∂f/∂u_j`) and its product with `A⁻ᵀ`.
-pub fn idd_solve_ops(n: usize, groups: &[usize]) -> OpCount {
-    let mut c = lu_many_ops(n, n, groups);
-    // `A⁻ᵀ` times `2n + 1` vectors, and `n` products `(∂A/∂x_j)ᵀ τ` subtracted.
-    c.mul += (2 * n + 1) * n * n + n * n * n;
-    c.add += (2 * n + 1) * n * (n - 1) + n * n * n;
-    c
-}
-
-fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
-    OpCount {
-        add: a.add + b.add * times,
-        mul: a.mul + b.mul * times,
-        neg: a.neg + b.neg * times,
-        div: a.div + b.div * times,
-        sqrt: a.sqrt + b.sqrt * times,
-        sin_cos: a.sin_cos + b.sin_cos * times,
-        cmp: a.cmp + b.cmp * times,
-        atan2: a.atan2 + b.atan2 * times,
-    }
-}
-
 /// Generate the module of a parallel mechanism for `scene`: only the functions it selects
 /// (`inverse_kinematics` and `forward_kinematics` are always emitted), with its run-time
 /// parameters (`[scene] parameters = "runtime"`: the platform's payload, the run-time bodies
@@ -343,7 +309,7 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
         );
     }
     let frames: &[Frame] = if want("frames") { &scene.frames } else { &[] };
-    let k = kernels_with_frames(&plan, &layout, frames).map_err(|e| {
+    let k = kernels_for(model, &plan, &layout, frames, want("regressor")).map_err(|e| {
         format!("the mechanism is singular for every input ({e}); check the leg geometry")
     })?;
     let n = plan.dof();
@@ -360,6 +326,9 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     };
     let mut items = items(model, &plan, params, &layout, cfg, &emitted);
     items.extend(frame_items(frames));
+    if let Some((_, base)) = k.regressor.as_ref().filter(|_| emitted("regressor")) {
+        items.extend(crate::tree::base_parameter_items(base, "x, u, ud"));
+    }
     let code = module::render(
         &ModulePlan {
             name: &model.name,
@@ -544,10 +513,21 @@ fn functions(
             true,
         )
     });
+    let regressor = k.regressor.as_ref().map(|(kernel, base)| {
+        fns.make(
+            "regressor_parts",
+            vec!["Kernel of `regressor`: `A` and the generalized forces `F_b` of the base parameters, one column each.".into()],
+            vec![Arg::X, Arg::U, Arg::Ud],
+            kernel,
+            fallible(&[Part::Matrix, Part::Regressor(base.kept.len())]),
+            false,
+        )
+    });
     functions
         .into_iter()
         .chain(friction)
         .chain(pose)
+        .chain(regressor)
         .filter(|f| {
             want(match f.name {
                 "id_parts" => "inverse_dynamics",
@@ -686,11 +666,20 @@ fn stats(
         .iter()
         .any(|f| f.name == "platform_pose")
         .then(|| ("platform_pose".to_string(), ops("platform_pose")));
+    let regressor = functions
+        .iter()
+        .find(|f| f.name == "regressor_parts")
+        .map(|f| {
+            let nbp = f.outputs.len() / n - n;
+            let solve = op_counts::regressor_solve_ops(lu_many_ops(n, n, groups), n, nbp);
+            ("regressor".to_string(), plus(f.schedule.ops, solve, 1))
+        });
     let frames = names.iter().flatten().map(|f| (f.clone(), ops(f)));
     stats
         .into_iter()
         .chain(friction)
         .chain(pose)
+        .chain(regressor)
         .filter(|(n, _)| want(n))
         .chain(frames)
         .collect()

@@ -270,7 +270,7 @@ pub fn generate(model: &Model, scene: &Scene, cfg: &Config) -> Generated {
         .map(|rp| params_template(model, rp))
         .unwrap_or_default();
     if let Some(base) = &base {
-        extra.extend(base_parameter_items(base));
+        extra.extend(base_parameter_items(base, "q, q̇, q̈"));
     }
     let frame_names: Vec<&str> = frames.iter().map(|f| f.name.as_str()).collect();
     let items = items(n, &joint_names, &frame_names, &functions, extra);
@@ -525,8 +525,9 @@ fn tree_functions<'a>(
         .collect()
 }
 
-/// `NBP`, `BASE_PARAMETERS` and `BASE_PARAMETER_NAMES`, emitted with `regressor`.
-fn base_parameter_items(base: &dynamics::Base) -> TokenStream {
+/// `NBP`, `BASE_PARAMETERS` and `BASE_PARAMETER_NAMES`, emitted with `regressor` (whose
+/// arguments are `args`, as its docs write them).
+pub(crate) fn base_parameter_items(base: &dynamics::Base, args: &str) -> TokenStream {
     let real = crate::emit::real();
     let nbp = Literal::usize_unsuffixed(base.values.len());
     // In single precision, the values rounded to `f32` (as many digits as the type holds).
@@ -539,12 +540,13 @@ fn base_parameter_items(base: &dynamics::Base) -> TokenStream {
         }
     });
     let names = base.names.iter();
+    let values_doc = format!(" `regressor({args}) · BASE_PARAMETERS = inverse_dynamics({args})`.");
     quote! {
         /// Number of base (identifiable) parameters: the rank of the standard regressor over
         /// generic states (docs/method.md, "Identification: the regressor and base parameters").
         pub const NBP: usize = #nbp;
         /// The spec's values of the base parameters, so that
-        /// `regressor(q, q̇, q̈) · BASE_PARAMETERS = inverse_dynamics(q, q̇, q̈)`.
+        #[doc = #values_doc]
         pub const BASE_PARAMETERS: [#real; NBP] = [#(#values),*];
         /// What each base parameter is: the linear combination of standard parameters it
         /// groups. Standard parameters (Khalil's convention) per body, in its body frame about

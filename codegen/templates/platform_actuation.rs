@@ -136,3 +136,37 @@ pub fn inverse_dynamics_derivatives(
     }
     Ok((dx, du))
 }
+
+/// The regressor over the base parameters: `inverse_dynamics(x, u, ud) = regressor(x, u, ud) ·
+/// BASE_PARAMETERS`, element `[i][k]` the effort of actuator `i` per unit of base parameter
+/// `k` (`BASE_PARAMETER_NAMES[k]`: the standard parameters it groups). `Y = A⁻ᵀ F_b` with the
+/// generalized forces `F_b` of the base parameters (eq. 66 column by column); `Err` at a leg
+/// or parallel singularity, as `inverse_dynamics`.
+#[allow(clippy::all)]
+pub fn regressor(
+    x: &[f64; NX],
+    u: &[f64; DOF],
+    ud: &[f64; DOF],
+) -> Result<[[f64; NBP]; DOF], Singular> {
+    let (a, f) = regressor_parts(x, u, ud)?;
+    let ai = lu_inverse(&a)?;
+    // Row `r` of `A⁻ᵀ F_b`: column `r` of `A⁻¹` against each column of `F_b`.
+    let mut y = [[0.0; NBP]; DOF];
+    for r in 0..DOF {
+        for c in 0..NBP {
+            let mut s = 0.0;
+            for k in 0..DOF {
+                s += ai[k][r] * f[k][c];
+            }
+            if !s.is_finite() {
+                return Err(Singular {
+                    site: Site::Input,
+                    value: s,
+                    condition_estimate: f64::INFINITY,
+                });
+            }
+            y[r][c] = s;
+        }
+    }
+    Ok(y)
+}

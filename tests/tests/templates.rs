@@ -220,6 +220,20 @@ mod actuation {
         let dfu = [[0.0, 1.0, 0.0], [-2.0, 0.0, 0.0], [0.0; DOF]];
         Ok((a_of(x), f_of(u, ud), da, [[0.0; DOF]; DOF], dfu))
     }
+    pub const NBP: usize = 2;
+    /// `F_b`: two parameters whose forces are `f_of(u, ud)` and `(u₀, 0, 1)`.
+    pub fn fb_of(u: &[f64; DOF], ud: &[f64; DOF]) -> [[f64; NBP]; DOF] {
+        let f = f_of(u, ud);
+        [[f[0], u[0]], [f[1], 0.0], [f[2], 1.0]]
+    }
+    #[allow(clippy::type_complexity)]
+    fn regressor_parts(
+        x: &[f64; NX],
+        u: &[f64; DOF],
+        ud: &[f64; DOF],
+    ) -> Result<(Matrix, [[f64; NBP]; DOF]), Singular> {
+        Ok((a_of(x), fb_of(u, ud)))
+    }
     fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
         Ok((a_of(x), i_of(x, p)))
     }
@@ -391,6 +405,15 @@ fn platform_actuation_solves_with_a_transposed() {
         for j in 0..DOF {
             assert!((got[i][j] - want[(i, j)]).abs() < 1e-13 * want.amax());
             assert_eq!(got[i][j], got[j][i]);
+        }
+    }
+    // The regressor: Aᵀ Y = F_b, checked by multiplication, column by column.
+    let y = regressor(&x, &u, &ud).expect("regular");
+    let fb = fb_of(&u, &ud);
+    for c in 0..NBP {
+        for j in 0..DOF {
+            let s: f64 = (0..DOF).map(|i| a[i][j] * y[i][c]).sum();
+            assert!((s - fb[j][c]).abs() < 1e-13, "column {c}, row {j}");
         }
     }
 }

@@ -38,10 +38,11 @@ const DEPENDENT: f64 = 1e-7;
 const SNAP: f64 = 1e-10;
 
 /// Deterministic pseudo-random numbers in `[-1, 1)` (SplitMix64).
-struct Stream(u64);
+pub struct Stream(u64);
 
 impl Stream {
-    fn next(&mut self) -> f64 {
+    /// The next number.
+    pub fn draw(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
@@ -51,27 +52,42 @@ impl Stream {
     }
 }
 
-/// The standard columns evaluated at `states` states: `cols[k][row]`, rows state-major.
-/// `q_scale[i]` is joint `i`'s range of positions (π for revolute joints).
-fn sample(g: &Graph, std: &Standard, q_scale: &[f64], states: usize) -> Vec<Vec<f64>> {
-    let n = q_scale.len();
+/// One state's inputs, drawn from the stream: `(argument, values)` pairs.
+pub type State = Vec<(Arg, Vec<f64>)>;
+
+/// The standard columns evaluated at `states` states drawn by `draw`: `cols[k][row]`, rows
+/// state-major (`n` rows per state). A state where a column is not finite (a failed guard:
+/// out of reach, singular) is drawn again, at most `20 · states` draws in all.
+fn sample(
+    g: &Graph,
+    std: &Standard,
+    n: usize,
+    states: usize,
+    draw: &mut dyn FnMut(&mut Stream) -> State,
+) -> Vec<Vec<f64>> {
     let roots: Vec<ExprId> = std.columns.iter().flatten().copied().collect();
     let mut cols = vec![Vec::with_capacity(states * n); std.columns.len()];
     let mut r = Stream(0x6e6f_6364_796e);
-    for _ in 0..states {
-        let q: Vec<f64> = q_scale.iter().map(|s| s * r.next()).collect();
-        let qd: Vec<f64> = (0..n).map(|_| 2.0 * r.next()).collect();
-        let qdd: Vec<f64> = (0..n).map(|_| 2.0 * r.next()).collect();
-        let input = |a: Arg, i: usize| match a {
-            Arg::Q => q[i],
-            Arg::Qd => qd[i],
-            Arg::Qdd => qdd[i],
-            _ => f64::NAN,
+    let mut taken = 0;
+    for _ in 0..20 * states {
+        if taken == states {
+            break;
+        }
+        let state = draw(&mut r);
+        let input = |a: Arg, i: usize| {
+            state
+                .iter()
+                .find(|(b, _)| *b == a)
+                .map_or(f64::NAN, |(_, v)| v[i])
         };
         let v = g.eval(&roots, &input);
+        if !v.iter().all(|x| x.is_finite()) {
+            continue;
+        }
         for (k, col) in cols.iter_mut().enumerate() {
             col.extend_from_slice(&v[k * n..(k + 1) * n]);
         }
+        taken += 1;
     }
     cols
 }
@@ -116,13 +132,30 @@ impl Qr {
     }
 }
 
-/// The base parameters of the standard regressor `std` (built on `g`); `q_scale` as in
-/// [`sample`].
+/// The base parameters of a tree's standard regressor `std` (built on `g`) at random states:
+/// joint `i` within `±q_scale[i]` (π for revolute joints), speeds and accelerations in
+/// `[-2, 2)`.
 pub fn base_parameters(g: &Graph, std: &Standard, q_scale: &[f64]) -> Base {
-    let n = q_scale.len().max(1);
+    let n = q_scale.len();
+    base_parameters_with(g, std, n, &mut |r| {
+        let q: Vec<f64> = q_scale.iter().map(|s| s * r.draw()).collect();
+        let qd: Vec<f64> = (0..n).map(|_| 2.0 * r.draw()).collect();
+        let qdd: Vec<f64> = (0..n).map(|_| 2.0 * r.draw()).collect();
+        vec![(Arg::Q, q), (Arg::Qd, qd), (Arg::Qdd, qdd)]
+    })
+}
+
+/// The base parameters of the standard regressor `std` (built on `g`, `n` rows per state) at
+/// the states `draw` gives.
+pub fn base_parameters_with(
+    g: &Graph,
+    std: &Standard,
+    n: usize,
+    draw: &mut dyn FnMut(&mut Stream) -> State,
+) -> Base {
     let ncols = std.columns.len();
-    let states = 3 * ncols / n + 12;
-    let cols = sample(g, std, q_scale, states);
+    let states = 3 * ncols / n.max(1) + 12;
+    let cols = sample(g, std, n, states, draw);
     let norms: Vec<f64> = cols.iter().map(|c| norm(c)).collect();
     let largest = norms.iter().copied().fold(0.0, f64::max);
     let mut qr = Qr {

@@ -70,6 +70,7 @@ pub(super) fn templates(
     let inverse: Vec<&str> = [
         ("inertia", "actuator_mass_matrix"),
         ("idd", "inverse_dynamics_derivatives"),
+        ("regressor", "regressor"),
     ]
     .into_iter()
     .filter(|(kernel, _)| want(kernel))

@@ -134,6 +134,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Regressor,
                 Frames,
             ],
             Kind::Closed => &[
@@ -146,6 +147,7 @@ impl Kind {
                 Gravity,
                 Coriolis,
                 Friction,
+                Regressor,
                 Frames,
             ],
         }

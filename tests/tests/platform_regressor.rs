@@ -1,0 +1,215 @@
+//! The generated `regressor` and base parameters of the bundled platform modules (issue 23's
+//! checks, in actuator space):
+//! * `regressor · BASE_PARAMETERS` equals the module's `inverse_dynamics` on 500 random regular
+//!   states each (‖a − b‖∞ / ‖b‖∞ ≤ 1e-12);
+//! * `NBP` is the rank of the standard regressor built by another route: the runtime's `f64`
+//!   evaluator on ten models per body with *random* masses, mass centres and inertias (every
+//!   other body zero), whose generalized forces `f(π_1 … π_10)` give the body's ten standard
+//!   columns as `[f(π_1) … f(π_10)] Π⁻¹` (linearity; the generator uses unit parameters
+//!   instead), computed by an SVD of the column-normalized stack over many states; the
+//!   generated regressor, mapped back by `Aᵀ` (runtime), has full column rank `NBP`, and
+//!   appending it to the standard stack does not raise the rank (each spans the other).
+
+use nalgebra::DMatrix;
+use rand::Rng;
+use rand::rngs::StdRng;
+use runtime::model::{Body, Drive, Mat3};
+use runtime::parallel::ParallelModel;
+use runtime::parallel::noc::{self, Plan};
+
+/// Khalil's standard parameters `XX … ZZ, MX, MY, MZ, M` of `(m, c, I_c)`, about the origin
+/// (parallel-axis theorem, written here).
+fn standard(m: f64, c: &[f64; 3], ic: &Mat3) -> [f64; 10] {
+    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let j = |r: usize, k: usize| ic[r][k] + m * (if r == k { cc } else { 0.0 } - c[r] * c[k]);
+    [
+        j(0, 0),
+        j(0, 1),
+        j(0, 2),
+        j(1, 1),
+        j(1, 2),
+        j(2, 2),
+        m * c[0],
+        m * c[1],
+        m * c[2],
+        m,
+    ]
+}
+
+/// The model's bodies: the platform, then each leg's in order.
+fn bodies(m: &mut ParallelModel) -> Vec<&mut Body> {
+    std::iter::once(&mut m.platform)
+        .chain(m.legs.iter_mut().flat_map(|l| l.bodies.iter_mut()))
+        .collect()
+}
+
+/// Per body, ten models with random parameters on that body alone, and the matrix `Π⁻¹` of
+/// their standard parameters (columns) inverted.
+fn random_models(m: &ParallelModel, rng: &mut StdRng) -> Vec<(Vec<Plan>, DMatrix<f64>)> {
+    let mut bare = m.clone();
+    for b in bodies(&mut bare) {
+        b.mass = 0.0;
+        b.com = [0.0; 3];
+        b.inertia = [[0.0; 3]; 3];
+    }
+    for l in &mut bare.legs {
+        for j in &mut l.joints {
+            j.drive = Drive::NONE;
+        }
+    }
+    let count = bodies(&mut bare.clone()).len();
+    (0..count)
+        .map(|b| {
+            let mut pi = DMatrix::zeros(10, 10);
+            let plans = (0..10)
+                .map(|k| {
+                    let mut s = bare.clone();
+                    let body = bodies(&mut s).swap_remove(b);
+                    body.mass = rng.random_range(0.5..2.0);
+                    body.com = std::array::from_fn(|_| rng.random_range(-0.3..0.3));
+                    let a: Mat3 = std::array::from_fn(|_| {
+                        std::array::from_fn(|_| rng.random_range(-1.0..1.0))
+                    });
+                    // A symmetric tensor (any: the dynamics is linear in it).
+                    body.inertia =
+                        std::array::from_fn(|r| std::array::from_fn(|c| a[r][c] + a[c][r]));
+                    let p = standard(body.mass, &body.com, &body.inertia);
+                    for (r, v) in p.iter().enumerate() {
+                        pi[(r, k)] = *v;
+                    }
+                    Plan::new(&s).expect("a plan")
+                })
+                .collect();
+            (plans, pi.try_inverse().expect("generic parameters"))
+        })
+        .collect()
+}
+
+/// The numerical rank of `a` after scaling each column to unit norm (zero columns dropped).
+fn rank(a: &DMatrix<f64>) -> usize {
+    let cols: Vec<_> = a
+        .column_iter()
+        .filter(|c| c.norm() > 1e-12 * a.amax().max(1e-300) * (a.nrows() as f64).sqrt())
+        .map(|c| c.normalize())
+        .collect();
+    if cols.is_empty() {
+        return 0;
+    }
+    let m = DMatrix::from_columns(&cols);
+    let s = m.svd(false, false).singular_values;
+    let top = s.max();
+    s.iter().filter(|&&v| v > 1e-9 * top).count()
+}
+
+macro_rules! platforms {
+    ($($name:ident),* $(,)?) => {
+        #[test]
+        fn regressor_times_base_parameters_is_inverse_dynamics() {
+            let mut failed = Vec::new();
+            $({
+                use mechanisms::$name as g;
+                let m = tests::pkm::model(stringify!($name));
+                let plan = Plan::new(&m).unwrap();
+                let home = tests::pkm::home_x(&m);
+                let r = reach(stringify!($name));
+                let mut rng = tests::rng(0x7e61 ^ g::NBP as u64);
+                let mut worst = 0.0f64;
+                for _ in 0..500 {
+                    let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 4.0 * r, r);
+                    let (x, u, ud) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
+                    let tau = g::inverse_dynamics(&x, &u, &ud).unwrap();
+                    let y = g::regressor(&x, &u, &ud).unwrap();
+                    let yp: Vec<f64> = y
+                        .iter()
+                        .map(|row| row.iter().zip(&g::BASE_PARAMETERS).map(|(a, b)| a * b).sum())
+                        .collect();
+                    worst = worst.max(tests::pkm::rel(&yp, &tau));
+                }
+                println!("{}: NBP {}, regressor · BASE_PARAMETERS vs inverse_dynamics {worst:.1e}", stringify!($name), g::NBP);
+                if !(worst <= 1e-12) {
+                    failed.push((stringify!($name), worst));
+                }
+            })*
+            assert!(failed.is_empty(), "{failed:?}");
+        }
+
+        #[test]
+        fn nbp_is_the_rank_of_the_standard_regressor() {
+            let mut failed = Vec::new();
+            $({
+                use mechanisms::$name as g;
+                let m = tests::pkm::model(stringify!($name));
+                let plan = Plan::new(&m).unwrap();
+                let home = tests::pkm::home_x(&m);
+                let r = reach(stringify!($name));
+                let mut rng = tests::rng(0x5a4b ^ g::NBP as u64);
+                let models = random_models(&m, &mut rng);
+                let n = g::DOF;
+                let ncols = 10 * models.len();
+                let states = 3 * (ncols + g::NBP) / n + 20;
+                let mut std_rows = DMatrix::zeros(states * n, ncols);
+                let mut gen_rows = DMatrix::zeros(states * n, g::NBP);
+                for s in 0..states {
+                    let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 4.0 * r, r);
+                    for (b, (plans, pinv)) in models.iter().enumerate() {
+                        let f = DMatrix::from_columns(
+                            &plans
+                                .iter()
+                                .map(|p| {
+                                    nalgebra::DVector::from_vec(
+                                        noc::generalized_effort(p, &x, &u, &ud).unwrap(),
+                                    )
+                                })
+                                .collect::<Vec<_>>(),
+                        );
+                        let cols = f * pinv;
+                        std_rows.view_mut((s * n, 10 * b), (n, 10)).copy_from(&cols);
+                    }
+                    // The generated regressor mapped back to generalized forces: Aᵀ Y.
+                    let a = noc::actuation(&plan, &x).unwrap();
+                    let a = DMatrix::from_fn(n, n, |i, j| a[i][j]);
+                    let (xa, ua, uda) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
+                    let y = g::regressor(&xa, &ua, &uda).unwrap();
+                    let y = DMatrix::from_fn(n, g::NBP, |i, k| y[i][k]);
+                    gen_rows.view_mut((s * n, 0), (n, g::NBP)).copy_from(&(a.transpose() * y));
+                }
+                let rs = rank(&std_rows);
+                let rg = rank(&gen_rows);
+                let both = DMatrix::from_fn(states * n, ncols + g::NBP, |i, k| {
+                    if k < ncols { std_rows[(i, k)] } else { gen_rows[(i, k - ncols)] }
+                });
+                let rb = rank(&both);
+                println!(
+                    "{}: {} standard parameters, SVD rank {rs}; NBP {}, generated regressor rank {rg}, both {rb}",
+                    stringify!($name), ncols, g::NBP
+                );
+                if !(rs == g::NBP && rg == g::NBP && rb == g::NBP) {
+                    failed.push((stringify!($name), rs, rg, rb, g::NBP));
+                }
+            })*
+            assert!(failed.is_empty(), "(name, SVD rank, generated rank, joint rank, NBP): {failed:?}");
+        }
+    };
+}
+
+/// How far the random states move from home (m; turns 4× that in rad), as the derivative
+/// tests do.
+fn reach(name: &str) -> f64 {
+    match name {
+        "planar_five_bar" | "delta_rl5" | "delta4_rl5" | "planar_3rrr" => 0.1,
+        "gough_stewart" | "tsai_3upu" | "prs_head" => 0.02,
+        _ => 0.5,
+    }
+}
+
+// (The 6-PUS and 6-RUS hexapods' scenes leave the regressor out.)
+platforms!(
+    gough_stewart,
+    agile_eye,
+    planar_five_bar,
+    delta_rl5,
+    planar_3rrr,
+    tsai_3upu,
+    prs_head,
+    delta4_rl5,
+);
