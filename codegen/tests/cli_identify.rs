@@ -429,6 +429,9 @@ fn bad_input_is_exit_code_2_without_a_panic() {
         vec!["excite", PUMA, "--q-max", "1,2"],
         vec!["excite", PUMA, "--qd-max", "-1"],
         vec!["excite", PUMA, "--samples", "1"],
+        vec!["excite", PUMA, "--noise", "0.1"],
+        vec!["excite", PUMA, "--with-tau", "--noise", "0.1,0.2"],
+        vec!["identify", PUMA, "x.csv", "--cutoff", "0"],
         vec!["identify", PUMA, "x.csv", "--weights", "heavy"],
     ] {
         let o = run(&args);

@@ -54,6 +54,13 @@ pub struct ExciteArgs {
     /// Also write `tau1..` from the spec's inverse dynamics (the runtime's RNEA and drives).
     #[arg(long)]
     pub with_tau: bool,
+    /// With `--with-tau`: add Gaussian noise of this standard deviation to the efforts (N·m or
+    /// N; one value, or one per joint), to try `identify` on simulated measurements.
+    #[arg(long, value_delimiter = ',', requires = "with_tau")]
+    pub noise: Vec<f64>,
+    /// Seed of the noise (default: `--seed`).
+    #[arg(long)]
+    pub noise_seed: Option<u64>,
     /// Write the CSV here (default: standard output).
     #[arg(short, long, value_name = "TRAJ.csv")]
     pub output: Option<PathBuf>,
@@ -178,6 +185,15 @@ fn check(args: &ExciteArgs, reg: &TreeRegressor) -> Result<(Vec<f64>, Vec<f64>),
     if args.restarts == 0 || args.restarts > 1000 || args.evaluations > 10_000_000 {
         return Err("error: --restarts must be in 1..=1000 and --evaluations at most 1e7".into());
     }
+    let k = args.noise.len();
+    if !(k == 0 || k == 1 || k == n) {
+        return Err(format!(
+            "error: --noise: {k} values for {n} joints (give 1 or {n})"
+        ));
+    }
+    if args.noise.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        return Err("error: --noise: standard deviations must be finite and >= 0".into());
+    }
     Ok((
         per_joint(&args.q_max, n, "--q-max")?,
         per_joint(&args.qd_max, n, "--qd-max")?,
@@ -219,6 +235,12 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         }
     }
     csv.push('\n');
+    let sigma: Vec<f64> = match args.noise.len() {
+        0 => vec![0.0; n],
+        1 => vec![args.noise[0]; n],
+        _ => args.noise.clone(),
+    };
+    let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
     let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
     for k in 0..args.samples {
         let t = args.period * k as f64 / args.samples as f64;
@@ -228,7 +250,14 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         row.extend(&qd);
         row.extend(&qdd);
         if args.with_tau {
-            row.extend(reg.inverse_dynamics(&q, &qd, &qdd));
+            let tau = reg.inverse_dynamics(&q, &qd, &qdd);
+            row.extend(tau.iter().zip(&sigma).map(|(t, s)| {
+                if *s > 0.0 {
+                    t + s * gauss(&mut noise)
+                } else {
+                    *t
+                }
+            }));
         }
         for i in 0..n {
             mq[i] = mq[i].max(q[i].abs());
@@ -258,6 +287,13 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         None => out!("{csv}"),
     }
     ExitCode::SUCCESS
+}
+
+/// A standard normal number (Box–Muller).
+fn gauss(r: &mut Rng) -> f64 {
+    let u1 = r.uniform(0.0, 1.0).max(1e-300);
+    let u2 = r.uniform(0.0, 1.0);
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 fn fmt_list(v: &[f64]) -> String {

@@ -56,6 +56,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         eprintln!("error: --max-rel-std must be a positive percentage");
         return ExitCode::from(2);
     }
+    if !(args.cutoff > 0.0 && args.cutoff.is_finite()) {
+        eprintln!("error: --cutoff must be a positive frequency in Hz");
+        return ExitCode::from(2);
+    }
     let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
         Ok(r) => r,
         Err(e) => {
