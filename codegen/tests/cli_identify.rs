@@ -442,3 +442,38 @@ fn bad_input_is_exit_code_2_without_a_panic() {
     let o = run(&["identify", PUMA, s(&dir.join("absent.csv"))]);
     assert_eq!(o.status.code(), Some(1));
 }
+
+#[test]
+fn a_joint_that_never_moves_leaves_parameters_unexcited_and_excite_repeats() {
+    let dir = scratch("unexcited");
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(PUMA)).unwrap();
+    let model = tree("puma560.toml", &src);
+    let rows = trajectory(&dir, 300);
+    // The same seed gives the same file.
+    let first = std::fs::read(dir.join("traj.csv")).unwrap();
+    trajectory(&dir, 300);
+    assert_eq!(first, std::fs::read(dir.join("traj.csv")).unwrap());
+    // Joint 1 held at zero: the first base parameter (the inertia about its axis) is seen only
+    // through its acceleration, which is zero.
+    let mut csv = String::from(
+        "q1,q2,q3,q4,q5,q6,qd1,qd2,qd3,qd4,qd5,qd6,qdd1,qdd2,qdd3,qdd4,qdd5,qdd6,tau1,tau2,tau3,tau4,tau5,tau6\n",
+    );
+    for row in &rows {
+        let mut x = row[1..19].to_vec();
+        (x[0], x[6], x[12]) = (0.0, 0.0, 0.0);
+        let tau = runtime::rnea::inverse_dynamics(&model, &x[0..6], &x[6..12], &x[12..18]);
+        x.extend(tau.iter());
+        let line: Vec<String> = x.iter().map(|v| format!("{v}")).collect();
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("still1.csv");
+    std::fs::write(&data, csv).unwrap();
+    let o = run(&["identify", PUMA, s(&data)]);
+    ok(&o);
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("warning: base parameter 0 (ZZ_link1") && err.contains("near-null direction"),
+        "{err}"
+    );
+}
