@@ -432,6 +432,13 @@ fn bad_input_is_exit_code_2_without_a_panic() {
         vec!["excite", PUMA, "--noise", "0.1"],
         vec!["excite", PUMA, "--with-tau", "--noise", "0.1,0.2"],
         vec!["identify", PUMA, "x.csv", "--cutoff", "0"],
+        vec![
+            "identify",
+            "../mechanisms/specs/iiwa14.urdf",
+            "x.csv",
+            "--out",
+            "y.toml",
+        ],
         vec!["identify", PUMA, "x.csv", "--weights", "heavy"],
     ] {
         let o = run(&args);

@@ -60,6 +60,12 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         eprintln!("error: --cutoff must be a positive frequency in Hz");
         return ExitCode::from(2);
     }
+    if args.out.is_some() && name.ends_with(".urdf") {
+        eprintln!(
+            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
+        );
+        return ExitCode::from(2);
+    }
     let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
         Ok(r) => r,
         Err(e) => {

@@ -387,3 +387,46 @@ fn consistency(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn standard_parameters_round_trip_and_refuse_what_no_body_has() {
+        let (m, c, ic) = (
+            2.5,
+            [0.1, -0.2, 0.3],
+            [[0.4, 0.01, 0.0], [0.01, 0.5, 0.02], [0.0, 0.02, 0.6]],
+        );
+        let p = codegen::dynamics::body_standard_parameters(m, &c, &ic);
+        let (m2, c2, ic2) = from_standard(&p).unwrap();
+        assert!((m2 - m).abs() < 1e-15);
+        for k in 0..3 {
+            assert!((c2[k] - c[k]).abs() < 1e-15);
+            for l in 0..3 {
+                assert!((ic2[k][l] - ic[k][l]).abs() < 1e-14);
+            }
+        }
+        let mut neg = p;
+        neg[9] = -1.0;
+        assert!(from_standard(&neg).unwrap_err().contains("< 0"));
+        let mut massless = [0.0; 10];
+        massless[6] = 0.1;
+        assert!(
+            from_standard(&massless)
+                .unwrap_err()
+                .contains("without mass")
+        );
+    }
+
+    #[test]
+    fn numbers_are_written_as_floats_that_read_back_exactly() {
+        for v in [0.0, 17.0, -0.0203, 7.9e-31, 1.5e7, 0.1 + 0.2] {
+            let text = number(v).to_string();
+            let back: f64 = text.trim().parse().unwrap();
+            assert_eq!(back, v, "{text}");
+            assert!(text.contains(['.', 'e']), "{text}");
+        }
+    }
+}
