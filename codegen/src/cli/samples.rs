@@ -49,6 +49,7 @@ pub fn read(
     filtering: Filtering,
 ) -> Result<Samples, String> {
     let n = joints.len();
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -237,7 +238,8 @@ mod tests {
 
     #[test]
     fn columns_by_index_or_joint_name_in_any_order() {
-        let text = "tau2,q1,q_b,qd1,qd2,qdd1,qdd_b,tau_a,extra\n1,2,3,4,5,6,7,8,9\n";
+        // A byte-order mark and CRLF line ends are read as well.
+        let text = "\u{feff}tau2,q1,q_b,qd1,qd2,qdd1,qdd_b,tau_a,extra\r\n1,2,3,4,5,6,7,8,9\r\n";
         let s = read("d.csv", text, &joints(), 1, F).unwrap();
         assert_eq!(s.q, vec![vec![2.0, 3.0]]);
         assert_eq!(s.qd, vec![vec![4.0, 5.0]]);
