@@ -6,10 +6,13 @@
 //! cargo run -p codegen -- map SPEC --index dci|dci2|cond|gie|manip|iso [--axes A,B] [--range LO:HI[,LO:HI]] [--steps N[,M]] [-o PREFIX]
 //! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
 //! cargo run -p codegen -- draw SPEC [-o home.svg]
+//! cargo run -p codegen -- excite SPEC [--harmonics 5] [--period 10] [--samples N] [--seed S] [--q-max RAD] [--qd-max RAD/S] [--with-tau] [-o traj.csv]
+//! cargo run -p codegen -- identify SPEC data.csv [--out updated.toml] [--weights auto|none] [--cutoff HZ] [--estimates est.csv]
 //! ```
+//! `excite` and `identify` work on trees (docs/identification.md).
 //! Exit codes: 0 success, 2 invalid spec (also one that is not UTF-8) or arguments (diagnostics
-//! on stderr, nothing written), 1 I/O error. A spec file literally named `map` or `isotropy`
-//! must be written `./map`.
+//! on stderr, nothing written), 1 I/O error. A spec file literally named like a subcommand (`map`,
+//! `identify`, …) must be written `./map`.
 
 /// `print!`/`println!` to standard output that never panics: when the reader has gone
 /// (`codegen spec.toml | head`), the process ends quietly with exit code 0, as the output was
@@ -147,6 +150,12 @@ enum Command {
     /// Draw the home pose in three orthographic views (SVG): joints by kind, actuated joints
     /// and loop cuts highlighted.
     Draw(cli::draw::DrawArgs),
+    /// Identify a tree's base parameters from measured motions and efforts (weighted least
+    /// squares), and write the spec updated to them (docs/identification.md).
+    Identify(cli::identify::IdentifyArgs),
+    /// Design an exciting trajectory for identification (finite Fourier series within joint
+    /// bounds, minimizing the base regressor's condition number), written as CSV.
+    Excite(cli::excite::ExciteArgs),
     /// A URDF as a TOML spec that generates the same module (for a `[scene]`, `reduce`, …).
     #[cfg(feature = "urdf")]
     Convert(cli::convert::ConvertArgs),
@@ -160,6 +169,8 @@ fn main() -> ExitCode {
         Some(Command::Reduce(args)) => return cli::reduce::run(&args),
         Some(Command::FixHome(args)) => return cli::fix_home::run(&args),
         Some(Command::Draw(args)) => return cli::draw::run(&args),
+        Some(Command::Identify(args)) => return cli::identify::run(&args),
+        Some(Command::Excite(args)) => return cli::excite::run(&args),
         #[cfg(feature = "urdf")]
         Some(Command::Convert(args)) => return cli::convert::run(&args),
         None => {}

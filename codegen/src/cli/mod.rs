@@ -1,4 +1,6 @@
-//! The workspace tools of the CLI (`docs/indices.md`): `map` and `isotropy`.
+//! The tools of the CLI: the workspace tools `map` and `isotropy` (`docs/indices.md`), and
+//! the identification tools `identify` and `excite` (`docs/identification.md`: `identify`,
+//! `excite`, with `tree_regressor`, `tape`, `samples`, `filter`, `wls`, `spec_update`).
 //!
 //! Both evaluate the mechanism with the runtime, not with generated code, through one
 //! `Box<dyn` [`runtime::workspace::Workspace`]`>` (no match on the kind here):
@@ -13,11 +15,19 @@
 pub mod convert;
 pub mod design;
 pub mod draw;
+pub mod excite;
+pub mod filter;
 pub mod fix_home;
+pub mod identify;
 pub mod isotropy;
 pub mod map;
 pub mod reduce;
+pub mod samples;
+pub mod spec_update;
 pub mod svg;
+pub mod tape;
+pub mod tree_regressor;
+pub mod wls;
 
 use std::process::ExitCode;
 

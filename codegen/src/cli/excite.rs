@@ -1,0 +1,404 @@
+//! `codegen excite SPEC`: an exciting trajectory for identification (docs/identification.md,
+//! "Exciting trajectories"). Each joint follows a finite Fourier series of period `T`
+//! (Swevers et al. 1997),
+//! `q_i(t) = Σ_{l=1..L} a_il/(l ω_f) sin(l ω_f t) − b_il/(l ω_f) cos(l ω_f t)`, `ω_f = 2π/T`,
+//! periodic and analytic in `q̇` and `q̈`. The coefficients minimize the condition number of
+//! the base regressor stacked over the period, subject to `|q_i| ≤ q_max` and `|q̇_i| ≤
+//! q̇_max`: a candidate's joints are scaled down until they hold (on a grid of 400 points per
+//! period, with a 0.1 % margin), so every candidate is feasible. The search is a coordinate
+//! (pattern) search from random starts: each coefficient moved by `± h`, kept when the
+//! condition number drops; `h` halves after a sweep without gain. Deterministic for a seed.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+use nalgebra::DMatrix;
+
+use super::Rng;
+use super::tree_regressor::TreeRegressor;
+use super::wls::condition;
+
+/// Arguments of `excite`.
+#[derive(Debug, Args)]
+pub struct ExciteArgs {
+    /// Tree spec (`.toml` or `.urdf`).
+    pub spec: PathBuf,
+    /// Harmonics per joint, `L`.
+    #[arg(long, default_value_t = 5)]
+    pub harmonics: usize,
+    /// Period `T`, s.
+    #[arg(long, default_value_t = 10.0)]
+    pub period: f64,
+    /// Samples written over one period (`t = k T / N`).
+    #[arg(long, default_value_t = 1000)]
+    pub samples: usize,
+    /// Seed of the random starts.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Position bound per joint (rad or m): one value, or one per joint separated by commas.
+    #[arg(long, value_delimiter = ',', default_value = "1.0")]
+    pub q_max: Vec<f64>,
+    /// Velocity bound per joint (rad/s or m/s): one value, or one per joint.
+    #[arg(long, value_delimiter = ',', default_value = "2.0")]
+    pub qd_max: Vec<f64>,
+    /// Random starts of the search.
+    #[arg(long, default_value_t = 3)]
+    pub restarts: usize,
+    /// Evaluations of the condition number per start.
+    #[arg(long, default_value_t = 600)]
+    pub evaluations: usize,
+    /// States per period at which the condition number is taken during the search.
+    #[arg(long, default_value_t = 60)]
+    pub search_samples: usize,
+    /// Also write `tau1..` from the spec's inverse dynamics (the runtime's RNEA and drives).
+    #[arg(long)]
+    pub with_tau: bool,
+    /// With `--with-tau`: add Gaussian noise of this standard deviation to the efforts (N·m or
+    /// N; one value, or one per joint), to try `identify` on simulated measurements.
+    #[arg(long, value_delimiter = ',', requires = "with_tau")]
+    pub noise: Vec<f64>,
+    /// Seed of the noise (default: `--seed`).
+    #[arg(long)]
+    pub noise_seed: Option<u64>,
+    /// Write the CSV here (default: standard output).
+    #[arg(short, long, value_name = "TRAJ.csv")]
+    pub output: Option<PathBuf>,
+}
+
+/// A Fourier trajectory: coefficients `a` then `b`, `L` each, per joint.
+#[derive(Clone, Debug)]
+pub struct Fourier {
+    /// `2L` per joint: `a_i1..a_iL, b_i1..b_iL`.
+    pub c: Vec<f64>,
+    /// Joints.
+    pub n: usize,
+    /// Harmonics.
+    pub l: usize,
+    /// Fundamental `ω_f`, rad/s.
+    pub w: f64,
+}
+
+impl Fourier {
+    /// `(q, q̇, q̈)` of joint `i` at `t`.
+    pub fn joint(&self, i: usize, t: f64) -> (f64, f64, f64) {
+        let (mut q, mut qd, mut qdd) = (0.0, 0.0, 0.0);
+        let base = 2 * self.l * i;
+        for h in 1..=self.l {
+            let (a, b) = (self.c[base + h - 1], self.c[base + self.l + h - 1]);
+            let wl = self.w * h as f64;
+            let (s, c) = (wl * t).sin_cos();
+            q += (a * s - b * c) / wl;
+            qd += a * c + b * s;
+            qdd += wl * (b * c - a * s);
+        }
+        (q, qd, qdd)
+    }
+
+    /// All joints at `t`.
+    pub fn state(&self, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let mut s = (vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]);
+        for i in 0..self.n {
+            (s.0[i], s.1[i], s.2[i]) = self.joint(i, t);
+        }
+        s
+    }
+
+    /// Scale each joint's coefficients so that `|q_i| ≤ q_max_i` and `|q̇_i| ≤ q̇_max_i` on
+    /// `grid` points per period, with a 0.1 % margin.
+    fn feasible(&self, q_max: &[f64], qd_max: &[f64], grid: usize) -> Fourier {
+        let mut f = self.clone();
+        let period = 2.0 * std::f64::consts::PI / self.w;
+        for i in 0..self.n {
+            let (mut mq, mut mqd) = (0.0f64, 0.0f64);
+            for k in 0..grid {
+                let (q, qd, _) = self.joint(i, period * k as f64 / grid as f64);
+                mq = mq.max(q.abs());
+                mqd = mqd.max(qd.abs());
+            }
+            let s = (0.999 * q_max[i] / mq)
+                .min(0.999 * qd_max[i] / mqd)
+                .min(1.0);
+            if s.is_finite() {
+                for c in &mut f.c[2 * self.l * i..2 * self.l * (i + 1)] {
+                    *c *= s;
+                }
+            }
+        }
+        f
+    }
+}
+
+/// The base regressor stacked at `m` equally spaced times over a period.
+fn stacked(reg: &TreeRegressor, f: &Fourier, m: usize) -> DMatrix<f64> {
+    let (n, nbp) = (reg.dof(), reg.nbp());
+    let period = 2.0 * std::f64::consts::PI / f.w;
+    let mut w = DMatrix::zeros(m * n, nbp);
+    let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
+    for k in 0..m {
+        let (q, qd, qdd) = f.state(period * k as f64 / m as f64);
+        reg.rows(&q, &qd, &qdd, &mut buf, &mut y);
+        for i in 0..n {
+            for p in 0..nbp {
+                w[(k * n + i, p)] = y[i * nbp + p];
+            }
+        }
+    }
+    w
+}
+
+/// One bound per joint from a list of one or `n` values.
+fn per_joint(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
+    let out = match v.len() {
+        1 => vec![v[0]; n],
+        k if k == n => v.to_vec(),
+        k => {
+            return Err(format!(
+                "error: {what}: {k} values for {n} joints (give 1 or {n})"
+            ));
+        }
+    };
+    if out.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+        return Err(format!("error: {what}: bounds must be positive and finite"));
+    }
+    Ok(out)
+}
+
+/// Check the arguments; `Err` is the message (exit code 2).
+fn check(args: &ExciteArgs, reg: &TreeRegressor) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let n = reg.dof();
+    if args.harmonics == 0 || args.harmonics > 50 {
+        return Err("error: --harmonics must be in 1..=50".into());
+    }
+    if !(args.period.is_finite() && args.period > 0.0) {
+        return Err("error: --period must be a positive number of seconds".into());
+    }
+    let min = reg.nbp() / n.max(1) + 1;
+    if args.samples < min || args.samples > 10_000_000 {
+        return Err(format!(
+            "error: --samples must be in {min}..=10000000 (the regressor needs at least {min} states)"
+        ));
+    }
+    if args.search_samples < min || args.search_samples > 100_000 {
+        return Err(format!("error: --search-samples must be in {min}..=100000"));
+    }
+    if args.restarts == 0 || args.restarts > 1000 || args.evaluations > 10_000_000 {
+        return Err("error: --restarts must be in 1..=1000 and --evaluations at most 1e7".into());
+    }
+    let k = args.noise.len();
+    if !(k == 0 || k == 1 || k == n) {
+        return Err(format!(
+            "error: --noise: {k} values for {n} joints (give 1 or {n})"
+        ));
+    }
+    if args.noise.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        return Err("error: --noise: standard deviations must be finite and >= 0".into());
+    }
+    Ok((
+        per_joint(&args.q_max, n, "--q-max")?,
+        per_joint(&args.qd_max, n, "--qd-max")?,
+    ))
+}
+
+/// Run `excite`.
+pub fn run(args: &ExciteArgs) -> ExitCode {
+    let (name, source) = match super::read_spec(&args.spec) {
+        Ok(r) => r,
+        Err(c) => return c,
+    };
+    let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
+        Ok(r) => r,
+        Err(e) => {
+            eprint!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    if !warnings.is_empty() {
+        eprint!("{warnings}");
+    }
+    let (q_max, qd_max) = match check(args, &reg) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    let best = search(&reg, args, &q_max, &qd_max);
+    let n = reg.dof();
+    let mut csv = String::from("t");
+    for kind in ["q", "qd", "qdd"]
+        .iter()
+        .chain(if args.with_tau { &["tau"][..] } else { &[][..] })
+    {
+        for i in 1..=n {
+            csv.push_str(&format!(",{kind}{i}"));
+        }
+    }
+    csv.push('\n');
+    let sigma: Vec<f64> = match args.noise.len() {
+        0 => vec![0.0; n],
+        1 => vec![args.noise[0]; n],
+        _ => args.noise.clone(),
+    };
+    let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
+    let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
+    for k in 0..args.samples {
+        let t = args.period * k as f64 / args.samples as f64;
+        let (q, qd, qdd) = best.state(t);
+        let mut row = vec![t];
+        row.extend(&q);
+        row.extend(&qd);
+        row.extend(&qdd);
+        if args.with_tau {
+            let tau = reg.inverse_dynamics(&q, &qd, &qdd);
+            row.extend(tau.iter().zip(&sigma).map(|(t, s)| {
+                if *s > 0.0 {
+                    t + s * gauss(&mut noise)
+                } else {
+                    *t
+                }
+            }));
+        }
+        for i in 0..n {
+            mq[i] = mq[i].max(q[i].abs());
+            mqd[i] = mqd[i].max(qd[i].abs());
+        }
+        let line: Vec<String> = row.iter().map(|v| format!("{v}")).collect();
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+    }
+    let cond = condition(&stacked(&reg, &best, args.samples));
+    eprintln!(
+        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}; max |q| {}; max |qd| {}",
+        reg.model.name,
+        args.harmonics,
+        args.period,
+        args.samples,
+        fmt_list(&mq),
+        fmt_list(&mqd)
+    );
+    match &args.output {
+        Some(p) => {
+            if let Err(e) = codegen::build_script::write_if_changed(p, &csv) {
+                eprintln!("error: {e}");
+                return ExitCode::from(1);
+            }
+        }
+        None => out!("{csv}"),
+    }
+    ExitCode::SUCCESS
+}
+
+/// A standard normal number (Box–Muller).
+fn gauss(r: &mut Rng) -> f64 {
+    let u1 = r.uniform(0.0, 1.0).max(1e-300);
+    let u2 = r.uniform(0.0, 1.0);
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+fn fmt_list(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format!("{x:.3}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The random starts and coordinate search; progress on standard error.
+fn search(reg: &TreeRegressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> Fourier {
+    const GRID: usize = 400;
+    let n = reg.dof();
+    let l = args.harmonics;
+    let w = 2.0 * std::f64::consts::PI / args.period;
+    let mut rng = Rng::new(args.seed);
+    // A coefficient's natural size: the velocity amplitude that reaches the bound.
+    let unit: Vec<f64> = (0..n).map(|i| (q_max[i] * w).min(qd_max[i])).collect();
+    let cost = |f: &Fourier| {
+        let c = condition(&stacked(reg, f, args.search_samples));
+        if c.is_finite() { c } else { f64::MAX }
+    };
+    let mut best: Option<(f64, Fourier)> = None;
+    for r in 0..args.restarts {
+        let c: Vec<f64> = (0..n * 2 * l)
+            .map(|k| unit[k / (2 * l)] * rng.uniform(-1.0, 1.0))
+            .collect();
+        let mut cur = Fourier { c, n, l, w }.feasible(q_max, qd_max, GRID);
+        let mut fc = cost(&cur);
+        let mut evals = 1;
+        let mut h = 0.5;
+        let mut sweep = 0;
+        'search: while h > 1e-3 {
+            let mut gained = false;
+            for k in 0..cur.c.len() {
+                for sign in [1.0, -1.0] {
+                    if evals >= args.evaluations {
+                        break 'search;
+                    }
+                    let mut t = cur.clone();
+                    t.c[k] += sign * h * unit[k / (2 * l)];
+                    let t = t.feasible(q_max, qd_max, GRID);
+                    let ft = cost(&t);
+                    evals += 1;
+                    if ft < fc {
+                        (cur, fc, gained) = (t, ft, true);
+                        break;
+                    }
+                }
+            }
+            sweep += 1;
+            eprintln!(
+                "excite: start {}/{}, sweep {sweep}: step {h:.4}, condition number {fc:.4e} ({evals} evaluations)",
+                r + 1,
+                args.restarts
+            );
+            if !gained {
+                h *= 0.5;
+            }
+        }
+        eprintln!(
+            "excite: start {}/{} done: condition number {fc:.4e} after {evals} evaluations",
+            r + 1,
+            args.restarts
+        );
+        if best.as_ref().is_none_or(|(b, _)| fc < *b) {
+            best = Some((fc, cur));
+        }
+    }
+    match best {
+        Some((_, f)) => f,
+        None => Fourier {
+            c: vec![0.0; n * 2 * l],
+            n,
+            l,
+            w,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derivatives_are_those_of_the_series_and_bounds_hold() {
+        let f = Fourier {
+            c: vec![0.3, -0.2, 0.5, 0.1, 1.0, 2.0, -0.4, 0.7],
+            n: 2,
+            l: 2,
+            w: 0.7,
+        };
+        let (t, h) = (1.3, 1e-5);
+        for i in 0..2 {
+            let (q0, qd, qdd) = f.joint(i, t);
+            let (qp, qdp, _) = f.joint(i, t + h);
+            let (qm, qdm, _) = f.joint(i, t - h);
+            assert!(((qp - qm) / (2.0 * h) - qd).abs() < 1e-8, "{q0}");
+            assert!(((qdp - qdm) / (2.0 * h) - qdd).abs() < 1e-8);
+        }
+        let g = f.feasible(&[0.1, 0.1], &[0.05, 10.0], 400);
+        for k in 0..1000 {
+            let (q, qd, _) = g.state(9.0 * k as f64 / 1000.0);
+            assert!(q.iter().all(|x| x.abs() <= 0.1 * 1.0001));
+            assert!(qd[0].abs() <= 0.05 * 1.0001);
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Smoothing and differentiation of sampled joint positions (`identify` with `t, q, tau` only,
+//! docs/identification.md, "Positions only"): a second-order Butterworth low-pass run forward
+//! then backward (zero phase, fourth-order roll-off, gain 1/2 at the cutoff), then central
+//! differences for `q̇` and `q̈`. The efforts go through the same filter, so that the model and
+//! the measurement see the same frequency band (Gautier's parallel filtering).
+
+/// The coefficients `(b0, b1, b2, a1, a2)` of a second-order Butterworth low-pass with cutoff
+/// `fc` at sample rate `fs` (bilinear transform with prewarping): `y_k = b0 x_k + b1 x_{k−1}
+/// + b2 x_{k−2} − a1 y_{k−1} − a2 y_{k−2}`.
+fn butterworth(fc: f64, fs: f64) -> [f64; 5] {
+    let k = (std::f64::consts::PI * fc / fs).tan();
+    let r2 = std::f64::consts::SQRT_2;
+    let norm = 1.0 / (1.0 + r2 * k + k * k);
+    let b0 = k * k * norm;
+    [
+        b0,
+        2.0 * b0,
+        b0,
+        2.0 * (k * k - 1.0) * norm,
+        (1.0 - r2 * k + k * k) * norm,
+    ]
+}
+
+/// One pass of the biquad, started in the steady state of the first sample (no transient for
+/// a signal that starts flat).
+fn pass(c: &[f64; 5], x: &mut [f64]) {
+    let [b0, b1, b2, a1, a2] = *c;
+    let Some(&x0) = x.first() else { return };
+    let mut z2 = (b2 - a2) * x0;
+    let mut z1 = (b1 - a1) * x0 + z2;
+    for v in x.iter_mut() {
+        let xi = *v;
+        let y = b0 * xi + z1;
+        z1 = b1 * xi - a1 * y + z2;
+        z2 = b2 * xi - a2 * y;
+        *v = y;
+    }
+}
+
+/// Zero-phase low-pass of `x` (forward, then backward).
+pub fn filtfilt(x: &mut [f64], fc: f64, fs: f64) {
+    let c = butterworth(fc, fs);
+    pass(&c, x);
+    x.reverse();
+    pass(&c, x);
+    x.reverse();
+}
+
+/// Central differences of uniformly sampled `x` (step `dt`): `(ẋ, ẍ)`, second order inside;
+/// the two end samples take the one-sided values of their neighbours (the caller drops them).
+pub fn differentiate(x: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
+    let n = x.len();
+    let mut d = vec![0.0; n];
+    let mut dd = vec![0.0; n];
+    for k in 1..n.saturating_sub(1) {
+        d[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+        dd[k] = (x[k + 1] - 2.0 * x[k] + x[k - 1]) / (dt * dt);
+    }
+    if n >= 3 {
+        d[0] = d[1];
+        dd[0] = dd[1];
+        d[n - 1] = d[n - 2];
+        dd[n - 1] = dd[n - 2];
+    }
+    (d, dd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dc_passes_and_high_frequencies_are_cut() {
+        let fs = 1000.0;
+        let mut flat = vec![2.5; 200];
+        filtfilt(&mut flat, 20.0, fs);
+        assert!(flat.iter().all(|v| (v - 2.5).abs() < 1e-12));
+        // 200 Hz through a 20 Hz cutoff: (20/200)^4 ≈ 1e-4 of the amplitude.
+        let mut hf: Vec<f64> = (0..2000)
+            .map(|k| (2.0 * std::f64::consts::PI * 200.0 * k as f64 / fs).sin())
+            .collect();
+        filtfilt(&mut hf, 20.0, fs);
+        let inner = &hf[200..1800];
+        assert!(inner.iter().all(|v| v.abs() < 1e-3), "{:e}", inner[500]);
+    }
+
+    #[test]
+    fn a_slow_sine_is_differentiated_within_the_band() {
+        let (fs, f) = (500.0, 0.5);
+        let w = 2.0 * std::f64::consts::PI * f;
+        let mut x: Vec<f64> = (0..5000).map(|k| (w * k as f64 / fs).sin()).collect();
+        filtfilt(&mut x, 10.0, fs);
+        let (d, dd) = differentiate(&x, 1.0 / fs);
+        for k in 500..4500 {
+            let t = k as f64 / fs;
+            assert!((d[k] - w * (w * t).cos()).abs() < 1e-3 * w, "{k}");
+            assert!((dd[k] + w * w * (w * t).sin()).abs() < 1e-3 * w * w, "{k}");
+        }
+    }
+}

@@ -1,0 +1,301 @@
+//! `codegen identify SPEC data.csv`: the base parameters of a tree from measured motions and
+//! efforts by weighted least squares, with their standard deviations, the regressor's
+//! condition number, warnings for parameters the data do not excite, and (`--out`) the spec
+//! updated so that its model has the identified base parameters (docs/identification.md).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, ValueEnum};
+use nalgebra::{DMatrix, DVector};
+
+use super::samples::{self, Filtering};
+use super::tree_regressor::TreeRegressor;
+use super::wls::{self, Stacked};
+
+/// How the rows are weighted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Weights {
+    /// Per joint by `1/σ_j`, `σ_j` the noise estimated from an ordinary least-squares pass.
+    Auto,
+    /// Ordinary least squares.
+    None,
+}
+
+/// Arguments of `identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    /// Tree spec (`.toml` or `.urdf`) whose base parameters are identified.
+    pub spec: PathBuf,
+    /// Measurements: CSV with a header `t,q1..,qd1..,qdd1..,tau1..` (or `t,q1..,tau1..`).
+    pub data: PathBuf,
+    /// Write the spec updated to the identified base parameters here (TOML specs only).
+    #[arg(long, value_name = "UPDATED.toml")]
+    pub out: Option<PathBuf>,
+    /// Row weights.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub weights: Weights,
+    /// Positions-only data: cutoff of the zero-phase low-pass before differentiating, Hz.
+    #[arg(long, default_value_t = 5.0, value_name = "HZ")]
+    pub cutoff: f64,
+    /// Warn when a parameter's relative standard deviation exceeds this, percent.
+    #[arg(long, default_value_t = 10.0, value_name = "PERCENT")]
+    pub max_rel_std: f64,
+    /// Also write the estimates as CSV (`k,name,spec,estimate,std`, full precision).
+    #[arg(long, value_name = "FILE.csv")]
+    pub estimates: Option<PathBuf>,
+}
+
+/// Run `identify`.
+pub fn run(args: &IdentifyArgs) -> ExitCode {
+    let (name, source) = match super::read_spec(&args.spec) {
+        Ok(r) => r,
+        Err(c) => return c,
+    };
+    if !(args.max_rel_std > 0.0 && args.max_rel_std.is_finite()) {
+        eprintln!("error: --max-rel-std must be a positive percentage");
+        return ExitCode::from(2);
+    }
+    if !(args.cutoff > 0.0 && args.cutoff.is_finite()) {
+        eprintln!("error: --cutoff must be a positive frequency in Hz");
+        return ExitCode::from(2);
+    }
+    if args.out.is_some() && name.ends_with(".urdf") {
+        eprintln!(
+            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
+        );
+        return ExitCode::from(2);
+    }
+    let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
+        Ok(r) => r,
+        Err(e) => {
+            eprint!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    if !warnings.is_empty() {
+        eprint!("{warnings}");
+    }
+    let data_name = args.data.to_string_lossy().into_owned();
+    let text = match std::fs::read(&args.data) {
+        Ok(b) => match String::from_utf8(b) {
+            Ok(t) => t,
+            Err(_) => {
+                eprintln!("error: {data_name}: not UTF-8 text");
+                return ExitCode::from(2);
+            }
+        },
+        Err(e) => {
+            eprintln!("error: cannot read {data_name}: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let (n, nbp) = (reg.dof(), reg.nbp());
+    let joints: Vec<String> = reg.model.joints.iter().map(|j| j.name.clone()).collect();
+    let data = match samples::read(
+        &data_name,
+        &text,
+        &joints,
+        nbp / n.max(1) + 1,
+        Filtering {
+            cutoff: args.cutoff,
+        },
+    ) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    let rows = data.q.len();
+    let mut w = DMatrix::zeros(rows * n, nbp);
+    let mut tau = DVector::zeros(rows * n);
+    let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
+    for s in 0..rows {
+        reg.rows(&data.q[s], &data.qd[s], &data.qdd[s], &mut buf, &mut y);
+        for i in 0..n {
+            for k in 0..nbp {
+                w[(s * n + i, k)] = y[i * nbp + k];
+            }
+            tau[s * n + i] = data.tau[s][i];
+        }
+    }
+    let fit = wls::fit(&Stacked { w, tau, n }, args.weights == Weights::Auto);
+    report(&reg, &name, &data_name, rows, &data.note, &fit, args);
+    if let Some(path) = &args.estimates {
+        let mut csv = String::from("k,name,spec,estimate,std\n");
+        for k in 0..nbp {
+            csv.push_str(&format!(
+                "{k},\"{}\",{},{},{}\n",
+                reg.names[k], reg.values[k], fit.estimate[k], fit.std[k]
+            ));
+        }
+        if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
+            eprintln!("error: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    if let Some(path) = &args.out {
+        return write_update(&reg, &name, &source, &fit, path);
+    }
+    ExitCode::SUCCESS
+}
+
+/// The table of estimates, the condition number, warnings and residuals.
+fn report(
+    reg: &TreeRegressor,
+    name: &str,
+    data_name: &str,
+    rows: usize,
+    note: &Option<String>,
+    fit: &wls::Fit,
+    args: &IdentifyArgs,
+) {
+    let (n, nbp) = (reg.dof(), reg.nbp());
+    outln!(
+        "identify: {} ({name}) from {data_name}: {rows} samples x {n} joints, {nbp} base parameters, {}",
+        reg.model.name,
+        match args.weights {
+            Weights::Auto =>
+                "rows weighted by 1/sigma_j per joint (sigma_j from an ordinary least-squares pass)",
+            Weights::None => "ordinary least squares",
+        }
+    );
+    if let Some(note) = note {
+        outln!("data: {note}");
+    }
+    outln!(
+        "condition number of the {}stacked regressor: {:.4e}",
+        if args.weights == Weights::Auto {
+            "weighted "
+        } else {
+            ""
+        },
+        fit.condition
+    );
+    outln!(
+        "{:>4} {:>14} {:>14} {:>12} {:>10}  name",
+        "k",
+        "spec",
+        "estimate",
+        "std",
+        "rel.std%"
+    );
+    let mut warnings = Vec::new();
+    // Below this the estimate is zero to rounding and its relative deviation meaningless.
+    let tiny = 1e-12 * fit.estimate.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for k in 0..nbp {
+        let rel = if fit.estimate[k].abs().max(fit.std[k]) <= tiny {
+            0.0
+        } else {
+            100.0 * fit.std[k] / fit.estimate[k].abs()
+        };
+        outln!(
+            "{k:>4} {:>14.6e} {:>14.6e} {:>12.4e} {:>10.3}  {}",
+            reg.values[k],
+            fit.estimate[k],
+            fit.std[k],
+            rel,
+            reg.names[k]
+        );
+        if fit.unidentifiable[k] {
+            warnings.push(format!(
+                "warning: base parameter {k} ({}) lies in a near-null direction of the data: not excited, its estimate is the minimum-norm one",
+                reg.names[k]
+            ));
+        } else if rel.is_nan() || rel > args.max_rel_std {
+            warnings.push(format!(
+                "warning: base parameter {k} ({}): relative std {rel:.3}% > {}%: poorly excited by the data (or negligible)",
+                reg.names[k], args.max_rel_std
+            ));
+        }
+    }
+    let joint = |i: usize| &reg.model.joints[i].name;
+    outln!(
+        "residual RMS per joint (N·m or N): {}",
+        (0..n)
+            .map(|i| format!("{} {:.4e}", joint(i), fit.residual_rms[i]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if args.weights == Weights::Auto {
+        outln!(
+            "noise estimate sigma_j (the weights' inverse): {}",
+            (0..n)
+                .map(|i| format!("{} {:.4e}", joint(i), fit.sigma[i]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    for w in warnings {
+        eprintln!("{w}");
+    }
+}
+
+/// `max_k |a_k − b_k| / max(|b_k|, 1e-9 ‖b‖∞)` over the `keep` entries: relative, except for
+/// entries that are zero to the precision of the largest.
+pub fn relative_mismatch(a: &[f64], b: &[f64], keep: &[bool]) -> f64 {
+    let scale = 1e-9 * b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (0..b.len())
+        .filter(|&k| keep[k])
+        .map(|k| (a[k] - b[k]).abs() / b[k].abs().max(scale).max(f64::MIN_POSITIVE))
+        .fold(0.0, f64::max)
+}
+
+/// Write the updated spec and report its physical consistency.
+fn write_update(
+    reg: &TreeRegressor,
+    name: &str,
+    source: &str,
+    fit: &wls::Fit,
+    path: &std::path::Path,
+) -> ExitCode {
+    let identified: Vec<bool> = fit.unidentifiable.iter().map(|u| !u).collect();
+    let up = match super::spec_update::update(reg, name, source, &fit.estimate, &identified) {
+        Ok(u) => u,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    for s in &up.skipped {
+        eprintln!(
+            "note: body `{s}` has values that are not plain numbers (expressions, angle strings): left unchanged"
+        );
+    }
+    let worst = relative_mismatch(&up.written, &fit.estimate, &identified);
+    outln!(
+        "updated spec: {} (changed: {}); its base parameters match the estimates to {worst:.2e} (relative)",
+        path.display(),
+        if up.changed.is_empty() {
+            "nothing".to_string()
+        } else {
+            up.changed.join(", ")
+        }
+    );
+    if worst > 1e-6 {
+        eprintln!(
+            "warning: the spec's numbers cannot reproduce every identified base parameter (worst relative difference {worst:.2e}): a drive parameter whose scene switch is off?"
+        );
+    }
+    for (body, what, involved) in &up.violations {
+        eprintln!(
+            "warning: body `{body}` of the updated spec is not physical: {what}; base parameters involved: {}",
+            involved
+                .iter()
+                .map(|k| format!("{k} ({})", reg.names[*k]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    if up.violations.is_empty() {
+        outln!(
+            "physical consistency: every body of the updated spec has mass >= 0 and a positive definite inertia that satisfies the triangle inequality"
+        );
+    }
+    if let Err(e) = codegen::build_script::write_if_changed(path, &up.text) {
+        eprintln!("error: {e}");
+        return ExitCode::from(1);
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,432 @@
+//! The spec update of `identify --out` (docs/identification.md, "The updated spec"): the
+//! smallest change of the spec's standard parameters whose model has the identified base
+//! parameters, written into the spec's text (comments and layout kept).
+//!
+//! The unknowns are the spec's own numbers: per `[[body]]` its ten standard parameters in its
+//! body frame about its origin (`XX … ZZ`, `MX, MY, MZ`, `M`: the inertia about the origin, the
+//! first moment, the mass, which the body's `mass`, `com` and `inertia` are a non-linear but
+//! invertible form of), per `[[joint]]` its `damping`, `friction` and `armature`. The map `P`
+//! from them to the base parameters is linear (a frame change, merging and regrouping are
+//! linear in the standard parameters); its columns are found by loading the spec with one
+//! unknown moved at a time, so every conversion the loader makes (standard DH frames, fixed
+//! joints merged, the `[scene]`) is the loader's own. `Δ = P⁺ (π̂ − π_spec)` is the
+//! minimum-norm change; the written spec is loaded again to check it.
+
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use toml_edit::{DocumentMut, InlineTable, Item, Value};
+
+use runtime::model::{Mat3, Vec3};
+
+use super::tree_regressor::TreeRegressor;
+
+/// One unknown of the update.
+#[derive(Clone, Debug)]
+enum Unknown {
+    /// Standard parameter `k` (0..10) of `[[body]]` element `index`.
+    Body { index: usize, k: usize },
+    /// `damping`, `friction` or `armature` of `[[joint]]` element `index`.
+    Drive { index: usize, key: &'static str },
+}
+
+/// The outcome of an update.
+pub struct Update {
+    /// The updated spec text.
+    pub text: String,
+    /// Base parameters of the written spec (loaded again).
+    pub written: Vec<f64>,
+    /// Per body whose physics the written numbers break: `(body, what, base parameters
+    /// involved)`.
+    pub violations: Vec<(String, String, Vec<usize>)>,
+    /// Bodies whose numbers are not plain numbers (left unchanged).
+    pub skipped: Vec<String>,
+    /// The bodies and joints changed.
+    pub changed: Vec<String>,
+}
+
+/// A number as TOML: plain decimals between 1e-3 and 1e6, exponent form outside, always a
+/// float; the shortest text that reads back to the same `f64`.
+fn number(v: f64) -> Value {
+    let a = v.abs();
+    let mut s = if a == 0.0 || (1e-3..1e6).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    };
+    if !s.contains(['.', 'e']) {
+        s.push_str(".0");
+    }
+    s.parse().unwrap_or_else(|_| Value::from(v))
+}
+
+fn value(v: impl Into<Value>) -> Item {
+    Item::Value(v.into())
+}
+
+fn num(item: Option<&Item>) -> Option<f64> {
+    let v = item?.as_value()?;
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
+}
+
+fn get_num(t: &dyn toml_edit::TableLike, key: &str) -> Option<f64> {
+    num(t.get(key))
+}
+
+/// A body's ten standard parameters from its spec entry, `None` if a value is not a plain
+/// number (an expression, an angle string).
+fn body_parameters(t: &dyn toml_edit::TableLike) -> Option<[f64; 10]> {
+    let mass = get_num(t, "mass")?;
+    let com = match t.get("com") {
+        None => [0.0; 3],
+        Some(i) => {
+            let a = i.as_value()?.as_array()?;
+            let v: Vec<f64> = a
+                .iter()
+                .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                .collect::<Option<_>>()?;
+            [*v.first()?, *v.get(1)?, *v.get(2)?]
+        }
+    };
+    let mut ic = [[0.0; 3]; 3];
+    if let Some(i) = t.get("inertia") {
+        let it = i.as_table_like()?;
+        let g = |k: &str| match it.get(k) {
+            None => Some(0.0),
+            Some(x) => num(Some(x)),
+        };
+        let (xx, yy, zz) = (g("ixx")?, g("iyy")?, g("izz")?);
+        let (xy, xz, yz) = (g("ixy")?, g("ixz")?, g("iyz")?);
+        ic = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
+    }
+    if let Some(i) = t.get("inertia_rpy") {
+        let a = i.as_value()?.as_array()?;
+        let v: Vec<f64> = a
+            .iter()
+            .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+            .collect::<Option<_>>()?;
+        let r = runtime::model::rpy_to_matrix([*v.first()?, *v.get(1)?, *v.get(2)?]);
+        let m = DMatrix::from_fn(3, 3, |i, j| r[i][j]);
+        let i3 = DMatrix::from_fn(3, 3, |i, j| ic[i][j]);
+        let rot = &m * i3 * m.transpose();
+        ic = std::array::from_fn(|i| std::array::from_fn(|j| rot[(i, j)]));
+    }
+    Some(codegen::dynamics::body_standard_parameters(mass, &com, &ic))
+}
+
+/// `(mass, com, inertia about the com)` of standard parameters `p`; `Err` when no body has them
+/// (a negative mass, or a first moment without mass).
+fn from_standard(p: &[f64; 10]) -> Result<(f64, Vec3, Mat3), String> {
+    let m = p[9];
+    let h = [p[6], p[7], p[8]];
+    if m < 0.0 {
+        return Err(format!("mass {m} kg < 0"));
+    }
+    let c = if m > 0.0 {
+        [h[0] / m, h[1] / m, h[2] / m]
+    } else if h.iter().all(|x| *x == 0.0) {
+        [0.0; 3]
+    } else {
+        return Err("a first moment without mass".into());
+    };
+    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let jo = [[p[0], p[1], p[2]], [p[1], p[3], p[4]], [p[2], p[4], p[5]]];
+    let ic = std::array::from_fn(|r| {
+        std::array::from_fn(|k| jo[r][k] - m * (if r == k { cc } else { 0.0 } - c[r] * c[k]))
+    });
+    Ok((m, c, ic))
+}
+
+/// Write a body's numbers (`inertia_rpy` removed: the inertia is written in body axes).
+fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), String> {
+    let (m, c, ic) = from_standard(p)?;
+    t.insert("mass", value(number(m)));
+    let mut com = toml_edit::Array::new();
+    for x in c {
+        com.push(number(x));
+    }
+    t.insert("com", value(com));
+    let mut it = InlineTable::new();
+    for (k, (r, c)) in [
+        ("ixx", (0, 0)),
+        ("iyy", (1, 1)),
+        ("izz", (2, 2)),
+        ("ixy", (0, 1)),
+        ("ixz", (0, 2)),
+        ("iyz", (1, 2)),
+    ] {
+        it.insert(k, number(ic[r][c]));
+    }
+    t.insert("inertia", value(it));
+    t.remove("inertia_rpy");
+    Ok(())
+}
+
+/// Apply `values` (one per unknown) to a copy of `doc`.
+fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<DocumentMut, String> {
+    let mut d = doc.clone();
+    let mut bodies: std::collections::BTreeMap<usize, [f64; 10]> = Default::default();
+    for (u, &v) in unknowns.iter().zip(values) {
+        match u {
+            Unknown::Body { index, k } => bodies.entry(*index).or_insert([0.0; 10])[*k] = v,
+            Unknown::Drive { index, key } => {
+                if let Some(t) = d["joint"]
+                    .as_array_of_tables_mut()
+                    .and_then(|a| a.get_mut(*index))
+                {
+                    t.insert(key, value(number(v)));
+                }
+            }
+        }
+    }
+    for (index, p) in bodies {
+        if let Some(t) = d["body"]
+            .as_array_of_tables_mut()
+            .and_then(|a| a.get_mut(index))
+        {
+            let name = t
+                .get("name")
+                .and_then(|n| n.as_str())
+                .unwrap_or("?")
+                .to_string();
+            set_body(t, &p).map_err(|e| format!("body `{name}`: {e}"))?;
+        }
+    }
+    Ok(d)
+}
+
+/// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
+fn base_of(reg: &TreeRegressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
+    let loaded = codegen::spec::load(file, text, &codegen::spec::SceneOverrides::default())
+        .map_err(|d| d.render())?;
+    match loaded.mechanism {
+        codegen::spec::Mechanism::Tree(m) => Ok(reg.base_of(&m)),
+        _ => Err("not a tree".into()),
+    }
+}
+
+/// The update of `source` whose model has base parameters `target` where `fit[k]` (elsewhere
+/// the spec's).
+pub fn update(
+    reg: &TreeRegressor,
+    file: &str,
+    source: &str,
+    target: &[f64],
+    fit: &[bool],
+) -> Result<Update, String> {
+    if file.ends_with(".urdf") {
+        return Err(
+            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
+                .into(),
+        );
+    }
+    let doc: DocumentMut = source
+        .parse()
+        .map_err(|e| format!("error: {file}: not TOML: {e}"))?;
+    let mut unknowns = Vec::new();
+    let mut z0 = Vec::new();
+    let mut skipped = Vec::new();
+    let mut names = Vec::new();
+    if let Some(a) = doc.get("body").and_then(Item::as_array_of_tables) {
+        for (index, t) in a.iter().enumerate() {
+            let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            match body_parameters(t) {
+                Some(p) => {
+                    for (k, v) in p.into_iter().enumerate() {
+                        unknowns.push(Unknown::Body { index, k });
+                        z0.push(v);
+                        names.push(format!("body `{name}`"));
+                    }
+                }
+                None => skipped.push(name.to_string()),
+            }
+        }
+    }
+    if let Some(a) = doc.get("joint").and_then(Item::as_array_of_tables) {
+        for (index, t) in a.iter().enumerate() {
+            let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            for key in ["damping", "friction", "armature"] {
+                if let Some(v) = match t.get(key) {
+                    None => Some(0.0),
+                    Some(i) => num(Some(i)),
+                } {
+                    unknowns.push(Unknown::Drive { index, key });
+                    z0.push(v);
+                    names.push(format!("joint `{name}`"));
+                }
+            }
+        }
+    }
+    // The spec normalized (every body written from its standard parameters) must be the spec.
+    let norm = apply(&doc, &unknowns, &z0)?;
+    let pi0 = base_of(reg, file, &norm.to_string())?;
+    // The columns of P: each unknown moved from a reference point where every body is valid.
+    let nbp = reg.nbp();
+    let mut p = DMatrix::zeros(nbp, unknowns.len());
+    let mut reference = z0.clone();
+    for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
+        if let Unknown::Body { k, .. } = u {
+            *r = match k {
+                0 | 3 | 5 | 9 => 1.0,
+                _ => 0.0,
+            };
+        }
+    }
+    let ref_doc = apply(&doc, &unknowns, &reference)?;
+    let pi_ref = base_of(reg, file, &ref_doc.to_string())?;
+    for c in 0..unknowns.len() {
+        let mut z = reference.clone();
+        z[c] += 1.0;
+        let d = apply(&doc, &unknowns, &z)?;
+        let pi = base_of(reg, file, &d.to_string())?;
+        for r in 0..nbp {
+            p[(r, c)] = pi[r] - pi_ref[r];
+        }
+    }
+    // Rounding noise of the differences (the exact entries are sums of grouping coefficients).
+    let pmax = p.amax();
+    p.apply(|x| {
+        if x.abs() <= 1e-12 * pmax {
+            *x = 0.0
+        }
+    });
+    let d = DVector::from_fn(nbp, |k, _| if fit[k] { target[k] - pi0[k] } else { 0.0 });
+    let dz = p
+        .clone()
+        .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
+        .map_err(|e| format!("error: the update's least squares failed: {e}"))?
+        * d;
+    // An unknown that moves no base parameter stays as written (the SVD leaves rounding
+    // noise there).
+    let mut dz = dz;
+    for c in 0..unknowns.len() {
+        if p.column(c).iter().all(|x| *x == 0.0) {
+            dz[c] = 0.0;
+        }
+    }
+    let z: Vec<f64> = z0.iter().zip(dz.iter()).map(|(a, b)| a + b).collect();
+    let mut changed: Vec<String> = Vec::new();
+    let largest = dz.amax();
+    for (c, name) in names.iter().enumerate() {
+        if dz[c].abs() > 1e-13 * largest && !changed.contains(name) {
+            changed.push(name.clone());
+        }
+    }
+    // Only the entries that change are rewritten; the others keep their text.
+    let touched: Vec<usize> = (0..unknowns.len())
+        .filter(|&c| changed.contains(&names[c]))
+        .collect();
+    let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c].clone()).collect();
+    let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
+    let out = apply(&doc, &sub_u, &sub_z).map_err(|e| {
+        format!("error: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
+    })?;
+    let text = out.to_string();
+    let written = base_of(reg, file, &text)?;
+    let violations = consistency(&out, &unknowns, &p);
+    Ok(Update {
+        text,
+        written,
+        violations,
+        skipped,
+        changed,
+    })
+}
+
+/// The bodies of `doc` whose numbers break positive mass, a positive definite inertia or the
+/// triangle inequality, with the base parameters their unknowns move.
+fn consistency(
+    doc: &DocumentMut,
+    unknowns: &[Unknown],
+    p: &DMatrix<f64>,
+) -> Vec<(String, String, Vec<usize>)> {
+    let mut out = Vec::new();
+    let Some(a) = doc.get("body").and_then(Item::as_array_of_tables) else {
+        return out;
+    };
+    for (index, t) in a.iter().enumerate() {
+        let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+        let Some(sp) = body_parameters(t) else {
+            continue;
+        };
+        let Ok((m, _, ic)) = from_standard(&sp) else {
+            continue;
+        };
+        let mut what = Vec::new();
+        let zero_inertia = ic.iter().flatten().all(|x| *x == 0.0);
+        if m < 0.0 {
+            what.push(format!("mass {m:.6e} kg < 0"));
+        } else if m == 0.0 && !zero_inertia {
+            what.push("zero mass but a non-zero inertia".into());
+        }
+        let e = SymmetricEigen::new(DMatrix::from_fn(3, 3, |i, j| ic[i][j])).eigenvalues;
+        let mut ev: Vec<f64> = e.iter().copied().collect();
+        ev.sort_by(f64::total_cmp);
+        let scale = ev[2].abs().max(f64::MIN_POSITIVE);
+        if ev[0] <= 1e-12 * scale && !zero_inertia {
+            what.push(format!(
+                "inertia about the mass centre not positive definite (principal moments {:.4e}, {:.4e}, {:.4e} kg·m²)",
+                ev[0], ev[1], ev[2]
+            ));
+        } else if ev[0] + ev[1] < ev[2] * (1.0 - 1e-12) {
+            what.push(format!(
+                "principal moments {:.4e} + {:.4e} < {:.4e} kg·m² (triangle inequality)",
+                ev[0], ev[1], ev[2]
+            ));
+        }
+        if what.is_empty() {
+            continue;
+        }
+        let involved: Vec<usize> = (0..p.nrows())
+            .filter(|&r| {
+                unknowns.iter().enumerate().any(|(c, u)| {
+                    matches!(u, Unknown::Body { index: i, .. } if *i == index)
+                        && p[(r, c)].abs() > 1e-12
+                })
+            })
+            .collect();
+        out.push((name.to_string(), what.join("; "), involved));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn standard_parameters_round_trip_and_refuse_what_no_body_has() {
+        let (m, c, ic) = (
+            2.5,
+            [0.1, -0.2, 0.3],
+            [[0.4, 0.01, 0.0], [0.01, 0.5, 0.02], [0.0, 0.02, 0.6]],
+        );
+        let p = codegen::dynamics::body_standard_parameters(m, &c, &ic);
+        let (m2, c2, ic2) = from_standard(&p).unwrap();
+        assert!((m2 - m).abs() < 1e-15);
+        for k in 0..3 {
+            assert!((c2[k] - c[k]).abs() < 1e-15);
+            for l in 0..3 {
+                assert!((ic2[k][l] - ic[k][l]).abs() < 1e-14);
+            }
+        }
+        let mut neg = p;
+        neg[9] = -1.0;
+        assert!(from_standard(&neg).unwrap_err().contains("< 0"));
+        let mut massless = [0.0; 10];
+        massless[6] = 0.1;
+        assert!(
+            from_standard(&massless)
+                .unwrap_err()
+                .contains("without mass")
+        );
+    }
+
+    #[test]
+    fn numbers_are_written_as_floats_that_read_back_exactly() {
+        for v in [0.0, 17.0, -0.0203, 7.9e-31, 1.5e7, 0.1 + 0.2] {
+            let text = number(v).to_string();
+            let back: f64 = text.trim().parse().unwrap();
+            assert_eq!(back, v, "{text}");
+            assert!(text.contains(['.', 'e']), "{text}");
+        }
+    }
+}

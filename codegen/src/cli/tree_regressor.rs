@@ -1,0 +1,152 @@
+//! A tree's base regressor for the identification tools (`identify`, `excite`): the spec loaded
+//! with its `[scene]`, the generator's regressor over the base parameters
+//! (`codegen::dynamics::regressor`, the one the generated module's `regressor` is), flattened
+//! for evaluation at many states, and the grouping matrix `G` of the base parameters
+//! (`π_base = G · π_standard`, docs/identification.md).
+
+use std::collections::HashMap;
+
+use codegen::dynamics::{BODY_PARAMETERS, Tree, body_standard_parameters};
+use codegen::spec::Mechanism;
+use codegen::sym::{Arg, Graph};
+use runtime::model::Model;
+
+use super::tape::Tape;
+
+/// The base regressor of a tree spec.
+pub struct TreeRegressor {
+    /// The model (the spec with its `[scene]` applied).
+    pub model: Model,
+    /// `BASE_PARAMETER_NAMES`.
+    pub names: Vec<String>,
+    /// `BASE_PARAMETERS` of the spec.
+    pub values: Vec<f64>,
+    /// The standard parameters' names (`XX_link2`, `FV_j1`, …), in the regressor's order.
+    pub standard_names: Vec<String>,
+    /// `G`, `NBP` rows of `standard_names.len()` entries: `π_base = G π_standard`.
+    pub grouping: Vec<Vec<f64>>,
+    tape: Tape,
+}
+
+/// Why a spec has no tree regressor: the rendered diagnostics, or the refusal of a kind.
+pub fn refusal_for_kind(name: &str, m: &Mechanism) -> Option<String> {
+    match m {
+        Mechanism::Tree(_) => None,
+        Mechanism::Parallel(_) => Some(format!(
+            "error: {name}: a parallel mechanism; identification works on trees only (regressors of platforms and closed loops are not generated yet, issue 23)\n"
+        )),
+        Mechanism::Closed(_) => Some(format!(
+            "error: {name}: a mechanism with closed loops; identification works on trees only (regressors of platforms and closed loops are not generated yet, issue 23)\n"
+        )),
+    }
+}
+
+impl TreeRegressor {
+    /// Load a spec's text (with its `[scene]`). The error is rendered text (exit code 2).
+    pub fn compile(name: &str, source: &str) -> Result<(TreeRegressor, String), String> {
+        let loaded = codegen::spec::load(name, source, &codegen::spec::SceneOverrides::default())
+            .map_err(|d| d.render())?;
+        let warnings = if loaded.warnings.is_empty() {
+            String::new()
+        } else {
+            loaded.warnings.render()
+        };
+        if let Some(e) = refusal_for_kind(name, &loaded.mechanism) {
+            return Err(e);
+        }
+        let Mechanism::Tree(model) = loaded.mechanism else {
+            return Err(format!("error: {name}: not a tree\n"));
+        };
+        Ok((TreeRegressor::new(model), warnings))
+    }
+
+    /// The regressor of a validated tree model.
+    pub fn new(model: Model) -> TreeRegressor {
+        let tree = Tree::new(&model);
+        let mut g = Graph::new();
+        let r = codegen::dynamics::regressor(&mut g, &tree, &model);
+        let nstd = r.standard.names.len();
+        let grouping = r
+            .base
+            .groups
+            .iter()
+            .map(|gr| {
+                let mut row = vec![0.0; nstd];
+                for &(k, c) in gr {
+                    row[k] += c;
+                }
+                row
+            })
+            .collect();
+        TreeRegressor {
+            tape: Tape::new(&g, &r.outputs),
+            names: r.base.names,
+            values: r.base.values,
+            standard_names: r.standard.names,
+            grouping,
+            model,
+        }
+    }
+
+    /// Degrees of freedom.
+    pub fn dof(&self) -> usize {
+        self.model.dof()
+    }
+
+    /// Number of base parameters.
+    pub fn nbp(&self) -> usize {
+        self.values.len()
+    }
+
+    /// `Y(q, q̇, q̈)` into `out` (`DOF × NBP`, row-major); `buf` is scratch space.
+    pub fn rows(&self, q: &[f64], qd: &[f64], qdd: &[f64], buf: &mut Vec<f64>, out: &mut [f64]) {
+        let input = |a: Arg, i: usize| match a {
+            Arg::Q => q[i],
+            Arg::Qd => qd[i],
+            Arg::Qdd => qdd[i],
+            _ => f64::NAN,
+        };
+        self.tape.eval(&input, buf, out);
+    }
+
+    /// Inverse dynamics by the runtime's RNEA (independent of the regressor) plus the drives.
+    pub fn inverse_dynamics(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
+        let tau = runtime::rnea::inverse_dynamics(&self.model, q, qd, qdd);
+        (0..self.dof())
+            .map(|i| tau[i] + self.model.joints[i].drive.effort(qd[i], qdd[i]))
+            .collect()
+    }
+
+    /// The base parameters of a model with the same structure: `G · π_standard(model)`
+    /// (standard values read by name; a name the model lacks counts 0).
+    pub fn base_of(&self, model: &Model) -> Vec<f64> {
+        let s = standard_values(model);
+        let x: Vec<f64> = self
+            .standard_names
+            .iter()
+            .map(|n| s.get(n).copied().unwrap_or(0.0))
+            .collect();
+        self.grouping
+            .iter()
+            .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
+            .collect()
+    }
+}
+
+/// Every standard parameter a model could have, by name (`XX_<body>` … `M_<body>`, and
+/// `FV_`, `FC_`, `IA_<joint>` from the drives as the scene made them).
+pub fn standard_values(model: &Model) -> HashMap<String, f64> {
+    let mut out = HashMap::new();
+    for b in &model.bodies {
+        let v = body_standard_parameters(b.mass, &b.com, &b.inertia);
+        for (p, x) in BODY_PARAMETERS.iter().zip(v) {
+            out.insert(format!("{p}_{}", b.name), x);
+        }
+    }
+    for j in &model.joints {
+        out.insert(format!("FV_{}", j.name), j.drive.viscous);
+        out.insert(format!("FC_{}", j.name), j.drive.coulomb);
+        out.insert(format!("IA_{}", j.name), j.drive.armature);
+    }
+    out
+}
