@@ -49,6 +49,10 @@ int main(void) {
     memcpy(d + N * N, d2, sizeof d2);
     memcpy(d + 2 * N * N, d3, sizeof d3);
     output("forward_dynamics_derivatives", s, d, 3 * N * N);
+    {
+        double y[N * DELTA_RL5_NBP];
+        output("regressor", delta_rl5_regressor(x, u, ud, y, &err), y, N * DELTA_RL5_NBP);
+    }
     /* Forward kinematics from home back to x. */
     output("forward_kinematics", delta_rl5_forward_kinematics(q, home, fk, &err), fk, NX);
     s = delta_rl5_inertia_indices(am, &ix, &err);

@@ -416,6 +416,11 @@ fn delta_rl5_from_c() {
         &g::forward_dynamics(&x, &u, &tau).unwrap(),
     );
     check_derivatives!(p, g, x, u, ud, tau);
+    let y = g::regressor(&x, &u, &ud).unwrap();
+    p.check(
+        "regressor",
+        &y.iter().flatten().copied().collect::<Vec<_>>(),
+    );
     p.check(
         "forward_kinematics",
         &g::forward_kinematics(&q, &g::HOME).unwrap(),
