@@ -22,6 +22,7 @@ use crate::spec::{Frame, Kind, RuntimeBody, RuntimeParams, Scene};
 use crate::sym::{Arg, ExprId, Graph};
 use crate::{Config, Generated, MathBackend, VERSION, tangent};
 
+mod regressor;
 mod templates;
 
 use templates::templates;
@@ -57,6 +58,9 @@ pub struct Kernels {
     pub forward_dynamics_derivatives: Kernel,
     /// Per frame of [`kernels_with_frames`]: its pose at `x` (`R` row-major, then `p`).
     pub frames: Vec<Kernel>,
+    /// The generalized forces of the base parameters (`DOF × NBP`, row-major), with the base
+    /// parameters: [`kernels_for`] a model with constant parameters only.
+    pub regressor: Option<(Kernel, crate::dynamics::Base)>,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -85,7 +89,21 @@ pub fn kernels_with_frames(
     bodies: &[usize],
     frames: &[Frame],
 ) -> Result<Kernels, Singular> {
-    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body, bodies, frames));
+    let (r, graph) = in_fresh_graph(|| build(plan, layout, payload_body, bodies, frames, None));
+    r.map(|k| Kernels { graph, ..k })
+}
+
+/// [`kernels_with_frames`] of `model` (whose plan is `plan`) without run-time parameters, with
+/// its regressor over the base parameters when `regressor`.
+pub fn kernels_for(
+    model: &ClosedModel,
+    plan: &Plan,
+    frames: &[Frame],
+    regressor: bool,
+) -> Result<Kernels, Singular> {
+    let model = regressor.then_some(model);
+    let layout = Layout::default();
+    let (r, graph) = in_fresh_graph(|| build(plan, &layout, None, &[], frames, model));
     r.map(|k| Kernels { graph, ..k })
 }
 
@@ -95,6 +113,7 @@ fn build(
     payload_body: Option<usize>,
     bodies: &[usize],
     frames: &[Frame],
+    model: Option<&ClosedModel>,
 ) -> Result<Kernels, Singular> {
     let d = plan.dof();
     let x = inputs(Arg::X, plan.nx());
@@ -226,6 +245,12 @@ fn build(
                 Kernel::new(ids(&out), Vec::new())
             })
             .collect(),
+        // The regressor, after everything else.
+        regressor: match model {
+            Some(m) => regressor::regressor(m, plan, &x, &u, &ud)?
+                .map(|r| (Kernel::new(r.outputs, r.guards), r.base)),
+            None => None,
+        },
     })
 }
 
@@ -260,10 +285,14 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
     let body_links: Vec<usize> = bodies.iter().map(|b| b.body).collect();
     let wanted = |name: &str| scene.functions.wants(Kind::Closed, name);
     let frames: &[Frame] = if wanted("frames") { &scene.frames } else { &[] };
-    let k = kernels_with_frames(&plan, &layout, payload.map(|p| p.0), &body_links, frames)
-        .map_err(|e| {
-            format!("the mechanism is singular for every input ({e}); check the loop geometry")
-        })?;
+    let k = if layout.any() {
+        kernels_with_frames(&plan, &layout, payload.map(|p| p.0), &body_links, frames)
+    } else {
+        kernels_for(model, &plan, frames, wanted("regressor"))
+    }
+    .map_err(|e| {
+        format!("the mechanism is singular for every input ({e}); check the loop geometry")
+    })?;
     let n = plan.dof();
     let functions = functions(&k, &plan, &layout);
     let mut stats = stats(&functions, &wanted);
@@ -300,7 +329,10 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         .map(|&j| joint_names[j].clone())
         .collect();
     let header = header(model, &plan, &layout, bodies, cfg, &act_names, &stats);
-    let items = items(cfg, model, &plan, params, &layout, &joint_names, &act_names);
+    let mut items = items(cfg, model, &plan, params, &layout, &joint_names, &act_names);
+    if let Some((_, base)) = k.regressor.as_ref().filter(|_| wanted("regressor")) {
+        items.extend(crate::tree::base_parameter_items(base, "x, u, ud"));
+    }
     // The names every actuator-space module has (parallel mechanisms): here the actuated
     // joints are the independent coordinates, so `A = 1`.
     let actuator_mass_matrix = if wanted("mass_matrix") {
@@ -469,6 +501,18 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
         ),
     ];
     functions.extend(friction);
+    functions.extend(k.regressor.as_ref().map(|(kernel, base)| {
+        fns.make(
+            "regressor",
+            vec![format!(
+                "The regressor over the base parameters: `inverse_dynamics(x, u, ud) = regressor(x, u, ud) · BASE_PARAMETERS`, element `[i][k]` the effort of independent coordinate `i` per unit of base parameter `k` (`BASE_PARAMETER_NAMES[k]`: the standard parameters it groups; springs' stiffness `K_` and damping `D_` among them). {coords}. `Err` where `inverse_dynamics` fails."
+            )],
+            vec![Arg::X, Arg::U, Arg::Ud],
+            kernel,
+            fallible(&[Part::Regressor(base.kept.len())]),
+            true,
+        )
+    }));
     functions
 }
 

@@ -53,6 +53,7 @@ pub mod sym;
 mod tangent;
 mod template;
 pub mod tree;
+mod unit_parameters;
 
 use schedule::OpCount;
 

@@ -48,6 +48,10 @@ int main(void) {
     memcpy(d + N * N, d2, sizeof d2);
     memcpy(d + 2 * N * N, d3, sizeof d3);
     output("forward_dynamics_derivatives", s, d, 3 * N * N);
+    {
+        double y[N * FOUR_BAR_NBP];
+        output("regressor", four_bar_regressor(x, u, ud, y, &err), y, N * FOUR_BAR_NBP);
+    }
     output("gravity", four_bar_gravity(x, g, &err), g, N);
     output("coriolis", four_bar_coriolis(x, u, c, &err), c, N);
     output("actuator_mass_matrix", four_bar_actuator_mass_matrix(x, am, &err), am, N * N);

@@ -492,6 +492,11 @@ fn four_bar_from_c() {
         &g::forward_dynamics(&x, &u, &tau).unwrap(),
     );
     check_derivatives!(p, g, x, u, ud, tau);
+    let y = g::regressor(&x, &u, &ud).unwrap();
+    p.check(
+        "regressor",
+        &y.iter().flatten().copied().collect::<Vec<_>>(),
+    );
     p.check("gravity", &g::gravity(&x).unwrap());
     p.check("coriolis", &g::coriolis(&x, &u).unwrap());
     let am = g::actuator_mass_matrix(&x).unwrap();

@@ -16,25 +16,7 @@ use rand::rngs::StdRng;
 use runtime::model::{Body, Drive, Mat3};
 use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
-
-/// Khalil's standard parameters `XX … ZZ, MX, MY, MZ, M` of `(m, c, I_c)`, about the origin
-/// (parallel-axis theorem, written here).
-fn standard(m: f64, c: &[f64; 3], ic: &Mat3) -> [f64; 10] {
-    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-    let j = |r: usize, k: usize| ic[r][k] + m * (if r == k { cc } else { 0.0 } - c[r] * c[k]);
-    [
-        j(0, 0),
-        j(0, 1),
-        j(0, 2),
-        j(1, 1),
-        j(1, 2),
-        j(2, 2),
-        m * c[0],
-        m * c[1],
-        m * c[2],
-        m,
-    ]
-}
+use tests::base_parameters::{rank_of, standard};
 
 /// The model's bodies: the platform, then each leg's in order.
 fn bodies(m: &mut ParallelModel) -> Vec<&mut Body> {
@@ -83,22 +65,6 @@ fn random_models(m: &ParallelModel, rng: &mut StdRng) -> Vec<(Vec<Plan>, DMatrix
             (plans, pi.try_inverse().expect("generic parameters"))
         })
         .collect()
-}
-
-/// The numerical rank of `a` after scaling each column to unit norm (zero columns dropped).
-fn rank(a: &DMatrix<f64>) -> usize {
-    let cols: Vec<_> = a
-        .column_iter()
-        .filter(|c| c.norm() > 1e-12 * a.amax().max(1e-300) * (a.nrows() as f64).sqrt())
-        .map(|c| c.normalize())
-        .collect();
-    if cols.is_empty() {
-        return 0;
-    }
-    let m = DMatrix::from_columns(&cols);
-    let s = m.svd(false, false).singular_values;
-    let top = s.max();
-    s.iter().filter(|&&v| v > 1e-9 * top).count()
 }
 
 macro_rules! platforms {
@@ -173,12 +139,12 @@ macro_rules! platforms {
                     let y = DMatrix::from_fn(n, g::NBP, |i, k| y[i][k]);
                     gen_rows.view_mut((s * n, 0), (n, g::NBP)).copy_from(&(a.transpose() * y));
                 }
-                let rs = rank(&std_rows);
-                let rg = rank(&gen_rows);
+                let rs = rank_of(&std_rows);
+                let rg = rank_of(&gen_rows);
                 let both = DMatrix::from_fn(states * n, ncols + g::NBP, |i, k| {
                     if k < ncols { std_rows[(i, k)] } else { gen_rows[(i, k - ncols)] }
                 });
-                let rb = rank(&both);
+                let rb = rank_of(&both);
                 println!(
                     "{}: {} standard parameters, SVD rank {rs}; NBP {}, generated regressor rank {rg}, both {rb}",
                     stringify!($name), ncols, g::NBP

@@ -11,9 +11,9 @@
 //!   on a revolute joint's axis, carried by the joint's body or by its parent) give the same
 //!   efforts and the same base parameter values.
 
-use nalgebra::DMatrix;
 use rand::Rng;
 use runtime::model::{Drive, Mat3, Model, Vec3};
+use tests::base_parameters::{rank, standard};
 use tests::{rel_err, rng};
 
 const STATES: usize = 500;
@@ -23,25 +23,6 @@ fn model(file: &str, src: &str) -> Model {
         Ok((m, _)) => m,
         Err(d) => panic!("{d}"),
     }
-}
-
-/// Khalil's ten standard parameters `XX, XY, XZ, YY, YZ, ZZ, MX, MY, MZ, M` of a body (inertia
-/// about the body-frame origin), written here from the parallel-axis theorem.
-fn standard(mass: f64, c: &Vec3, ic: &Mat3) -> [f64; 10] {
-    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-    let j = |r: usize, k: usize| ic[r][k] + mass * (if r == k { cc } else { 0.0 } - c[r] * c[k]);
-    [
-        j(0, 0),
-        j(0, 1),
-        j(0, 2),
-        j(1, 1),
-        j(1, 2),
-        j(2, 2),
-        mass * c[0],
-        mass * c[1],
-        mass * c[2],
-        mass,
-    ]
 }
 
 /// The body `(mass, com, inertia about the com)` of standard parameters `p` (`M ≠ 0`).
@@ -114,30 +95,6 @@ fn standard_rows(m: &Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<Vec<f64>>
         }
     }
     cols
-}
-
-/// Numerical rank of the columns (each scaled to unit norm; columns below `1e-10` of the
-/// largest norm are zero) by an SVD, relative tolerance `1e-8`.
-fn rank(cols: &[Vec<f64>]) -> usize {
-    let largest = cols
-        .iter()
-        .map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
-        .fold(0.0, f64::max);
-    let kept: Vec<Vec<f64>> = cols
-        .iter()
-        .filter_map(|c| {
-            let nrm = c.iter().map(|x| x * x).sum::<f64>().sqrt();
-            (nrm > 1e-10 * largest).then(|| c.iter().map(|x| x / nrm).collect())
-        })
-        .collect();
-    if kept.is_empty() {
-        return 0;
-    }
-    let rows = kept[0].len();
-    let a = DMatrix::from_fn(rows, kept.len(), |i, j| kept[j][i]);
-    let sv = a.svd(false, false).singular_values;
-    let max = sv.iter().copied().fold(0.0, f64::max);
-    sv.iter().filter(|&&s| s > 1e-8 * max).count()
 }
 
 macro_rules! regressor_tests {
