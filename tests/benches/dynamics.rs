@@ -392,6 +392,18 @@ task_vs_joints!(
     [1.0, 0.5, -2.0, 5.0]
 );
 
+/// A state near home: the actuated coordinates moved by 0.01, speeds and rates fixed numbers.
+fn near_home<M: runtime::Dynamics<NX, N, Scalar = f64>, const NX: usize, const N: usize>(
+    m: &M,
+) -> ([f64; NX], [f64; N], [f64; N]) {
+    let q0 = m.inverse_kinematics(&M::HOME).expect("home is regular");
+    let q: [f64; N] = core::array::from_fn(|i| q0[i] + 0.01 * (i as f64 + 1.0));
+    let x = m.forward_kinematics(&q, &M::HOME).expect("assembles");
+    let u: [f64; N] = core::array::from_fn(|i| 0.3 - 0.1 * i as f64);
+    let ud: [f64; N] = core::array::from_fn(|i| 1.0 - 0.4 * i as f64);
+    (x, u, ud)
+}
+
 /// The derivative functions beside `inverse_dynamics`, generated, through `runtime::Dynamics`
 /// (the module's own functions, forwarded): `{name}/derivatives/{function}` at a state near
 /// home (the actuated coordinates moved by 0.01, speeds and rates fixed numbers).
@@ -399,11 +411,7 @@ fn derivatives_of<M: runtime::Dynamics<NX, N, Scalar = f64>, const NX: usize, co
     c: &mut Criterion,
     m: &M,
 ) {
-    let q0 = m.inverse_kinematics(&M::HOME).expect("home is regular");
-    let q: [f64; N] = core::array::from_fn(|i| q0[i] + 0.01 * (i as f64 + 1.0));
-    let x = m.forward_kinematics(&q, &M::HOME).expect("assembles");
-    let u: [f64; N] = core::array::from_fn(|i| 0.3 - 0.1 * i as f64);
-    let ud: [f64; N] = core::array::from_fn(|i| 1.0 - 0.4 * i as f64);
+    let (x, u, ud) = near_home(m);
     let tau = m.inverse_dynamics(&x, &u, &ud).expect("regular");
     assert!(
         m.inverse_dynamics_derivatives(&x, &u, &ud)
@@ -436,9 +444,41 @@ fn derivatives(c: &mut Criterion) {
     derivatives_of(c, &mechanisms::andrews_squeezer::Module);
 }
 
+/// `regressor` beside `inverse_dynamics` (`{name}/regressor/{function}`), at the derivative
+/// benches' state near home; a tree's `regressor` returns the array, the others a `Result`.
+macro_rules! regressor_benches {
+    ($($m:ident),* $(,)?) => {
+        fn regressor(c: &mut Criterion) {
+            use runtime::Dynamics;
+            $({
+                use mechanisms::$m as g;
+                let m = g::Module;
+                let (x, u, ud) = near_home(&m);
+                let mut grp = c.benchmark_group(format!("{}/regressor", stringify!($m)));
+                grp.bench_function("inverse_dynamics", |b| {
+                    b.iter(|| m.inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+                });
+                grp.bench_function("regressor", |b| {
+                    b.iter(|| g::regressor(black_box(&x), black_box(&u), black_box(&ud)))
+                });
+                grp.finish();
+            })*
+        }
+    };
+}
+
+regressor_benches!(
+    puma560,
+    chain7,
+    gough_stewart,
+    delta_rl5,
+    agile_eye,
+    andrews_squeezer
+);
+
 criterion_group! {
     name = benches;
     config = config();
-    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, prs_task_vs_joints, delta4_rl5, delta4_task_vs_joints, five_bar_joints, spherical_five_bar, derivatives
+    targets = puma560, chain7, gough_stewart, agile_eye, delta_rl5, delta_task_vs_joints, planar_3rrr, planar3_task_vs_joints, tsai_3upu, upu_task_vs_joints, prs_task_vs_joints, delta4_rl5, delta4_task_vs_joints, five_bar_joints, spherical_five_bar, derivatives, regressor
 }
 criterion_main!(benches);
