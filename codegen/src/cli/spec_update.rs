@@ -11,13 +11,20 @@
 //! unknown moved at a time, so every conversion the loader makes (standard DH frames, fixed
 //! joints merged, the `[scene]`) is the loader's own. `Δ = P⁺ (π̂ − π_spec)` is the
 //! minimum-norm change; the written spec is loaded again to check it.
+//!
+//! A platform's legs are usually one `[[pattern]]` whose bodies every copy shares: their
+//! unknowns are per copy (the values the spec's text gives each copy, patterns expanded), and a
+//! changed pattern body is written as expressions indexing per-copy arrays that the update adds
+//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). Base parameters that no written
+//! number moves (a massless U joint's cross, a parallelogram's rods) keep the spec's values and
+//! are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::tree_regressor::TreeRegressor;
+use super::regressor::Regressor;
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -26,6 +33,14 @@ enum Unknown {
     Body { index: usize, k: usize },
     /// `damping`, `friction` or `armature` of `[[joint]]` element `index`.
     Drive { index: usize, key: &'static str },
+    /// Standard parameter `k` of copy `copy` (from 1) of `[[pattern]]` element `pattern`'s
+    /// `[[pattern.body]]` element `body`.
+    Copy {
+        pattern: usize,
+        body: usize,
+        copy: usize,
+        k: usize,
+    },
 }
 
 /// The outcome of an update.
@@ -41,6 +56,8 @@ pub struct Update {
     pub skipped: Vec<String>,
     /// The bodies and joints changed.
     pub changed: Vec<String>,
+    /// The base parameters that no number of the update moves (kept at the spec's values).
+    pub unreachable: Vec<usize>,
 }
 
 /// A number as TOML: plain decimals between 1e-3 and 1e6, exponent form outside, always a
@@ -160,12 +177,103 @@ fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), Strin
     Ok(())
 }
 
+/// A pattern body's copies as per-copy arrays in `[parameters]`, which its entries index
+/// (`inertia_rpy` removed).
+fn set_copies(
+    d: &mut DocumentMut,
+    pattern: usize,
+    body: usize,
+    copies: &[[f64; 10]],
+) -> Result<(), String> {
+    let Some(t) = d["pattern"]
+        .as_array_of_tables_mut()
+        .and_then(|a| a.get_mut(pattern))
+        .and_then(|p| p.get_mut("body"))
+        .and_then(Item::as_array_of_tables_mut)
+        .and_then(|a| a.get_mut(body))
+    else {
+        return Ok(());
+    };
+    let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("body");
+    let stem: String = template
+        .replace("{i}", "")
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    let stem = format!("identified_{}", stem.trim_matches('_'));
+    let mut arrays: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut per = Vec::new();
+    for (c, p) in copies.iter().enumerate() {
+        per.push(from_standard(p).map_err(|e| format!("body `{template}` copy {}: {e}", c + 1))?);
+    }
+    let key = |what: &str| format!("{stem}_{what}");
+    arrays.push((key("mass"), per.iter().map(|b| b.0).collect()));
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        arrays.push((
+            key(&format!("com_{axis}")),
+            per.iter().map(|b| b.1[a]).collect(),
+        ));
+    }
+    let entries = [
+        ("ixx", (0, 0)),
+        ("iyy", (1, 1)),
+        ("izz", (2, 2)),
+        ("ixy", (0, 1)),
+        ("ixz", (0, 2)),
+        ("iyz", (1, 2)),
+    ];
+    for (k, (r, c)) in entries {
+        arrays.push((key(k), per.iter().map(|b| b.2[r][c]).collect()));
+    }
+    let at = |k: &str| Value::from(format!("{k}[i]"));
+    t.insert("mass", value(at(&key("mass"))));
+    let mut com = toml_edit::Array::new();
+    for axis in ["x", "y", "z"] {
+        com.push(at(&key(&format!("com_{axis}"))));
+    }
+    t.insert("com", value(com));
+    let mut it = InlineTable::new();
+    for (k, _) in entries {
+        it.insert(k, at(&key(k)));
+    }
+    t.insert("inertia", value(it));
+    t.remove("inertia_rpy");
+    if !d.contains_key("parameters") {
+        d["parameters"] = Item::Table(toml_edit::Table::new());
+    }
+    let params = d["parameters"]
+        .as_table_like_mut()
+        .ok_or("`parameters` is not a table")?;
+    for (name, values) in arrays {
+        let mut a = toml_edit::Array::new();
+        for v in values {
+            a.push(number(v));
+        }
+        params.insert(&name, value(a));
+    }
+    Ok(())
+}
+
 /// Apply `values` (one per unknown) to a copy of `doc`.
 fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<DocumentMut, String> {
     let mut d = doc.clone();
     let mut bodies: std::collections::BTreeMap<usize, [f64; 10]> = Default::default();
+    type Copies = std::collections::BTreeMap<usize, [f64; 10]>;
+    let mut copies: std::collections::BTreeMap<(usize, usize), Copies> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::Copy {
+                pattern,
+                body,
+                copy,
+                k,
+            } => {
+                copies
+                    .entry((*pattern, *body))
+                    .or_default()
+                    .entry(*copy)
+                    .or_insert([0.0; 10])[*k] = v
+            }
             Unknown::Body { index, k } => bodies.entry(*index).or_insert([0.0; 10])[*k] = v,
             Unknown::Drive { index, key } => {
                 if let Some(t) = d["joint"]
@@ -190,23 +298,71 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
             set_body(t, &p).map_err(|e| format!("body `{name}`: {e}"))?;
         }
     }
+    for ((pattern, body), c) in copies {
+        let c: Vec<[f64; 10]> = c.into_values().collect();
+        set_copies(&mut d, pattern, body, &c)?;
+    }
     Ok(d)
 }
 
-/// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
-fn base_of(reg: &TreeRegressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
-    let loaded = codegen::spec::load(file, text, &codegen::spec::SceneOverrides::default())
-        .map_err(|d| d.render())?;
-    match loaded.mechanism {
-        codegen::spec::Mechanism::Tree(m) => Ok(reg.base_of(&m)),
-        _ => Err("not a tree".into()),
+/// The unknowns of the `[[pattern.body]]` entries: per copy, the values the spec gives it
+/// (`written`, patterns expanded); a body some copy of which is not found is skipped.
+fn pattern_unknowns(
+    doc: &DocumentMut,
+    written: &[(String, f64, Vec3, Mat3)],
+    unknowns: &mut Vec<Unknown>,
+    z0: &mut Vec<f64>,
+    names: &mut Vec<String>,
+    skipped: &mut Vec<String>,
+) {
+    let Some(patterns) = doc.get("pattern").and_then(Item::as_array_of_tables) else {
+        return;
+    };
+    for (pattern, p) in patterns.iter().enumerate() {
+        let copies = p.get("copies").and_then(|c| c.as_integer()).unwrap_or(0) as usize;
+        let Some(bodies) = p.get("body").and_then(Item::as_array_of_tables) else {
+            continue;
+        };
+        for (body, t) in bodies.iter().enumerate() {
+            let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            let values: Option<Vec<[f64; 10]>> = (1..=copies)
+                .map(|i| {
+                    let name = template.replace("{i}", &i.to_string());
+                    written
+                        .iter()
+                        .find(|b| b.0 == name)
+                        .map(|b| codegen::dynamics::body_standard_parameters(b.1, &b.2, &b.3))
+                })
+                .collect();
+            let Some(values) = values else {
+                skipped.push(template.to_string());
+                continue;
+            };
+            for (c, v) in values.iter().enumerate() {
+                for (k, x) in v.iter().enumerate() {
+                    unknowns.push(Unknown::Copy {
+                        pattern,
+                        body,
+                        copy: c + 1,
+                        k,
+                    });
+                    z0.push(*x);
+                    names.push(format!("body `{template}`"));
+                }
+            }
+        }
     }
+}
+
+/// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
+fn base_of(reg: &Regressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
+    reg.base_of_spec(file, text)
 }
 
 /// The update of `source` whose model has base parameters `target` where `fit[k]` (elsewhere
 /// the spec's).
 pub fn update(
-    reg: &TreeRegressor,
+    reg: &Regressor,
     file: &str,
     source: &str,
     target: &[f64],
@@ -255,15 +411,32 @@ pub fn update(
             }
         }
     }
+    if let Some(written) = codegen::spec::written_bodies(file, source) {
+        pattern_unknowns(
+            &doc,
+            &written,
+            &mut unknowns,
+            &mut z0,
+            &mut names,
+            &mut skipped,
+        );
+    }
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
     let pi0 = base_of(reg, file, &norm.to_string())?;
+    let pi_spec = base_of(reg, file, source)?;
+    let drift = super::identify::relative_mismatch(&pi0, &pi_spec, &vec![true; pi0.len()]);
+    if drift > 1e-9 {
+        return Err(format!(
+            "error: {file}: its bodies written back as numbers change its base parameters ({drift:.2e} relative): --out cannot rewrite this spec (no file written)"
+        ));
+    }
     // The columns of P: each unknown moved from a reference point where every body is valid.
     let nbp = reg.nbp();
     let mut p = DMatrix::zeros(nbp, unknowns.len());
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
-        if let Unknown::Body { k, .. } = u {
+        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } = u {
             *r = match k {
                 0 | 3 | 5 | 9 => 1.0,
                 _ => 0.0,
@@ -288,7 +461,16 @@ pub fn update(
             *x = 0.0
         }
     });
-    let d = DVector::from_fn(nbp, |k, _| if fit[k] { target[k] - pi0[k] } else { 0.0 });
+    let unreachable: Vec<usize> = (0..nbp)
+        .filter(|&r| p.row(r).iter().all(|x| *x == 0.0))
+        .collect();
+    let d = DVector::from_fn(nbp, |k, _| {
+        if fit[k] && !unreachable.contains(&k) {
+            target[k] - pi0[k]
+        } else {
+            0.0
+        }
+    });
     let dz = p
         .clone()
         .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
@@ -321,13 +503,15 @@ pub fn update(
     })?;
     let text = out.to_string();
     let written = base_of(reg, file, &text)?;
-    let violations = consistency(&out, &unknowns, &p);
+    let mut violations = consistency(&out, &unknowns, &p);
+    violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
     Ok(Update {
         text,
         written,
         violations,
         skipped,
         changed,
+        unreachable,
     })
 }
 
@@ -350,6 +534,66 @@ fn consistency(
         let Ok((m, _, ic)) = from_standard(&sp) else {
             continue;
         };
+        let what = physics(m, &ic);
+        if what.is_empty() {
+            continue;
+        }
+        let involved: Vec<usize> = (0..p.nrows())
+            .filter(|&r| {
+                unknowns.iter().enumerate().any(|(c, u)| {
+                    matches!(u, Unknown::Body { index: i, .. } if *i == index)
+                        && p[(r, c)].abs() > 1e-12
+                })
+            })
+            .collect();
+        out.push((name.to_string(), what.join("; "), involved));
+    }
+    out
+}
+
+/// The changed pattern bodies' copies that break physics, as [`consistency`].
+fn copy_consistency(
+    unknowns: &[Unknown],
+    z: &[f64],
+    names: &[String],
+    changed: &[String],
+    p: &DMatrix<f64>,
+) -> Vec<(String, String, Vec<usize>)> {
+    let mut out = Vec::new();
+    let mut c = 0;
+    while c < unknowns.len() {
+        let Unknown::Copy { copy, .. } = unknowns[c] else {
+            c += 1;
+            continue;
+        };
+        let sp: [f64; 10] = std::array::from_fn(|k| z[c + k]);
+        let cols = c..c + 10;
+        c += 10;
+        if !changed.contains(&names[cols.start]) {
+            continue;
+        }
+        let Ok((m, _, ic)) = from_standard(&sp) else {
+            continue;
+        };
+        let what = physics(m, &ic);
+        if what.is_empty() {
+            continue;
+        }
+        let involved: Vec<usize> = (0..p.nrows())
+            .filter(|&r| cols.clone().any(|k| p[(r, k)].abs() > 1e-12))
+            .collect();
+        let name = names[cols.start]
+            .trim_start_matches("body `")
+            .trim_end_matches('`')
+            .replace("{i}", &copy.to_string());
+        out.push((name, what.join("; "), involved));
+    }
+    out
+}
+
+/// What a body of mass `m` and central inertia `ic` breaks (empty: nothing).
+fn physics(m: f64, ic: &Mat3) -> Vec<String> {
+    {
         let mut what = Vec::new();
         let zero_inertia = ic.iter().flatten().all(|x| *x == 0.0);
         if m < 0.0 {
@@ -372,20 +616,8 @@ fn consistency(
                 ev[0], ev[1], ev[2]
             ));
         }
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| {
-                unknowns.iter().enumerate().any(|(c, u)| {
-                    matches!(u, Unknown::Body { index: i, .. } if *i == index)
-                        && p[(r, c)].abs() > 1e-12
-                })
-            })
-            .collect();
-        out.push((name.to_string(), what.join("; "), involved));
+        what
     }
-    out
 }
 
 #[cfg(test)]

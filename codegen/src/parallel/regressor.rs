@@ -31,6 +31,10 @@ pub(super) struct PlatformRegressor {
     pub guards: Vec<ExprId>,
     /// The base parameters.
     pub base: Base,
+    /// The standard parameters' names, in the order the groups index.
+    pub standard_names: Vec<String>,
+    /// The model's standard parameters, same order.
+    pub standard_values: Vec<f64>,
 }
 
 /// What a standard parameter's column is made of: the generalized force of `plus`, less that
@@ -249,5 +253,7 @@ pub(super) fn regressor(
         outputs,
         guards,
         base,
+        standard_names: standard.names,
+        standard_values: standard.values,
     }))
 }
