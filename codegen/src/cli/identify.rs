@@ -272,7 +272,7 @@ fn write_update(
     };
     for s in &up.skipped {
         eprintln!(
-            "note: body `{s}` has values that are not plain numbers (expressions, angle strings): left unchanged"
+            "note: {s} has values that are not plain numbers (expressions, angle strings): left unchanged"
         );
     }
     let reproduced: Vec<bool> = (0..identified.len())
@@ -301,8 +301,17 @@ fn write_update(
         );
     }
     if worst > 1e-6 {
+        let off: Vec<String> = (0..reproduced.len())
+            .filter(|&k| {
+                let mut one = vec![false; reproduced.len()];
+                one[k] = reproduced[k];
+                relative_mismatch(&up.written, &fit.estimate, &one) > 1e-6
+            })
+            .map(|k| format!("{k} ({})", reg.names()[k]))
+            .collect();
         eprintln!(
-            "warning: the spec's numbers cannot reproduce every identified base parameter (worst relative difference {worst:.2e}): a drive parameter whose scene switch is off?"
+            "warning: the spec's numbers cannot reproduce base parameters {} (worst relative difference {worst:.2e}; the update is their least-squares fit): a drive whose scene switch is off, or numbers one spec entry sets for several model joints (a U joint's two axes)?",
+            off.join(", ")
         );
     }
     for (body, what, involved) in &up.violations {

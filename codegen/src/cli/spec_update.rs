@@ -26,6 +26,9 @@ use runtime::model::{Mat3, Vec3};
 
 use super::regressor::Regressor;
 
+mod patterns;
+use patterns::{copy_consistency, pattern_unknowns, set_copies};
+
 /// One unknown of the update.
 #[derive(Clone, Debug)]
 enum Unknown {
@@ -40,6 +43,14 @@ enum Unknown {
         body: usize,
         copy: usize,
         k: usize,
+    },
+    /// `damping`, `friction` or `armature` of copy `copy` (from 1) of `[[pattern]]` element
+    /// `pattern`'s `[[pattern.joint]]` element `joint`.
+    CopyDrive {
+        pattern: usize,
+        joint: usize,
+        copy: usize,
+        key: &'static str,
     },
 }
 
@@ -177,91 +188,27 @@ fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), Strin
     Ok(())
 }
 
-/// A pattern body's copies as per-copy arrays in `[parameters]`, which its entries index
-/// (`inertia_rpy` removed).
-fn set_copies(
-    d: &mut DocumentMut,
-    pattern: usize,
-    body: usize,
-    copies: &[[f64; 10]],
-) -> Result<(), String> {
-    let Some(t) = d["pattern"]
-        .as_array_of_tables_mut()
-        .and_then(|a| a.get_mut(pattern))
-        .and_then(|p| p.get_mut("body"))
-        .and_then(Item::as_array_of_tables_mut)
-        .and_then(|a| a.get_mut(body))
-    else {
-        return Ok(());
-    };
-    let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("body");
-    let stem: String = template
-        .replace("{i}", "")
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect();
-    let stem = format!("identified_{}", stem.trim_matches('_'));
-    let mut arrays: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut per = Vec::new();
-    for (c, p) in copies.iter().enumerate() {
-        per.push(from_standard(p).map_err(|e| format!("body `{template}` copy {}: {e}", c + 1))?);
-    }
-    let key = |what: &str| format!("{stem}_{what}");
-    arrays.push((key("mass"), per.iter().map(|b| b.0).collect()));
-    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
-        arrays.push((
-            key(&format!("com_{axis}")),
-            per.iter().map(|b| b.1[a]).collect(),
-        ));
-    }
-    let entries = [
-        ("ixx", (0, 0)),
-        ("iyy", (1, 1)),
-        ("izz", (2, 2)),
-        ("ixy", (0, 1)),
-        ("ixz", (0, 2)),
-        ("iyz", (1, 2)),
-    ];
-    for (k, (r, c)) in entries {
-        arrays.push((key(k), per.iter().map(|b| b.2[r][c]).collect()));
-    }
-    let at = |k: &str| Value::from(format!("{k}[i]"));
-    t.insert("mass", value(at(&key("mass"))));
-    let mut com = toml_edit::Array::new();
-    for axis in ["x", "y", "z"] {
-        com.push(at(&key(&format!("com_{axis}"))));
-    }
-    t.insert("com", value(com));
-    let mut it = InlineTable::new();
-    for (k, _) in entries {
-        it.insert(k, at(&key(k)));
-    }
-    t.insert("inertia", value(it));
-    t.remove("inertia_rpy");
-    if !d.contains_key("parameters") {
-        d["parameters"] = Item::Table(toml_edit::Table::new());
-    }
-    let params = d["parameters"]
-        .as_table_like_mut()
-        .ok_or("`parameters` is not a table")?;
-    for (name, values) in arrays {
-        let mut a = toml_edit::Array::new();
-        for v in values {
-            a.push(number(v));
-        }
-        params.insert(&name, value(a));
-    }
-    Ok(())
-}
-
 /// Apply `values` (one per unknown) to a copy of `doc`.
 fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<DocumentMut, String> {
     let mut d = doc.clone();
     let mut bodies: std::collections::BTreeMap<usize, [f64; 10]> = Default::default();
     type Copies = std::collections::BTreeMap<usize, [f64; 10]>;
     let mut copies: std::collections::BTreeMap<(usize, usize), Copies> = Default::default();
+    type Drives = std::collections::BTreeMap<usize, f64>;
+    let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::CopyDrive {
+                pattern,
+                joint,
+                copy,
+                key,
+            } => {
+                drives
+                    .entry((*pattern, *joint, key))
+                    .or_default()
+                    .insert(*copy, v);
+            }
             Unknown::Copy {
                 pattern,
                 body,
@@ -302,56 +249,11 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
         let c: Vec<[f64; 10]> = c.into_values().collect();
         set_copies(&mut d, pattern, body, &c)?;
     }
-    Ok(d)
-}
-
-/// The unknowns of the `[[pattern.body]]` entries: per copy, the values the spec gives it
-/// (`written`, patterns expanded); a body some copy of which is not found is skipped.
-fn pattern_unknowns(
-    doc: &DocumentMut,
-    written: &[(String, f64, Vec3, Mat3)],
-    unknowns: &mut Vec<Unknown>,
-    z0: &mut Vec<f64>,
-    names: &mut Vec<String>,
-    skipped: &mut Vec<String>,
-) {
-    let Some(patterns) = doc.get("pattern").and_then(Item::as_array_of_tables) else {
-        return;
-    };
-    for (pattern, p) in patterns.iter().enumerate() {
-        let copies = p.get("copies").and_then(|c| c.as_integer()).unwrap_or(0) as usize;
-        let Some(bodies) = p.get("body").and_then(Item::as_array_of_tables) else {
-            continue;
-        };
-        for (body, t) in bodies.iter().enumerate() {
-            let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
-            let values: Option<Vec<[f64; 10]>> = (1..=copies)
-                .map(|i| {
-                    let name = template.replace("{i}", &i.to_string());
-                    written
-                        .iter()
-                        .find(|b| b.0 == name)
-                        .map(|b| codegen::dynamics::body_standard_parameters(b.1, &b.2, &b.3))
-                })
-                .collect();
-            let Some(values) = values else {
-                skipped.push(template.to_string());
-                continue;
-            };
-            for (c, v) in values.iter().enumerate() {
-                for (k, x) in v.iter().enumerate() {
-                    unknowns.push(Unknown::Copy {
-                        pattern,
-                        body,
-                        copy: c + 1,
-                        k,
-                    });
-                    z0.push(*x);
-                    names.push(format!("body `{template}`"));
-                }
-            }
-        }
+    for ((pattern, joint, key), c) in drives {
+        let c: Vec<f64> = c.into_values().collect();
+        patterns::set_copy_drives(&mut d, pattern, joint, key, &c)?;
     }
+    Ok(d)
 }
 
 /// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
@@ -392,7 +294,7 @@ pub fn update(
                         names.push(format!("body `{name}`"));
                     }
                 }
-                None => skipped.push(name.to_string()),
+                None => skipped.push(format!("body `{name}`")),
             }
         }
     }
@@ -547,46 +449,6 @@ fn consistency(
             })
             .collect();
         out.push((name.to_string(), what.join("; "), involved));
-    }
-    out
-}
-
-/// The changed pattern bodies' copies that break physics, as [`consistency`].
-fn copy_consistency(
-    unknowns: &[Unknown],
-    z: &[f64],
-    names: &[String],
-    changed: &[String],
-    p: &DMatrix<f64>,
-) -> Vec<(String, String, Vec<usize>)> {
-    let mut out = Vec::new();
-    let mut c = 0;
-    while c < unknowns.len() {
-        let Unknown::Copy { copy, .. } = unknowns[c] else {
-            c += 1;
-            continue;
-        };
-        let sp: [f64; 10] = std::array::from_fn(|k| z[c + k]);
-        let cols = c..c + 10;
-        c += 10;
-        if !changed.contains(&names[cols.start]) {
-            continue;
-        }
-        let Ok((m, _, ic)) = from_standard(&sp) else {
-            continue;
-        };
-        let what = physics(m, &ic);
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| cols.clone().any(|k| p[(r, k)].abs() > 1e-12))
-            .collect();
-        let name = names[cols.start]
-            .trim_start_matches("body `")
-            .trim_end_matches('`')
-            .replace("{i}", &copy.to_string());
-        out.push((name, what.join("; "), involved));
     }
     out
 }
