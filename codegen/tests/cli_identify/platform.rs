@@ -436,3 +436,24 @@ fn bad_platform_data_is_exit_code_2_without_a_panic() {
         assert!(!text(&o.stderr).contains("panicked"));
     }
 }
+
+#[test]
+fn platform_excite_repeats_and_stays_within_its_bounds() {
+    let dir = scratch("platform_excite");
+    let m = platform("delta_rl5.toml", &bundled(DELTA));
+    let home = m.home_x();
+    let mut first = None;
+    for _ in 0..2 {
+        let states = platform_trajectory(&dir, Path::new(DELTA), &m, 0.25, 0.1);
+        for [x, _, _] in &states {
+            for k in 0..3 {
+                assert!((x[k] - home[k]).abs() <= 0.25, "{x:?}");
+            }
+        }
+        let bytes = std::fs::read(dir.join("traj.csv")).unwrap();
+        match &first {
+            None => first = Some(bytes),
+            Some(f) => assert_eq!(*f, bytes, "excite is deterministic for a seed"),
+        }
+    }
+}
