@@ -74,7 +74,19 @@ pub struct Kernels {
     pub frames: Vec<[Kernel; 3]>,
     /// `A` then the generalized forces of the base parameters (`DOF × NBP`), with the base
     /// parameters: [`kernels_for`] a model with constant parameters only.
-    pub regressor: Option<(Kernel, crate::dynamics::Base)>,
+    pub regressor: Option<RegressorKernel>,
+}
+
+/// A platform's regressor kernel and what its columns are.
+pub struct RegressorKernel {
+    /// `A` (row-major), then `F_b` (`DOF × NBP`, row-major): `τ = A⁻ᵀ F_b π_b`.
+    pub kernel: Kernel,
+    /// The base parameters (their groups index [`RegressorKernel::standard_names`]).
+    pub base: crate::dynamics::Base,
+    /// The standard parameters' names (`XX_platform`, …, `FV_<joint>`), in the groups' order.
+    pub standard_names: Vec<String>,
+    /// The model's standard parameters, same order.
+    pub standard_values: Vec<f64>,
 }
 
 /// Build the kernels (a generation-time `Singular` means the mechanism is singular for every
@@ -209,7 +221,12 @@ fn build(
     let regressor = match model {
         Some(m) => regressor::regressor(m, &x, &u, &ud, &a)?.map(|r| {
             let guards = tangent::union(kin_guards.clone(), r.guards);
-            (Kernel::new(r.outputs, guards), r.base)
+            RegressorKernel {
+                kernel: Kernel::new(r.outputs, guards),
+                base: r.base,
+                standard_names: r.standard_names,
+                standard_values: r.standard_values,
+            }
         }),
         None => None,
     };
@@ -326,8 +343,8 @@ pub fn generate(model: &ParallelModel, scene: &Scene, cfg: &Config) -> Result<Ge
     };
     let mut items = items(model, &plan, params, &layout, cfg, &emitted);
     items.extend(frame_items(frames));
-    if let Some((_, base)) = k.regressor.as_ref().filter(|_| emitted("regressor")) {
-        items.extend(crate::tree::base_parameter_items(base, "x, u, ud"));
+    if let Some(r) = k.regressor.as_ref().filter(|_| emitted("regressor")) {
+        items.extend(crate::tree::base_parameter_items(&r.base, "x, u, ud"));
     }
     let code = module::render(
         &ModulePlan {
@@ -513,13 +530,13 @@ fn functions(
             true,
         )
     });
-    let regressor = k.regressor.as_ref().map(|(kernel, base)| {
+    let regressor = k.regressor.as_ref().map(|r| {
         fns.make(
             "regressor_parts",
             vec!["Kernel of `regressor`: `A` and the generalized forces `F_b` of the base parameters, one column each.".into()],
             vec![Arg::X, Arg::U, Arg::Ud],
-            kernel,
-            fallible(&[Part::Matrix, Part::Regressor(base.kept.len())]),
+            &r.kernel,
+            fallible(&[Part::Matrix, Part::Regressor(r.base.kept.len())]),
             false,
         )
     });

@@ -6,7 +6,8 @@
 //! (`BASE_PARAMETERS` of `codegen::compile`, checked against the RNEA in
 //! `tests/tests/regressor.rs`), never numbers `identify` produced. Then the spec `identify`
 //! writes is compiled again and its `BASE_PARAMETERS` compared with the estimates. Bad input
-//! gives exit code 2 (1 for I/O) and never a panic.
+//! gives exit code 2 (1 for I/O) and never a panic. The same for the Gough–Stewart and the
+//! Delta in `cli_identify/platform.rs`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -412,13 +413,13 @@ fn bad_input_is_exit_code_2_without_a_panic() {
         assert!(err.contains(want), "{name}: {err}");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
-    // Not a tree: refused with the reason, for both commands.
-    let gs = "../mechanisms/specs/gough_stewart.toml";
-    for args in [vec!["identify", gs, "x.csv"], vec!["excite", gs]] {
+    // Closed loops: refused with the reason, for both commands.
+    let loops = "../mechanisms/specs/four_bar.toml";
+    for args in [vec!["identify", loops, "x.csv"], vec!["excite", loops]] {
         let o = run(&args);
         assert_eq!(o.status.code(), Some(2));
         assert!(
-            text(&o.stderr).contains("trees only"),
+            text(&o.stderr).contains("closed loops not yet"),
             "{}",
             text(&o.stderr)
         );
@@ -484,3 +485,7 @@ fn a_joint_that_never_moves_leaves_parameters_unexcited_and_excite_repeats() {
         "{err}"
     );
 }
+
+// Platforms: the Gough–Stewart and the Delta.
+#[path = "cli_identify/platform.rs"]
+mod platform;

@@ -8,6 +8,10 @@
 //! period, with a 0.1 % margin), so every candidate is feasible. The search is a coordinate
 //! (pattern) search from random starts: each coefficient moved by `± h`, kept when the
 //! condition number drops; `h` halves after a sweep without gain. Deterministic for a seed.
+//!
+//! A platform's series are its coordinates around home ([`super::platform_path`]), bounded by
+//! `--turn` (rad) and `--reach` (m); a candidate with a state where the regressor has no value
+//! (out of reach, a singularity) is rejected.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,13 +20,13 @@ use clap::Args;
 use nalgebra::DMatrix;
 
 use super::Rng;
-use super::tree_regressor::TreeRegressor;
+use super::regressor::Regressor;
 use super::wls::condition;
 
 /// Arguments of `excite`.
 #[derive(Debug, Args)]
 pub struct ExciteArgs {
-    /// Tree spec (`.toml` or `.urdf`).
+    /// Tree (`.toml` or `.urdf`) or platform spec.
     pub spec: PathBuf,
     /// Harmonics per joint, `L`.
     #[arg(long, default_value_t = 5)]
@@ -36,10 +40,18 @@ pub struct ExciteArgs {
     /// Seed of the random starts.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Position bound per joint (rad or m): one value, or one per joint separated by commas.
+    /// Position bound per joint (rad or m): one value, or one per joint separated by commas
+    /// (trees).
     #[arg(long, value_delimiter = ',', default_value = "1.0")]
     pub q_max: Vec<f64>,
-    /// Velocity bound per joint (rad/s or m/s): one value, or one per joint.
+    /// A platform's bound on each move from home, m.
+    #[arg(long, default_value_t = 0.05, value_name = "M")]
+    pub reach: f64,
+    /// A platform's bound on each of its turn angles from home, rad.
+    #[arg(long, default_value_t = 0.1, value_name = "RAD")]
+    pub turn: f64,
+    /// Velocity bound per joint (rad/s or m/s): one value, or one per joint (a platform's
+    /// speeds `u`).
     #[arg(long, value_delimiter = ',', default_value = "2.0")]
     pub qd_max: Vec<f64>,
     /// Random starts of the search.
@@ -51,7 +63,8 @@ pub struct ExciteArgs {
     /// States per period at which the condition number is taken during the search.
     #[arg(long, default_value_t = 60)]
     pub search_samples: usize,
-    /// Also write `tau1..` from the spec's inverse dynamics (the runtime's RNEA and drives).
+    /// Also write `tau1..` from the spec's inverse dynamics (the runtime's: a tree's RNEA and
+    /// drives, a platform's `f64` evaluator).
     #[arg(long)]
     pub with_tau: bool,
     /// With `--with-tau`: add Gaussian noise of this standard deviation to the efforts (N·m or
@@ -129,22 +142,30 @@ impl Fourier {
     }
 }
 
-/// The base regressor stacked at `m` equally spaced times over a period.
-fn stacked(reg: &TreeRegressor, f: &Fourier, m: usize) -> DMatrix<f64> {
+/// The mechanism's state at `t` on `f`.
+fn at(reg: &Regressor, f: &Fourier, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (d, dd, ddd) = f.state(t);
+    reg.state(&d, &dd, &ddd)
+}
+
+/// The base regressor stacked at `m` equally spaced times over a period; `Err(t)` at the first
+/// time where it has no value.
+fn stacked(reg: &Regressor, f: &Fourier, m: usize) -> Result<DMatrix<f64>, f64> {
     let (n, nbp) = (reg.dof(), reg.nbp());
     let period = 2.0 * std::f64::consts::PI / f.w;
     let mut w = DMatrix::zeros(m * n, nbp);
     let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
     for k in 0..m {
-        let (q, qd, qdd) = f.state(period * k as f64 / m as f64);
-        reg.rows(&q, &qd, &qdd, &mut buf, &mut y);
+        let t = period * k as f64 / m as f64;
+        let (p, v, a) = at(reg, f, t);
+        reg.rows(&p, &v, &a, &mut buf, &mut y).map_err(|_| t)?;
         for i in 0..n {
             for p in 0..nbp {
                 w[(k * n + i, p)] = y[i * nbp + p];
             }
         }
     }
-    w
+    Ok(w)
 }
 
 /// One bound per joint from a list of one or `n` values.
@@ -165,7 +186,7 @@ fn per_joint(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
 }
 
 /// Check the arguments; `Err` is the message (exit code 2).
-fn check(args: &ExciteArgs, reg: &TreeRegressor) -> Result<(Vec<f64>, Vec<f64>), String> {
+fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), String> {
     let n = reg.dof();
     if args.harmonics == 0 || args.harmonics > 50 {
         return Err("error: --harmonics must be in 1..=50".into());
@@ -194,10 +215,23 @@ fn check(args: &ExciteArgs, reg: &TreeRegressor) -> Result<(Vec<f64>, Vec<f64>),
     if args.noise.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
         return Err("error: --noise: standard deviations must be finite and >= 0".into());
     }
-    Ok((
-        per_joint(&args.q_max, n, "--q-max")?,
-        per_joint(&args.qd_max, n, "--qd-max")?,
-    ))
+    let q_max = match reg.turns(0) {
+        None => per_joint(&args.q_max, n, "--q-max")?,
+        Some(_) => {
+            let reach = per_joint(&[args.reach], 1, "--reach")?[0];
+            let turn = per_joint(&[args.turn], 1, "--turn")?[0];
+            (0..n)
+                .map(|j| {
+                    if reg.turns(j) == Some(true) {
+                        turn
+                    } else {
+                        reach
+                    }
+                })
+                .collect()
+        }
+    };
+    Ok((q_max, per_joint(&args.qd_max, n, "--qd-max")?))
 }
 
 /// Run `excite`.
@@ -206,7 +240,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         Ok(r) => r,
         Err(c) => return c,
     };
-    let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
+    let (reg, warnings) = match Regressor::compile(&name, &source) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -225,13 +259,11 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     let best = search(&reg, args, &q_max, &qd_max);
     let n = reg.dof();
+    let columns = reg.columns();
     let mut csv = String::from("t");
-    for kind in ["q", "qd", "qdd"]
-        .iter()
-        .chain(if args.with_tau { &["tau"][..] } else { &[][..] })
-    {
-        for i in 1..=n {
-            csv.push_str(&format!(",{kind}{i}"));
+    for k in 0..if args.with_tau { 4 } else { 3 } {
+        for i in 1..=columns.counts[k] {
+            csv.push_str(&format!(",{}{i}", columns.kinds[k]));
         }
     }
     csv.push('\n');
@@ -242,15 +274,28 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
     let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
+    let cond = match stacked(&reg, &best, args.samples) {
+        Ok(w) => condition(&w),
+        Err(t) => {
+            eprintln!(
+                "error: the best trajectory found leaves the workspace or meets a singularity at t = {t} s (between the search's samples): reduce --reach or --turn, or raise --search-samples"
+            );
+            return ExitCode::from(2);
+        }
+    };
     for k in 0..args.samples {
         let t = args.period * k as f64 / args.samples as f64;
-        let (q, qd, qdd) = best.state(t);
+        let (d, dd, _) = best.state(t);
+        let (q, qd, qdd) = at(&reg, &best, t);
         let mut row = vec![t];
         row.extend(&q);
         row.extend(&qd);
         row.extend(&qdd);
         if args.with_tau {
-            let tau = reg.inverse_dynamics(&q, &qd, &qdd);
+            let Some(tau) = reg.inverse_dynamics(&q, &qd, &qdd) else {
+                eprintln!("error: the runtime's inverse dynamics fails at t = {t} s");
+                return ExitCode::from(2);
+            };
             row.extend(tau.iter().zip(&sigma).map(|(t, s)| {
                 if *s > 0.0 {
                     t + s * gauss(&mut noise)
@@ -260,21 +305,22 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
             }));
         }
         for i in 0..n {
-            mq[i] = mq[i].max(q[i].abs());
-            mqd[i] = mqd[i].max(qd[i].abs());
+            mq[i] = mq[i].max(d[i].abs());
+            mqd[i] = mqd[i].max(dd[i].abs());
         }
         let line: Vec<String> = row.iter().map(|v| format!("{v}")).collect();
         csv.push_str(&line.join(","));
         csv.push('\n');
     }
-    let cond = condition(&stacked(&reg, &best, args.samples));
     eprintln!(
-        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}; max |q| {}; max |qd| {}",
-        reg.model.name,
+        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}; max |{}| {}; max |{}| {}",
+        reg.mechanism(),
         args.harmonics,
         args.period,
         args.samples,
+        if reg.turns(0).is_some() { "d" } else { "q" },
         fmt_list(&mq),
+        if reg.turns(0).is_some() { "dd" } else { "qd" },
         fmt_list(&mqd)
     );
     match &args.output {
@@ -304,7 +350,7 @@ fn fmt_list(v: &[f64]) -> String {
 }
 
 /// The random starts and coordinate search; progress on standard error.
-fn search(reg: &TreeRegressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> Fourier {
+fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> Fourier {
     const GRID: usize = 400;
     let n = reg.dof();
     let l = args.harmonics;
@@ -312,8 +358,9 @@ fn search(reg: &TreeRegressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64])
     let mut rng = Rng::new(args.seed);
     // A coefficient's natural size: the velocity amplitude that reaches the bound.
     let unit: Vec<f64> = (0..n).map(|i| (q_max[i] * w).min(qd_max[i])).collect();
+    // A trajectory where the regressor has no value somewhere is rejected.
     let cost = |f: &Fourier| {
-        let c = condition(&stacked(reg, f, args.search_samples));
+        let c = stacked(reg, f, args.search_samples).map_or(f64::MAX, |w| condition(&w));
         if c.is_finite() { c } else { f64::MAX }
     };
     let mut best: Option<(f64, Fourier)> = None;

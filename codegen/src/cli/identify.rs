@@ -1,5 +1,5 @@
-//! `codegen identify SPEC data.csv`: the base parameters of a tree from measured motions and
-//! efforts by weighted least squares, with their standard deviations, the regressor's
+//! `codegen identify SPEC data.csv`: the base parameters of a tree or a platform from measured
+//! motions and efforts by weighted least squares, with their standard deviations, the regressor's
 //! condition number, warnings for parameters the data do not excite, and (`--out`) the spec
 //! updated so that its model has the identified base parameters (docs/identification.md).
 
@@ -9,8 +9,8 @@ use std::process::ExitCode;
 use clap::{Args, ValueEnum};
 use nalgebra::{DMatrix, DVector};
 
+use super::regressor::Regressor;
 use super::samples::{self, Filtering};
-use super::tree_regressor::TreeRegressor;
 use super::wls::{self, Stacked};
 
 /// How the rows are weighted.
@@ -25,9 +25,10 @@ pub enum Weights {
 /// Arguments of `identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
-    /// Tree spec (`.toml` or `.urdf`) whose base parameters are identified.
+    /// Tree (`.toml` or `.urdf`) or platform spec whose base parameters are identified.
     pub spec: PathBuf,
-    /// Measurements: CSV with a header `t,q1..,qd1..,qdd1..,tau1..` (or `t,q1..,tau1..`).
+    /// Measurements: CSV with a header `t,q1..,qd1..,qdd1..,tau1..` (or `t,q1..,tau1..`); a
+    /// platform's `t,x1..,u1..,ud1..,tau1..`.
     pub data: PathBuf,
     /// Write the spec updated to the identified base parameters here (TOML specs only).
     #[arg(long, value_name = "UPDATED.toml")]
@@ -66,7 +67,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let (reg, warnings) = match TreeRegressor::compile(&name, &source) {
+    let (reg, warnings) = match Regressor::compile(&name, &source) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -91,11 +92,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     };
     let (n, nbp) = (reg.dof(), reg.nbp());
-    let joints: Vec<String> = reg.model.joints.iter().map(|j| j.name.clone()).collect();
     let data = match samples::read(
         &data_name,
         &text,
-        &joints,
+        &reg.columns(),
         nbp / n.max(1) + 1,
         Filtering {
             cutoff: args.cutoff,
@@ -112,7 +112,13 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     let mut tau = DVector::zeros(rows * n);
     let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
     for s in 0..rows {
-        reg.rows(&data.q[s], &data.qd[s], &data.qdd[s], &mut buf, &mut y);
+        if let Err(e) = reg.rows(&data.q[s], &data.qd[s], &data.qdd[s], &mut buf, &mut y) {
+            eprintln!(
+                "error: {data_name}:{}: no regressor at this state: {} (remove the row, or check the columns' order and units)",
+                data.lines[s], e.0
+            );
+            return ExitCode::from(2);
+        }
         for i in 0..n {
             for k in 0..nbp {
                 w[(s * n + i, k)] = y[i * nbp + k];
@@ -127,7 +133,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         for k in 0..nbp {
             csv.push_str(&format!(
                 "{k},\"{}\",{},{},{}\n",
-                reg.names[k], reg.values[k], fit.estimate[k], fit.std[k]
+                reg.names()[k],
+                reg.values()[k],
+                fit.estimate[k],
+                fit.std[k]
             ));
         }
         if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
@@ -143,7 +152,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
 
 /// The table of estimates, the condition number, warnings and residuals.
 fn report(
-    reg: &TreeRegressor,
+    reg: &Regressor,
     name: &str,
     data_name: &str,
     rows: usize,
@@ -153,8 +162,9 @@ fn report(
 ) {
     let (n, nbp) = (reg.dof(), reg.nbp());
     outln!(
-        "identify: {} ({name}) from {data_name}: {rows} samples x {n} joints, {nbp} base parameters, {}",
-        reg.model.name,
+        "identify: {} ({name}) from {data_name}: {rows} samples x {n} {}s, {nbp} base parameters, {}",
+        reg.mechanism(),
+        reg.effort_kind(),
         match args.weights {
             Weights::Auto =>
                 "rows weighted by 1/sigma_j per joint (sigma_j from an ordinary least-squares pass)",
@@ -192,25 +202,27 @@ fn report(
         };
         outln!(
             "{k:>4} {:>14.6e} {:>14.6e} {:>12.4e} {:>10.3}  {}",
-            reg.values[k],
+            reg.values()[k],
             fit.estimate[k],
             fit.std[k],
             rel,
-            reg.names[k]
+            reg.names()[k]
         );
         if fit.unidentifiable[k] {
             warnings.push(format!(
                 "warning: base parameter {k} ({}) lies in a near-null direction of the data: not excited, its estimate is the minimum-norm one",
-                reg.names[k]
+                reg.names()[k]
             ));
         } else if rel.is_nan() || rel > args.max_rel_std {
             warnings.push(format!(
                 "warning: base parameter {k} ({}): relative std {rel:.3}% > {}%: poorly excited by the data (or negligible)",
-                reg.names[k], args.max_rel_std
+                reg.names()[k],
+                args.max_rel_std
             ));
         }
     }
-    let joint = |i: usize| &reg.model.joints[i].name;
+    let efforts = reg.effort_names();
+    let joint = |i: usize| &efforts[i];
     outln!(
         "residual RMS per joint (N·m or N): {}",
         (0..n)
@@ -244,7 +256,7 @@ pub fn relative_mismatch(a: &[f64], b: &[f64], keep: &[bool]) -> f64 {
 
 /// Write the updated spec and report its physical consistency.
 fn write_update(
-    reg: &TreeRegressor,
+    reg: &Regressor,
     name: &str,
     source: &str,
     fit: &wls::Fit,
@@ -260,10 +272,13 @@ fn write_update(
     };
     for s in &up.skipped {
         eprintln!(
-            "note: body `{s}` has values that are not plain numbers (expressions, angle strings): left unchanged"
+            "note: {s} has values that are not plain numbers (expressions, angle strings): left unchanged"
         );
     }
-    let worst = relative_mismatch(&up.written, &fit.estimate, &identified);
+    let reproduced: Vec<bool> = (0..identified.len())
+        .map(|k| identified[k] && !up.unreachable.contains(&k))
+        .collect();
+    let worst = relative_mismatch(&up.written, &fit.estimate, &reproduced);
     outln!(
         "updated spec: {} (changed: {}); its base parameters match the estimates to {worst:.2e} (relative)",
         path.display(),
@@ -273,9 +288,30 @@ fn write_update(
             up.changed.join(", ")
         }
     );
-    if worst > 1e-6 {
+    if !up.unreachable.is_empty() {
         eprintln!(
-            "warning: the spec's numbers cannot reproduce every identified base parameter (worst relative difference {worst:.2e}): a drive parameter whose scene switch is off?"
+            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a massless body the loader adds (a U joint's cross), a parallelogram's rods, or a drive",
+            if up.unreachable.len() == 1 { "" } else { "s" },
+            up.unreachable
+                .iter()
+                .map(|k| format!("{k} ({})", reg.names()[*k]))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if up.unreachable.len() == 1 { "" } else { "s" },
+        );
+    }
+    if worst > 1e-6 {
+        let off: Vec<String> = (0..reproduced.len())
+            .filter(|&k| {
+                let mut one = vec![false; reproduced.len()];
+                one[k] = reproduced[k];
+                relative_mismatch(&up.written, &fit.estimate, &one) > 1e-6
+            })
+            .map(|k| format!("{k} ({})", reg.names()[k]))
+            .collect();
+        eprintln!(
+            "warning: the spec's numbers cannot reproduce base parameters {} (worst relative difference {worst:.2e}; the update is their least-squares fit): a drive whose scene switch is off, or numbers one spec entry sets for several model joints (a U joint's two axes)?",
+            off.join(", ")
         );
     }
     for (body, what, involved) in &up.violations {
@@ -283,7 +319,7 @@ fn write_update(
             "warning: body `{body}` of the updated spec is not physical: {what}; base parameters involved: {}",
             involved
                 .iter()
-                .map(|k| format!("{k} ({})", reg.names[*k]))
+                .map(|k| format!("{k} ({})", reg.names()[*k]))
                 .collect::<Vec<_>>()
                 .join(", ")
         );

@@ -21,6 +21,8 @@ pub struct Samples {
     pub tau: Vec<Vec<f64>>,
     /// What was done to the data (filtering), for the report.
     pub note: Option<String>,
+    /// The file's line (1-based) of each kept row.
+    pub lines: Vec<usize>,
 }
 
 /// How positions-only data are filtered.
@@ -30,25 +32,54 @@ pub struct Filtering {
     pub cutoff: f64,
 }
 
-/// The quantities per joint, as the header names them.
-const KINDS: [&str; 4] = ["q", "qd", "qdd", "tau"];
-
-/// Where column `kind` of joint `i` is, if anywhere: `kind{i+1}` or `kind_{joint name}`.
-fn find(header: &[String], kind: &str, i: usize, joint: &str) -> Option<usize> {
-    let (a, b) = (format!("{kind}{}", i + 1), format!("{kind}_{joint}"));
-    header.iter().position(|h| *h == a || *h == b)
+/// The columns a mechanism's file has: positions, speeds, accelerations and efforts.
+#[derive(Clone, Debug)]
+pub struct Columns {
+    /// The prefixes of the four kinds: `q, qd, qdd, tau` (trees) or `x, u, ud, tau`
+    /// (platforms).
+    pub kinds: [&'static str; 4],
+    /// How many columns of each kind.
+    pub counts: [usize; 4],
+    /// Per kind, the names `kind_<name>` may use in place of `kind<i>` (empty: none).
+    pub names: [Vec<String>; 4],
+    /// Whether positions-only data (`t`, positions, efforts) can be filtered and
+    /// differentiated (the speeds are the positions' rates).
+    pub differentiable: bool,
 }
 
-/// Read `text` (the file `file`) for a tree with joints `joints`, needing at least `min_rows`
-/// samples after filtering.
+impl Columns {
+    /// A tree's: `q, qd, qdd, tau` per joint, or by the joint's name.
+    pub fn joints(joints: &[String]) -> Columns {
+        let n = joints.len();
+        Columns {
+            kinds: ["q", "qd", "qdd", "tau"],
+            counts: [n; 4],
+            names: std::array::from_fn(|_| joints.to_vec()),
+            differentiable: true,
+        }
+    }
+}
+
+/// Where column `kind` number `i` is, if anywhere: `kind{i+1}` or `kind_{name}`.
+fn find(header: &[String], kind: &str, i: usize, name: Option<&String>) -> Option<usize> {
+    let a = format!("{kind}{}", i + 1);
+    let b = name.map(|n| format!("{kind}_{n}"));
+    header
+        .iter()
+        .position(|h| *h == a || b.as_ref().is_some_and(|b| h == b))
+}
+
+/// Read `text` (the file `file`) with columns `columns`, needing at least `min_rows` samples
+/// after filtering.
 pub fn read(
     file: &str,
     text: &str,
-    joints: &[String],
+    columns: &Columns,
     min_rows: usize,
     filtering: Filtering,
 ) -> Result<Samples, String> {
-    let n = joints.len();
+    let kinds = columns.kinds;
+    let n = columns.counts[3];
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
@@ -56,7 +87,8 @@ pub fn read(
         .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     let Some((hline, header)) = lines.next() else {
         return Err(format!(
-            "error: {file}: empty: expected a header line (t, q1.., qd1.., qdd1.., tau1..)"
+            "error: {file}: empty: expected a header line (t, {}1.., {}1.., {}1.., {}1..)",
+            kinds[0], kinds[1], kinds[2], kinds[3]
         ));
     };
     let header: Vec<String> = header.split(',').map(|h| h.trim().to_string()).collect();
@@ -70,41 +102,65 @@ pub fn read(
         }
     }
     let mut cols: Vec<Vec<Option<usize>>> = Vec::new();
-    for kind in KINDS {
-        cols.push((0..n).map(|i| find(&header, kind, i, &joints[i])).collect());
+    for (k, kind) in kinds.iter().enumerate() {
+        cols.push(
+            (0..columns.counts[k])
+                .map(|i| find(&header, kind, i, columns.names[k].get(i)))
+                .collect(),
+        );
     }
     let t_col = header.iter().position(|h| h == "t");
     let has = |k: usize| cols[k].iter().all(Option::is_some);
     let none = |k: usize| cols[k].iter().all(Option::is_none);
-    let positions_only = has(0) && has(3) && none(1) && none(2);
+    let positions_only = columns.differentiable && has(0) && has(3) && none(1) && none(2);
     if positions_only && t_col.is_none() {
         return Err(format!(
-            "error: {file}:{}: only `q` and `tau` columns: a `t` column is needed to differentiate the positions",
-            hline + 1
+            "error: {file}:{}: only `{}` and `{}` columns: a `t` column is needed to differentiate the positions",
+            hline + 1,
+            kinds[0],
+            kinds[3]
         ));
     }
     if !positions_only {
         let cols = &cols;
-        let missing: Vec<String> = KINDS
+        let missing: Vec<String> = kinds
             .iter()
             .enumerate()
             .flat_map(|(k, kind)| {
-                (0..n)
-                    .filter(move |&i| cols[k][i].is_none())
-                    .map(move |i| format!("{kind}{}", i + 1))
+                cols[k]
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| c.is_none())
+                    .map(move |(i, _)| format!("{kind}{}", i + 1))
             })
             .collect();
         if !missing.is_empty() {
+            let expected: Vec<String> = kinds
+                .iter()
+                .zip(columns.counts)
+                .map(|(k, c)| format!("{k}1..{k}{c}"))
+                .collect();
+            let alternatives = if columns.differentiable {
+                format!(
+                    ", or {}_<joint> … by joint name; or t, {} and {} only, to filter and differentiate",
+                    kinds[0], kinds[0], kinds[3]
+                )
+            } else {
+                format!(", or {}_<actuated joint>", kinds[3])
+            };
             return Err(format!(
-                "error: {file}:{}: missing column{} {} (expected t (optional), q1..q{n}, qd1..qd{n}, qdd1..qdd{n}, tau1..tau{n}, or q_<joint> … by joint name; or t, q and tau only, to filter and differentiate)",
+                "error: {file}:{}: missing column{} {} (expected t (optional), {}{alternatives})",
                 hline + 1,
                 if missing.len() == 1 { "" } else { "s" },
-                missing.join(", ")
+                missing.join(", "),
+                expected.join(", ")
             ));
         }
     }
     let mut rows: Vec<Vec<f64>> = Vec::new();
+    let mut line_of = Vec::new();
     for (ln, line) in lines {
+        line_of.push(ln + 1);
         let fields: Vec<&str> = line.split(',').collect();
         if fields.len() != header.len() {
             return Err(format!(
@@ -183,6 +239,7 @@ pub fn read(
             s.qd.push((0..n).map(|i| qd_cols[i][k]).collect());
             s.qdd.push((0..n).map(|i| qdd_cols[i][k]).collect());
             s.tau.push((0..n).map(|i| tau_cols[i][k]).collect());
+            s.lines.push(line_of[k]);
         }
         s.note = Some(format!(
             "positions only: q and tau low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling), qd and qdd by central differences; {edge} samples dropped at each end",
@@ -195,6 +252,7 @@ pub fn read(
                 rows.len()
             ));
         }
+        s.lines = line_of;
         for r in &rows {
             s.q.push(pick(0, r));
             s.qd.push(pick(1, r));
@@ -240,7 +298,7 @@ mod tests {
     fn columns_by_index_or_joint_name_in_any_order() {
         // A byte-order mark and CRLF line ends are read as well.
         let text = "\u{feff}tau2,q1,q_b,qd1,qd2,qdd1,qdd_b,tau_a,extra\r\n1,2,3,4,5,6,7,8,9\r\n";
-        let s = read("d.csv", text, &joints(), 1, F).unwrap();
+        let s = read("d.csv", text, &Columns::joints(&joints()), 1, F).unwrap();
         assert_eq!(s.q, vec![vec![2.0, 3.0]]);
         assert_eq!(s.qd, vec![vec![4.0, 5.0]]);
         assert_eq!(s.qdd, vec![vec![6.0, 7.0]]);
@@ -250,7 +308,7 @@ mod tests {
     #[test]
     fn bad_files_are_errors_at_their_place() {
         let h = "t,q1,q2,qd1,qd2,qdd1,qdd2,tau1,tau2\n";
-        let e = |t: &str| read("d.csv", t, &joints(), 1, F).unwrap_err();
+        let e = |t: &str| read("d.csv", t, &Columns::joints(&joints()), 1, F).unwrap_err();
         assert!(e("").contains("empty"));
         assert!(e("q1,q2\n").contains("missing columns qd1, qd2"));
         assert!(e(&format!("{h}0,1,2,3,4,5,6,7\n")).contains("d.csv:2: 8 fields"));

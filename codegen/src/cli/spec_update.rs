@@ -11,13 +11,23 @@
 //! unknown moved at a time, so every conversion the loader makes (standard DH frames, fixed
 //! joints merged, the `[scene]`) is the loader's own. `Δ = P⁺ (π̂ − π_spec)` is the
 //! minimum-norm change; the written spec is loaded again to check it.
+//!
+//! A platform's legs are usually one `[[pattern]]` whose bodies every copy shares: their
+//! unknowns are per copy (the values the spec's text gives each copy, patterns expanded), and a
+//! changed pattern body is written as expressions indexing per-copy arrays that the update adds
+//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). Base parameters that no written
+//! number moves (a massless U joint's cross, a parallelogram's rods) keep the spec's values and
+//! are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::tree_regressor::TreeRegressor;
+use super::regressor::Regressor;
+
+mod patterns;
+use patterns::{copy_consistency, pattern_unknowns, set_copies};
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -26,6 +36,22 @@ enum Unknown {
     Body { index: usize, k: usize },
     /// `damping`, `friction` or `armature` of `[[joint]]` element `index`.
     Drive { index: usize, key: &'static str },
+    /// Standard parameter `k` of copy `copy` (from 1) of `[[pattern]]` element `pattern`'s
+    /// `[[pattern.body]]` element `body`.
+    Copy {
+        pattern: usize,
+        body: usize,
+        copy: usize,
+        k: usize,
+    },
+    /// `damping`, `friction` or `armature` of copy `copy` (from 1) of `[[pattern]]` element
+    /// `pattern`'s `[[pattern.joint]]` element `joint`.
+    CopyDrive {
+        pattern: usize,
+        joint: usize,
+        copy: usize,
+        key: &'static str,
+    },
 }
 
 /// The outcome of an update.
@@ -41,6 +67,8 @@ pub struct Update {
     pub skipped: Vec<String>,
     /// The bodies and joints changed.
     pub changed: Vec<String>,
+    /// The base parameters that no number of the update moves (kept at the spec's values).
+    pub unreachable: Vec<usize>,
 }
 
 /// A number as TOML: plain decimals between 1e-3 and 1e6, exponent form outside, always a
@@ -164,8 +192,35 @@ fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), Strin
 fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<DocumentMut, String> {
     let mut d = doc.clone();
     let mut bodies: std::collections::BTreeMap<usize, [f64; 10]> = Default::default();
+    type Copies = std::collections::BTreeMap<usize, [f64; 10]>;
+    let mut copies: std::collections::BTreeMap<(usize, usize), Copies> = Default::default();
+    type Drives = std::collections::BTreeMap<usize, f64>;
+    let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::CopyDrive {
+                pattern,
+                joint,
+                copy,
+                key,
+            } => {
+                drives
+                    .entry((*pattern, *joint, key))
+                    .or_default()
+                    .insert(*copy, v);
+            }
+            Unknown::Copy {
+                pattern,
+                body,
+                copy,
+                k,
+            } => {
+                copies
+                    .entry((*pattern, *body))
+                    .or_default()
+                    .entry(*copy)
+                    .or_insert([0.0; 10])[*k] = v
+            }
             Unknown::Body { index, k } => bodies.entry(*index).or_insert([0.0; 10])[*k] = v,
             Unknown::Drive { index, key } => {
                 if let Some(t) = d["joint"]
@@ -190,23 +245,26 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
             set_body(t, &p).map_err(|e| format!("body `{name}`: {e}"))?;
         }
     }
+    for ((pattern, body), c) in copies {
+        let c: Vec<[f64; 10]> = c.into_values().collect();
+        set_copies(&mut d, pattern, body, &c)?;
+    }
+    for ((pattern, joint, key), c) in drives {
+        let c: Vec<f64> = c.into_values().collect();
+        patterns::set_copy_drives(&mut d, pattern, joint, key, &c)?;
+    }
     Ok(d)
 }
 
 /// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
-fn base_of(reg: &TreeRegressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
-    let loaded = codegen::spec::load(file, text, &codegen::spec::SceneOverrides::default())
-        .map_err(|d| d.render())?;
-    match loaded.mechanism {
-        codegen::spec::Mechanism::Tree(m) => Ok(reg.base_of(&m)),
-        _ => Err("not a tree".into()),
-    }
+fn base_of(reg: &Regressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
+    reg.base_of_spec(file, text)
 }
 
 /// The update of `source` whose model has base parameters `target` where `fit[k]` (elsewhere
 /// the spec's).
 pub fn update(
-    reg: &TreeRegressor,
+    reg: &Regressor,
     file: &str,
     source: &str,
     target: &[f64],
@@ -236,7 +294,7 @@ pub fn update(
                         names.push(format!("body `{name}`"));
                     }
                 }
-                None => skipped.push(name.to_string()),
+                None => skipped.push(format!("body `{name}`")),
             }
         }
     }
@@ -255,15 +313,32 @@ pub fn update(
             }
         }
     }
+    if let Some(written) = codegen::spec::written_bodies(file, source) {
+        pattern_unknowns(
+            &doc,
+            &written,
+            &mut unknowns,
+            &mut z0,
+            &mut names,
+            &mut skipped,
+        );
+    }
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
     let pi0 = base_of(reg, file, &norm.to_string())?;
+    let pi_spec = base_of(reg, file, source)?;
+    let drift = super::identify::relative_mismatch(&pi0, &pi_spec, &vec![true; pi0.len()]);
+    if drift > 1e-9 {
+        return Err(format!(
+            "error: {file}: its bodies written back as numbers change its base parameters ({drift:.2e} relative): --out cannot rewrite this spec (no file written)"
+        ));
+    }
     // The columns of P: each unknown moved from a reference point where every body is valid.
     let nbp = reg.nbp();
     let mut p = DMatrix::zeros(nbp, unknowns.len());
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
-        if let Unknown::Body { k, .. } = u {
+        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } = u {
             *r = match k {
                 0 | 3 | 5 | 9 => 1.0,
                 _ => 0.0,
@@ -288,7 +363,16 @@ pub fn update(
             *x = 0.0
         }
     });
-    let d = DVector::from_fn(nbp, |k, _| if fit[k] { target[k] - pi0[k] } else { 0.0 });
+    let unreachable: Vec<usize> = (0..nbp)
+        .filter(|&r| p.row(r).iter().all(|x| *x == 0.0))
+        .collect();
+    let d = DVector::from_fn(nbp, |k, _| {
+        if fit[k] && !unreachable.contains(&k) {
+            target[k] - pi0[k]
+        } else {
+            0.0
+        }
+    });
     let dz = p
         .clone()
         .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
@@ -321,13 +405,15 @@ pub fn update(
     })?;
     let text = out.to_string();
     let written = base_of(reg, file, &text)?;
-    let violations = consistency(&out, &unknowns, &p);
+    let mut violations = consistency(&out, &unknowns, &p);
+    violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
     Ok(Update {
         text,
         written,
         violations,
         skipped,
         changed,
+        unreachable,
     })
 }
 
@@ -350,6 +436,26 @@ fn consistency(
         let Ok((m, _, ic)) = from_standard(&sp) else {
             continue;
         };
+        let what = physics(m, &ic);
+        if what.is_empty() {
+            continue;
+        }
+        let involved: Vec<usize> = (0..p.nrows())
+            .filter(|&r| {
+                unknowns.iter().enumerate().any(|(c, u)| {
+                    matches!(u, Unknown::Body { index: i, .. } if *i == index)
+                        && p[(r, c)].abs() > 1e-12
+                })
+            })
+            .collect();
+        out.push((name.to_string(), what.join("; "), involved));
+    }
+    out
+}
+
+/// What a body of mass `m` and central inertia `ic` breaks (empty: nothing).
+fn physics(m: f64, ic: &Mat3) -> Vec<String> {
+    {
         let mut what = Vec::new();
         let zero_inertia = ic.iter().flatten().all(|x| *x == 0.0);
         if m < 0.0 {
@@ -372,20 +478,8 @@ fn consistency(
                 ev[0], ev[1], ev[2]
             ));
         }
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| {
-                unknowns.iter().enumerate().any(|(c, u)| {
-                    matches!(u, Unknown::Body { index: i, .. } if *i == index)
-                        && p[(r, c)].abs() > 1e-12
-                })
-            })
-            .collect();
-        out.push((name.to_string(), what.join("; "), involved));
+        what
     }
-    out
 }
 
 #[cfg(test)]

@@ -7,7 +7,6 @@
 use std::collections::HashMap;
 
 use codegen::dynamics::{BODY_PARAMETERS, Tree, body_standard_parameters};
-use codegen::spec::Mechanism;
 use codegen::sym::{Arg, Graph};
 use runtime::model::Model;
 
@@ -28,38 +27,7 @@ pub struct TreeRegressor {
     tape: Tape,
 }
 
-/// Why a spec has no tree regressor: the rendered diagnostics, or the refusal of a kind.
-pub fn refusal_for_kind(name: &str, m: &Mechanism) -> Option<String> {
-    match m {
-        Mechanism::Tree(_) => None,
-        Mechanism::Parallel(_) => Some(format!(
-            "error: {name}: a parallel mechanism; identification works on trees only (regressors of platforms and closed loops are not generated yet, issue 23)\n"
-        )),
-        Mechanism::Closed(_) => Some(format!(
-            "error: {name}: a mechanism with closed loops; identification works on trees only (regressors of platforms and closed loops are not generated yet, issue 23)\n"
-        )),
-    }
-}
-
 impl TreeRegressor {
-    /// Load a spec's text (with its `[scene]`). The error is rendered text (exit code 2).
-    pub fn compile(name: &str, source: &str) -> Result<(TreeRegressor, String), String> {
-        let loaded = codegen::spec::load(name, source, &codegen::spec::SceneOverrides::default())
-            .map_err(|d| d.render())?;
-        let warnings = if loaded.warnings.is_empty() {
-            String::new()
-        } else {
-            loaded.warnings.render()
-        };
-        if let Some(e) = refusal_for_kind(name, &loaded.mechanism) {
-            return Err(e);
-        }
-        let Mechanism::Tree(model) = loaded.mechanism else {
-            return Err(format!("error: {name}: not a tree\n"));
-        };
-        Ok((TreeRegressor::new(model), warnings))
-    }
-
     /// The regressor of a validated tree model.
     pub fn new(model: Model) -> TreeRegressor {
         let tree = Tree::new(&model);
@@ -91,11 +59,6 @@ impl TreeRegressor {
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.model.dof()
-    }
-
-    /// Number of base parameters.
-    pub fn nbp(&self) -> usize {
-        self.values.len()
     }
 
     /// `Y(q, q̇, q̈)` into `out` (`DOF × NBP`, row-major); `buf` is scratch space.

@@ -25,6 +25,10 @@ pub(super) struct PlatformRegressor {
     pub guards: Vec<ExprId>,
     /// The base parameters.
     pub base: Base,
+    /// The standard parameters' names, in the order the groups index.
+    pub standard_names: Vec<String>,
+    /// The model's standard parameters, same order.
+    pub standard_values: Vec<f64>,
 }
 
 /// `model` with every body and drive zero.
@@ -157,5 +161,7 @@ pub(super) fn regressor(
         outputs,
         guards,
         base,
+        standard_names: standard.names,
+        standard_values: standard.values,
     }))
 }

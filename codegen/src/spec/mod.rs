@@ -363,6 +363,27 @@ fn load_any(
     }
 }
 
+/// The bodies of a spec as its text gives them (patterns expanded, expressions evaluated,
+/// before any lowering): `(name, mass, mass centre, inertia about it)` in each body's spec
+/// frame. For tools that write a spec's numbers back (`codegen identify --out`); `None` after
+/// errors (the spec does not load).
+pub fn written_bodies(
+    file_name: &str,
+    source: &str,
+) -> Option<Vec<(String, f64, runtime::model::Vec3, runtime::model::Mat3)>> {
+    let mut d = Diagnostics::new(file_name, source);
+    let s = read_ir(file_name, source, &mut d)?;
+    if d.has_errors() {
+        return None;
+    }
+    Some(
+        s.bodies
+            .into_iter()
+            .map(|b| (b.name, b.mass, b.com, b.inertia))
+            .collect(),
+    )
+}
+
 /// The format-neutral spec of `source` (TOML or URDF by `file_name`, as [`load`] chooses),
 /// within the size limits; `None` after errors in `d`.
 fn read_ir(file_name: &str, source: &str, d: &mut Diagnostics) -> Option<ir::Spec> {
