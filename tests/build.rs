@@ -173,6 +173,20 @@ fn main() {
     let p = write(&out, "closed_inertia", &src);
     generate(&out, "closed_inertia", &p, |_| {});
 
+    // Fused multiply–add (`tests/tests/fma.rs`, the `fma` bench group): a tree of 6 and of 7
+    // joints, a platform and a closed loop, each with `Config::fma`.
+    for spec in [
+        puma,
+        "../mechanisms/specs/chain7.toml",
+        gs,
+        "../mechanisms/specs/spherical_five_bar.toml",
+    ] {
+        println!("cargo:rerun-if-changed={spec}");
+        generate(&out, "fma", Path::new(spec), |b| {
+            b.fma(true).implement("runtime");
+        });
+    }
+
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
     println!("cargo:rerun-if-changed={iiwa}");

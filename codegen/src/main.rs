@@ -86,6 +86,10 @@ struct Cli {
     /// Scalar type of the generated code (`f32`: single precision, thresholds rescaled).
     #[arg(long, value_enum, default_value = "f64")]
     float: FloatArg,
+    /// Fuse `a*b ± c` into `mul_add` (one rounding; an `fma` column in the op counts). Pays
+    /// where the target has FMA (`-C target-cpu=native`).
+    #[arg(long)]
+    fma: bool,
     /// Apply the joints' viscous and Coulomb friction (as `[scene] friction = true`; for a URDF,
     /// its `<dynamics damping friction>`).
     #[arg(long)]
@@ -259,6 +263,7 @@ fn main() -> ExitCode {
                 EmitArg::Rust => codegen::Emit::Rust,
                 EmitArg::C => codegen::Emit::C,
             },
+            fma: cli.fma,
         },
     ) {
         Ok(o) => o,
@@ -328,6 +333,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
         },
         implement: None,
         emit: codegen::Emit::Rust,
+        fma: cli.fma,
     }
 }
 

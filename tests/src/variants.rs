@@ -147,3 +147,27 @@ pub mod tripod_task {
         "/variants/tripod_task/tripod_3prs_task.rs"
     ));
 }
+
+/// The PUMA 560, the 7-joint chain, the Gough–Stewart platform and the spherical five-bar with
+/// fused multiply–adds (`Config::fma`; `tests/tests/fma.rs`).
+pub mod fma {
+    /// The PUMA 560 with `mul_add`.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/puma560.rs"));
+    }
+    /// The 7-joint chain with `mul_add`.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/chain7.rs"));
+    }
+    /// The Gough–Stewart platform with `mul_add`.
+    pub mod gough_stewart {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/gough_stewart.rs"));
+    }
+    /// The spherical five-bar with `mul_add`.
+    pub mod spherical_five_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/fma/spherical_five_bar.rs"
+        ));
+    }
+}

@@ -268,6 +268,7 @@ impl Args {
             scene,
             implement: self.implement.as_ref().map(LitStr::value),
             emit: codegen::Emit::Rust,
+            fma: false,
         })
     }
 }
