@@ -187,6 +187,30 @@ fn main() {
         });
     }
 
+    // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
+    // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.
+    let trees = [
+        "../mechanisms/specs/puma560.toml",
+        "../mechanisms/specs/puma560.urdf",
+        "../mechanisms/specs/chain7.toml",
+        "../mechanisms/specs/gripper_tree.toml",
+        "../mechanisms/specs/iiwa14.urdf",
+        "../mechanisms/specs/planar_2r.toml",
+        "../mechanisms/specs/stanford_arm.toml",
+    ];
+    for spec in trees {
+        println!("cargo:rerun-if-changed={spec}");
+    }
+    generate(&out, "lanes", Path::new(trees[0]), |b| {
+        for spec in &trees[1..] {
+            b.spec(spec);
+        }
+        b.lanes(Some(4));
+    });
+    generate(&out, "lanes_f32", Path::new(puma), |b| {
+        b.lanes(Some(8)).float(codegen::Float::F32);
+    });
+
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
     println!("cargo:rerun-if-changed={iiwa}");

@@ -117,11 +117,11 @@ pub(crate) fn float_lit(v: f64) -> TokenStream {
     }
 }
 
-fn var(n: usize) -> Ident {
+pub(crate) fn var(n: usize) -> Ident {
     format_ident!("x{}", n)
 }
 
-fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
+pub(crate) fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
     match s.operand(g, id) {
         Operand::Var(n) => {
             let v = var(n);
@@ -382,7 +382,7 @@ fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
 }
 
 /// The returned expression of the function's shape.
-fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
+pub(crate) fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
     match f.shape {
         Shape::Vector => quote!([#(#outs),*]),
         Shape::FallibleVector => quote!(Ok([#(#outs),*])),
@@ -461,7 +461,7 @@ fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
 /// information, and rustc's LLVM backend recurses once per nested scope: thousands of `let`s in
 /// one block overflow its stack. Blocks keep the nesting depth near `CHUNK` plus the number of
 /// blocks. Short bodies are left as they are.
-fn chunked(
+pub(crate) fn chunked(
     g: &Graph,
     s: &Schedule,
     outputs: &[ExprId],
@@ -565,17 +565,7 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
             quote!(#a: &[#real; #len])
         })
         .collect();
-    let ret = match &f.shape {
-        Shape::Vector => quote!([#real; DOF]),
-        Shape::Matrix => quote!([[#real; DOF]; DOF]),
-        Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
-        Shape::Fallible(parts) => {
-            let t = parts_type(parts);
-            quote!(Result<#t, Singular>)
-        }
-        Shape::Tuple(parts) => parts_type(parts),
-        Shape::Regressor => quote!([[#real; NBP]; DOF]),
-    };
+    let ret = return_type(&f.shape);
     let docs = f.doc.iter().map(|d| {
         let d = format!(" {d}");
         quote!(#[doc = #d])
@@ -601,6 +591,22 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
         #vis fn #name(#(#args),*) -> #ret {
             #body
         }
+    }
+}
+
+/// The type a function of `shape` returns.
+pub(crate) fn return_type(shape: &Shape) -> TokenStream {
+    let real = real();
+    match shape {
+        Shape::Vector => quote!([#real; DOF]),
+        Shape::Matrix => quote!([[#real; DOF]; DOF]),
+        Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
+        Shape::Fallible(parts) => {
+            let t = parts_type(parts);
+            quote!(Result<#t, Singular>)
+        }
+        Shape::Tuple(parts) => parts_type(parts),
+        Shape::Regressor => quote!([[#real; NBP]; DOF]),
     }
 }
 

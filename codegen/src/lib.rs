@@ -42,6 +42,7 @@ pub mod emit;
 pub mod fma;
 mod implement;
 pub mod indices;
+pub mod lanes;
 mod lu;
 pub mod macro_support;
 mod module;
@@ -119,6 +120,13 @@ pub struct Config {
     /// library call. Results differ from the unfused ones by rounding (tests: ≤ 1e-12
     /// relative).
     pub fma: bool,
+    /// `Some(L)`: a tree module also holds `<name>_lanes` of its dynamics functions
+    /// ([`lanes::FUNCTIONS`]), which evaluate `L` states per call (`LANES = L`, 2 to
+    /// [`lanes::MAX`]): `q: &[[f64; DOF]; LANES]` in, `[[f64; DOF]; LANES]` out, and
+    /// `[Result<…, Singular>; LANES]` for `forward_dynamics`, each lane's result bit for bit
+    /// the scalar function's on that state ([`lanes`]). 4 fills an AVX2 register in `f64`, 8 in
+    /// `f32`. `None` (default): the module as before, byte for byte. Trees only.
+    pub lanes: Option<usize>,
 }
 
 impl Default for Config {
@@ -130,6 +138,7 @@ impl Default for Config {
             implement: None,
             emit: Emit::Rust,
             fma: false,
+            lanes: None,
         }
     }
 }
@@ -194,6 +203,20 @@ pub fn generate(
             "the C wrapper crate (`emit c`) takes the `libm` math backend and no `implement`"
                 .into(),
         );
+    }
+    if let Some(l) = cfg.lanes {
+        if !(2..=lanes::MAX).contains(&l) {
+            return Err(format!(
+                "`lanes` takes 2 to {} states per call, not {l}",
+                lanes::MAX
+            ));
+        }
+        if !matches!(mechanism, spec::Mechanism::Tree(_)) {
+            return Err("`lanes` (many states per call) is offered for trees only so far".into());
+        }
+        if cfg.emit == Emit::C {
+            return Err("the C wrapper crate (`emit c`) takes no `lanes`".into());
+        }
     }
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || {

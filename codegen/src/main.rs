@@ -90,6 +90,10 @@ struct Cli {
     /// where the target has FMA (`-C target-cpu=native`).
     #[arg(long)]
     fma: bool,
+    /// Also emit `<function>_lanes` of a tree's dynamics functions, evaluating N states per
+    /// call (`4` fills an AVX2 register in `f64`, `8` in `f32`).
+    #[arg(long, value_name = "N")]
+    lanes: Option<usize>,
     /// Apply the joints' viscous and Coulomb friction (as `[scene] friction = true`; for a URDF,
     /// its `<dynamics damping friction>`).
     #[arg(long)]
@@ -264,6 +268,7 @@ fn main() -> ExitCode {
                 EmitArg::C => codegen::Emit::C,
             },
             fma: cli.fma,
+            lanes: cli.lanes,
         },
     ) {
         Ok(o) => o,
@@ -334,6 +339,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
         implement: None,
         emit: codegen::Emit::Rust,
         fma: cli.fma,
+        lanes: None,
     }
 }
 

@@ -46,7 +46,23 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
     if let Some(runtime) = &cfg.implement {
         module.extend(crate::implement::items(&module, runtime, plan.name));
     }
+    if let Some(l) = cfg.lanes {
+        module.extend(crate::lanes::items(plan.graph, cfg, &plan.functions, l));
+    }
     let mut header = plan.header.clone();
+    if let Some(l) = cfg.lanes {
+        let at = header
+            .iter()
+            .position(|h| h.starts_with("Math backend"))
+            .map_or(header.len(), |i| i + 1);
+        header.insert(
+            at,
+            format!(
+                "Lanes: {l} states per call in the `_lanes` functions ({}).",
+                crate::lanes::FUNCTIONS.join(", ")
+            ),
+        );
+    }
     if cfg.fma {
         // Named right after the math backend (the table follows).
         let at = header

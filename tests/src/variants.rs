@@ -171,3 +171,40 @@ pub mod fma {
         ));
     }
 }
+
+/// Every bundled tree with `_lanes` functions of 4 states per call (`Config::lanes`;
+/// `tests/tests/lanes.rs`).
+pub mod lanes {
+    /// `mechanisms/specs/puma560` with 4 lanes.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/puma560.rs"));
+    }
+    /// `mechanisms/specs/puma560_urdf` with 4 lanes.
+    pub mod puma560_urdf {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/puma560_urdf.rs"));
+    }
+    /// `mechanisms/specs/chain7` with 4 lanes.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/chain7.rs"));
+    }
+    /// `mechanisms/specs/gripper_tree` with 4 lanes.
+    pub mod gripper_tree {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/gripper_tree.rs"));
+    }
+    /// `mechanisms/specs/iiwa14` with 4 lanes.
+    pub mod iiwa14 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/iiwa14.rs"));
+    }
+    /// `mechanisms/specs/planar_2r` with 4 lanes.
+    pub mod planar_2r {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/planar_2r.rs"));
+    }
+    /// `mechanisms/specs/stanford_arm` with 4 lanes.
+    pub mod stanford_arm {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/stanford_arm.rs"));
+    }
+}
+/// The PUMA 560 in `f32` with 8 lanes.
+pub mod lanes_f32_puma560 {
+    include!(concat!(env!("OUT_DIR"), "/variants/lanes_f32/puma560.rs"));
+}

@@ -269,6 +269,7 @@ impl Args {
             implement: self.implement.as_ref().map(LitStr::value),
             emit: codegen::Emit::Rust,
             fma: false,
+            lanes: None,
         })
     }
 }
