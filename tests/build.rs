@@ -207,6 +207,13 @@ fn main() {
         }
         b.lanes(Some(4));
     });
+    // The same with trigonometry from the `libm` crate (half the cost of std's `sin_cos` here,
+    // and inlined): the `lanes_libm` bench groups.
+    generate(&out, "lanes_libm", Path::new(puma), |b| {
+        b.spec(trees[2])
+            .lanes(Some(4))
+            .math(codegen::MathBackend::Libm);
+    });
     generate(&out, "lanes_f32", Path::new(puma), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });

@@ -8,13 +8,17 @@
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
 //! backend once per lane.
 //!
-//! The states are given and returned one per lane, as a batched call (MuJoCo's rollouts, JAX's
-//! `vmap`) expects them: `q: &[[f64; DOF]; LANES]` (`q[k]` is state `k`), the result
-//! `[[f64; DOF]; LANES]`, and a fallible function returns `[Result<[f64; DOF], Singular>;
-//! LANES]`, each lane's `Err` the one the scalar function reports for that state. A lane that
-//! fails does not stop the others: its guards record the first failure and it is skipped from
-//! there on, while the other lanes go on. Every loop is unrolled at generation time: constant
-//! indices only, no panicking operation, no heap.
+//! Arguments and results are structures of arrays, lane last: `q: &[[f64; LANES]; DOF]`, where
+//! `q[i][k]` is coordinate `i` of state `k`, and `[[f64; LANES]; DOF]` out (a matrix
+//! `[[[f64; LANES]; DOF]; DOF]`). That is the layout the vector instructions load and store
+//! whole; with the states one per row instead (`[[f64; DOF]; LANES]`, which a batched call à la
+//! JAX's `vmap` would take), LLVM keeps every operation scalar and nothing is gained (measured:
+//! slower than the scalar function four times). `forward_dynamics_lanes` returns the values and
+//! each lane's status, `([[f64; LANES]; DOF], [Result<(), Singular>; LANES])`: a lane's `Err`
+//! is the one the scalar function reports for that state, and it does not stop the others (its
+//! guards record the first failure and skip it from there on; its values are not to be read).
+//! Every per-lane step is unrolled at generation time: constant indices only, no panicking
+//! operation, no heap.
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -42,6 +46,12 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     let chosen: Vec<&Function<'_>> = functions
         .iter()
         .filter(|f| f.public && !f.sites && FUNCTIONS.contains(&f.name))
+        .filter(|f| {
+            matches!(
+                f.shape,
+                Shape::Vector | Shape::Matrix | Shape::FallibleVector
+            )
+        })
         .collect();
     if chosen.is_empty() {
         return TokenStream::new();
@@ -226,9 +236,10 @@ fn binary(a: TokenStream, op: TokenStream, b: TokenStream) -> TokenStream {
     quote!(#a #op #b)
 }
 
-/// A tree's pivot test in lane `k`: the lane's first failure is kept, later tests skip it.
+/// A tree's pivot test in lane `k`, without a branch: the lane's first failure is kept (its
+/// pivot, value, magnitude and scale, so that the `Err` is built at the end as the scalar
+/// function builds it), later tests leave it.
 fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize) -> TokenStream {
-    let real = emit::real();
     let Node::Guard {
         value,
         tol,
@@ -255,23 +266,34 @@ fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize) -> TokenStream {
     };
     let lane = Literal::usize_unsuffixed(k);
     quote! {
-        if err[#lane].is_none() && !(#test) {
-            let a = #magnitude;
-            err[#lane] = Some(Singular {
-                pivot: #pivot,
-                value: #v,
-                condition_estimate: if a > 0.0 { #sc / a } else { #real::INFINITY },
-            });
+        let bad = fail_at[#lane] == usize::MAX && !(#test);
+        fail_at[#lane] = if bad { #pivot } else { fail_at[#lane] };
+        fail_value[#lane] = if bad { #v } else { fail_value[#lane] };
+        fail_magnitude[#lane] = if bad { #magnitude } else { fail_magnitude[#lane] };
+        fail_scale[#lane] = if bad { #sc } else { fail_scale[#lane] };
+    }
+}
+
+/// An output over lanes, as the array the caller gets: `x7.0`, `q[3].0` or `[c; LANES]`.
+fn lane_array(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
+    match s.operand(g, id) {
+        Operand::Const(c) => {
+            let c = emit::float_lit(c);
+            quote!([#c; LANES])
+        }
+        _ => {
+            let x = emit::operand(g, s, id);
+            quote!(#x.0)
         }
     }
 }
 
-/// The `_lanes` version of `f`.
+/// The `_lanes` version of `f` (a [`Shape::Vector`], [`Shape::Matrix`] or
+/// [`Shape::FallibleVector`] function).
 fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
     let s = &f.schedule;
     let name = format_ident!("{}_lanes", f.name);
-    let dof = Literal::usize_unsuffixed(f.dof);
     let mut args = Vec::new();
     let mut entry = Vec::new();
     for a in &f.args {
@@ -281,68 +303,101 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
             continue;
         }
         let id = Ident::new(a.name(), Span::call_site());
-        args.push(quote!(#id: &[[#real; DOF]; LANES]));
-        let rows = (0..f.dof).map(|i| {
-            let i = Literal::usize_unsuffixed(i);
-            let each = (0..l).map(|k| {
-                let k = Literal::usize_unsuffixed(k);
-                quote!(#id[#k][#i])
-            });
-            quote!(Lanes([#(#each),*]))
-        });
-        entry.push(quote!(let #id: [Lanes; #dof] = [#(#rows),*];));
+        args.push(quote!(#id: &[[#real; LANES]; DOF]));
+        entry.push(quote!(let #id: [Lanes; DOF] = #id.map(Lanes);));
     }
-    let fallible = matches!(f.shape, Shape::FallibleVector | Shape::Fallible(_));
+    let fallible = matches!(f.shape, Shape::FallibleVector);
     if fallible {
-        entry.push(quote!(let mut err: [Option<Singular>; LANES] = [None; LANES];));
+        entry.push(quote! {
+            let mut fail_at = [usize::MAX; LANES];
+            let mut fail_value: [#real; LANES] = [0.0; LANES];
+            let mut fail_magnitude: [#real; LANES] = [0.0; LANES];
+            let mut fail_scale: [#real; LANES] = [0.0; LANES];
+        });
     }
+    // The `sin_cos` of inputs first: each is a call per lane, and a call spills every vector
+    // register, so they are made while nothing else is live (pure functions: the order is free).
+    let mut hoisted = s.clone();
+    let (first, rest): (Vec<Step>, Vec<Step>) = s.steps.iter().partition(
+        |st| matches!(st, Step::SinCos { arg, .. } if matches!(s.operand(g, *arg), Operand::Input(..))),
+    );
+    hoisted.steps = first.into_iter().chain(rest).collect();
+    let s = &hoisted;
     let stmts: Vec<TokenStream> = s.steps.iter().map(|st| step(g, s, st, l)).collect();
     let stmts = emit::chunked(g, s, &f.outputs, stmts);
-    let all_const = f.outputs.iter().all(|&o| g.as_const(o).is_some());
-    let results = (0..l).map(|k| {
-        let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
-        let ret = emit::return_tokens(f, &outs);
-        if !fallible {
-            return ret;
-        }
-        let lane = Literal::usize_unsuffixed(k);
-        let finite = (!all_const).then(|| {
-            quote! {
-                for v in [#(#outs),*].iter() {
-                    if !v.is_finite() {
-                        break 'lane Err(Singular {
-                            pivot: DOF,
-                            value: *v,
-                            condition_estimate: #real::INFINITY,
-                        });
+    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
+    let values = emit::return_tokens(f, &outs);
+    let lane = quote!([#real; LANES]);
+    let (ret_ty, ret) = match f.shape {
+        Shape::Vector => (quote!([#lane; DOF]), values),
+        Shape::Matrix => (quote!([[#lane; DOF]; DOF]), values),
+        Shape::FallibleVector => {
+            let all_const = f.outputs.iter().all(|&o| g.as_const(o).is_some());
+            let status = (0..l).map(|k| {
+                let outs: Vec<TokenStream> =
+                    f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
+                let k = Literal::usize_unsuffixed(k);
+                let finite = (!all_const).then(|| {
+                    quote! {
+                        for v in [#(#outs),*].iter() {
+                            if !v.is_finite() {
+                                break 'lane Err(Singular {
+                                    pivot: DOF,
+                                    value: *v,
+                                    condition_estimate: #real::INFINITY,
+                                });
+                            }
+                        }
+                    }
+                });
+                quote! {
+                    'lane: {
+                        if fail_at[#k] != usize::MAX {
+                            let a = fail_magnitude[#k];
+                            break 'lane Err(Singular {
+                                pivot: fail_at[#k],
+                                value: fail_value[#k],
+                                condition_estimate: if a > 0.0 {
+                                    fail_scale[#k] / a
+                                } else {
+                                    #real::INFINITY
+                                },
+                            });
+                        }
+                        #finite
+                        Ok(())
                     }
                 }
-            }
-        });
-        quote! {
-            'lane: {
-                if let Some(e) = err[#lane] {
-                    break 'lane Err(e);
-                }
-                #finite
-                #ret
-            }
+            });
+            (
+                quote!(([#lane; DOF], [Result<(), Singular>; LANES])),
+                quote!(([#(#outs),*], [#(#status),*])),
+            )
         }
-    });
-    let ret_ty = emit::return_type(&f.shape);
+        _ => panic!("internal error: no lanes version of `{}`", f.name),
+    };
     let doc = format!(
-        " `{}` of `LANES` states at once: state `k` is argument `[k]`, and result `[k]` is \
-         bit for bit `{}` of it (each lane's own `Err`, the others unaffected).",
+        " `{}` of `LANES` states at once, lane by lane: entry `[i][k]` of an argument or of the \
+         result is entry `i` of state `k`, bit for bit what `{}` gives for that state.",
         f.name, f.name
     );
+    let doc_err = fallible.then(|| {
+        quote! {
+            #[doc = ""]
+            #[doc = " The second part is each lane's status: `Err` where the scalar function \
+                     returns that `Err` for the lane's state (that lane's values are then not \
+                     to be read); the other lanes are not affected."]
+        }
+    });
     quote! {
         #[doc = #doc]
+        #doc_err
         #[inline]
         #[allow(unused_variables, unused_mut, clippy::all)]
-        pub fn #name(#(#args),*) -> [#ret_ty; LANES] {
+        pub fn #name(#(#args),*) -> #ret_ty {
             #(#entry)*
             #(#stmts)*
-            [#(#results),*]
+            #ret
         }
     }
 }

@@ -122,10 +122,11 @@ pub struct Config {
     pub fma: bool,
     /// `Some(L)`: a tree module also holds `<name>_lanes` of its dynamics functions
     /// ([`lanes::FUNCTIONS`]), which evaluate `L` states per call (`LANES = L`, 2 to
-    /// [`lanes::MAX`]): `q: &[[f64; DOF]; LANES]` in, `[[f64; DOF]; LANES]` out, and
-    /// `[Result<…, Singular>; LANES]` for `forward_dynamics`, each lane's result bit for bit
-    /// the scalar function's on that state ([`lanes`]). 4 fills an AVX2 register in `f64`, 8 in
-    /// `f32`. `None` (default): the module as before, byte for byte. Trees only.
+    /// [`lanes::MAX`]), lane last: `q: &[[f64; LANES]; DOF]` in (`q[i][k]`: coordinate `i` of
+    /// state `k`), `[[f64; LANES]; DOF]` out, and for `forward_dynamics` also each lane's
+    /// status `[Result<(), Singular>; LANES]`; every lane bit for bit the scalar function on its
+    /// state ([`lanes`]). 4 fills an AVX2 register in `f64`, 8 in `f32`. `None` (default): the
+    /// module as before, byte for byte. Trees only.
     pub lanes: Option<usize>,
 }
 

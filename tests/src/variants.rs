@@ -208,3 +208,14 @@ pub mod lanes {
 pub mod lanes_f32_puma560 {
     include!(concat!(env!("OUT_DIR"), "/variants/lanes_f32/puma560.rs"));
 }
+/// The PUMA 560 and the 7-joint chain with 4 lanes and the `libm` math backend.
+pub mod lanes_libm {
+    /// `mechanisms/specs/puma560.toml`.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_libm/puma560.rs"));
+    }
+    /// `mechanisms/specs/chain7.toml`.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_libm/chain7.rs"));
+    }
+}
