@@ -7,8 +7,8 @@
 //! [`Step::MulAdd`], and the `Mul`'s own step goes. When both operands qualify, the left one is
 //! fused. The rule depends only on the schedule, so the output stays deterministic.
 //!
-//! Each fusion removes one `mul` and one `add` from the function's [`OpCount`] and adds one
-//! `fma`; [`OpCount::flops`] counts an `fma` as two, so the flops stay what they were.
+//! Each fusion removes one `mul` and one `add` from the function's [`OpCount`](crate::schedule::OpCount) and adds one
+//! `fma`; [`OpCount::flops`](crate::schedule::OpCount::flops) counts an `fma` as two, so the flops stay what they were.
 //! Off (the default), nothing here runs and the output is byte for byte what it was.
 //!
 //! The call is the math backend's: `libm::fma` (`fmaf`), `f64::mul_add` (std), or
