@@ -173,6 +173,51 @@ fn main() {
     let p = write(&out, "closed_inertia", &src);
     generate(&out, "closed_inertia", &p, |_| {});
 
+    // Fused multiply–add (`tests/tests/fma.rs`, the `fma` bench group): a tree of 6 and of 7
+    // joints, a platform and a closed loop, each with `Config::fma`.
+    for spec in [
+        puma,
+        "../mechanisms/specs/chain7.toml",
+        gs,
+        "../mechanisms/specs/spherical_five_bar.toml",
+    ] {
+        println!("cargo:rerun-if-changed={spec}");
+        generate(&out, "fma", Path::new(spec), |b| {
+            b.fma(true).implement("runtime");
+        });
+    }
+
+    // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
+    // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.
+    let trees = [
+        "../mechanisms/specs/puma560.toml",
+        "../mechanisms/specs/puma560.urdf",
+        "../mechanisms/specs/chain7.toml",
+        "../mechanisms/specs/gripper_tree.toml",
+        "../mechanisms/specs/iiwa14.urdf",
+        "../mechanisms/specs/planar_2r.toml",
+        "../mechanisms/specs/stanford_arm.toml",
+    ];
+    for spec in trees {
+        println!("cargo:rerun-if-changed={spec}");
+    }
+    generate(&out, "lanes", Path::new(trees[0]), |b| {
+        for spec in &trees[1..] {
+            b.spec(spec);
+        }
+        b.lanes(Some(4));
+    });
+    // The same with trigonometry from the `libm` crate (half the cost of std's `sin_cos` here,
+    // and inlined): the `lanes_libm` bench groups.
+    generate(&out, "lanes_libm", Path::new(puma), |b| {
+        b.spec(trees[2])
+            .lanes(Some(4))
+            .math(codegen::MathBackend::Libm);
+    });
+    generate(&out, "lanes_f32", Path::new(puma), |b| {
+        b.lanes(Some(8)).float(codegen::Float::F32);
+    });
+
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
     println!("cargo:rerun-if-changed={iiwa}");

@@ -156,6 +156,18 @@ impl Builder {
         self
     }
 
+    /// Fuse multiply–adds into `mul_add` (`Config::fma`; off by default).
+    pub fn fma(&mut self, on: bool) -> &mut Self {
+        self.config.fma = on;
+        self
+    }
+
+    /// Also emit `_lanes` functions of `lanes` states per call (`Config::lanes`; trees only).
+    pub fn lanes(&mut self, lanes: Option<usize>) -> &mut Self {
+        self.config.lanes = lanes;
+        self
+    }
+
     /// Also implement the runtime's `Dynamics` trait in every module (`Config::implement`):
     /// `runtime` is the path of the nocdyn runtime crate as the including crate names it (e.g.
     /// `"runtime"`). Each module then holds `pub struct Module` and

@@ -121,11 +121,11 @@ pub(crate) fn float_lit(v: f64) -> TokenStream {
     }
 }
 
-fn var(n: usize) -> Ident {
+pub(crate) fn var(n: usize) -> Ident {
     format_ident!("x{}", n)
 }
 
-fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
+pub(crate) fn operand(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
     match s.operand(g, id) {
         Operand::Var(n) => {
             let v = var(n);
@@ -164,13 +164,18 @@ pub(crate) fn real_text(text: &str) -> String {
     }
 }
 
-/// A call of the math backend's `f` (`sin_cos`, `sqrt`, `atan2`) on the argument tokens `x`.
-/// In `f32` these are `libm::{sincosf, sqrtf, atan2f}`, `f32::…` and `runtime::math::*_f32`.
+/// A call of the math backend's `f` (`sin_cos`, `sqrt`, `atan2`, `mul_add`) on the argument
+/// tokens `x`. In `f32` these are `libm::{sincosf, sqrtf, atan2f, fmaf}`, `f32::…` and
+/// `runtime::math::*_f32`.
 pub(crate) fn math_call(cfg: &Config, f: &str, x: TokenStream) -> TokenStream {
     let single = crate::scalar::single();
     match &cfg.math {
         MathBackend::Libm => {
-            let f = if f == "sin_cos" { "sincos" } else { f };
+            let f = match f {
+                "sin_cos" => "sincos",
+                "mul_add" => "fma",
+                f => f,
+            };
             let f = format_ident!("{}{}", f, if single { "f" } else { "" });
             quote!(libm::#f(#x))
         }
@@ -220,6 +225,11 @@ fn step_tokens(g: &Graph, cfg: &Config, f: &Function<'_>, step: &Step) -> TokenS
         }
         Step::Check { node } => check_tokens(g, f, node),
         Step::Let { name, node } => let_tokens(g, cfg, s, name, node),
+        Step::MulAdd { name, node, mul } => {
+            let x = var(name);
+            let e = crate::fma::call(g, cfg, node, mul, &|id| operand(g, s, id));
+            quote!(let #x = #e;)
+        }
     }
 }
 
@@ -376,7 +386,7 @@ fn output_check(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
 }
 
 /// The returned expression of the function's shape.
-fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
+pub(crate) fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStream {
     match f.shape {
         Shape::Vector => quote!([#(#outs),*]),
         Shape::FallibleVector => quote!(Ok([#(#outs),*])),
@@ -451,6 +461,7 @@ fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
         Step::SinCos { sin, cos, arg } => (vec![sin, cos], var_of(arg).into_iter().collect()),
         Step::Check { node } => (vec![], g.operands(node).filter_map(var_of).collect()),
         Step::Let { name, node } => (vec![name], g.operands(node).filter_map(var_of).collect()),
+        Step::MulAdd { name, node, mul } => (vec![name], crate::fma::reads(g, s, node, mul)),
     }
 }
 
@@ -459,7 +470,7 @@ fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
 /// information, and rustc's LLVM backend recurses once per nested scope: thousands of `let`s in
 /// one block overflow its stack. Blocks keep the nesting depth near `CHUNK` plus the number of
 /// blocks. Short bodies are left as they are.
-fn chunked(
+pub(crate) fn chunked(
     g: &Graph,
     s: &Schedule,
     outputs: &[ExprId],
@@ -563,17 +574,7 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
             quote!(#a: &[#real; #len])
         })
         .collect();
-    let ret = match &f.shape {
-        Shape::Vector => quote!([#real; DOF]),
-        Shape::Matrix => quote!([[#real; DOF]; DOF]),
-        Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
-        Shape::Fallible(parts) => {
-            let t = parts_type(parts);
-            quote!(Result<#t, Singular>)
-        }
-        Shape::Tuple(parts) => parts_type(parts),
-        Shape::Regressor => quote!([[#real; NBP]; DOF]),
-    };
+    let ret = return_type(&f.shape);
     let docs = f.doc.iter().map(|d| {
         let d = format!(" {d}");
         quote!(#[doc = #d])
@@ -599,6 +600,22 @@ pub(crate) fn function(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream
         #vis fn #name(#(#args),*) -> #ret {
             #body
         }
+    }
+}
+
+/// The type a function of `shape` returns.
+pub(crate) fn return_type(shape: &Shape) -> TokenStream {
+    let real = real();
+    match shape {
+        Shape::Vector => quote!([#real; DOF]),
+        Shape::Matrix => quote!([[#real; DOF]; DOF]),
+        Shape::FallibleVector => quote!(Result<[#real; DOF], Singular>),
+        Shape::Fallible(parts) => {
+            let t = parts_type(parts);
+            quote!(Result<#t, Singular>)
+        }
+        Shape::Tuple(parts) => parts_type(parts),
+        Shape::Regressor => quote!([[#real; NBP]; DOF]),
     }
 }
 
@@ -654,11 +671,14 @@ pub fn stats_table_per(rows: &[(String, OpCount)], dof: usize, per: &str) -> Vec
     } else {
         ("", "")
     };
+    // Likewise the `fma` column, only with fused multiply–adds (`Config::fma`).
+    let fma = rows.iter().any(|(_, c)| c.fma > 0);
+    let (f1, f2) = if fma { (" fma |", "---:|") } else { ("", "") };
     let mut v = vec![
         format!(
-            "| function | flops | flops/{per} | add | mul | neg | div | sqrt | sin_cos | cmp |{h1}"
+            "| function | flops | flops/{per} | add | mul |{f1} neg | div | sqrt | sin_cos | cmp |{h1}"
         ),
-        format!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|{h2}"),
+        format!("|---|---:|---:|---:|---:|{f2}---:|---:|---:|---:|---:|{h2}"),
     ];
     for (name, c) in rows {
         let extra = if atan2 {
@@ -666,8 +686,13 @@ pub fn stats_table_per(rows: &[(String, OpCount)], dof: usize, per: &str) -> Vec
         } else {
             String::new()
         };
+        let fused = if fma {
+            format!(" {} |", c.fma)
+        } else {
+            String::new()
+        };
         v.push(format!(
-            "| {name} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |{extra}",
+            "| {name} | {} | {:.1} | {} | {} |{fused} {} | {} | {} | {} | {} |{extra}",
             c.flops(),
             c.flops() as f64 / dof.max(1) as f64,
             c.add,

@@ -46,7 +46,36 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
     if let Some(runtime) = &cfg.implement {
         module.extend(crate::implement::items(&module, runtime, plan.name));
     }
-    emit::render(&plan.header, module)
+    if let Some(l) = cfg.lanes {
+        module.extend(crate::lanes::items(plan.graph, cfg, &plan.functions, l));
+    }
+    let mut header = plan.header.clone();
+    if let Some(l) = cfg.lanes {
+        let at = header
+            .iter()
+            .position(|h| h.starts_with("Math backend"))
+            .map_or(header.len(), |i| i + 1);
+        header.insert(
+            at,
+            format!(
+                "Lanes: {l} states per call in the `_lanes` functions ({}).",
+                crate::lanes::FUNCTIONS.join(", ")
+            ),
+        );
+    }
+    if cfg.fma {
+        // Named right after the math backend (the table follows).
+        let at = header
+            .iter()
+            .position(|h| h.starts_with("Math backend"))
+            .map_or(header.len(), |i| i + 1);
+        header.insert(
+            at,
+            "Fused multiply–add: on (`mul_add`, one rounding; `fma` column: each is 2 flops)."
+                .into(),
+        );
+    }
+    emit::render(&header, module)
 }
 
 /// The `Singular` and `NoConvergence` types of a platform or closed-loop module (each kind has

@@ -30,12 +30,17 @@ pub struct OpCount {
     pub cmp: usize,
     /// `atan2` calls (parallel mechanisms: revolute actuator angles).
     pub atan2: usize,
+    /// Fused multiply–adds (`mul_add`, one rounding), with [`crate::Config::fma`] only: each
+    /// replaces one `mul` and one `add` ([`crate::fma`]).
+    pub fma: usize,
 }
 
 impl OpCount {
-    /// Arithmetic operations: add + mul + neg + div + sqrt (trigonometry and comparisons apart).
+    /// Arithmetic operations: add + mul + neg + div + sqrt + 2 × fma (trigonometry and
+    /// comparisons apart). A fused multiply–add is two of them, a multiply and an add, so that
+    /// the count is the same with and without fusion.
     pub fn flops(&self) -> usize {
-        self.add + self.mul + self.neg + self.div + self.sqrt
+        self.add + self.mul + self.neg + self.div + self.sqrt + 2 * self.fma
     }
 }
 
@@ -56,6 +61,9 @@ impl fmt::Display for OpCount {
         if self.atan2 > 0 {
             write!(f, ", {} atan2", self.atan2)?;
         }
+        if self.fma > 0 {
+            write!(f, ", {} fma (counted as 2 flops each)", self.fma)?;
+        }
         Ok(())
     }
 }
@@ -69,6 +77,13 @@ pub enum Step {
     SinCos { sin: usize, cos: usize, arg: ExprId },
     /// Pivot check of a `Guard` node: return `Err` unless the value exceeds the tolerance.
     Check { node: ExprId },
+    /// `let x{name} = mul_add(…);`: the `Add` or `Sub` `node` with its operand `mul` (a `Mul`
+    /// read nowhere else) fused into it ([`crate::fma`]).
+    MulAdd {
+        name: usize,
+        node: ExprId,
+        mul: ExprId,
+    },
 }
 
 /// How an operand is referred to in generated code.
@@ -87,7 +102,7 @@ pub enum Operand {
 pub struct Schedule {
     /// Statements.
     pub steps: Vec<Step>,
-    names: HashMap<ExprId, usize>,
+    pub(crate) names: HashMap<ExprId, usize>,
     /// Operation count.
     pub ops: OpCount,
 }
@@ -190,6 +205,9 @@ pub fn schedule(g: &Graph, k: &Kernel) -> Schedule {
                 next += 1;
             }
         }
+    }
+    if crate::fma::enabled() {
+        crate::fma::fuse(g, k, &mut s);
     }
     s
 }

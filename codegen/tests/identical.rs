@@ -75,6 +75,8 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
         scene: Default::default(),
         implement: None,
         emit: codegen::Emit::Rust,
+        fma: false,
+        lanes: None,
     };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -1,4 +1,4 @@
-//! The math layer generated code calls: `sin_cos`, `sqrt`.
+//! The math layer generated code calls: `sin_cos`, `sqrt`, `atan2`, `mul_add`.
 //!
 //! With the `std` feature (and without `libm-force`) these are std's methods (LLVM intrinsics and
 //! the platform libm); otherwise the pure-Rust `libm` crate, which gives bit-identical results on
@@ -79,5 +79,33 @@ pub fn atan2_f32(y: f32, x: f32) -> f32 {
     #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
     {
         libm::atan2f(y, x)
+    }
+}
+
+/// `x * y + z` with one rounding (fused multiply–add; generated code with `Config::fma`). One
+/// instruction where the target has FMA (`-C target-cpu=native`); otherwise std calls the
+/// platform's `fma` and the `libm` crate computes it in software, both exact to one rounding.
+#[inline(always)]
+pub fn mul_add(x: f64, y: f64, z: f64) -> f64 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.mul_add(y, z)
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::fma(x, y, z)
+    }
+}
+
+/// [`mul_add`] in single precision.
+#[inline(always)]
+pub fn mul_add_f32(x: f32, y: f32, z: f32) -> f32 {
+    #[cfg(all(feature = "std", not(feature = "libm-force")))]
+    {
+        x.mul_add(y, z)
+    }
+    #[cfg(not(all(feature = "std", not(feature = "libm-force"))))]
+    {
+        libm::fmaf(x, y, z)
     }
 }

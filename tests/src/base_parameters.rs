@@ -55,3 +55,47 @@ pub fn rank_of(a: &DMatrix<f64>) -> usize {
         .collect();
     rank(&cols)
 }
+
+/// The worst `‖Y π − τ‖∞ / ‖τ‖∞` over `states` states, `draw` giving each state's efforts `τ`
+/// and regressor `Y` (rows of `K` entries).
+pub fn worst_linear_form_error<const K: usize>(
+    pi: &[f64; K],
+    states: usize,
+    mut draw: impl FnMut() -> (Vec<f64>, Vec<[f64; K]>),
+) -> f64 {
+    let mut worst = 0.0f64;
+    for _ in 0..states {
+        let (tau, y) = draw();
+        let yp: Vec<f64> = y
+            .iter()
+            .map(|row| row.iter().zip(pi).map(|(a, b)| a * b).sum())
+            .collect();
+        worst = worst.max(crate::pkm::rel(&yp, &tau));
+    }
+    worst
+}
+
+/// The ranks of the standard regressor stacked over `states` states, of the generated one, and
+/// of both side by side: `draw` gives each state's `n × ncols` standard block and `n × nbp`
+/// generated block.
+pub fn stacked_ranks(
+    states: usize,
+    (n, ncols, nbp): (usize, usize, usize),
+    mut draw: impl FnMut() -> (DMatrix<f64>, DMatrix<f64>),
+) -> (usize, usize, usize) {
+    let mut std_rows = DMatrix::zeros(states * n, ncols);
+    let mut gen_rows = DMatrix::zeros(states * n, nbp);
+    for s in 0..states {
+        let (a, b) = draw();
+        std_rows.view_mut((s * n, 0), (n, ncols)).copy_from(&a);
+        gen_rows.view_mut((s * n, 0), (n, nbp)).copy_from(&b);
+    }
+    let both = DMatrix::from_fn(states * n, ncols + nbp, |i, k| {
+        if k < ncols {
+            std_rows[(i, k)]
+        } else {
+            gen_rows[(i, k - ncols)]
+        }
+    });
+    (rank_of(&std_rows), rank_of(&gen_rows), rank_of(&both))
+}

@@ -147,3 +147,75 @@ pub mod tripod_task {
         "/variants/tripod_task/tripod_3prs_task.rs"
     ));
 }
+
+/// The PUMA 560, the 7-joint chain, the Gough–Stewart platform and the spherical five-bar with
+/// fused multiply–adds (`Config::fma`; `tests/tests/fma.rs`).
+pub mod fma {
+    /// The PUMA 560 with `mul_add`.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/puma560.rs"));
+    }
+    /// The 7-joint chain with `mul_add`.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/chain7.rs"));
+    }
+    /// The Gough–Stewart platform with `mul_add`.
+    pub mod gough_stewart {
+        include!(concat!(env!("OUT_DIR"), "/variants/fma/gough_stewart.rs"));
+    }
+    /// The spherical five-bar with `mul_add`.
+    pub mod spherical_five_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/fma/spherical_five_bar.rs"
+        ));
+    }
+}
+
+/// Every bundled tree with `_lanes` functions of 4 states per call (`Config::lanes`;
+/// `tests/tests/lanes.rs`).
+pub mod lanes {
+    /// `mechanisms/specs/puma560` with 4 lanes.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/puma560.rs"));
+    }
+    /// `mechanisms/specs/puma560_urdf` with 4 lanes.
+    pub mod puma560_urdf {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/puma560_urdf.rs"));
+    }
+    /// `mechanisms/specs/chain7` with 4 lanes.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/chain7.rs"));
+    }
+    /// `mechanisms/specs/gripper_tree` with 4 lanes.
+    pub mod gripper_tree {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/gripper_tree.rs"));
+    }
+    /// `mechanisms/specs/iiwa14` with 4 lanes.
+    pub mod iiwa14 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/iiwa14.rs"));
+    }
+    /// `mechanisms/specs/planar_2r` with 4 lanes.
+    pub mod planar_2r {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/planar_2r.rs"));
+    }
+    /// `mechanisms/specs/stanford_arm` with 4 lanes.
+    pub mod stanford_arm {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes/stanford_arm.rs"));
+    }
+}
+/// The PUMA 560 in `f32` with 8 lanes.
+pub mod lanes_f32_puma560 {
+    include!(concat!(env!("OUT_DIR"), "/variants/lanes_f32/puma560.rs"));
+}
+/// The PUMA 560 and the 7-joint chain with 4 lanes and the `libm` math backend.
+pub mod lanes_libm {
+    /// `mechanisms/specs/puma560.toml`.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_libm/puma560.rs"));
+    }
+    /// `mechanisms/specs/chain7.toml`.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_libm/chain7.rs"));
+    }
+}

@@ -15,7 +15,7 @@ use rand::rngs::StdRng;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 use runtime::model::{Drive, Mat3};
-use tests::base_parameters::{rank_of, standard};
+use tests::base_parameters::{stacked_ranks, standard, worst_linear_form_error};
 
 /// `model` with every body, drive and spring zero.
 fn bare(m: &ClosedModel) -> ClosedModel {
@@ -91,18 +91,12 @@ macro_rules! closed_loops {
                 let plan = Plan::new(&m).unwrap();
                 let reach = tests::closed::reach(stringify!($name));
                 let mut rng = tests::rng(0x7e62 ^ g::NBP as u64);
-                let mut worst = 0.0f64;
-                for _ in 0..500 {
+                let worst = worst_linear_form_error(&g::BASE_PARAMETERS, 500, || {
                     let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, reach);
                     let (x, u, ud) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
                     let tau = g::inverse_dynamics(&x, &u, &ud).unwrap();
-                    let y = g::regressor(&x, &u, &ud).unwrap();
-                    let yp: Vec<f64> = y
-                        .iter()
-                        .map(|row| row.iter().zip(&g::BASE_PARAMETERS).map(|(a, b)| a * b).sum())
-                        .collect();
-                    worst = worst.max(tests::pkm::rel(&yp, &tau));
-                }
+                    (tau.to_vec(), g::regressor(&x, &u, &ud).unwrap().to_vec())
+                });
                 println!("{}: NBP {}, regressor · BASE_PARAMETERS vs inverse_dynamics {worst:.1e}", stringify!($name), g::NBP);
                 if worst.is_nan() || worst > 1e-12 {
                     failed.push((stringify!($name), worst));
@@ -124,11 +118,10 @@ macro_rules! closed_loops {
                 let n = g::DOF;
                 let ncols: usize = sources.iter().map(|(p, _)| p.len()).sum();
                 let states = 3 * (ncols + g::NBP) / n + 20;
-                let mut std_rows = DMatrix::zeros(states * n, ncols);
-                let mut gen_rows = DMatrix::zeros(states * n, g::NBP);
-                for s in 0..states {
+                let (rs, rg, rb) = stacked_ranks(states, (n, ncols, g::NBP), || {
                     let (x, u, ud) = tests::closed::random_state(&plan, &mut rng, reach);
                     let mut col = 0;
+                    let mut std_block = DMatrix::zeros(n, ncols);
                     for (plans, pinv) in &sources {
                         let f = DMatrix::from_columns(
                             &plans
@@ -141,20 +134,14 @@ macro_rules! closed_loops {
                                 .collect::<Vec<_>>(),
                         );
                         let cols = f * pinv;
-                        std_rows.view_mut((s * n, col), (n, plans.len())).copy_from(&cols);
+                        std_block.view_mut((0, col), (n, plans.len())).copy_from(&cols);
                         col += plans.len();
                     }
                     let (xa, ua, uda) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
                     let y = g::regressor(&xa, &ua, &uda).unwrap();
                     let y = DMatrix::from_fn(n, g::NBP, |i, k| y[i][k]);
-                    gen_rows.view_mut((s * n, 0), (n, g::NBP)).copy_from(&y);
-                }
-                let rs = rank_of(&std_rows);
-                let rg = rank_of(&gen_rows);
-                let both = DMatrix::from_fn(states * n, ncols + g::NBP, |i, k| {
-                    if k < ncols { std_rows[(i, k)] } else { gen_rows[(i, k - ncols)] }
+                    (std_block, y)
                 });
-                let rb = rank_of(&both);
                 println!(
                     "{}: {} standard parameters, SVD rank {rs}; NBP {}, generated regressor rank {rg}, both {rb}",
                     stringify!($name), ncols, g::NBP

@@ -16,7 +16,7 @@ use rand::rngs::StdRng;
 use runtime::model::{Body, Drive, Mat3};
 use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
-use tests::base_parameters::{rank_of, standard};
+use tests::base_parameters::{stacked_ranks, standard, worst_linear_form_error};
 
 /// The model's bodies: the platform, then each leg's in order.
 fn bodies(m: &mut ParallelModel) -> Vec<&mut Body> {
@@ -79,18 +79,12 @@ macro_rules! platforms {
                 let home = tests::pkm::home_x(&m);
                 let r = reach(stringify!($name));
                 let mut rng = tests::rng(0x7e61 ^ g::NBP as u64);
-                let mut worst = 0.0f64;
-                for _ in 0..500 {
+                let worst = worst_linear_form_error(&g::BASE_PARAMETERS, 500, || {
                     let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 4.0 * r, r);
                     let (x, u, ud) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
                     let tau = g::inverse_dynamics(&x, &u, &ud).unwrap();
-                    let y = g::regressor(&x, &u, &ud).unwrap();
-                    let yp: Vec<f64> = y
-                        .iter()
-                        .map(|row| row.iter().zip(&g::BASE_PARAMETERS).map(|(a, b)| a * b).sum())
-                        .collect();
-                    worst = worst.max(tests::pkm::rel(&yp, &tau));
-                }
+                    (tau.to_vec(), g::regressor(&x, &u, &ud).unwrap().to_vec())
+                });
                 println!("{}: NBP {}, regressor · BASE_PARAMETERS vs inverse_dynamics {worst:.1e}", stringify!($name), g::NBP);
                 if worst.is_nan() || worst > 1e-12 {
                     failed.push((stringify!($name), worst));
@@ -113,10 +107,9 @@ macro_rules! platforms {
                 let n = g::DOF;
                 let ncols = 10 * models.len();
                 let states = 3 * (ncols + g::NBP) / n + 20;
-                let mut std_rows = DMatrix::zeros(states * n, ncols);
-                let mut gen_rows = DMatrix::zeros(states * n, g::NBP);
-                for s in 0..states {
+                let (rs, rg, rb) = stacked_ranks(states, (n, ncols, g::NBP), || {
                     let (x, u, ud) = tests::pkm::random_state(&plan, &home, &mut rng, 4.0 * r, r);
+                    let mut std_block = DMatrix::zeros(n, ncols);
                     for (b, (plans, pinv)) in models.iter().enumerate() {
                         let f = DMatrix::from_columns(
                             &plans
@@ -129,7 +122,7 @@ macro_rules! platforms {
                                 .collect::<Vec<_>>(),
                         );
                         let cols = f * pinv;
-                        std_rows.view_mut((s * n, 10 * b), (n, 10)).copy_from(&cols);
+                        std_block.view_mut((0, 10 * b), (n, 10)).copy_from(&cols);
                     }
                     // The generated regressor mapped back to generalized forces: Aᵀ Y.
                     let a = noc::actuation(&plan, &x).unwrap();
@@ -137,14 +130,8 @@ macro_rules! platforms {
                     let (xa, ua, uda) = (x.try_into().unwrap(), u.try_into().unwrap(), ud.try_into().unwrap());
                     let y = g::regressor(&xa, &ua, &uda).unwrap();
                     let y = DMatrix::from_fn(n, g::NBP, |i, k| y[i][k]);
-                    gen_rows.view_mut((s * n, 0), (n, g::NBP)).copy_from(&(a.transpose() * y));
-                }
-                let rs = rank_of(&std_rows);
-                let rg = rank_of(&gen_rows);
-                let both = DMatrix::from_fn(states * n, ncols + g::NBP, |i, k| {
-                    if k < ncols { std_rows[(i, k)] } else { gen_rows[(i, k - ncols)] }
+                    (std_block, a.transpose() * y)
                 });
-                let rb = rank_of(&both);
                 println!(
                     "{}: {} standard parameters, SVD rank {rs}; NBP {}, generated regressor rank {rg}, both {rb}",
                     stringify!($name), ncols, g::NBP

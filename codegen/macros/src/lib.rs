@@ -269,6 +269,8 @@ impl Args {
             scene,
             implement: self.implement.as_ref().map(LitStr::value),
             emit: codegen::Emit::Rust,
+            fma: false,
+            lanes: None,
         })
     }
 }

@@ -71,6 +71,7 @@ pub(super) fn plus(a: OpCount, b: OpCount, times: usize) -> OpCount {
         sin_cos: a.sin_cos + b.sin_cos * times,
         cmp: a.cmp + b.cmp * times,
         atan2: a.atan2 + b.atan2 * times,
+        fma: a.fma + b.fma * times,
     }
 }
 

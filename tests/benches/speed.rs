@@ -1,0 +1,209 @@
+//! Fused multiply–add and many states per call (issue 24), in one run:
+//!
+//! - `fma/{mechanism}/{function}/{plain,fused}`: the bundled module against the same spec
+//!   generated with `Config::fma` (`tests::variants::fma`), PUMA 560 and the 7-joint chain
+//!   (inverse dynamics, mass matrix), Gough–Stewart (inverse dynamics);
+//! - `lanes/{mechanism}/{function}/{scalar,lanes}`: `LANES` (4) states through the scalar
+//!   function one after the other against one call of its `_lanes` version (the same states,
+//!   lane last), in the same module (`tests::variants::lanes`); criterion's throughput is per
+//!   state; `lanes_libm/…` the same with the `libm` crate's trigonometry
+//!   (`tests::variants::lanes_libm`).
+//!
+//! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
+//! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
+//! the other builds' flags apart):
+//!
+//! ```text
+//! RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=$PWD/target/native \
+//!     cargo bench -p tests --bench speed
+//! ```
+//!
+//! `sin_cos/four_angles` times what one angle costs a `_lanes` function (a call per lane).
+//!
+//! The `#[inline(never)]` wrappers below are the functions whose instructions
+//! docs/performance.md counts (`objdump -d --no-show-raw-insn -C` on the bench binary).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use rand::Rng;
+
+/// PUMA 560 inverse dynamics, unfused (the instruction count's "before").
+#[inline(never)]
+pub fn puma_id_plain(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
+    mechanisms::puma560::inverse_dynamics(q, qd, qdd)
+}
+
+/// PUMA 560 inverse dynamics, fused (the instruction count's "after").
+#[inline(never)]
+pub fn puma_id_fused(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
+    tests::variants::fma::puma560::inverse_dynamics(q, qd, qdd)
+}
+
+/// PUMA 560 inverse dynamics of four states in one call.
+#[inline(never)]
+pub fn puma_id_lanes(q: &[[f64; 4]; 6], qd: &[[f64; 4]; 6], qdd: &[[f64; 4]; 6]) -> [[f64; 4]; 6] {
+    tests::variants::lanes::puma560::inverse_dynamics_lanes(q, qd, qdd)
+}
+
+/// Three arrays (angles, rates, accelerations) of `L` random states, state-major.
+fn states<const N: usize, const L: usize>(seed: u64) -> [[[f64; N]; L]; 3] {
+    let mut r = tests::rng(seed);
+    let pi = std::f64::consts::PI;
+    [pi, 2.0, 5.0]
+        .map(|a| core::array::from_fn(|_| core::array::from_fn(|_| r.random_range(-a..a))))
+}
+
+macro_rules! fma_tree {
+    ($fn_name:ident, $m:ident) => {
+        fn $fn_name(c: &mut Criterion) {
+            use mechanisms::$m as plain;
+            use tests::variants::fma::$m as fused;
+            const N: usize = plain::DOF;
+            let [q, qd, qdd] = states::<N, 1>(11).map(|s| s[0]);
+            let mut g = c.benchmark_group(concat!("fma/", stringify!($m), "/inverse_dynamics"));
+            g.bench_function("plain", |b| {
+                b.iter(|| plain::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd)))
+            });
+            g.bench_function("fused", |b| {
+                b.iter(|| fused::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd)))
+            });
+            g.finish();
+            let mut g = c.benchmark_group(concat!("fma/", stringify!($m), "/mass_matrix"));
+            g.bench_function("plain", |b| b.iter(|| plain::mass_matrix(black_box(&q))));
+            g.bench_function("fused", |b| b.iter(|| fused::mass_matrix(black_box(&q))));
+            g.finish();
+        }
+    };
+}
+fma_tree!(fma_puma560, puma560);
+fma_tree!(fma_chain7, chain7);
+
+fn fma_gough_stewart(c: &mut Criterion) {
+    use mechanisms::gough_stewart as plain;
+    use tests::variants::fma::gough_stewart as fused;
+    let x = plain::HOME;
+    let u: [f64; 6] = core::array::from_fn(|i| 0.1 - 0.03 * i as f64);
+    let ud: [f64; 6] = core::array::from_fn(|i| 0.5 - 0.2 * i as f64);
+    assert!(plain::inverse_dynamics(&x, &u, &ud).is_ok());
+    let mut g = c.benchmark_group("fma/gough_stewart/inverse_dynamics");
+    g.bench_function("plain", |b| {
+        b.iter(|| plain::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.bench_function("fused", |b| {
+        b.iter(|| fused::inverse_dynamics(black_box(&x), black_box(&u), black_box(&ud)))
+    });
+    g.finish();
+}
+
+macro_rules! lanes_tree {
+    ($fn_name:ident, $m:ident) => {
+        lanes_tree!($fn_name, lanes, $m);
+    };
+    ($fn_name:ident, $variant:ident, $m:ident) => {
+        fn $fn_name(c: &mut Criterion) {
+            use tests::variants::$variant::$m as g;
+            const N: usize = g::DOF;
+            const L: usize = g::LANES;
+            // One state per row for the scalar calls, lane-last (transposed) for the lanes.
+            let [q, qd, qdd] = states::<N, L>(12);
+            let [ql, qdl, qddl] = [q, qd, qdd].map(transpose);
+            let taul = g::inverse_dynamics_lanes(&ql, &qdl, &qddl);
+            let tau: [[f64; N]; L] = transpose(taul);
+            let name = concat!(stringify!($variant), "/", stringify!($m));
+            let mut grp = c.benchmark_group(format!("{name}/inverse_dynamics"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let (q, qd, qdd) = (black_box(&q), black_box(&qd), black_box(&qdd));
+                    core::array::from_fn::<_, L, _>(|k| g::inverse_dynamics(&q[k], &qd[k], &qdd[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| {
+                b.iter(|| {
+                    g::inverse_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&qddl))
+                })
+            });
+            grp.finish();
+            let mut grp = c.benchmark_group(format!("{name}/mass_matrix"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let q = black_box(&q);
+                    core::array::from_fn::<_, L, _>(|k| g::mass_matrix(&q[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| b.iter(|| g::mass_matrix_lanes(black_box(&ql))));
+            grp.finish();
+            let mut grp = c.benchmark_group(format!("{name}/forward_dynamics"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let (q, qd, tau) = (black_box(&q), black_box(&qd), black_box(&tau));
+                    core::array::from_fn::<_, L, _>(|k| g::forward_dynamics(&q[k], &qd[k], &tau[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| {
+                b.iter(|| {
+                    g::forward_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&taul))
+                })
+            });
+            grp.finish();
+        }
+    };
+}
+lanes_tree!(lanes_puma560, puma560);
+lanes_tree!(lanes_chain7, chain7);
+lanes_tree!(lanes_iiwa14, iiwa14);
+lanes_tree!(lanes_libm_puma560, lanes_libm, puma560);
+lanes_tree!(lanes_libm_chain7, lanes_libm, chain7);
+
+/// What a `_lanes` function pays per angle: four `sin_cos` calls of the math backend, std
+/// (the modules here: `runtime::math`) and the `libm` crate.
+fn sin_cos(c: &mut Criterion) {
+    let x: [f64; 4] = [0.3, -1.2, 2.5, -2.9];
+    let mut g = c.benchmark_group("sin_cos/four_angles");
+    g.throughput(Throughput::Elements(4));
+    g.bench_function("runtime_math_std", |b| {
+        b.iter(|| black_box(&x).map(runtime::math::sin_cos))
+    });
+    g.bench_function("libm", |b| b.iter(|| black_box(&x).map(libm::sincos)));
+    g.finish();
+}
+
+/// `a` with rows and columns swapped.
+fn transpose<const R: usize, const C: usize>(a: [[f64; C]; R]) -> [[f64; R]; C] {
+    core::array::from_fn(|j| core::array::from_fn(|i| a[i][j]))
+}
+
+/// The wrappers once, so that they are in the binary for the instruction count.
+fn wrappers(c: &mut Criterion) {
+    let [q, qd, qdd] = states::<6, 4>(13);
+    let [ql, qdl, qddl] = [q, qd, qdd].map(transpose);
+    let mut g = c.benchmark_group("wrappers/puma560/inverse_dynamics");
+    g.bench_function("plain", |b| {
+        b.iter(|| puma_id_plain(black_box(&q[0]), &qd[0], &qdd[0]))
+    });
+    g.bench_function("fused", |b| {
+        b.iter(|| puma_id_fused(black_box(&q[0]), &qd[0], &qdd[0]))
+    });
+    g.bench_function("lanes", |b| {
+        b.iter(|| puma_id_lanes(black_box(&ql), &qdl, &qddl))
+    });
+    g.finish();
+}
+
+fn config() -> Criterion {
+    Criterion::default()
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_millis(500))
+        .sample_size(30)
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, sin_cos, wrappers
+}
+criterion_main!(benches);
