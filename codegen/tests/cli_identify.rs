@@ -413,17 +413,6 @@ fn bad_input_is_exit_code_2_without_a_panic() {
         assert!(err.contains(want), "{name}: {err}");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
-    // Closed loops: refused with the reason, for both commands.
-    let loops = "../mechanisms/specs/four_bar.toml";
-    for args in [vec!["identify", loops, "x.csv"], vec!["excite", loops]] {
-        let o = run(&args);
-        assert_eq!(o.status.code(), Some(2));
-        assert!(
-            text(&o.stderr).contains("closed loops not yet"),
-            "{}",
-            text(&o.stderr)
-        );
-    }
     // Bad arguments.
     for args in [
         vec!["excite", PUMA, "--harmonics", "0"],
@@ -489,3 +478,7 @@ fn a_joint_that_never_moves_leaves_parameters_unexcited_and_excite_repeats() {
 // Platforms: the Gough–Stewart and the Delta.
 #[path = "cli_identify/platform.rs"]
 mod platform;
+
+// Closed loops: the four-bar and Andrews' squeezer.
+#[path = "cli_identify/closed.rs"]
+mod closed;

@@ -1,6 +1,6 @@
-//! `codegen identify SPEC data.csv`: the base parameters of a tree or a platform from measured
-//! motions and efforts by weighted least squares, with their standard deviations, the regressor's
-//! condition number, warnings for parameters the data do not excite, and (`--out`) the spec
+//! `codegen identify SPEC data.csv`: the base parameters of a tree, a platform or a closed loop
+//! from measured motions and efforts by weighted least squares, with their standard
+//! deviations, the regressor's condition number, warnings for parameters the data do not excite, and (`--out`) the spec
 //! updated so that its model has the identified base parameters (docs/identification.md).
 
 use std::path::PathBuf;
@@ -25,10 +25,12 @@ pub enum Weights {
 /// Arguments of `identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
-    /// Tree (`.toml` or `.urdf`) or platform spec whose base parameters are identified.
+    /// Tree (`.toml` or `.urdf`), platform or closed-loop spec whose base parameters are
+    /// identified.
     pub spec: PathBuf,
     /// Measurements: CSV with a header `t,q1..,qd1..,qdd1..,tau1..` (or `t,q1..,tau1..`); a
-    /// platform's `t,x1..,u1..,ud1..,tau1..`.
+    /// platform's `t,x1..,u1..,ud1..,tau1..`; a closed loop's `t,q1..,u1..,ud1..,tau1..` (the
+    /// independent coordinates) or `t,x1..xNX,u1..,ud1..,tau1..`.
     pub data: PathBuf,
     /// Write the spec updated to the identified base parameters here (TOML specs only).
     #[arg(long, value_name = "UPDATED.toml")]
@@ -92,10 +94,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     };
     let (n, nbp) = (reg.dof(), reg.nbp());
-    let data = match samples::read(
+    let mut data = match samples::read(
         &data_name,
         &text,
-        &reg.columns(),
+        &reg.columns_of(&text),
         nbp / n.max(1) + 1,
         Filtering {
             cutoff: args.cutoff,
@@ -107,6 +109,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Err(e) = reg.assemble_positions(&data_name, &mut data) {
+        eprintln!("{e}");
+        return ExitCode::from(2);
+    }
     let rows = data.q.len();
     let mut w = DMatrix::zeros(rows * n, nbp);
     let mut tau = DVector::zeros(rows * n);

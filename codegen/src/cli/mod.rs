@@ -11,6 +11,7 @@
 //! * closed loops: the inertia of the independent joints, assembled on the home branch. Where the runtime returns
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
+pub mod closed_regressor;
 #[cfg(feature = "urdf")]
 pub mod convert;
 pub mod design;
