@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Args, ValueEnum};
 use nalgebra::{DMatrix, DVector};
 
+use super::effort_plot::{EffortPlot, Panel};
 use super::regressor::Regressor;
 use super::samples::{self, Filtering};
 use super::wls::{self, Stacked};
@@ -47,6 +48,10 @@ pub struct IdentifyArgs {
     /// Also write the estimates as CSV (`k,name,spec,estimate,std`, full precision).
     #[arg(long, value_name = "FILE.csv")]
     pub estimates: Option<PathBuf>,
+    /// Also plot measured against predicted efforts per joint (SVG; time on x when the data
+    /// have `t`, else the sample index).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Run `identify`.
@@ -132,7 +137,8 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             tau[s * n + i] = data.tau[s][i];
         }
     }
-    let fit = wls::fit(&Stacked { w, tau, n }, args.weights == Weights::Auto);
+    let stacked = Stacked { w, tau, n };
+    let fit = wls::fit(&stacked, args.weights == Weights::Auto);
     report(&reg, &name, &data_name, rows, &data.note, &fit, args);
     if let Some(path) = &args.estimates {
         let mut csv = String::from("k,name,spec,estimate,std\n");
@@ -147,6 +153,38 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
         if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
             eprintln!("error: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    if let Some(path) = &args.plot {
+        let predicted = &stacked.w * DVector::from_column_slice(&fit.estimate);
+        let names = reg.effort_names();
+        let panels: Vec<Panel> = (0..n)
+            .map(|i| Panel {
+                name: names[i].clone(),
+                measured: (0..rows).map(|s| stacked.tau[s * n + i]).collect(),
+                predicted: (0..rows).map(|s| predicted[s * n + i]).collect(),
+            })
+            .collect();
+        let timed = data.t.len() == rows;
+        let xs: Vec<f64> = if timed {
+            data.t.clone()
+        } else {
+            (0..rows).map(|s| s as f64).collect()
+        };
+        let title = format!(
+            "{}: measured and predicted {} efforts ({data_name}, {rows} samples)",
+            reg.mechanism(),
+            reg.effort_kind()
+        );
+        let plot = EffortPlot {
+            title: &title,
+            x_label: if timed { "t (s)" } else { "sample" },
+            xs: &xs,
+            panels: &panels,
+        };
+        if let Err(e) = plot.write(path) {
+            eprintln!("error: {}: {e}", path.display());
             return ExitCode::from(1);
         }
     }

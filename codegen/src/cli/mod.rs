@@ -16,6 +16,7 @@ pub mod closed_regressor;
 pub mod convert;
 pub mod design;
 pub mod draw;
+pub mod effort_plot;
 pub mod excite;
 pub mod filter;
 pub mod fix_home;
