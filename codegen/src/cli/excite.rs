@@ -268,6 +268,16 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    eprintln!(
+        "excite: {} ({}): {} base parameters of {} standard, {} {}{}",
+        reg.mechanism(),
+        reg.kind(),
+        reg.nbp(),
+        reg.standard_count(),
+        reg.dof(),
+        reg.effort_kind(),
+        if reg.dof() == 1 { "" } else { "s" }
+    );
     let best = search(&reg, args, &q_max, &qd_max);
     let n = reg.dof();
     let columns = reg.columns();

@@ -63,6 +63,24 @@ impl Regressor {
         self.values().len()
     }
 
+    /// Number of standard parameters (the columns the base parameters group).
+    pub fn standard_count(&self) -> usize {
+        match self {
+            Regressor::Tree(r) => r.standard_names.len(),
+            Regressor::Platform(r) => r.standard_names.len(),
+            Regressor::Closed(r) => r.standard_names.len(),
+        }
+    }
+
+    /// The kind of mechanism: `tree`, `platform` or `closed loop`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Regressor::Tree(_) => "tree",
+            Regressor::Platform(_) => "platform",
+            Regressor::Closed(_) => "closed loop",
+        }
+    }
+
     /// `BASE_PARAMETER_NAMES`.
     pub fn names(&self) -> &[String] {
         match self {
