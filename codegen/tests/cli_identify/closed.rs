@@ -280,3 +280,55 @@ fn closed_loop_bad_input_is_exit_code_2_without_a_panic() {
         assert!(!text(&o.stderr).contains("panicked"));
     }
 }
+
+/// The same samples given as all tree coordinates `x1..xNX` (assembled here by the runtime)
+/// give the estimates of the independent coordinates' file, and `excite` writes the same bytes
+/// for a seed.
+#[test]
+fn all_coordinates_give_the_same_estimates_and_excite_repeats() {
+    let dir = scratch("closed_x");
+    let spec = Path::new(FOUR_BAR);
+    let states = closed_trajectory(&dir, spec, "1.0", "2.0");
+    let first = std::fs::read(dir.join("traj.csv")).unwrap();
+    closed_trajectory(&dir, spec, "1.0", "2.0");
+    assert_eq!(first, std::fs::read(dir.join("traj.csv")).unwrap());
+    let m = closed("four_bar.toml", &bundled(FOUR_BAR));
+    let q_file = dir.join("q.csv");
+    measure_closed(&q_file, &states, &m, 0.01, 4);
+    let plan = noc::Plan::new(&m).unwrap();
+    let mut x = plan.home();
+    let (_, rows) = csv_rows(&q_file);
+    let mut csv = format!(
+        "t,{},u1,ud1,tau1\n",
+        (1..=m.nx())
+            .map(|i| format!("x{i}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    );
+    for r in &rows {
+        x = noc::newton_assembly(&plan, &r[1..2], &x).unwrap();
+        let mut line = vec![r[0]];
+        line.extend(&x);
+        line.extend(&r[2..5]);
+        let line: Vec<String> = line.iter().map(|v| format!("{v}")).collect();
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+    }
+    let x_file = dir.join("x.csv");
+    std::fs::write(&x_file, csv).unwrap();
+    let mut got = Vec::new();
+    for (name, data) in [("q", &q_file), ("x", &x_file)] {
+        let est = dir.join(format!("{name}_est.csv"));
+        ok(&run(&[
+            "identify",
+            FOUR_BAR,
+            s(data),
+            "--estimates",
+            s(&est),
+        ]));
+        got.push(estimates(&est));
+    }
+    let err = rel(&got[1].0, &got[0].0);
+    eprintln!("x1..x3 against q1: estimates {err:.2e} (relative)");
+    assert!(err <= 1e-9, "{err:e}");
+}
