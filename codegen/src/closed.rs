@@ -60,7 +60,20 @@ pub struct Kernels {
     pub frames: Vec<Kernel>,
     /// The generalized forces of the base parameters (`DOF × NBP`, row-major), with the base
     /// parameters: [`kernels_for`] a model with constant parameters only.
-    pub regressor: Option<(Kernel, crate::dynamics::Base)>,
+    pub regressor: Option<RegressorKernel>,
+}
+
+/// A closed-loop module's regressor kernel and what its columns are.
+pub struct RegressorKernel {
+    /// The generalized forces of the base parameters (`DOF × NBP`, row-major): `τ = F_b π_b`.
+    pub kernel: Kernel,
+    /// The base parameters (their groups index [`RegressorKernel::standard_names`]).
+    pub base: crate::dynamics::Base,
+    /// The standard parameters' names (`XX_<body>`, …, `FV_<joint>`, `K_<spring>`,
+    /// `D_<spring>`), in the groups' order.
+    pub standard_names: Vec<String>,
+    /// The model's standard parameters, same order.
+    pub standard_values: Vec<f64>,
 }
 
 /// Build the kernels (a generation-time `Singular` is a structural singularity).
@@ -247,8 +260,12 @@ fn build(
             .collect(),
         // The regressor, after everything else.
         regressor: match model {
-            Some(m) => regressor::regressor(m, plan, &x, &u, &ud)?
-                .map(|r| (Kernel::new(r.outputs, r.guards), r.base)),
+            Some(m) => regressor::regressor(m, plan, &x, &u, &ud)?.map(|r| RegressorKernel {
+                kernel: Kernel::new(r.outputs, r.guards),
+                base: r.base,
+                standard_names: r.standard_names,
+                standard_values: r.standard_values,
+            }),
             None => None,
         },
     })
@@ -330,8 +347,8 @@ pub fn generate(model: &ClosedModel, scene: &Scene, cfg: &Config) -> Result<Gene
         .collect();
     let header = header(model, &plan, &layout, bodies, cfg, &act_names, &stats);
     let mut items = items(cfg, model, &plan, params, &layout, &joint_names, &act_names);
-    if let Some((_, base)) = k.regressor.as_ref().filter(|_| wanted("regressor")) {
-        items.extend(crate::tree::base_parameter_items(base, "x, u, ud"));
+    if let Some(r) = k.regressor.as_ref().filter(|_| wanted("regressor")) {
+        items.extend(crate::tree::base_parameter_items(&r.base, "x, u, ud"));
     }
     // The names every actuator-space module has (parallel mechanisms): here the actuated
     // joints are the independent coordinates, so `A = 1`.
@@ -501,7 +518,7 @@ fn functions(k: &Kernels, plan: &Plan, layout: &Layout) -> Vec<Function<'static>
         ),
     ];
     functions.extend(friction);
-    functions.extend(k.regressor.as_ref().map(|(kernel, base)| {
+    functions.extend(k.regressor.as_ref().map(|RegressorKernel { kernel, base, .. }| {
         fns.make(
             "regressor",
             vec![format!(

@@ -413,17 +413,6 @@ fn bad_input_is_exit_code_2_without_a_panic() {
         assert!(err.contains(want), "{name}: {err}");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
-    // Closed loops: refused with the reason, for both commands.
-    let loops = "../mechanisms/specs/four_bar.toml";
-    for args in [vec!["identify", loops, "x.csv"], vec!["excite", loops]] {
-        let o = run(&args);
-        assert_eq!(o.status.code(), Some(2));
-        assert!(
-            text(&o.stderr).contains("closed loops not yet"),
-            "{}",
-            text(&o.stderr)
-        );
-    }
     // Bad arguments.
     for args in [
         vec!["excite", PUMA, "--harmonics", "0"],
@@ -486,6 +475,56 @@ fn a_joint_that_never_moves_leaves_parameters_unexcited_and_excite_repeats() {
     );
 }
 
+/// `--plot`: one panel per joint with the measured and the predicted efforts, one polyline
+/// each in their colours, the residual RMS in the panel's title, the same bytes twice.
+#[test]
+fn identify_plots_measured_against_predicted_efforts() {
+    let dir = scratch("plot");
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        PUMA,
+        "--restarts",
+        "1",
+        "--evaluations",
+        "10",
+        "--samples",
+        "200",
+        "--with-tau",
+        "--noise",
+        "0.1",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let mut svgs = Vec::new();
+    for k in 0..2 {
+        let svg = dir.join(format!("plot{k}.svg"));
+        let o = run(&["identify", PUMA, s(&traj), "--plot", s(&svg)]);
+        ok(&o);
+        svgs.push(std::fs::read(&svg).unwrap());
+    }
+    assert_eq!(svgs[0], svgs[1]);
+    let t = String::from_utf8(svgs[0].clone()).unwrap();
+    assert!(t.starts_with("<svg") && t.trim_end().ends_with("</svg>"));
+    assert_eq!(t.matches("<text").count(), t.matches("</text>").count());
+    for (what, colour) in [("measured", "#969696"), ("predicted", "#D66014")] {
+        let n = t
+            .lines()
+            .filter(|l| l.starts_with("<polyline") && l.contains(&format!("stroke=\"{colour}\"")))
+            .count();
+        assert_eq!(n, 6, "{what}");
+    }
+    for j in 1..=6 {
+        assert!(t.contains(&format!("j{j}: residual RMS ")), "panel j{j}");
+    }
+    assert!(t.lines().any(|l| l == "t (s)"));
+}
+
 // Platforms: the Gough–Stewart and the Delta.
 #[path = "cli_identify/platform.rs"]
 mod platform;
+
+// Closed loops: the four-bar and Andrews' squeezer.
+#[path = "cli_identify/closed.rs"]
+mod closed;

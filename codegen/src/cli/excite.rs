@@ -11,7 +11,10 @@
 //!
 //! A platform's series are its coordinates around home ([`super::platform_path`]), bounded by
 //! `--turn` (rad) and `--reach` (m); a candidate with a state where the regressor has no value
-//! (out of reach, a singularity) is rejected.
+//! (out of reach, a singularity) is rejected. A closed loop's series are its independent
+//! coordinates around home, bounded by `--q-max`; the other coordinates are assembled by Newton
+//! from the state before (the first from home), and a candidate that does not assemble or
+//! where the regressor fails is rejected.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -26,7 +29,7 @@ use super::wls::condition;
 /// Arguments of `excite`.
 #[derive(Debug, Args)]
 pub struct ExciteArgs {
-    /// Tree (`.toml` or `.urdf`) or platform spec.
+    /// Tree (`.toml` or `.urdf`), platform or closed-loop spec.
     pub spec: PathBuf,
     /// Harmonics per joint, `L`.
     #[arg(long, default_value_t = 5)]
@@ -142,10 +145,16 @@ impl Fourier {
     }
 }
 
-/// The mechanism's state at `t` on `f`.
-fn at(reg: &Regressor, f: &Fourier, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+/// The mechanism's state at `t` on `f`; a closed loop assembled from the positions `from` of
+/// the state before (home when `None`). `None` where it does not assemble.
+fn at(
+    reg: &Regressor,
+    f: &Fourier,
+    t: f64,
+    from: Option<&[f64]>,
+) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     let (d, dd, ddd) = f.state(t);
-    reg.state(&d, &dd, &ddd)
+    reg.state(&d, &dd, &ddd, from)
 }
 
 /// The base regressor stacked at `m` equally spaced times over a period; `Err(t)` at the first
@@ -155,10 +164,12 @@ fn stacked(reg: &Regressor, f: &Fourier, m: usize) -> Result<DMatrix<f64>, f64> 
     let period = 2.0 * std::f64::consts::PI / f.w;
     let mut w = DMatrix::zeros(m * n, nbp);
     let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
+    let mut from: Option<Vec<f64>> = None;
     for k in 0..m {
         let t = period * k as f64 / m as f64;
-        let (p, v, a) = at(reg, f, t);
+        let (p, v, a) = at(reg, f, t, from.as_deref()).ok_or(t)?;
         reg.rows(&p, &v, &a, &mut buf, &mut y).map_err(|_| t)?;
+        from = Some(p);
         for i in 0..n {
             for p in 0..nbp {
                 w[(k * n + i, p)] = y[i * nbp + p];
@@ -257,6 +268,16 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    eprintln!(
+        "excite: {} ({}): {} base parameters of {} standard, {} {}{}",
+        reg.mechanism(),
+        reg.kind(),
+        reg.nbp(),
+        reg.standard_count(),
+        reg.dof(),
+        reg.effort_kind(),
+        if reg.dof() == 1 { "" } else { "s" }
+    );
     let best = search(&reg, args, &q_max, &qd_max);
     let n = reg.dof();
     let columns = reg.columns();
@@ -283,12 +304,17 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let mut from: Option<Vec<f64>> = None;
     for k in 0..args.samples {
         let t = args.period * k as f64 / args.samples as f64;
         let (d, dd, _) = best.state(t);
-        let (q, qd, qdd) = at(&reg, &best, t);
+        // Assembled where `stacked` assembled it above (the same states in the same order).
+        let Some((q, qd, qdd)) = at(&reg, &best, t, from.as_deref()) else {
+            eprintln!("error: the loops do not close at t = {t} s");
+            return ExitCode::from(2);
+        };
         let mut row = vec![t];
-        row.extend(&q);
+        row.extend(reg.written_positions(&q));
         row.extend(&qd);
         row.extend(&qdd);
         if args.with_tau {
@@ -304,6 +330,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
                 }
             }));
         }
+        from = Some(q);
         for i in 0..n {
             mq[i] = mq[i].max(d[i].abs());
             mqd[i] = mqd[i].max(dd[i].abs());

@@ -1,6 +1,6 @@
-//! `codegen identify SPEC data.csv`: the base parameters of a tree or a platform from measured
-//! motions and efforts by weighted least squares, with their standard deviations, the regressor's
-//! condition number, warnings for parameters the data do not excite, and (`--out`) the spec
+//! `codegen identify SPEC data.csv`: the base parameters of a tree, a platform or a closed loop
+//! from measured motions and efforts by weighted least squares, with their standard
+//! deviations, the regressor's condition number, warnings for parameters the data do not excite, and (`--out`) the spec
 //! updated so that its model has the identified base parameters (docs/identification.md).
 
 use std::path::PathBuf;
@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use clap::{Args, ValueEnum};
 use nalgebra::{DMatrix, DVector};
 
+use super::effort_plot::{EffortPlot, Panel};
 use super::regressor::Regressor;
 use super::samples::{self, Filtering};
 use super::wls::{self, Stacked};
@@ -25,10 +26,12 @@ pub enum Weights {
 /// Arguments of `identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
-    /// Tree (`.toml` or `.urdf`) or platform spec whose base parameters are identified.
+    /// Tree (`.toml` or `.urdf`), platform or closed-loop spec whose base parameters are
+    /// identified.
     pub spec: PathBuf,
     /// Measurements: CSV with a header `t,q1..,qd1..,qdd1..,tau1..` (or `t,q1..,tau1..`); a
-    /// platform's `t,x1..,u1..,ud1..,tau1..`.
+    /// platform's `t,x1..,u1..,ud1..,tau1..`; a closed loop's `t,q1..,u1..,ud1..,tau1..` (the
+    /// independent coordinates) or `t,x1..xNX,u1..,ud1..,tau1..`.
     pub data: PathBuf,
     /// Write the spec updated to the identified base parameters here (TOML specs only).
     #[arg(long, value_name = "UPDATED.toml")]
@@ -45,6 +48,10 @@ pub struct IdentifyArgs {
     /// Also write the estimates as CSV (`k,name,spec,estimate,std`, full precision).
     #[arg(long, value_name = "FILE.csv")]
     pub estimates: Option<PathBuf>,
+    /// Also plot measured against predicted efforts per joint (SVG; time on x when the data
+    /// have `t`, else the sample index).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
 }
 
 /// Run `identify`.
@@ -92,10 +99,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     };
     let (n, nbp) = (reg.dof(), reg.nbp());
-    let data = match samples::read(
+    let mut data = match samples::read(
         &data_name,
         &text,
-        &reg.columns(),
+        &reg.columns_of(&text),
         nbp / n.max(1) + 1,
         Filtering {
             cutoff: args.cutoff,
@@ -107,6 +114,10 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Err(e) = reg.assemble_positions(&data_name, &mut data) {
+        eprintln!("{e}");
+        return ExitCode::from(2);
+    }
     let rows = data.q.len();
     let mut w = DMatrix::zeros(rows * n, nbp);
     let mut tau = DVector::zeros(rows * n);
@@ -126,7 +137,8 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             tau[s * n + i] = data.tau[s][i];
         }
     }
-    let fit = wls::fit(&Stacked { w, tau, n }, args.weights == Weights::Auto);
+    let stacked = Stacked { w, tau, n };
+    let fit = wls::fit(&stacked, args.weights == Weights::Auto);
     report(&reg, &name, &data_name, rows, &data.note, &fit, args);
     if let Some(path) = &args.estimates {
         let mut csv = String::from("k,name,spec,estimate,std\n");
@@ -141,6 +153,38 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
         if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
             eprintln!("error: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    if let Some(path) = &args.plot {
+        let predicted = &stacked.w * DVector::from_column_slice(&fit.estimate);
+        let names = reg.effort_names();
+        let panels: Vec<Panel> = (0..n)
+            .map(|i| Panel {
+                name: names[i].clone(),
+                measured: (0..rows).map(|s| stacked.tau[s * n + i]).collect(),
+                predicted: (0..rows).map(|s| predicted[s * n + i]).collect(),
+            })
+            .collect();
+        let timed = data.t.len() == rows;
+        let xs: Vec<f64> = if timed {
+            data.t.clone()
+        } else {
+            (0..rows).map(|s| s as f64).collect()
+        };
+        let title = format!(
+            "{}: measured and predicted {} efforts ({data_name}, {rows} samples)",
+            reg.mechanism(),
+            reg.effort_kind()
+        );
+        let plot = EffortPlot {
+            title: &title,
+            x_label: if timed { "t (s)" } else { "sample" },
+            xs: &xs,
+            panels: &panels,
+        };
+        if let Err(e) = plot.write(path) {
+            eprintln!("error: {}: {e}", path.display());
             return ExitCode::from(1);
         }
     }

@@ -11,10 +11,12 @@
 //! * closed loops: the inertia of the independent joints, assembled on the home branch. Where the runtime returns
 //!   `Err(Singular)` the point is marked singular (or unreachable, for `Site::Reach`).
 
+pub mod closed_regressor;
 #[cfg(feature = "urdf")]
 pub mod convert;
 pub mod design;
 pub mod draw;
+pub mod effort_plot;
 pub mod excite;
 pub mod filter;
 pub mod fix_home;

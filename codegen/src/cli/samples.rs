@@ -23,6 +23,8 @@ pub struct Samples {
     pub note: Option<String>,
     /// The file's line (1-based) of each kept row.
     pub lines: Vec<usize>,
+    /// The `t` column of each kept row, s (empty without one).
+    pub t: Vec<f64>,
 }
 
 /// How positions-only data are filtered.
@@ -240,6 +242,7 @@ pub fn read(
             s.qdd.push((0..n).map(|i| qdd_cols[i][k]).collect());
             s.tau.push((0..n).map(|i| tau_cols[i][k]).collect());
             s.lines.push(line_of[k]);
+            s.t.push(t[k]);
         }
         s.note = Some(format!(
             "positions only: q and tau low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling), qd and qdd by central differences; {edge} samples dropped at each end",
@@ -254,6 +257,9 @@ pub fn read(
         }
         s.lines = line_of;
         for r in &rows {
+            if let Some(c) = t_col {
+                s.t.push(r[c]);
+            }
             s.q.push(pick(0, r));
             s.qd.push(pick(1, r));
             s.qdd.push(pick(2, r));

@@ -36,6 +36,8 @@ enum Unknown {
     Body { index: usize, k: usize },
     /// `damping`, `friction` or `armature` of `[[joint]]` element `index`.
     Drive { index: usize, key: &'static str },
+    /// `stiffness` or `damping` of `[[spring]]` element `index` (a closed loop's).
+    Spring { index: usize, key: &'static str },
     /// Standard parameter `k` of copy `copy` (from 1) of `[[pattern]]` element `pattern`'s
     /// `[[pattern.body]]` element `body`.
     Copy {
@@ -222,6 +224,14 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
                     .or_insert([0.0; 10])[*k] = v
             }
             Unknown::Body { index, k } => bodies.entry(*index).or_insert([0.0; 10])[*k] = v,
+            Unknown::Spring { index, key } => {
+                if let Some(t) = d["spring"]
+                    .as_array_of_tables_mut()
+                    .and_then(|a| a.get_mut(*index))
+                {
+                    t.insert(key, value(number(v)));
+                }
+            }
             Unknown::Drive { index, key } => {
                 if let Some(t) = d["joint"]
                     .as_array_of_tables_mut()
@@ -299,7 +309,12 @@ pub fn update(
         }
     }
     if let Some(a) = doc.get("joint").and_then(Item::as_array_of_tables) {
-        for (index, t) in a.iter().enumerate() {
+        // A joint that closes a loop (`child_origin`) has no drive.
+        for (index, t) in a
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| !t.contains_key("child_origin"))
+        {
             let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
             for key in ["damping", "friction", "armature"] {
                 if let Some(v) = match t.get(key) {
@@ -309,6 +324,21 @@ pub fn update(
                     unknowns.push(Unknown::Drive { index, key });
                     z0.push(v);
                     names.push(format!("joint `{name}`"));
+                }
+            }
+        }
+    }
+    if let Some(a) = doc.get("spring").and_then(Item::as_array_of_tables) {
+        for (index, t) in a.iter().enumerate() {
+            let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+            for key in ["stiffness", "damping"] {
+                if let Some(v) = match t.get(key) {
+                    None => Some(0.0),
+                    Some(i) => num(Some(i)),
+                } {
+                    unknowns.push(Unknown::Spring { index, key });
+                    z0.push(v);
+                    names.push(format!("spring `{name}`"));
                 }
             }
         }

@@ -21,6 +21,10 @@ pub(super) struct ClosedRegressor {
     pub outputs: Vec<ExprId>,
     pub guards: Vec<ExprId>,
     pub base: Base,
+    /// The standard parameters' names, in the order the groups index.
+    pub standard_names: Vec<String>,
+    /// The model's standard parameters, same order.
+    pub standard_values: Vec<f64>,
 }
 
 /// `model` with every body, drive and spring zero.
@@ -146,5 +150,7 @@ pub(super) fn regressor(
         outputs,
         guards,
         base,
+        standard_names: standard.names,
+        standard_values: standard.values,
     }))
 }

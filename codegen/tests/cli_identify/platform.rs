@@ -24,7 +24,7 @@ fn platform(name: &str, source: &str) -> runtime::parallel::ParallelModel {
 }
 
 /// A spec value scaled (`f`) or moved (`d`): numbers in place, expressions wrapped.
-fn nudge(v: &toml_edit::Value, f: f64, d: f64) -> toml_edit::Value {
+pub(super) fn nudge(v: &toml_edit::Value, f: f64, d: f64) -> toml_edit::Value {
     match (
         v.as_float().or_else(|| v.as_integer().map(|i| i as f64)),
         v.as_str(),
@@ -35,39 +35,43 @@ fn nudge(v: &toml_edit::Value, f: f64, d: f64) -> toml_edit::Value {
     }
 }
 
+/// A body table's mass, mass centre (entries moved by `0.05 (f() − 1)`) and inertia (scaled
+/// whole) moved by `f()`, its keys prefixed by `prefix`.
+pub(super) fn perturb_body(t: &mut toml_edit::Table, prefix: &str, f: &mut dyn FnMut() -> f64) {
+    let key = |k: &str| format!("{prefix}{k}");
+    if let Some(m) = t.get(&key("mass")).and_then(|i| i.as_value()).cloned() {
+        t[&key("mass")] = toml_edit::value(nudge(&m, f(), 0.0));
+    }
+    if let Some(c) = t.get_mut(&key("com")).and_then(|i| i.as_value_mut()) {
+        if let Some(a) = c.as_array_mut() {
+            for k in 0..a.len() {
+                let v = nudge(a.get(k).unwrap(), 1.0, 0.05 * (f() - 1.0));
+                a.replace(k, v);
+            }
+        } else {
+            *c = nudge(c, 1.0, 0.05 * (f() - 1.0));
+        }
+    }
+    let scale = f();
+    if let Some(it) = t
+        .get_mut(&key("inertia"))
+        .and_then(|i| i.as_inline_table_mut())
+    {
+        let keys: Vec<String> = it.iter().map(|(k, _)| k.to_string()).collect();
+        for k in keys {
+            let v = nudge(it.get(&k).unwrap(), scale, 0.0);
+            it.insert(&k, v);
+        }
+    }
+}
+
 /// Every body's (the `[[body]]`s, the patterns' bodies and parallelograms' rods) mass, mass
 /// centre and inertia moved by up to ±`rel` in the spec's text (inertias scaled whole).
 fn perturbed_platform(source: &str, rel: f64, seed: u64) -> String {
     let mut doc: toml_edit::DocumentMut = source.parse().unwrap();
     let mut r = Rng(seed);
     let mut f = move || 1.0 + rel * (2.0 * r.uniform() - 1.0);
-    let body = |t: &mut toml_edit::Table, prefix: &str, f: &mut dyn FnMut() -> f64| {
-        let key = |k: &str| format!("{prefix}{k}");
-        if let Some(m) = t.get(&key("mass")).and_then(|i| i.as_value()).cloned() {
-            t[&key("mass")] = toml_edit::value(nudge(&m, f(), 0.0));
-        }
-        if let Some(c) = t.get_mut(&key("com")).and_then(|i| i.as_value_mut()) {
-            if let Some(a) = c.as_array_mut() {
-                for k in 0..a.len() {
-                    let v = nudge(a.get(k).unwrap(), 1.0, 0.05 * (f() - 1.0));
-                    a.replace(k, v);
-                }
-            } else {
-                *c = nudge(c, 1.0, 0.05 * (f() - 1.0));
-            }
-        }
-        let scale = f();
-        if let Some(it) = t
-            .get_mut(&key("inertia"))
-            .and_then(|i| i.as_inline_table_mut())
-        {
-            let keys: Vec<String> = it.iter().map(|(k, _)| k.to_string()).collect();
-            for k in keys {
-                let v = nudge(it.get(&k).unwrap(), scale, 0.0);
-                it.insert(&k, v);
-            }
-        }
-    };
+    let body = perturb_body;
     for t in doc["body"].as_array_of_tables_mut().unwrap().iter_mut() {
         body(t, "", &mut f);
     }
@@ -170,7 +174,7 @@ fn measure_platform(
 
 /// The base parameters listed on the line of `stderr` that starts with `start`, before `end`
 /// (`… parameters 4 (name), 5 (name)` then `end`).
-fn listed(stderr: &str, start: &str, end: &str) -> Vec<usize> {
+pub(super) fn listed(stderr: &str, start: &str, end: &str) -> Vec<usize> {
     let Some(line) = stderr.lines().find(|l| l.starts_with(start)) else {
         return Vec::new();
     };
@@ -322,7 +326,7 @@ fn platform_end_to_end(
 // 20 runs of the two tests (Delta seed 2: 3.56; Gough–Stewart seeds 3 and 9: 4.00, 3.41); seed 6
 // passes both.
 
-fn bundled(path: &str) -> String {
+pub(super) fn bundled(path: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
 }
 

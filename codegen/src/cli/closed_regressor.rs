@@ -1,0 +1,203 @@
+//! A closed loop's base regressor for the identification tools (`identify`, `excite`): the
+//! generator's regressor kernel of a closed-loop module (`codegen::closed::kernels_for`, the one
+//! the generated module's `regressor` wraps), flattened for evaluation at many states. Its
+//! outputs are `F_b` (`DOF × NBP`, row-major) directly: `τ = F_b π_b`, the efforts of the
+//! independent coordinates, over all `NX` tree joint coordinates `x` (assembled), the
+//! independent speeds `u` and rates `u̇` (docs/closed-loops.md, "Regressor and base
+//! parameters"). A measurement file gives the independent coordinates `q`, assembled here by
+//! the module's own Newton solve from the previous row (the first from home), or all of `x`.
+
+use std::collections::HashMap;
+
+use codegen::dynamics::{BODY_PARAMETERS, body_standard_parameters};
+use codegen::sym::Arg;
+use runtime::closed::ClosedModel;
+use runtime::closed::noc::{self, Plan};
+
+use super::platform_regressor::NoRegressor;
+use super::tape::Tape;
+
+/// The base regressor of a closed-loop spec.
+pub struct ClosedRegressor {
+    /// The model (the spec with its `[scene]` applied).
+    pub model: ClosedModel,
+    /// Its plan (the runtime's evaluator: assembly and independent efforts).
+    pub plan: Plan,
+    /// All tree joint coordinates at home.
+    pub home: Vec<f64>,
+    /// `BASE_PARAMETER_NAMES`.
+    pub names: Vec<String>,
+    /// `BASE_PARAMETERS` of the spec.
+    pub values: Vec<f64>,
+    /// The standard parameters' names (`XX_<body>`, `FV_<joint>`, `K_<spring>`, …), in the
+    /// regressor's order.
+    pub standard_names: Vec<String>,
+    /// `G`, `NBP` rows of `standard_names.len()` entries: `π_base = G π_standard`.
+    pub grouping: Vec<Vec<f64>>,
+    /// The guards, then `F_b` (row-major).
+    tape: Tape,
+    guards: usize,
+}
+
+impl ClosedRegressor {
+    /// The regressor of a validated closed-loop model; `Err` is the message (exit code 2).
+    pub fn new(model: ClosedModel) -> Result<ClosedRegressor, String> {
+        let plan = Plan::new(&model).map_err(|e| format!("error: {}: {e}\n", model.name))?;
+        let k = codegen::closed::kernels_for(&model, &plan, &[], true).map_err(|e| {
+            format!(
+                "error: {}: the mechanism is singular for every input ({e})\n",
+                model.name
+            )
+        })?;
+        let Some(r) = k.regressor else {
+            return Err(format!(
+                "error: {}: this mechanism has no regressor (a standard parameter's model has no plan)\n",
+                model.name
+            ));
+        };
+        let nstd = r.standard_names.len();
+        let grouping = r
+            .base
+            .groups
+            .iter()
+            .map(|gr| {
+                let mut row = vec![0.0; nstd];
+                for &(k, c) in gr {
+                    row[k] += c;
+                }
+                row
+            })
+            .collect();
+        let roots: Vec<_> = r
+            .kernel
+            .guards
+            .iter()
+            .chain(&r.kernel.outputs)
+            .copied()
+            .collect();
+        Ok(ClosedRegressor {
+            tape: Tape::new(&k.graph, &roots),
+            guards: r.kernel.guards.len(),
+            names: r.base.names,
+            values: r.base.values,
+            standard_names: r.standard_names,
+            grouping,
+            home: plan.home(),
+            model,
+            plan,
+        })
+    }
+
+    /// Degrees of freedom (independent coordinates).
+    pub fn dof(&self) -> usize {
+        self.plan.dof()
+    }
+
+    /// Tree joint coordinates `x`.
+    pub fn nx(&self) -> usize {
+        self.plan.nx()
+    }
+
+    /// Number of base parameters.
+    pub fn nbp(&self) -> usize {
+        self.values.len()
+    }
+
+    /// The independent (actuated) joints' names.
+    pub fn independent(&self) -> Vec<String> {
+        self.plan
+            .independent
+            .iter()
+            .map(|&j| self.model.tree.joints[j].name.clone())
+            .collect()
+    }
+
+    /// The closed configuration `x` with independent coordinates `q`, by the module's Newton
+    /// solve from `from` (home when `None`); `None` where it does not converge.
+    pub fn assemble(&self, q: &[f64], from: Option<&[f64]>) -> Option<Vec<f64>> {
+        noc::newton_assembly(&self.plan, q, from.unwrap_or(&self.home)).ok()
+    }
+
+    /// The independent coordinates of a configuration `x`.
+    pub fn coordinates(&self, x: &[f64]) -> Vec<f64> {
+        self.plan.independent.iter().map(|&j| x[j]).collect()
+    }
+
+    /// The independent coordinates at home.
+    pub fn home_coordinates(&self) -> Vec<f64> {
+        self.coordinates(&self.home)
+    }
+
+    /// `F_b(x, u, u̇)` into `out` (`DOF × NBP`, row-major); `buf` is scratch space.
+    pub fn rows(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        ud: &[f64],
+        buf: &mut Vec<f64>,
+        out: &mut [f64],
+    ) -> Result<(), NoRegressor> {
+        let (n, nbp) = (self.dof(), self.nbp());
+        let input = |a: Arg, i: usize| match a {
+            Arg::X => x[i],
+            Arg::U => u[i],
+            Arg::Ud => ud[i],
+            _ => f64::NAN,
+        };
+        let mut all = vec![0.0; self.guards + n * nbp];
+        self.tape.eval(&input, buf, &mut all);
+        if all[..self.guards].iter().any(|v| v.is_nan()) {
+            return Err(NoRegressor(
+                "the configuration does not close the loops, or the constraints are singular there",
+            ));
+        }
+        if !all[self.guards..].iter().all(|v| v.is_finite()) {
+            return Err(NoRegressor("the regressor is not finite there"));
+        }
+        out[..n * nbp].copy_from_slice(&all[self.guards..]);
+        Ok(())
+    }
+
+    /// Efforts of the independent coordinates by the runtime's `f64` evaluator (independent
+    /// of the regressor); `None` where it fails.
+    pub fn inverse_dynamics(&self, x: &[f64], u: &[f64], ud: &[f64]) -> Option<Vec<f64>> {
+        noc::inverse_dynamics(&self.plan, x, u, ud).ok()
+    }
+
+    /// The base parameters of a model with the same structure: `G · π_standard(model)`
+    /// (standard values read by name; a name the model lacks counts 0).
+    pub fn base_of(&self, model: &ClosedModel) -> Vec<f64> {
+        let s = standard_values(model);
+        let x: Vec<f64> = self
+            .standard_names
+            .iter()
+            .map(|n| s.get(n).copied().unwrap_or(0.0))
+            .collect();
+        self.grouping
+            .iter()
+            .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
+            .collect()
+    }
+}
+
+/// Every standard parameter a closed-loop model could have, by name: `XX_<body>` … `M_<body>`
+/// of the tree bodies, `FV_`, `FC_`, `IA_<joint>` of the tree joints, `K_`, `D_<spring>`.
+pub fn standard_values(model: &ClosedModel) -> HashMap<String, f64> {
+    let mut out = HashMap::new();
+    for b in &model.tree.bodies {
+        let v = body_standard_parameters(b.mass, &b.com, &b.inertia);
+        for (p, x) in BODY_PARAMETERS.iter().zip(v) {
+            out.insert(format!("{p}_{}", b.name), x);
+        }
+    }
+    for j in &model.tree.joints {
+        out.insert(format!("FV_{}", j.name), j.drive.viscous);
+        out.insert(format!("FC_{}", j.name), j.drive.coulomb);
+        out.insert(format!("IA_{}", j.name), j.drive.armature);
+    }
+    for s in &model.springs {
+        out.insert(format!("K_{}", s.name), s.stiffness);
+        out.insert(format!("D_{}", s.name), s.damping);
+    }
+    out
+}
