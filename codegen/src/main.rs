@@ -7,7 +7,7 @@
 //! cargo run -p codegen -- isotropy SPEC [--samples N] [--seed S] [--design NAME=LO:HI]
 //! cargo run -p codegen -- draw SPEC [-o home.svg]
 //! cargo run -p codegen -- excite SPEC [--harmonics 5] [--period 10] [--samples N] [--seed S] [--q-max RAD] [--qd-max RAD/S] [--with-tau] [-o traj.csv]
-//! cargo run -p codegen -- identify SPEC data.csv [--out updated.toml] [--weights auto|none] [--cutoff HZ] [--estimates est.csv]
+//! cargo run -p codegen -- identify SPEC data.csv [--out updated.toml] [--plot efforts.svg] [--weights auto|none] [--cutoff HZ] [--estimates est.csv]
 //! ```
 //! `excite` and `identify` work on trees (docs/identification.md).
 //! Exit codes: 0 success, 2 invalid spec (also one that is not UTF-8) or arguments (diagnostics

@@ -166,3 +166,40 @@ platforms!(
     prs_head,
     delta4_rl5,
 );
+
+/// The Delta's platform only translates, so its inertia tensor moves nothing: two models that
+/// differ in it (standard parameters `XX … ZZ` of the platform) give the same efforts (the
+/// runtime's `f64` evaluator, 200 states) and the same base parameters (the generator's).
+#[test]
+fn models_with_the_same_base_parameters_have_the_same_efforts() {
+    let m = tests::pkm::model("delta_rl5");
+    let mut turned = m.clone();
+    for (i, v) in [0.1, 0.2, 0.3].into_iter().enumerate() {
+        turned.platform.inertia[i][i] += v;
+    }
+    let base = |m: &ParallelModel| {
+        let plan = Plan::new(m).unwrap();
+        let k = codegen::parallel::kernels_for(m, &plan, &Default::default(), &[], true).unwrap();
+        let r = k.regressor.expect("a regressor");
+        (r.base.values, r.standard_values)
+    };
+    let ((b0, s0), (b1, s1)) = (base(&m), base(&turned));
+    assert_ne!(s0, s1, "the standard parameters differ");
+    assert_eq!(b0.len(), b1.len());
+    let scale = b0.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (a, b) in b0.iter().zip(&b1) {
+        assert!((a - b).abs() <= 1e-12 * scale, "base parameters {a} vs {b}");
+    }
+    let (p0, p1) = (Plan::new(&m).unwrap(), Plan::new(&turned).unwrap());
+    let home = tests::pkm::home_x(&m);
+    let mut rng = tests::rng(0xde17a);
+    let mut worst = 0.0f64;
+    for _ in 0..200 {
+        let (x, u, ud) = tests::pkm::random_state(&p0, &home, &mut rng, 0.4, 0.1);
+        let t0 = noc::inverse_dynamics(&p0, &x, &u, &ud).unwrap();
+        let t1 = noc::inverse_dynamics(&p1, &x, &u, &ud).unwrap();
+        worst = worst.max(tests::pkm::rel(&t1, &t0));
+    }
+    println!("delta_rl5: platform inertia changed, efforts differ by {worst:.1e}");
+    assert!(worst <= 1e-13, "{worst:e}");
+}

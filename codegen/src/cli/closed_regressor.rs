@@ -9,11 +9,11 @@
 
 use std::collections::HashMap;
 
-use codegen::dynamics::{BODY_PARAMETERS, body_standard_parameters};
 use codegen::sym::Arg;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
+use super::grouping::Grouping;
 use super::platform_regressor::NoRegressor;
 use super::tape::Tape;
 
@@ -29,11 +29,9 @@ pub struct ClosedRegressor {
     pub names: Vec<String>,
     /// `BASE_PARAMETERS` of the spec.
     pub values: Vec<f64>,
-    /// The standard parameters' names (`XX_<body>`, `FV_<joint>`, `K_<spring>`, …), in the
-    /// regressor's order.
-    pub standard_names: Vec<String>,
-    /// `G`, `NBP` rows of `standard_names.len()` entries: `π_base = G π_standard`.
-    pub grouping: Vec<Vec<f64>>,
+    /// `G` over the named standard parameters (`XX_<body>`, `FV_<joint>`, `K_<spring>`, …):
+    /// `π_base = G π_standard`.
+    pub grouping: Grouping,
     /// The guards, then `F_b` (row-major).
     tape: Tape,
     guards: usize,
@@ -55,19 +53,6 @@ impl ClosedRegressor {
                 model.name
             ));
         };
-        let nstd = r.standard_names.len();
-        let grouping = r
-            .base
-            .groups
-            .iter()
-            .map(|gr| {
-                let mut row = vec![0.0; nstd];
-                for &(k, c) in gr {
-                    row[k] += c;
-                }
-                row
-            })
-            .collect();
         let roots: Vec<_> = r
             .kernel
             .guards
@@ -80,8 +65,7 @@ impl ClosedRegressor {
             guards: r.kernel.guards.len(),
             names: r.base.names,
             values: r.base.values,
-            standard_names: r.standard_names,
-            grouping,
+            grouping: Grouping::new(&r.base.groups, r.standard_names),
             home: plan.home(),
             model,
             plan,
@@ -167,34 +151,14 @@ impl ClosedRegressor {
     /// The base parameters of a model with the same structure: `G · π_standard(model)`
     /// (standard values read by name; a name the model lacks counts 0).
     pub fn base_of(&self, model: &ClosedModel) -> Vec<f64> {
-        let s = standard_values(model);
-        let x: Vec<f64> = self
-            .standard_names
-            .iter()
-            .map(|n| s.get(n).copied().unwrap_or(0.0))
-            .collect();
-        self.grouping
-            .iter()
-            .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
-            .collect()
+        self.grouping.apply(&standard_values(model))
     }
 }
 
 /// Every standard parameter a closed-loop model could have, by name: `XX_<body>` … `M_<body>`
 /// of the tree bodies, `FV_`, `FC_`, `IA_<joint>` of the tree joints, `K_`, `D_<spring>`.
 pub fn standard_values(model: &ClosedModel) -> HashMap<String, f64> {
-    let mut out = HashMap::new();
-    for b in &model.tree.bodies {
-        let v = body_standard_parameters(b.mass, &b.com, &b.inertia);
-        for (p, x) in BODY_PARAMETERS.iter().zip(v) {
-            out.insert(format!("{p}_{}", b.name), x);
-        }
-    }
-    for j in &model.tree.joints {
-        out.insert(format!("FV_{}", j.name), j.drive.viscous);
-        out.insert(format!("FC_{}", j.name), j.drive.coulomb);
-        out.insert(format!("IA_{}", j.name), j.drive.armature);
-    }
+    let mut out = super::tree_regressor::standard_values(&model.tree);
     for s in &model.springs {
         out.insert(format!("K_{}", s.name), s.stiffness);
         out.insert(format!("D_{}", s.name), s.damping);

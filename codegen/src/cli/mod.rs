@@ -20,6 +20,7 @@ pub mod effort_plot;
 pub mod excite;
 pub mod filter;
 pub mod fix_home;
+pub mod grouping;
 pub mod identify;
 pub mod isotropy;
 pub mod map;

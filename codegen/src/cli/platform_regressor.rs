@@ -14,6 +14,7 @@ use nalgebra::DMatrix;
 use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
+use super::grouping::Grouping;
 use super::tape::Tape;
 
 /// The base regressor of a platform spec.
@@ -28,10 +29,8 @@ pub struct PlatformRegressor {
     pub names: Vec<String>,
     /// `BASE_PARAMETERS` of the spec.
     pub values: Vec<f64>,
-    /// The standard parameters' names (`XX_platform`, …), in the regressor's order.
-    pub standard_names: Vec<String>,
-    /// `G`, `NBP` rows of `standard_names.len()` entries: `π_base = G π_standard`.
-    pub grouping: Vec<Vec<f64>>,
+    /// `G` over the named standard parameters: `π_base = G π_standard`.
+    pub grouping: Grouping,
     /// The guards, then `A` (row-major), then `F_b` (row-major).
     tape: Tape,
     guards: usize,
@@ -58,19 +57,6 @@ impl PlatformRegressor {
                 model.name
             ));
         };
-        let nstd = r.standard_names.len();
-        let grouping = r
-            .base
-            .groups
-            .iter()
-            .map(|gr| {
-                let mut row = vec![0.0; nstd];
-                for &(k, c) in gr {
-                    row[k] += c;
-                }
-                row
-            })
-            .collect();
         let roots: Vec<_> = r
             .kernel
             .guards
@@ -83,8 +69,7 @@ impl PlatformRegressor {
             guards: r.kernel.guards.len(),
             names: r.base.names,
             values: r.base.values,
-            standard_names: r.standard_names,
-            grouping,
+            grouping: Grouping::new(&r.base.groups, r.standard_names),
             home: model.home_x(),
             model,
             plan,
@@ -172,16 +157,7 @@ impl PlatformRegressor {
     /// The base parameters of a model with the same structure: `G · π_standard(model)`
     /// (standard values read by name; a name the model lacks counts 0).
     pub fn base_of(&self, model: &ParallelModel) -> Vec<f64> {
-        let s = standard_values(model);
-        let x: Vec<f64> = self
-            .standard_names
-            .iter()
-            .map(|n| s.get(n).copied().unwrap_or(0.0))
-            .collect();
-        self.grouping
-            .iter()
-            .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
-            .collect()
+        self.grouping.apply(&standard_values(model))
     }
 }
 

@@ -66,9 +66,9 @@ impl Regressor {
     /// Number of standard parameters (the columns the base parameters group).
     pub fn standard_count(&self) -> usize {
         match self {
-            Regressor::Tree(r) => r.standard_names.len(),
-            Regressor::Platform(r) => r.standard_names.len(),
-            Regressor::Closed(r) => r.standard_names.len(),
+            Regressor::Tree(r) => r.grouping.standard_names.len(),
+            Regressor::Platform(r) => r.grouping.standard_names.len(),
+            Regressor::Closed(r) => r.grouping.standard_names.len(),
         }
     }
 

@@ -10,6 +10,7 @@ use codegen::dynamics::{BODY_PARAMETERS, Tree, body_standard_parameters};
 use codegen::sym::{Arg, Graph};
 use runtime::model::Model;
 
+use super::grouping::Grouping;
 use super::tape::Tape;
 
 /// The base regressor of a tree spec.
@@ -20,10 +21,8 @@ pub struct TreeRegressor {
     pub names: Vec<String>,
     /// `BASE_PARAMETERS` of the spec.
     pub values: Vec<f64>,
-    /// The standard parameters' names (`XX_link2`, `FV_j1`, …), in the regressor's order.
-    pub standard_names: Vec<String>,
-    /// `G`, `NBP` rows of `standard_names.len()` entries: `π_base = G π_standard`.
-    pub grouping: Vec<Vec<f64>>,
+    /// `G` over the named standard parameters: `π_base = G π_standard`.
+    pub grouping: Grouping,
     tape: Tape,
 }
 
@@ -33,25 +32,11 @@ impl TreeRegressor {
         let tree = Tree::new(&model);
         let mut g = Graph::new();
         let r = codegen::dynamics::regressor(&mut g, &tree, &model);
-        let nstd = r.standard.names.len();
-        let grouping = r
-            .base
-            .groups
-            .iter()
-            .map(|gr| {
-                let mut row = vec![0.0; nstd];
-                for &(k, c) in gr {
-                    row[k] += c;
-                }
-                row
-            })
-            .collect();
         TreeRegressor {
             tape: Tape::new(&g, &r.outputs),
             names: r.base.names,
             values: r.base.values,
-            standard_names: r.standard.names,
-            grouping,
+            grouping: Grouping::new(&r.base.groups, r.standard.names),
             model,
         }
     }
@@ -83,16 +68,7 @@ impl TreeRegressor {
     /// The base parameters of a model with the same structure: `G · π_standard(model)`
     /// (standard values read by name; a name the model lacks counts 0).
     pub fn base_of(&self, model: &Model) -> Vec<f64> {
-        let s = standard_values(model);
-        let x: Vec<f64> = self
-            .standard_names
-            .iter()
-            .map(|n| s.get(n).copied().unwrap_or(0.0))
-            .collect();
-        self.grouping
-            .iter()
-            .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
-            .collect()
+        self.grouping.apply(&standard_values(model))
     }
 }
 
