@@ -9,13 +9,12 @@
 
 use std::collections::HashMap;
 
-use codegen::sym::Arg;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
 use super::grouping::Grouping;
 use super::platform_regressor::NoRegressor;
-use super::tape::Tape;
+use super::tape::GuardedTape;
 
 /// The base regressor of a closed-loop spec.
 pub struct ClosedRegressor {
@@ -33,8 +32,7 @@ pub struct ClosedRegressor {
     /// `π_base = G π_standard`.
     pub grouping: Grouping,
     /// The guards, then `F_b` (row-major).
-    tape: Tape,
-    guards: usize,
+    tape: GuardedTape,
 }
 
 impl ClosedRegressor {
@@ -53,16 +51,8 @@ impl ClosedRegressor {
                 model.name
             ));
         };
-        let roots: Vec<_> = r
-            .kernel
-            .guards
-            .iter()
-            .chain(&r.kernel.outputs)
-            .copied()
-            .collect();
         Ok(ClosedRegressor {
-            tape: Tape::new(&k.graph, &roots),
-            guards: r.kernel.guards.len(),
+            tape: GuardedTape::new(&k.graph, &r.kernel),
             names: r.base.names,
             values: r.base.values,
             grouping: Grouping::new(&r.base.groups, r.standard_names),
@@ -122,23 +112,13 @@ impl ClosedRegressor {
         out: &mut [f64],
     ) -> Result<(), NoRegressor> {
         let (n, nbp) = (self.dof(), self.nbp());
-        let input = |a: Arg, i: usize| match a {
-            Arg::X => x[i],
-            Arg::U => u[i],
-            Arg::Ud => ud[i],
-            _ => f64::NAN,
-        };
-        let mut all = vec![0.0; self.guards + n * nbp];
-        self.tape.eval(&input, buf, &mut all);
-        if all[..self.guards].iter().any(|v| v.is_nan()) {
-            return Err(NoRegressor(
-                "the configuration does not close the loops, or the constraints are singular there",
-            ));
-        }
-        if !all[self.guards..].iter().all(|v| v.is_finite()) {
+        let all = self.tape.eval(x, u, ud, buf).ok_or(NoRegressor(
+            "the configuration does not close the loops, or the constraints are singular there",
+        ))?;
+        if !all.iter().all(|v| v.is_finite()) {
             return Err(NoRegressor("the regressor is not finite there"));
         }
-        out[..n * nbp].copy_from_slice(&all[self.guards..]);
+        out[..n * nbp].copy_from_slice(&all);
         Ok(())
     }
 

@@ -9,13 +9,12 @@ use std::collections::HashMap;
 
 use codegen::dynamics::{BODY_PARAMETERS, body_standard_parameters};
 use codegen::parallel::Layout;
-use codegen::sym::Arg;
 use nalgebra::DMatrix;
 use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
 use super::grouping::Grouping;
-use super::tape::Tape;
+use super::tape::GuardedTape;
 
 /// The base regressor of a platform spec.
 pub struct PlatformRegressor {
@@ -32,8 +31,7 @@ pub struct PlatformRegressor {
     /// `G` over the named standard parameters: `π_base = G π_standard`.
     pub grouping: Grouping,
     /// The guards, then `A` (row-major), then `F_b` (row-major).
-    tape: Tape,
-    guards: usize,
+    tape: GuardedTape,
 }
 
 /// A state with no regressor: the reason.
@@ -57,16 +55,8 @@ impl PlatformRegressor {
                 model.name
             ));
         };
-        let roots: Vec<_> = r
-            .kernel
-            .guards
-            .iter()
-            .chain(&r.kernel.outputs)
-            .copied()
-            .collect();
         Ok(PlatformRegressor {
-            tape: Tape::new(&k.graph, &roots),
-            guards: r.kernel.guards.len(),
+            tape: GuardedTape::new(&k.graph, &r.kernel),
             names: r.base.names,
             values: r.base.values,
             grouping: Grouping::new(&r.base.groups, r.standard_names),
@@ -110,23 +100,12 @@ impl PlatformRegressor {
         out: &mut [f64],
     ) -> Result<(), NoRegressor> {
         let (n, nbp) = (self.dof(), self.nbp());
-        let input = |a: Arg, i: usize| match a {
-            Arg::X => x[i],
-            Arg::U => u[i],
-            Arg::Ud => ud[i],
-            _ => f64::NAN,
-        };
-        let mut all = vec![0.0; self.guards + n * n + n * nbp];
-        self.tape.eval(&input, buf, &mut all);
-        if all[..self.guards].iter().any(|v| v.is_nan()) {
-            return Err(NoRegressor(
-                "the kinematics fail there (out of reach, or a leg at a singularity)",
-            ));
-        }
-        let at = self.guards;
+        let all = self.tape.eval(x, u, ud, buf).ok_or(NoRegressor(
+            "the kinematics fail there (out of reach, or a leg at a singularity)",
+        ))?;
         // `A` row-major; solve `Aᵀ Y = F_b`.
-        let at_t = DMatrix::from_fn(n, n, |r, c| all[at + c * n + r]);
-        let fb = DMatrix::from_row_slice(n, nbp, &all[at + n * n..]);
+        let at_t = DMatrix::from_fn(n, n, |r, c| all[c * n + r]);
+        let fb = DMatrix::from_row_slice(n, nbp, &all[n * n..]);
         if !(at_t.iter().chain(fb.iter()).all(|v| v.is_finite())) {
             return Err(NoRegressor("the regressor is not finite there"));
         }

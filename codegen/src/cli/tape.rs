@@ -137,3 +137,44 @@ mod tests {
         assert_eq!(want, out.to_vec());
     }
 }
+
+/// A kernel with guards, flattened: its guards, then its outputs, evaluated at `(x, u, u̇)`.
+#[derive(Clone, Debug)]
+pub struct GuardedTape {
+    tape: Tape,
+    guards: usize,
+    outputs: usize,
+}
+
+impl GuardedTape {
+    /// Flatten `kernel` of `g`.
+    pub fn new(g: &Graph, kernel: &codegen::schedule::Kernel) -> GuardedTape {
+        let roots: Vec<ExprId> = kernel
+            .guards
+            .iter()
+            .chain(&kernel.outputs)
+            .copied()
+            .collect();
+        GuardedTape {
+            tape: Tape::new(g, &roots),
+            guards: kernel.guards.len(),
+            outputs: kernel.outputs.len(),
+        }
+    }
+
+    /// The outputs at `(x, u, u̇)`; `None` when a guard fails. `buf` is scratch space.
+    pub fn eval(&self, x: &[f64], u: &[f64], ud: &[f64], buf: &mut Vec<f64>) -> Option<Vec<f64>> {
+        let input = |a: Arg, i: usize| match a {
+            Arg::X => x[i],
+            Arg::U => u[i],
+            Arg::Ud => ud[i],
+            _ => f64::NAN,
+        };
+        let mut all = vec![0.0; self.guards + self.outputs];
+        self.tape.eval(&input, buf, &mut all);
+        if all[..self.guards].iter().any(|v| v.is_nan()) {
+            return None;
+        }
+        Some(all.split_off(self.guards))
+    }
+}
