@@ -217,6 +217,30 @@ fn main() {
     generate(&out, "lanes_f32", Path::new(puma), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });
+    // `sin` and `cos` over all lanes at once (`Config::vector_sin_cos`): three arms in `f64`,
+    // the PUMA 560 also with 8 lanes in `f32`; dynamics only.
+    let dynamics_only = {
+        use codegen::spec::Function::*;
+        [
+            InverseDynamicsDerivatives,
+            ForwardDynamicsDerivatives,
+            Regressor,
+            Frames,
+        ]
+    };
+    generate(&out, "lanes_vector", Path::new(puma), |b| {
+        b.spec(trees[2])
+            .spec(trees[4])
+            .lanes(Some(4))
+            .vector_sin_cos(true)
+            .omit(&dynamics_only);
+    });
+    generate(&out, "lanes_vector_f32", Path::new(puma), |b| {
+        b.lanes(Some(8))
+            .float(codegen::Float::F32)
+            .vector_sin_cos(true)
+            .omit(&dynamics_only);
+    });
 
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));

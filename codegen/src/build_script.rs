@@ -168,6 +168,13 @@ impl Builder {
         self
     }
 
+    /// `sin` and `cos` of all lanes at once in the `_lanes` functions
+    /// (`Config::vector_sin_cos`; off by default).
+    pub fn vector_sin_cos(&mut self, on: bool) -> &mut Self {
+        self.config.vector_sin_cos = on;
+        self
+    }
+
     /// Also implement the runtime's `Dynamics` trait in every module (`Config::implement`):
     /// `runtime` is the path of the nocdyn runtime crate as the including crate names it (e.g.
     /// `"runtime"`). Each module then holds `pub struct Module` and

@@ -6,7 +6,8 @@
 //! instructions: one `vmulpd` of four lanes for one scalar `vmulsd`). Elementwise IEEE
 //! operations in the same order, so lane `k` of the result is bit for bit what the scalar
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
-//! backend once per lane.
+//! backend once per lane. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
+//! polynomial over all lanes ([`sin_cos`]), no longer bit for bit the backend's.
 //!
 //! Arguments and results are structures of arrays, lane last: `q: &[[f64; LANES]; DOF]`, where
 //! `q[i][k]` is coordinate `i` of state `k`, and `[[f64; LANES]; DOF]` out (a matrix
@@ -22,6 +23,8 @@
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
+
+mod sin_cos;
 
 use crate::Config;
 use crate::emit::{self, Function, Shape};
@@ -71,13 +74,21 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
     let idx: Vec<Literal> = (0..l).map(Literal::usize_unsuffixed).collect();
     let binop = |tr: &str, m: &str, op: TokenStream| {
         let (tr, m) = (format_ident!("{}", tr), format_ident!("{}", m));
-        let each = idx.iter().map(|i| quote!(self.0[#i] #op o.0[#i]));
+        // Each lane bound first: a binary operation as an array element reads, to clippy's
+        // `possible_missing_comma`, as a missing comma when the macro's tokens all carry the
+        // span of a call written over several lines.
+        let lanes: Vec<Ident> = (0..l).map(|k| format_ident!("r{}", k)).collect();
+        let each = idx
+            .iter()
+            .zip(&lanes)
+            .map(|(i, r)| quote!(let #r = self.0[#i] #op o.0[#i];));
         quote! {
             impl core::ops::#tr for Lanes {
                 type Output = Lanes;
                 #[inline(always)]
                 fn #m(self, o: Lanes) -> Lanes {
-                    Lanes([#(#each),*])
+                    #(#each)*
+                    Lanes([#(#lanes),*])
                 }
             }
         }
@@ -99,10 +110,32 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
         .iter()
         .map(|i| emit::math_call(cfg, "mul_add", quote!(self.0[#i], b.0[#i], c.0[#i])));
     let pairs: Vec<Ident> = (0..l).map(|k| format_ident!("p{}", k)).collect();
-    let sin_cos = idx.iter().zip(&pairs).map(|(i, p)| {
-        let call = emit::math_call(cfg, "sin_cos", quote!(self.0[#i]));
-        quote!(let #p = #call;)
-    });
+    let per_lane: Vec<TokenStream> = idx
+        .iter()
+        .zip(&pairs)
+        .map(|(i, p)| {
+            let call = emit::math_call(cfg, "sin_cos", quote!(self.0[#i]));
+            quote!(let #p = #call;)
+        })
+        .collect();
+    let (sin_cos_doc, sin_cos, kernel) = if cfg.vector_sin_cos {
+        let (body, kernel) = sin_cos::body_and_kernel(&idx, &pairs, &per_lane);
+        (
+            " `(sin, cos)` of every lane at once (a polynomial; the backend per lane beyond \
+             |x| = 2¹⁹·π/2 or for a non-finite lane).",
+            body,
+            kernel,
+        )
+    } else {
+        (
+            " `(sin, cos)` per lane.",
+            quote! {
+                #(#per_lane)*
+                (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
+            },
+            TokenStream::new(),
+        )
+    };
     let select = idx.iter().map(
         |i| quote!(if #real::abs(self.0[#i]) > #real::abs(b.0[#i]) { x.0[#i] } else { y.0[#i] }),
     );
@@ -146,11 +179,10 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             pub fn mul_add(self, b: Lanes, c: Lanes) -> Lanes {
                 Lanes([#(#mul_add),*])
             }
-            /// `(sin, cos)` per lane.
+            #[doc = #sin_cos_doc]
             #[inline(always)]
             pub fn sin_cos(self) -> (Lanes, Lanes) {
-                #(#sin_cos)*
-                (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
+                #sin_cos
             }
             /// Per lane: `x` where `|self| > |b|`, else `y`.
             #[inline(always)]
@@ -158,6 +190,7 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
                 Lanes([#(#select),*])
             }
         }
+        #kernel
     }
 }
 

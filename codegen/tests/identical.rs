@@ -77,6 +77,7 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
         emit: codegen::Emit::Rust,
         fma: false,
         lanes: None,
+        vector_sin_cos: false,
     };
     macro_support::expand(manifest_dir(), spec, &cfg)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -219,3 +219,30 @@ pub mod lanes_libm {
         include!(concat!(env!("OUT_DIR"), "/variants/lanes_libm/chain7.rs"));
     }
 }
+
+/// Three arms with 4 lanes whose `sin_cos` is one polynomial over all lanes
+/// (`Config::vector_sin_cos`), dynamics only.
+pub mod lanes_vector {
+    /// `mechanisms/specs/puma560.toml`.
+    pub mod puma560 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector/puma560.rs"
+        ));
+    }
+    /// `mechanisms/specs/chain7.toml`.
+    pub mod chain7 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_vector/chain7.rs"));
+    }
+    /// `mechanisms/specs/iiwa14.urdf`.
+    pub mod iiwa14 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_vector/iiwa14.rs"));
+    }
+}
+/// The PUMA 560 in `f32` with 8 lanes and the vector `sin_cos`.
+pub mod lanes_vector_f32_puma560 {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/lanes_vector_f32/puma560.rs"
+    ));
+}

@@ -1,7 +1,9 @@
 //! Many states per call (`codegen::Config::lanes`): on every bundled tree, lane `k` of each
 //! `_lanes` function is bit for bit the scalar function at state `k` (the same module, so the
 //! same math backend); a failing lane (a NaN input) gets the scalar function's own `Err` and
-//! leaves the other lanes as they are.
+//! leaves the other lanes as they are. With `Config::vector_sin_cos` (one polynomial `sin_cos`
+//! over all lanes), `sin_cos` is within 2 ulp of correctly rounded values from an independent
+//! route (mpmath), and the lanes agree with the scalar functions to rounding.
 
 #![allow(clippy::needless_range_loop)] // lane k of every array, as the lanes are numbered
 
@@ -142,4 +144,170 @@ fn lanes_options_are_checked() {
     let code = compile("planar_2r.toml", 4).unwrap();
     assert!(code.contains("pub fn forward_dynamics_lanes"));
     assert!(code.contains("// Lanes: 4 states per call"));
+}
+
+/// ulp of `y` (of the smallest normal for 0 and subnormals).
+fn ulp(y: f64) -> f64 {
+    let e = y.abs().max(f64::MIN_POSITIVE).log2().floor();
+    2f64.powf(e - 52.0)
+}
+
+/// The vector `sin_cos` against `sin` and `cos` correctly rounded to `f64` by mpmath at 80
+/// digits (`tests/data/sin_cos_reference.csv`, written by `sin_cos_reference.py` beside it):
+/// 6,415 arguments up to the polynomial's range `|x| ≤ 823,549` (random in ±1 … ±8.2e5 rad,
+/// and the doubles next to multiples of π/2, where the reduction is at its worst). Within
+/// 2 ulp where `|y| ≥ 2⁻²⁰`; near a zero of `sin` or `cos` the absolute error stays within
+/// 2⁻⁵³ (the reduction's, not relative). Beyond the range and for non-finite lanes the call
+/// is the backend's, bit for bit.
+#[test]
+fn vector_sin_cos_against_correctly_rounded_values() {
+    use tests::variants::lanes_vector::puma560::Lanes;
+    let text = std::fs::read_to_string("data/sin_cos_reference.csv").expect("the reference");
+    let (mut worst_ulp, mut worst_abs, mut count) = (0.0f64, 0.0f64, 0);
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|t| t.parse().expect("a number"))
+            .collect();
+        let (x, sin, cos) = (v[0], v[1], v[2]);
+        // Lane 2 carries x; the others ordinary angles, which must not disturb it.
+        let (s, c) = Lanes([0.3, -2.0, x, 7.5]).sin_cos();
+        for (got, want) in [(s.0[2], sin), (c.0[2], cos)] {
+            let err = (got - want).abs();
+            worst_abs = worst_abs.max(err);
+            if want.abs() >= 2f64.powi(-20) {
+                worst_ulp = worst_ulp.max(err / ulp(want));
+            }
+        }
+        let (s0, c0) = Lanes([0.3; 4]).sin_cos();
+        assert!(
+            same(&(s.0[0], c.0[0]), &(s0.0[0], c0.0[0])),
+            "lanes are independent"
+        );
+        count += 1;
+    }
+    println!(
+        "vector sin_cos: {count} arguments, worst {worst_ulp} ulp, worst absolute {worst_abs:e}"
+    );
+    assert!(count > 6000, "{count}");
+    assert!(worst_ulp <= 2.0, "{worst_ulp} ulp");
+    assert!(worst_abs <= f64::EPSILON / 2.0, "{worst_abs:e}");
+    // Beyond the range, or a lane not finite: every lane is the backend's.
+    for odd in [1e6, -3e7, 1e300, f64::INFINITY, f64::NAN] {
+        let x = [0.5, odd, -1.25, 3.0];
+        let (s, c) = Lanes(x).sin_cos();
+        for k in 0..4 {
+            let (bs, bc) = runtime::math::sin_cos(x[k]);
+            assert!(same(&(s.0[k], c.0[k]), &(bs, bc)), "{odd}: lane {k}");
+        }
+    }
+}
+
+macro_rules! check_vector_lanes {
+    ($test:ident, $m:ident, $seed:expr) => {
+        /// The `_lanes` functions with the vector `sin_cos` against the scalar functions of the
+        /// same module: relative ∞-norm ≤ 1e-13 (the values agree to rounding; bit for bit is
+        /// not promised), the same `Err` for a NaN lane.
+        #[test]
+        fn $test() {
+            use tests::variants::lanes_vector::$m as g;
+            const N: usize = g::DOF;
+            const L: usize = g::LANES;
+            let name = stringify!($m);
+            let mut r = tests::rng($seed);
+            let mut random = |a: f64| -> [[f64; L]; N] {
+                core::array::from_fn(|_| core::array::from_fn(|_| r.random_range(-a..a)))
+            };
+            let close = |a: &[f64], b: &[f64], what: &str| {
+                let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let d = a
+                    .iter()
+                    .zip(b)
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+                assert!(d <= 1e-13 * scale, "{name} {what}: {d:e} of {scale:e}");
+                d / scale
+            };
+            let mut worst = 0.0f64;
+            for round in 0..50 {
+                // Angles up to ±40 rad: several turns, every quadrant.
+                let (q, mut qd, qdd) = (random(40.0), random(2.0), random(5.0));
+                let bad = (round % 5 == 4).then(|| round % L);
+                if let Some(k) = bad {
+                    qd[0][k] = f64::NAN;
+                }
+                let tau = g::inverse_dynamics_lanes(&q, &qd, &qdd);
+                let m = g::mass_matrix_lanes(&q);
+                let gr = g::gravity_lanes(&q);
+                let (fd, status) = g::forward_dynamics_lanes(&q, &qd, &tau);
+                for k in 0..L {
+                    let (qk, qdk, qddk, tauk) =
+                        (lane(&q, k), lane(&qd, k), lane(&qdd, k), lane(&tau, k));
+                    let m_k = lane_matrix(&m, k);
+                    worst = worst.max(close(
+                        m_k.as_flattened(),
+                        g::mass_matrix(&qk).as_flattened(),
+                        "M",
+                    ));
+                    worst = worst.max(close(&lane(&gr, k), &g::gravity(&qk), "G"));
+                    let scalar = g::forward_dynamics(&qk, &qdk, &tauk);
+                    assert_eq!(status[k].is_err(), bad == Some(k), "{name} FD lane {k}");
+                    match (status[k], scalar) {
+                        (Ok(()), Ok(a)) => {
+                            worst = worst.max(close(&lane(&fd, k), &a, "FD"));
+                            let id = g::inverse_dynamics(&qk, &qdk, &qddk);
+                            worst = worst.max(close(&tauk, &id, "ID"));
+                        }
+                        (Err(a), Err(b)) => assert_eq!(a.pivot, b.pivot, "{name} FD lane {k}"),
+                        (a, b) => panic!("{name} FD lane {k}: {a:?} vs {b:?}"),
+                    }
+                }
+            }
+            println!("{name}: vector sin_cos lanes within {worst:e} of the scalar functions");
+        }
+    };
+}
+
+check_vector_lanes!(puma560_vector_sin_cos, puma560, 11);
+check_vector_lanes!(chain7_vector_sin_cos, chain7, 12);
+check_vector_lanes!(iiwa14_vector_sin_cos, iiwa14, 13);
+
+/// The `f32` vector `sin_cos` (widened to `f64` and rounded back): the lanes' inverse dynamics
+/// within 2e-5 (relative ∞-norm) of the scalar `f32` function.
+#[test]
+fn puma560_f32_vector_sin_cos() {
+    use tests::variants::lanes_vector_f32_puma560 as g;
+    const N: usize = g::DOF;
+    const L: usize = g::LANES;
+    let mut r = tests::rng(14);
+    let mut random = |a: f32| -> [[f32; L]; N] {
+        core::array::from_fn(|_| core::array::from_fn(|_| r.random_range(-a..a)))
+    };
+    for _ in 0..50 {
+        let (q, qd, qdd) = (random(20.0), random(2.0), random(5.0));
+        let tau = g::inverse_dynamics_lanes(&q, &qd, &qdd);
+        for k in 0..L {
+            let want = g::inverse_dynamics(&lane(&q, k), &lane(&qd, k), &lane(&qdd, k));
+            let got = lane(&tau, k);
+            let scale = want.iter().fold(1.0f32, |m, v| m.max(v.abs()));
+            let d = got
+                .iter()
+                .zip(&want)
+                .fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+            assert!(d <= 2e-5 * scale, "lane {k}: {d:e} of {scale:e}");
+        }
+    }
+}
+
+/// `vector_sin_cos` without `lanes` is refused.
+#[test]
+fn vector_sin_cos_needs_lanes() {
+    let src = std::fs::read_to_string("../mechanisms/specs/planar_2r.toml").unwrap();
+    let cfg = codegen::Config {
+        vector_sin_cos: true,
+        ..Default::default()
+    };
+    let e = codegen::compile("planar_2r.toml", &src, &cfg)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("set `lanes` too"), "{e}");
 }

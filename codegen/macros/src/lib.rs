@@ -17,7 +17,8 @@
 //!
 //! ```text
 //! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"]
-//!            [, implement = "P"] [, friction = true] [, rotor_inertia = true] [, snap = 1e-4])
+//!            [, implement = "P"] [, friction = true] [, rotor_inertia = true] [, snap = 1e-4]
+//!            [, fma = true] [, lanes = 4] [, vector_sin_cos = true])
 //! ```
 //!
 //! - The path is relative to the calling crate's `CARGO_MANIFEST_DIR` (its `Cargo.toml`
@@ -27,6 +28,9 @@
 //! - `implement`, `friction`, `rotor_inertia` and `snap` are the CLI's `--implement` (with its
 //!   `--runtime-path`: the runtime crate's path as the calling crate names it), `--friction`,
 //!   `--rotor-inertia` and `--snap TOL` (and `Builder`'s methods of the same names).
+//! - `fma`, `lanes` and `vector_sin_cos` are the CLI's `--fma` (fused multiply–adds), `--lanes N`
+//!   (`_lanes` functions of `N` states per call; trees) and `--vector-sin-cos` (with `lanes`:
+//!   `sin` and `cos` of all lanes at once), `Config`'s fields of the same names.
 //!   - `"libm"`: the calling crate needs the `libm` crate as a dependency (`libm = "0.2"`); the
 //!     code is `no_std`.
 //!   - `"std"`: `f64::sin_cos` from std.
@@ -112,10 +116,13 @@ struct Args {
     friction: Option<LitBool>,
     rotor_inertia: Option<LitBool>,
     snap: Option<Lit>,
+    fma: Option<LitBool>,
+    lanes: Option<syn::LitInt>,
+    vector_sin_cos: Option<LitBool>,
 }
 
 /// The options and the kind of literal each takes.
-const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement` (strings), `friction`, `rotor_inertia` (`true` or `false`) or `snap` (a number)";
+const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement` (strings), `friction`, `rotor_inertia`, `fma`, `vector_sin_cos` (`true` or `false`), `snap` (a number) or `lanes` (an integer)";
 
 impl Parse for Args {
     fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
@@ -129,6 +136,9 @@ impl Parse for Args {
             friction: None,
             rotor_inertia: None,
             snap: None,
+            fma: None,
+            lanes: None,
+            vector_sin_cos: None,
         };
         while !input.is_empty() {
             input.parse::<Token![,]>()?;
@@ -155,17 +165,29 @@ impl Parse for Args {
                 ("math" | "runtime_path" | "float" | "implement", _) => {
                     return Err(wrong("a string"));
                 }
-                (name @ ("friction" | "rotor_inertia"), Lit::Bool(v)) => {
-                    let slot = if name == "friction" {
-                        &mut args.friction
-                    } else {
-                        &mut args.rotor_inertia
+                (
+                    name @ ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos"),
+                    Lit::Bool(v),
+                ) => {
+                    let slot = match name {
+                        "friction" => &mut args.friction,
+                        "rotor_inertia" => &mut args.rotor_inertia,
+                        "fma" => &mut args.fma,
+                        _ => &mut args.vector_sin_cos,
                     };
                     if slot.replace(v.clone()).is_some() {
                         return Err(twice());
                     }
                 }
-                ("friction" | "rotor_inertia", _) => return Err(wrong("`true` or `false`")),
+                ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos", _) => {
+                    return Err(wrong("`true` or `false`"));
+                }
+                ("lanes", Lit::Int(v)) => {
+                    if args.lanes.replace(v.clone()).is_some() {
+                        return Err(twice());
+                    }
+                }
+                ("lanes", _) => return Err(wrong("an integer (states per call)")),
                 ("snap", Lit::Float(_) | Lit::Int(_)) => {
                     if args.snap.replace(value.clone()).is_some() {
                         return Err(twice());
@@ -263,14 +285,38 @@ impl Args {
                 "`implement` takes the runtime crate's path (e.g. \"runtime\")",
             ));
         }
+        let lanes = match &self.lanes {
+            None => None,
+            Some(l) => {
+                let n: usize = l.base10_parse()?;
+                if !(2..=codegen::lanes::MAX).contains(&n) {
+                    return Err(Error::new(
+                        l.span(),
+                        format!("`lanes` takes 2 to {} states per call", codegen::lanes::MAX),
+                    ));
+                }
+                Some(n)
+            }
+        };
+        let vector_sin_cos = self.vector_sin_cos.as_ref().is_some_and(LitBool::value);
+        if let Some(v) = &self.vector_sin_cos
+            && vector_sin_cos
+            && lanes.is_none()
+        {
+            return Err(Error::new(
+                v.span(),
+                "`vector_sin_cos` is for the `_lanes` functions: set `lanes` too",
+            ));
+        }
         Ok(Config {
             math,
             float,
             scene,
             implement: self.implement.as_ref().map(LitStr::value),
             emit: codegen::Emit::Rust,
-            fma: false,
-            lanes: None,
+            fma: self.fma.as_ref().is_some_and(LitBool::value),
+            lanes,
+            vector_sin_cos,
         })
     }
 }

@@ -16,6 +16,16 @@ mod planar_runtime {
     );
 }
 
+/// The same spec with fused multiply–adds and 4 states per call, `sin` and `cos` over the lanes.
+mod planar_lanes {
+    nocdyn_macros::mechanism!(
+        "../../mechanisms/specs/planar_2r.toml",
+        fma = true,
+        lanes = 4,
+        vector_sin_cos = true,
+    );
+}
+
 /// The Gough–Stewart platform (6-UPS).
 mod gough_stewart {
     nocdyn_macros::mechanism!("../../mechanisms/specs/gough_stewart.toml");
@@ -93,4 +103,27 @@ fn gough_stewart_inverse_dynamics_at_home() {
     // Every leg joint is at zero at home.
     let q = gough_stewart::inverse_kinematics(&x).expect("home is reachable");
     assert!(q.iter().all(|qi| qi.abs() <= 1e-12), "{q:?}");
+}
+
+/// The options `fma`, `lanes` and `vector_sin_cos` reach the generator: four states per call,
+/// each within rounding of the plain expansion's scalar inverse dynamics.
+#[test]
+fn fma_and_lanes_options() {
+    assert_eq!(planar_lanes::LANES, 4);
+    let st = states();
+    let lane = |i: usize, j: usize| -> [f64; 4] { core::array::from_fn(|k| st[k][i][j]) };
+    let (q, qd, qdd) = (
+        [lane(0, 0), lane(0, 1)],
+        [lane(1, 0), lane(1, 1)],
+        [lane(2, 0), lane(2, 1)],
+    );
+    let tau = planar_lanes::inverse_dynamics_lanes(&q, &qd, &qdd);
+    for (k, s) in st.iter().take(4).enumerate() {
+        let want = planar::inverse_dynamics(&s[0], &s[1], &s[2]);
+        let got = [tau[0][k], tau[1][k]];
+        assert!(
+            rel_err(&got, &want) <= 1e-13,
+            "state {k}: {got:?} vs {want:?}"
+        );
+    }
 }
