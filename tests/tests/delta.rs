@@ -161,6 +161,50 @@ fn delta_constraint_couples_over_the_reach() {
     assert!(smallest > 100.0 * noc::CONSTRAINT_TOLERANCE, "{smallest:e}");
 }
 
+/// The Delta legs' generic route (taken when a leg joint has a drive: here damping on the
+/// motors) forms each couple from the chain (`e₀ × (P − E)`, the crank axis and the rod from
+/// the elbow's U centre), the closed form from its rod direction (`a × d`): the same unit
+/// couples, up to sign, at 100 random states.
+#[test]
+fn delta_generic_legs_have_the_closed_form_couples() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/delta_rl5.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let src = src
+        .replacen("[platform]", "[scene]\nfriction = true\n\n[platform]", 1)
+        .replace("actuated = true\n", "actuated = true\ndamping = 0.5\n");
+    let (codegen::spec::Mechanism::Parallel(damped), _) =
+        codegen::spec::load_mechanism(&path.to_string_lossy(), &src)
+            .unwrap_or_else(|d| panic!("{d}"))
+    else {
+        panic!("not a parallel mechanism")
+    };
+    let generic = Plan::new(&damped).unwrap();
+    assert!(
+        generic.legs.iter().all(|l| l.delta.is_none()),
+        "drives take the generic route"
+    );
+    let m = model("delta_rl5");
+    let closed = Plan::new(&m).unwrap();
+    assert!(closed.legs.iter().all(|l| l.delta.is_some()));
+    let home = m.home_x();
+    let mut rng = tests::rng(0xde1c);
+    for _ in 0..100 {
+        let (p, _, _) = random_state(&closed, &home, &mut rng, 0.0, 0.1 * m.size());
+        let (_, gl) = noc::positions(&generic, &p).unwrap();
+        let (_, cl) = noc::positions(&closed, &p).unwrap();
+        let (g, c) = (
+            noc::constraint_couples(&generic, &gl),
+            noc::constraint_couples(&closed, &cl),
+        );
+        assert_eq!((g.len(), c.len()), (3, 3));
+        for (g, c) in g.iter().zip(&c) {
+            let dot: f64 = (0..3).map(|i| g[i] * c[i]).sum();
+            assert!((dot.abs() - 1.0).abs() < 1e-13, "{p:?}: {g:?} vs {c:?}");
+        }
+    }
+}
+
 /// The smallest pivot of the couples' LU, in magnitude.
 fn min_pivot(pivots: &[f64]) -> f64 {
     pivots.iter().fold(f64::INFINITY, |m, p| m.min(p.abs()))

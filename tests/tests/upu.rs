@@ -161,7 +161,8 @@ fn upu_round_trip_and_power_balance() {
 /// With viscous friction on the actuated prismatic joints (`[scene] friction = true`), the
 /// legs leave the closed form for the generic leg route (Newton–Euler of the U-P chain to the
 /// platform U's centre, the drives at the joints); the platform form still agrees with the
-/// joint-coordinate route, which applies the same damping at the same joints.
+/// joint-coordinate route, which applies the same damping at the same joints. The generic legs'
+/// constraint couples are the closed form's, and they fail at the same constraint singularity.
 #[test]
 fn upu_with_joint_damping_matches_joint_coordinates() {
     let load = |file: &str, before: &str| {
@@ -223,6 +224,27 @@ fn upu_with_joint_damping_matches_joint_coordinates() {
     );
     assert!(damping > 1.0, "the damping must matter");
     assert!(worst <= 1e-12, "{worst:e}");
+    // The generic legs' constraint couples (from the chain's U axes, `e₀ × e₁`) are the closed
+    // form's (from `e₀ × e₁′`), up to sign, and fail at the same constraint singularity.
+    let closed = Plan::new(&model("tsai_3upu")).unwrap();
+    let mut rng = tests::rng(0x0b06);
+    for _ in 0..100 {
+        let (p, _, _) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let (_, generic_legs) = noc::positions(&pplan, &p).unwrap();
+        let (_, closed_legs) = noc::positions(&closed, &p).unwrap();
+        let g = noc::constraint_couples(&pplan, &generic_legs);
+        let c = noc::constraint_couples(&closed, &closed_legs);
+        assert_eq!((g.len(), c.len()), (3, 3));
+        for (g, c) in g.iter().zip(&c) {
+            let dot: f64 = (0..3).map(|i| g[i] * c[i]).sum();
+            assert!((dot.abs() - 1.0).abs() < 1e-13, "{g:?} vs {c:?}");
+        }
+    }
+    let e = noc::inverse_dynamics(&pplan, &on_ray(0.3), &[0.1; 3], &[0.0; 3]).unwrap_err();
+    assert!(
+        matches!(e.site, runtime::scalar::Site::Constraint(_)),
+        "{e:?}"
+    );
 }
 
 /// The platform at `|p_xy| = r` in the direction 40° from `x`, `z = 0.35 m`: on the circle
