@@ -26,11 +26,13 @@ use runtime::scalar::{Singular, Site};
 const ACCURACY: f64 = 1e-6;
 /// An `Err` at a singularity must report a condition estimate at least the inverse of the
 /// documented threshold of its site (`noc::LEG_TOLERANCE` for legs, `ACTUATION_TOLERANCE` for
-/// `A`; a reach failure or a zero value may report infinity).
+/// `A`, `CONSTRAINT_TOLERANCE` for the legs' constraint couples; a reach failure or a zero
+/// value may report infinity).
 fn min_condition(site: Site) -> f64 {
     match site {
         Site::Leg(_) => 0.99 / noc::LEG_TOLERANCE,
         Site::Actuation(_) => 0.99 / noc::ACTUATION_TOLERANCE,
+        Site::Constraint(_) => 0.99 / noc::CONSTRAINT_TOLERANCE,
         _ => 0.0,
     }
 }
@@ -251,6 +253,7 @@ fn site_from_debug(d: &str) -> Site {
         "Actuation" => 768,
         "Platform" => 1024,
         "Input" => 1025,
+        "Constraint" => 1536,
         other => panic!("unknown generated site {other}"),
     };
     let site = Site::from_code(base + index);
@@ -1120,7 +1123,13 @@ fn upu_leg_singularity() {
 
 /// Tsai's 3-UPU (`tsai_3upu`): the platform lowered into the base plane, `(0, 0, δ)`: the three
 /// leg directions `s_k` (the rows of `A`) become coplanar while every leg stays regular (each
-/// leg radial, `|e₀ × s| = 1`), a parallel (type-II) singularity.
+/// leg radial, `|e₀ × s| = 1`), a parallel (type-II) singularity. It is a constraint
+/// singularity as well: each leg's couple (normal to its base U's two axes, `s` less its
+/// component along the tangent `e₀`) is `∝ −(a − b) r_k + δ e_z` here, so the three turn
+/// horizontal and the platform gains the turn about `z` (every U's second axis is vertical in
+/// the base plane). The couples' test is the looser one: `Constraint(2)` from δ = 1e-6 m (its
+/// pivot is 20 δ), runtime, generated and double-double alike; `A`'s own pivot test would
+/// answer only below 1e-10 m (`Actuation(2)` before the couples were tested).
 #[test]
 fn upu_parallel_singularity() {
     let m = model("tsai_3upu");
@@ -1138,9 +1147,113 @@ fn upu_parallel_singularity() {
         &walk,
         &states(3, 0x0b1),
         Some(generated_id("tsai_3upu")),
-        &[|s| matches!(s, Site::Actuation(_))],
+        &[
+            |s| matches!(s, Site::Constraint(_)),
+            |s| matches!(s, Site::Actuation(_)),
+        ],
     );
     finish(&bad);
+}
+
+/// The determinant of the unit constraint couples of the legs at `x` (positions only, no
+/// test), with the couples.
+fn couple_det(plan: &Plan, x: &[f64]) -> f64 {
+    let (_, legs) = noc::positions(plan, x).unwrap();
+    let c: Vec<[f64; 3]> = noc::constraint_couples(plan, &legs)
+        .into_iter()
+        .map(|v| {
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            [v[0] / n, v[1] / n, v[2] / n]
+        })
+        .collect();
+    assert_eq!(c.len(), 3);
+    c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
+        - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
+        + c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0])
+}
+
+/// Tsai's 3-UPU (`tsai_3upu`): a constraint singularity away from every other kind. Each leg is
+/// held by one couple, normal to both of its base U's axes (the platform U's are parallel to
+/// them). With the base U's first axis `e₀ₖ` tangent to the base circle (radius `a = 0.3 m`,
+/// legs at 0°, 120°, 240°, radial directions `rₖ`), its second axis at right angles to the leg
+/// and the platform U's centres on a circle of radius `b = 0.15 m`, the couple is the leg
+/// direction less its component along `e₀ₖ`: `nₖ ∝ cₖ rₖ + z e_z` with `cₖ = p·rₖ − (a − b)`
+/// for the platform at `p = (px, py, z)`. Then `det[n₀ n₁ n₂] ∝ z (c₀c₁ + c₁c₂ + c₂c₀)`, and
+/// from `Σ cₖ = −3 (a − b)`, `Σ cₖ² = (3/2) |p_xy|² + 3 (a − b)²`:
+/// `c₀c₁ + c₁c₂ + c₂c₀ = 3 (a − b)² − (3/4) |p_xy|²`. So above the base plane the couples
+/// are coplanar exactly where the platform's centre is `2 (a − b) = 0.3 m` from the axis, at
+/// every height: there the platform gains a rotation no leg resists (about `(z, 0, −(a − b))`
+/// turned to the walk's direction), while every leg and `A` stay regular. The walk: at 40° and
+/// `z = 0.35 m`, `|p_xy| = 0.3 m − δ` (1e-1 … 1e-12 m, then 0); the runtime's couple
+/// determinant is checked to change sign across `0.3 m` first. Measured (`--nocapture`): `Ok`
+/// (errors ≤ 5.8e-16 against double-double, `A` well conditioned throughout) down to
+/// δ = 1e-5 m, `Err(Constraint(2))` from 1e-6 m to δ = 0 (the pivot is about 10 δ, so the test
+/// answers within about 1e-5 m), runtime, generated and double-double alike.
+#[test]
+fn upu_constraint_singularity() {
+    let m = model("tsai_3upu");
+    let plan = plan(&m);
+    let (c, s) = (40f64.to_radians().cos(), 40f64.to_radians().sin());
+    let at = |r: f64| vec![r * c, r * s, 0.35];
+    let (inside, outside) = (couple_det(&plan, &at(0.299)), couple_det(&plan, &at(0.301)));
+    assert!(
+        inside * outside < 0.0,
+        "the couples' determinant keeps its sign across |p_xy| = 0.3 m: {inside:e}, {outside:e}"
+    );
+    assert!(couple_det(&plan, &at(0.3)).abs() < 1e-14);
+    let walk: Vec<Point> = deltas()
+        .into_iter()
+        .map(|d| Point {
+            delta: d,
+            x: at(0.3 - d),
+        })
+        .collect();
+    let bad = walk_report(
+        "3-UPU, |p_xy| = 0.3 m − δ at 40°, z = 0.35 m (the legs' couples coplanar)",
+        &plan,
+        &walk,
+        &states(3, 0x0b2),
+        Some(generated_id("tsai_3upu")),
+        &[|s| matches!(s, Site::Constraint(_))],
+    );
+    finish(&bad);
+    // The other functions that test the legs' Jacobians fail there too, generated and runtime;
+    // the positions alone do not.
+    let x = at(0.3);
+    for (name, f) in generated("tsai_3upu") {
+        let o = f(&x, &[0.1, 0.2, 0.3], &[0.3, 0.2, 0.1]);
+        if *name == "inverse_kinematics" {
+            assert!(o.is_ok(), "{name}: {o:?}");
+        } else {
+            assert!(
+                matches!(
+                    o,
+                    Err(Singular {
+                        site: Site::Constraint(_),
+                        ..
+                    })
+                ),
+                "{name}: {o:?}"
+            );
+        }
+    }
+    assert!(noc::inverse_kinematics(&plan, &x).is_ok());
+    for e in [
+        noc::mass_matrix(&plan, &x).map(|_| ()),
+        noc::actuator_rates(&plan, &x, &[0.1, 0.2, 0.3]).map(|_| ()),
+        noc::forward_dynamics(&plan, &x, &[0.0; 3], &[1.0; 3]).map(|_| ()),
+    ] {
+        assert!(
+            matches!(
+                e,
+                Err(Singular {
+                    site: Site::Constraint(_),
+                    ..
+                })
+            ),
+            "{e:?}"
+        );
+    }
 }
 
 /// A platform axis approaching the base axis of a *different* leg (`v₂ → u₃` by

@@ -161,7 +161,8 @@ fn upu_round_trip_and_power_balance() {
 /// With viscous friction on the actuated prismatic joints (`[scene] friction = true`), the
 /// legs leave the closed form for the generic leg route (Newton–Euler of the U-P chain to the
 /// platform U's centre, the drives at the joints); the platform form still agrees with the
-/// joint-coordinate route, which applies the same damping at the same joints.
+/// joint-coordinate route, which applies the same damping at the same joints. The generic legs'
+/// constraint couples are the closed form's, and they fail at the same constraint singularity.
 #[test]
 fn upu_with_joint_damping_matches_joint_coordinates() {
     let load = |file: &str, before: &str| {
@@ -223,4 +224,152 @@ fn upu_with_joint_damping_matches_joint_coordinates() {
     );
     assert!(damping > 1.0, "the damping must matter");
     assert!(worst <= 1e-12, "{worst:e}");
+    // The generic legs' constraint couples (from the chain's U axes, `e₀ × e₁`) are the closed
+    // form's (from `e₀ × e₁′`), up to sign, and fail at the same constraint singularity.
+    let closed = Plan::new(&model("tsai_3upu")).unwrap();
+    let mut rng = tests::rng(0x0b06);
+    for _ in 0..100 {
+        let (p, _, _) = random_state(&pplan, &home, &mut rng, 0.0, 0.05 * pm.size());
+        let (_, generic_legs) = noc::positions(&pplan, &p).unwrap();
+        let (_, closed_legs) = noc::positions(&closed, &p).unwrap();
+        let g = noc::constraint_couples(&pplan, &generic_legs);
+        let c = noc::constraint_couples(&closed, &closed_legs);
+        assert_eq!((g.len(), c.len()), (3, 3));
+        for (g, c) in g.iter().zip(&c) {
+            let dot: f64 = (0..3).map(|i| g[i] * c[i]).sum();
+            assert!((dot.abs() - 1.0).abs() < 1e-13, "{g:?} vs {c:?}");
+        }
+    }
+    let e = noc::inverse_dynamics(&pplan, &on_ray(0.3), &[0.1; 3], &[0.0; 3]).unwrap_err();
+    assert!(
+        matches!(e.site, runtime::scalar::Site::Constraint(_)),
+        "{e:?}"
+    );
+}
+
+/// The platform at `|p_xy| = r` in the direction 40° from `x`, `z = 0.35 m`: on the circle
+/// `r = 2 (a − b) = 0.3 m` the legs' constraint couples are coplanar (the derivation is at
+/// `upu_constraint_singularity` in tests/tests/singularities.rs).
+fn on_ray(r: f64) -> Vec<f64> {
+    let t = 40f64.to_radians();
+    vec![r * t.cos(), r * t.sin(), 0.35]
+}
+
+/// The constraint singularity is the whole mechanism's, not an artefact of `ω = 0`: the
+/// joint-coordinate twin (every U written out, the platform's orientation free and held only
+/// by the legs' joints, `ω = 0` nowhere assumed) degrades at the same place. Walking to
+/// `|p_xy| = 0.3 m` (40°, `z = 0.35 m`, δ = 1e-1 … 1e-12 m), the two routes agree to 9.0e-15
+/// at δ = 0.1 m, then drift apart as the couples turn dependent: 2.2e-13, 1.8e-10, 1.2e-8,
+/// 1.6e-5 (the worst of ID, `A⁻ᵀIA⁻¹`, FD) at 1e-2 … 1e-5 m, where the joint route still
+/// answers `Ok`; at 1e-6 m its assembly from `q` stalls (`NoConvergence`, `Stalled`), the
+/// same δ at which the task route's couple test answers `Err(Constraint(2))`.
+#[test]
+fn upu_constraint_singularity_in_joint_coordinates() {
+    let pm = model("tsai_3upu");
+    let jm = joints_model();
+    let pair = Pair::new(&pm, &jm);
+    let (pplan, jplan) = (&pair.task, &pair.joints);
+    let (v, a) = ([0.1, -0.2, 0.05], [0.3, 0.1, -0.2]);
+    let mut first = (None, None);
+    let mut guess = vec![0.0; jplan.nx()];
+    for k in 1..=12 {
+        let d = 10f64.powi(-k);
+        let p = on_ray(0.3 - d);
+        let task = noc::inverse_dynamics(pplan, &p, &v, &a);
+        let q = noc::inverse_kinematics(pplan, &p).unwrap();
+        // The joint-coordinate route: its assembly from `q`, then its inverse dynamics.
+        let joint = match cnoc::forward_kinematics(jplan, &q, &guess) {
+            Ok(x) => {
+                guess.clone_from(&x);
+                let qd = mat_vec(&noc::actuation(pplan, &p).unwrap_or_default(), &v);
+                match cnoc::inverse_dynamics(jplan, &x, &qd, &qd) {
+                    Ok(_) => Ok(()),
+                    Err(e) => Err(format!("{:?}", e.site)),
+                }
+            }
+            Err(e) => Err(format!("assembly {:?}", e.stop)),
+        };
+        println!(
+            "δ = {d:e} m: task {:?}, joints {joint:?}",
+            task.as_ref().map(|_| ()).map_err(|e| e.site),
+        );
+        if task.is_err() && first.0.is_none() {
+            first.0 = Some(d);
+        }
+        if joint.is_err() && first.1.is_none() {
+            first.1 = Some(d);
+        }
+        if let Err(e) = &task {
+            assert!(
+                matches!(e.site, runtime::scalar::Site::Constraint(_)),
+                "{e:?}"
+            );
+        }
+        if task.is_ok() && joint.is_ok() {
+            // The routes drift apart as the couples turn dependent: the joint-coordinate
+            // route solves with `Φ_d`, whose conditioning goes with the couples'.
+            let (e, _) = pair.compare(&p, &v, &a, 10.0);
+            println!(
+                "  task vs joints (ID, A⁻ᵀIA⁻¹, FD): {:.1e} {:.1e} {:.1e}",
+                e[0], e[1], e[2]
+            );
+            if k == 1 {
+                assert!(e.iter().all(|e| *e <= 1e-12), "δ = {d:e}: {e:?}");
+            }
+        }
+    }
+    println!(
+        "3-UPU toward |p_xy| = 0.3 m: first Err at δ = {:?} m (task coordinates), {:?} m (joint coordinates)",
+        first.0, first.1
+    );
+    assert_eq!(first.0, Some(1e-6));
+    assert!(
+        first.1.is_some_and(|d| d >= 1e-6),
+        "the joint-coordinate route still answers closer than the task route: {first:?}"
+    );
+}
+
+/// No false alarms: the couple test answers `Ok` at every state of a region that keeps at least
+/// 5 cm from the constraint-singular cylinder `|p_xy| = 0.3 m` and from the base plane (where
+/// the couples of the other kinds meet): 1,000 platform positions with `|p_xy| ≤ 0.25 m`,
+/// `z ∈ [0.15, 0.6] m`, each with a random `(u, u̇)`. There the runtime's and the generated
+/// efforts are `Ok`, agree to 1e-12 (relative, ∞-norm), and the smallest couple pivot is
+/// printed.
+#[test]
+fn upu_no_constraint_false_alarms() {
+    use mechanisms::tsai_3upu as g;
+    use rand::Rng;
+    let m = model("tsai_3upu");
+    let plan = Plan::new(&m).unwrap();
+    let mut rng = tests::rng(0x0b05);
+    let (mut worst, mut n) = (0.0f64, 0);
+    let mut smallest = f64::INFINITY;
+    while n < 1000 {
+        let (px, py) = (rng.random_range(-0.25..0.25), rng.random_range(-0.25..0.25));
+        if f64::hypot(px, py) > 0.25 {
+            continue;
+        }
+        let x = [px, py, rng.random_range(0.15..0.6)];
+        let u: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let ud: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+        let t = noc::inverse_dynamics(&plan, &x, &u, &ud)
+            .unwrap_or_else(|e| panic!("runtime at {x:?}: {e:?}"));
+        let tg = g::inverse_dynamics(&x, &u, &ud)
+            .unwrap_or_else(|e| panic!("generated at {x:?}: {e:?}"));
+        worst = worst.max(rel(&tg, &t));
+        // How far from dependent the couples are: their LU's pivots (untested).
+        let (_, legs) = noc::positions(&plan, &x).unwrap();
+        smallest = smallest.min(min_pivot(&noc::couple_pivots(&plan, &legs)));
+        n += 1;
+    }
+    println!(
+        "tsai_3upu: {n} states with |p_xy| ≤ 0.25 m, z in [0.15, 0.6] m: no Err; generated vs runtime {worst:.1e}; smallest couple pivot {smallest:.3}"
+    );
+    assert!(worst <= 1e-12, "{worst:e}");
+    assert!(smallest > 10.0 * noc::CONSTRAINT_TOLERANCE);
+}
+
+/// The smallest pivot of the couples' LU, in magnitude.
+fn min_pivot(pivots: &[f64]) -> f64 {
+    pivots.iter().fold(f64::INFINITY, |m, p| m.min(p.abs()))
 }

@@ -33,7 +33,11 @@ pub(super) fn templates(
     want: &dyn Fn(&str) -> bool,
     params: bool,
 ) -> TokenStream {
-    let types = error_types(plan.motion.parasitic(), plan.motion.schoenflies());
+    let types = error_types(
+        plan.motion.parasitic(),
+        plan.motion.schoenflies(),
+        noc::held_by_couples(plan),
+    );
     let lu_solve = lu_fn(
         cfg,
         plan,
@@ -107,9 +111,9 @@ pub(super) fn templates(
     }
 }
 
-/// `Site` (its leg and actuation variants documented with the tolerances), `Singular` and
-/// `NoConvergence`.
-fn error_types(parasitic: bool, schoenflies: bool) -> TokenStream {
+/// `Site` (its leg and actuation variants documented with the tolerances; `Constraint` for a
+/// platform held in rotation by its legs' couples, `couples`), `Singular` and `NoConvergence`.
+fn error_types(parasitic: bool, schoenflies: bool, couples: bool) -> TokenStream {
     let tol = crate::scalar::tolerance;
     let leg_tol = tol(noc::LEG_TOLERANCE);
     let act_tol = tol(noc::ACTUATION_TOLERANCE);
@@ -137,6 +141,19 @@ fn error_types(parasitic: bool, schoenflies: bool) -> TokenStream {
     } else {
         " Leg `k` cannot reach the platform: the pose is outside the workspace."
     };
+    // A platform whose coordinates hold its rotation: the legs' constraint couples must hold it.
+    let constraint_variant = if couples {
+        let doc = format!(
+            " Pivot `i` of the LU of the legs' constraint couples (unit rows, partial pivoting) is `|p| ≤ {:e}`: the couples no longer hold the rotation the coordinates fix (a constraint singularity; the platform gains a rotation no leg resists).",
+            tol(noc::CONSTRAINT_TOLERANCE)
+        );
+        quote! {
+            #[doc = #doc]
+            Constraint(usize),
+        }
+    } else {
+        quote!()
+    };
     let errors = crate::module::error_types(
         "Which matrix, leg or pivot.",
         "The determinant, pivot or discriminant that failed its test.",
@@ -156,6 +173,7 @@ fn error_types(parasitic: bool, schoenflies: bool) -> TokenStream {
             Actuation(usize),
             #[doc = #platform_doc]
             Platform,
+            #constraint_variant
             /// An input (`x`, `u`, `ud`, `tau`) is NaN or infinite, or so large that a result
             /// overflows.
             Input,

@@ -47,6 +47,9 @@
 //! * `subproblems.rs`: the Paden–Kahan subproblems of step 2.
 //! * `legs.rs`: steps 2–3, [`leg_kinematics`] ([`LegKin`]) and [`kinematics`] of every leg;
 //!   step 6's [`actuation_matrix`].
+//! * `constraint.rs`: after step 3, for a platform whose coordinates hold its rotation fixed
+//!   (`Translation`, a `Schoenflies` carrier), the legs' constraint couples and their test
+//!   ([`check_constraint`], `Site::Constraint`: the couples no longer hold the rotation).
 //! * `generic_leg.rs`: a generic leg's inverse kinematics by Newton steps.
 //! * `motion.rs`: step 4, the leg bodies' motions (`leg_motion`).
 //! * `force.rs`: step 5, [`generalized_force`] and [`payload_force`].
@@ -69,6 +72,7 @@
 
 mod api;
 mod assembly;
+mod constraint;
 mod delta;
 mod dynamics;
 mod force;
@@ -94,6 +98,7 @@ pub use api::{
     leg_joint_positions, leg_joint_rates, mass_matrix, platform_pose, potential_energy,
 };
 pub use assembly::{FK_MAX_ITERATIONS, FK_TOLERANCE, forward_kinematics, retract, tangent};
+pub use constraint::{check_constraint, constraint_couples, couple_pivots, held_by_couples};
 pub use delta::{DeltaKin, DeltaPlan};
 pub use dynamics::{forward_dynamics_generic, forward_dynamics_with};
 pub use force::{generalized_force, generalized_force_with, leg_rates, payload_force};
@@ -129,3 +134,9 @@ pub const LEG_TOLERANCE: f64 = 1e-4;
 /// `≤ ACTUATION_TOLERANCE` times the larger of 1 and the largest pivot; the condition estimate
 /// is the ratio of that reference to the pivot.
 pub const ACTUATION_TOLERANCE: f64 = 1e-8;
+/// Constraint-couple threshold of a platform held in rotation by its legs (`Translation`, a
+/// `Schoenflies` carrier): the legs' constraint couples, as unit rows, are dependent when a
+/// pivot of their partially pivoted LU is `≤ CONSTRAINT_TOLERANCE` in magnitude
+/// ([`check_constraint`], `Site::Constraint(i)`, condition estimate `1/|pivot|`); the same
+/// value as the closed loops' test of `Φ_d`.
+pub const CONSTRAINT_TOLERANCE: f64 = 1e-4;

@@ -9,6 +9,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::LEG_TOLERANCE;
+use super::constraint::check_constraint;
 use super::delta::{DeltaKin, delta_kin};
 use super::generic_leg::generic_ik;
 use super::plan::{LegPlan, Plan, cross3, dot3, sub3};
@@ -473,7 +474,8 @@ fn jacobian_inverse<R: Real>(
     Ok([scale(id, r0), scale(id, r1), scale(id, r2)])
 }
 
-/// The legs' kinematics at `x`, their Jacobians tested.
+/// The legs' kinematics at `x`, their Jacobians tested and, for a platform held in rotation by
+/// its legs, their constraint couples (`Site::Constraint`).
 pub fn kinematics<R: Real>(
     plan: &Plan,
     x: &[R],
@@ -496,6 +498,11 @@ fn kinematics_of<R: Real>(
     let mut legs = Vec::with_capacity(plan.legs.len());
     for k in 0..plan.legs.len() {
         legs.push(leg_kinematics(plan, k, &pl, jacobian)?);
+    }
+    // With the Jacobians (every velocity-level function), the legs' constraint couples must
+    // still hold the rotation the coordinates fix.
+    if jacobian {
+        check_constraint(plan, &legs)?;
     }
     Ok((pl, legs))
 }
