@@ -196,14 +196,22 @@ fn per_joint(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
     Ok(out)
 }
 
+/// The shortest `--period`, s.
+const MIN_PERIOD: f64 = 1e-3;
+/// The longest `--period`, s.
+const MAX_PERIOD: f64 = 1e5;
+
 /// Check the arguments; `Err` is the message (exit code 2).
 fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), String> {
     let n = reg.dof();
     if args.harmonics == 0 || args.harmonics > 50 {
         return Err("error: --harmonics must be in 1..=50".into());
     }
-    if !(args.period.is_finite() && args.period > 0.0) {
-        return Err("error: --period must be a positive number of seconds".into());
+    if !(MIN_PERIOD..=MAX_PERIOD).contains(&args.period) {
+        return Err(format!(
+            "error: --period {:?}: must be in [{MIN_PERIOD}, {MAX_PERIOD:e}] s (beyond, the accelerations or the motion per sample are lost to rounding)",
+            args.period
+        ));
     }
     let min = reg.nbp() / n.max(1) + 1;
     if args.samples < min || args.samples > 10_000_000 {
@@ -260,6 +268,12 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     if !warnings.is_empty() {
         eprint!("{warnings}");
+    }
+    if let Err(c) = super::distinct_outputs(
+        &[("the spec", &args.spec)],
+        &[("-o", args.output.as_deref())],
+    ) {
+        return c;
     }
     let (q_max, qd_max) = match check(args, &reg) {
         Ok(b) => b,
@@ -329,6 +343,13 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
                     *t
                 }
             }));
+        }
+        if let Some(v) = row.iter().find(|v| !v.is_finite()) {
+            eprintln!(
+                "error: at t = {t} s a value of the trajectory is {v} (--noise {:?}, --q-max, --qd-max or --period too large)",
+                args.noise
+            );
+            return ExitCode::from(2);
         }
         from = Some(q);
         for i in 0..n {

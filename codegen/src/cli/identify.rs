@@ -54,6 +54,9 @@ pub struct IdentifyArgs {
     pub plot: Option<PathBuf>,
 }
 
+/// The largest magnitude of a regressor entry or an effort that `identify` takes.
+const MAX_MAGNITUDE: f64 = 1e150;
+
 /// Run `identify`.
 pub fn run(args: &IdentifyArgs) -> ExitCode {
     let (name, source) = match super::read_spec(&args.spec) {
@@ -67,6 +70,16 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     if !(args.cutoff > 0.0 && args.cutoff.is_finite()) {
         eprintln!("error: --cutoff must be a positive frequency in Hz");
         return ExitCode::from(2);
+    }
+    if let Err(c) = super::distinct_outputs(
+        &[("the spec", &args.spec), ("the data file", &args.data)],
+        &[
+            ("--out", args.out.as_deref()),
+            ("--estimates", args.estimates.as_deref()),
+            ("--plot", args.plot.as_deref()),
+        ],
+    ) {
+        return c;
     }
     if args.out.is_some() && name.ends_with(".urdf") {
         eprintln!(
@@ -88,8 +101,15 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     let text = match std::fs::read(&args.data) {
         Ok(b) => match String::from_utf8(b) {
             Ok(t) => t,
-            Err(_) => {
-                eprintln!("error: {data_name}: not UTF-8 text");
+            Err(e) => {
+                let ok = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+                let line = ok.iter().filter(|b| **b == b'\n').count() + 1;
+                let start = ok.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+                let column = String::from_utf8_lossy(&ok[start..]).chars().count() + 1;
+                eprintln!(
+                    "error: {data_name}:{line}:{column}: not UTF-8 text (byte 0x{:02x}; save the file as UTF-8)",
+                    e.as_bytes()[ok.len()]
+                );
                 return ExitCode::from(2);
             }
         },
@@ -130,6 +150,19 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             );
             return ExitCode::from(2);
         }
+        // Squares of larger numbers overflow in the least squares (and the SVD does not
+        // return on what follows): no unit makes such values measurements.
+        if let Some(v) = y
+            .iter()
+            .chain(&data.tau[s])
+            .find(|v| v.is_nan() || v.abs() > MAX_MAGNITUDE)
+        {
+            eprintln!(
+                "error: {data_name}:{}: the regressor or the efforts reach {v:e} at this state, beyond {MAX_MAGNITUDE:e} (check the columns' order and units)",
+                data.lines[s]
+            );
+            return ExitCode::from(2);
+        }
         for i in 0..n {
             for k in 0..nbp {
                 w[(s * n + i, k)] = y[i * nbp + k];
@@ -139,6 +172,19 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     }
     let stacked = Stacked { w, tau, n };
     let fit = wls::fit(&stacked, args.weights == Weights::Auto);
+    if !fit
+        .estimate
+        .iter()
+        .chain(&fit.std)
+        .chain(&fit.residual_rms)
+        .chain(&fit.sigma)
+        .all(|v| v.is_finite())
+    {
+        eprintln!(
+            "error: {data_name}: the least squares of these data overflow (values too far apart in magnitude: check the columns' units)"
+        );
+        return ExitCode::from(2);
+    }
     report(&reg, &name, &data_name, rows, &data.note, &fit, args);
     if let Some(path) = &args.estimates {
         let mut csv = String::from("k,name,spec,estimate,std\n");
@@ -184,7 +230,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             panels: &panels,
         };
         if let Err(e) = plot.write(path) {
-            eprintln!("error: {}: {e}", path.display());
+            eprintln!("error: {e}");
             return ExitCode::from(1);
         }
     }
@@ -316,7 +362,7 @@ fn write_update(
     };
     for s in &up.skipped {
         eprintln!(
-            "note: {s} has values that are not plain numbers (expressions, angle strings): left unchanged"
+            "note: {s}: not plain numbers (expressions, angle strings), which the update cannot rewrite: the body is left unchanged (write its mass, com and inertia as numbers to have it updated)"
         );
     }
     let reproduced: Vec<bool> = (0..identified.len())

@@ -351,6 +351,56 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     Ok((lo, hi))
 }
 
+/// The file a path names, for comparing paths: the canonical path when it exists, else its
+/// directory's canonical path joined with its name (a file about to be written), else the path.
+fn file_identity(p: &std::path::Path) -> std::path::PathBuf {
+    if let Ok(c) = std::fs::canonicalize(p) {
+        return c;
+    }
+    let dir = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    match (std::fs::canonicalize(dir), p.file_name()) {
+        (Ok(d), Some(n)) => d.join(n),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// Refuse output files that would overwrite an input or another output (`(flag, path)` each,
+/// the inputs' flag being what names them in the message, e.g. `"the spec"`): exit code 2
+/// before any work, so that a slip of the shell never replaces the measurements with a plot.
+pub fn distinct_outputs(
+    inputs: &[(&str, &std::path::Path)],
+    outputs: &[(&str, Option<&std::path::Path>)],
+) -> Result<(), ExitCode> {
+    let outputs: Vec<(&str, &std::path::Path)> = outputs
+        .iter()
+        .filter_map(|(f, p)| p.map(|p| (*f, p)))
+        .collect();
+    for (k, (flag, path)) in outputs.iter().enumerate() {
+        let id = file_identity(path);
+        let clash = inputs
+            .iter()
+            .find(|(_, q)| file_identity(q) == id)
+            .map(|(what, _)| what.to_string())
+            .or_else(|| {
+                outputs[..k]
+                    .iter()
+                    .find(|(_, q)| file_identity(q) == id)
+                    .map(|(f, _)| format!("the file of {f}"))
+            });
+        if let Some(what) = clash {
+            eprintln!(
+                "error: {flag} {}: that is {what}, which it would overwrite: write to another file",
+                path.display()
+            );
+            return Err(ExitCode::from(2));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
