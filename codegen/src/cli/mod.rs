@@ -369,7 +369,8 @@ fn file_identity(p: &std::path::Path) -> std::path::PathBuf {
 
 /// Refuse output files that would overwrite an input or another output (`(flag, path)` each,
 /// the inputs' flag being what names them in the message, e.g. `"the spec"`): exit code 2
-/// before any work, so that a slip of the shell never replaces the measurements with a plot.
+/// before any work, so that a slip of the shell never replaces the measurements with a plot;
+/// and outputs onto a directory or into a missing one: exit code 1, nothing written.
 pub fn distinct_outputs(
     inputs: &[(&str, &std::path::Path)],
     outputs: &[(&str, Option<&std::path::Path>)],
@@ -396,6 +397,25 @@ pub fn distinct_outputs(
                 path.display()
             );
             return Err(ExitCode::from(2));
+        }
+    }
+    // Where a file cannot go, no other is written either (I/O error, exit code 1, before
+    // any work).
+    for (flag, path) in &outputs {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => std::path::Path::new("."),
+        };
+        let why = if path.is_dir() {
+            Some("is a directory")
+        } else if !dir.is_dir() {
+            Some("its directory does not exist")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            eprintln!("error: {flag} {}: {why}", path.display());
+            return Err(ExitCode::from(1));
         }
     }
     Ok(())

@@ -184,7 +184,8 @@ fn huge_values_are_located_errors_not_hangs_or_nan() {
 
 /// `--out`, `--plot`, `--estimates` (and `excite -o`) onto the spec or the data overwrote them
 /// with exit 0; two outputs onto one file kept the last. Now exit 2 before any work, the
-/// inputs untouched.
+/// inputs untouched. `--plot` onto a directory failed (exit 1) after `--estimates` had
+/// replaced its file (found by the fuzzer): now exit 1 before any file is written.
 #[test]
 fn outputs_never_overwrite_the_inputs() {
     let dir = scratch("abuse_outputs");
@@ -218,6 +219,28 @@ fn outputs_never_overwrite_the_inputs() {
         "the file of --estimates",
     );
     rejected(&["excite", s(&spec), "-o", s(&spec)], "the spec");
+    // An output that cannot be written (onto a directory, into a missing one) stops the run
+    // before any other is written: the existing estimates stay as they were.
+    let est = dir.join("est.csv");
+    std::fs::write(&est, "old\n").unwrap();
+    for bad in [dir.join("sub"), dir.join("missing").join("p.svg")] {
+        let o = run(&[
+            "identify",
+            s(&spec),
+            &data,
+            "--estimates",
+            s(&est),
+            "--plot",
+            s(&bad),
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains("error: --plot"),
+            "{}",
+            text(&o.stderr)
+        );
+        assert_eq!(std::fs::read_to_string(&est).unwrap(), "old\n");
+    }
     assert_eq!(std::fs::read(&spec).unwrap(), spec_bytes);
     assert_eq!(std::fs::read(&data).unwrap(), data_bytes);
     assert!(!other.exists());
