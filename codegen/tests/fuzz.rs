@@ -1016,8 +1016,13 @@ mod binary {
     impl Tally {
         fn fail(&mut self, kind: &str, c: &Case, dir: &Path, detail: &str) {
             if self.failures.len() < 8 {
-                // Kept for reproduction: the spec file stays in its directory under this name.
-                let keep = dir.join(format!("failure-{}-{}", self.failures.len(), c.file));
+                // Kept for reproduction beside the case's directory (which the next case
+                // empties).
+                let keep = dir.parent().unwrap_or(dir).join(format!(
+                    "failure-{}-{}",
+                    self.failures.len(),
+                    c.file
+                ));
                 let _ = std::fs::write(&keep, &c.bytes);
                 self.failures.push(format!(
                     "{kind} ({}, {}, flags {:?}, out {:?}; input kept in {}):\n{detail:.2000}",
@@ -1376,6 +1381,9 @@ mod binary {
             let mut bytes_edit: Option<u8> = None;
             // A third unchanged, so that the outputs of successful runs are checked too.
             for _ in 0..rng.below(3) {
+                if lines.is_empty() {
+                    break;
+                }
                 let header: Vec<String> = lines
                     .first()
                     .map(|h| h.split(',').map(str::to_owned).collect())
@@ -1403,6 +1411,7 @@ mod binary {
                             }
                             1 => header.get(c).map_or(String::new(), |h| h.to_uppercase()),
                             2 => String::new(),
+                            _ if header.is_empty() => String::new(),
                             _ => rng.pick(&header).clone(),
                         };
                         let mut h = header.clone();
@@ -1673,7 +1682,11 @@ mod binary {
             fn fail(&mut self, kind: &str, r: &Run, dir: &Path, err: &str) {
                 self.bad += 1;
                 if self.failures.len() < 8 {
-                    let keep = dir.join(format!("failure-{}.csv", self.failures.len()));
+                    // Beside the case's directory, which the next case empties.
+                    let keep = dir
+                        .parent()
+                        .unwrap_or(dir)
+                        .join(format!("failure-{}.csv", self.failures.len()));
                     if let Some(c) = &r.csv {
                         let _ = std::fs::write(&keep, c);
                     }
@@ -1795,12 +1808,12 @@ mod binary {
                 return tally.fail(&format!("exit {code}"), r, dir, &err);
             }
             // An error names the data file, the spec or a flag.
-            if code == 2
-                && !r.bad_args
-                && !["data.csv", "spec.toml", "error: --", "error: -o"]
+            let named = err.lines().filter(|l| l.starts_with("error:")).any(|l| {
+                ["data.csv", "spec.toml", "--", " -o "]
                     .iter()
-                    .any(|w| err.contains(w))
-            {
+                    .any(|w| l.contains(w))
+            });
+            if code == 2 && !r.bad_args && !named {
                 return tally.fail("unlocated error", r, dir, &err);
             }
             if out.contains("NaN") || (r.csv.is_none() && out.contains("inf")) {

@@ -196,6 +196,16 @@ fn per_joint(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
     Ok(out)
 }
 
+/// The most `--samples` (a CSV of about 0.5 GB for six joints).
+const MAX_SAMPLES: usize = 1_000_000;
+/// The most `--search-samples`: each of the search's evaluations stacks and decomposes the
+/// regressor at that many states.
+const MAX_SEARCH_SAMPLES: usize = 10_000;
+/// The most states the reported condition number is taken over (evenly spaced over the
+/// period; all of them up to this many `--samples`): 10 million states of a Gough–Stewart
+/// would stack 42 GB.
+const CONDITION_STATES: usize = 20_000;
+
 /// The shortest `--period`, s.
 const MIN_PERIOD: f64 = 1e-3;
 /// The longest `--period`, s.
@@ -214,13 +224,17 @@ fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), Str
         ));
     }
     let min = reg.nbp() / n.max(1) + 1;
-    if args.samples < min || args.samples > 10_000_000 {
+    if args.samples < min || args.samples > MAX_SAMPLES {
         return Err(format!(
-            "error: --samples must be in {min}..=10000000 (the regressor needs at least {min} states)"
+            "error: --samples {}: must be in {min}..={MAX_SAMPLES} (the regressor needs at least {min} states)",
+            args.samples
         ));
     }
-    if args.search_samples < min || args.search_samples > 100_000 {
-        return Err(format!("error: --search-samples must be in {min}..=100000"));
+    if args.search_samples < min || args.search_samples > MAX_SEARCH_SAMPLES {
+        return Err(format!(
+            "error: --search-samples {}: must be in {min}..={MAX_SEARCH_SAMPLES}",
+            args.search_samples
+        ));
     }
     if args.restarts == 0 || args.restarts > 1000 || args.evaluations > 10_000_000 {
         return Err("error: --restarts must be in 1..=1000 and --evaluations at most 1e7".into());
@@ -309,7 +323,8 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
     let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
-    let cond = match stacked(&reg, &best, args.samples) {
+    let cond_states = args.samples.min(CONDITION_STATES);
+    let cond = match stacked(&reg, &best, cond_states) {
         Ok(w) => condition(&w),
         Err(t) => {
             eprintln!(
@@ -361,11 +376,16 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         csv.push('\n');
     }
     eprintln!(
-        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}; max |{}| {}; max |{}| {}",
+        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}{}; max |{}| {}; max |{}| {}",
         reg.mechanism(),
         args.harmonics,
         args.period,
         args.samples,
+        if cond_states < args.samples {
+            format!(" (over {cond_states} evenly spaced states)")
+        } else {
+            String::new()
+        },
         if reg.turns(0).is_some() { "d" } else { "q" },
         fmt_list(&mq),
         if reg.turns(0).is_some() { "dd" } else { "qd" },

@@ -355,8 +355,16 @@ fn write_update(
     let identified: Vec<bool> = fit.unidentifiable.iter().map(|u| !u).collect();
     let up = match super::spec_update::update(reg, name, source, &fit.estimate, &identified) {
         Ok(u) => u,
-        Err(e) => {
+        Err(e) if e.starts_with("error:") => {
             eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            // A body no rigid body can be (`body `b`: mass -0.3 kg < 0`).
+            eprintln!(
+                "error: --out {}: the estimates give {e}: no spec can hold them (no file written; see the warnings above)",
+                path.display()
+            );
             return ExitCode::from(2);
         }
     };

@@ -459,7 +459,7 @@ pub fn update(
     let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c].clone()).collect();
     let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
     let out = apply(&doc, &sub_u, &sub_z).map_err(|e| {
-        format!("error: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
+        format!("error: --out: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
     })?;
     let text = out.to_string();
     let written = base_of(reg, file, &text)?;

@@ -13,6 +13,7 @@ use super::{ok, s, scratch, text};
 const TWO_R: &str = "../mechanisms/specs/planar_2r.toml";
 const DELTA: &str = "../mechanisms/specs/delta_rl5.toml";
 const FOUR_BAR: &str = "../mechanisms/specs/four_bar.toml";
+const GOUGH: &str = "../mechanisms/specs/gough_stewart.toml";
 
 /// `codegen ARGS`, killed after `limit` (then `None`).
 fn run_for(args: &[&str], limit: Duration) -> Option<Output> {
@@ -273,7 +274,8 @@ fn columns_the_file_does_not_need_are_ignored_and_ambiguous_ones_are_errors() {
     rejected(&["identify", TWO_R, s(&p)], "latin1.csv:5:6: not UTF-8");
 }
 
-/// `excite --period 1e308` never returned; `--noise 1e308` wrote `inf` efforts with exit 0.
+/// `excite --period 1e308` never returned; `--noise 1e308` wrote `inf` efforts with exit 0;
+/// `--samples 10000000` aborted (Gough–Stewart) or ran for minutes.
 #[test]
 fn excite_rejects_periods_and_noise_that_leave_the_numbers() {
     let dir = scratch("abuse_excite");
@@ -287,7 +289,29 @@ fn excite_rejects_periods_and_noise_that_leave_the_numbers() {
     let mut a = vec!["excite", TWO_R, "--with-tau", "--noise", "1e308"];
     a.extend(quick);
     rejected(&a, "--noise");
+    // The largest counts once accepted: 10 million samples of a Gough–Stewart aborted on a
+    // 42 GB allocation (the condition number's stacked regressor); 100,000 search samples ran
+    // for minutes per evaluation.
+    for (flag, n) in [("--samples", "10000000"), ("--search-samples", "100000")] {
+        let mut a = vec!["excite", GOUGH, flag, n];
+        a.extend(quick);
+        rejected(&a, flag);
+    }
     assert!(!out.exists());
+    // Up to the new bound, the condition number is taken over at most 20,000 states.
+    let mut a = vec!["excite", TWO_R, "--samples", "30000"];
+    a.extend(quick);
+    let o = run(&a);
+    ok(&o);
+    assert!(
+        text(&o.stderr).contains("(over 20000 evenly spaced states)"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap().lines().count(),
+        30001
+    );
 }
 
 /// `--lanes` with a platform or a closed loop was reported as a spec error keyed `platform`
