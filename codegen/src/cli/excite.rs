@@ -289,6 +289,12 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     ) {
         return c;
     }
+    if name.ends_with(".urdf") && source.contains("<limit") {
+        eprintln!(
+            "note: {name}: the URDF's <limit> elements are not read (joint limits are not part of the model): the trajectory keeps within --q-max {:?} and --qd-max {:?}",
+            args.q_max, args.qd_max
+        );
+    }
     let (q_max, qd_max) = match check(args, &reg) {
         Ok(b) => b,
         Err(e) => {
