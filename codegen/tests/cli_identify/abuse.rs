@@ -366,3 +366,25 @@ fn excite_on_a_urdf_with_limits_says_they_are_not_read() {
         text(&o.stderr)
     );
 }
+
+/// A header of 200,000 columns (none of them needed) took minutes: the check for a column
+/// named twice compared each with all before it. Now an error at once.
+#[test]
+fn a_very_wide_header_is_read_in_linear_time() {
+    let dir = scratch("abuse_wide");
+    let p = dir.join("wide.csv");
+    let header: Vec<String> = (0..200_000).map(|i| format!("c{i}")).collect();
+    std::fs::write(
+        &p,
+        format!("{}\n{}\n", header.join(","), vec!["1"; 200_000].join(",")),
+    )
+    .unwrap();
+    let o = run_for(&["identify", TWO_R, s(&p)], Duration::from_secs(20))
+        .expect("identify ends within 20 s");
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("missing columns"),
+        "{}",
+        text(&o.stderr)
+    );
+}
