@@ -252,9 +252,11 @@ fn report(
 ) {
     let (n, nbp) = (reg.dof(), reg.nbp());
     outln!(
-        "identify: {} ({name}) from {data_name}: {rows} samples x {n} {}s, {nbp} base parameters, {}",
+        "identify: {} ({name}) from {data_name}: {rows} sample{} x {n} {}{}, {nbp} base parameters, {}",
         reg.mechanism(),
+        if rows == 1 { "" } else { "s" },
         reg.effort_kind(),
+        if n == 1 { "" } else { "s" },
         match args.weights {
             Weights::Auto =>
                 "rows weighted by 1/sigma_j per joint (sigma_j from an ordinary least-squares pass)",
