@@ -388,3 +388,18 @@ fn a_very_wide_header_is_read_in_linear_time() {
         text(&o.stderr)
     );
 }
+
+/// `/dev/zero` as the data file was read without end (memory grew until the process was
+/// killed); a file is read up to 256 MiB.
+#[cfg(unix)]
+#[test]
+fn an_endless_data_file_is_an_error() {
+    let o = run_for(&["identify", TWO_R, "/dev/zero"], Duration::from_secs(30))
+        .expect("identify ends within 30 s");
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("larger than 256 MiB"),
+        "{}",
+        text(&o.stderr)
+    );
+}
