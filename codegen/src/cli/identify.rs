@@ -91,7 +91,13 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let (reg, warnings) = match Regressor::compile(&name, &source) {
+    // A URDF's `ROBOT.scene.toml` applies here as in generation (friction, rotor inertia,
+    // locked joints change the parameters).
+    let sidecar = match super::sidecar(&args.spec, None) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");

@@ -403,3 +403,56 @@ fn an_endless_data_file_is_an_error() {
         text(&o.stderr)
     );
 }
+
+/// A URDF's `ROBOT.scene.toml` beside it is read by generation (with a note), but `excite` and
+/// `identify` ignored it: with `friction = true` there, they identified a model without the
+/// friction parameters the generated module has. Now all three read it.
+#[test]
+fn identify_and_excite_read_a_urdf_scene_file_as_generation_does() {
+    let dir = scratch("abuse_urdf_scene");
+    let urdf = dir.join("arm.urdf");
+    std::fs::write(
+        &urdf,
+        r#"<robot name="arm"><link name="world"/>
+<link name="a"><inertial><origin xyz="0.2 0 0"/><mass value="2"/><inertia ixx="0.01" iyy="0.03" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j1" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/><dynamics damping="0.5" friction="0.2"/></joint>
+</robot>"#,
+    )
+    .unwrap();
+    let nbp = |err_or_out: &str| -> usize {
+        let i = err_or_out
+            .find(" base parameters")
+            .expect("a count of base parameters");
+        let head = &err_or_out[..i];
+        head[head.rfind(' ').unwrap() + 1..].parse().unwrap()
+    };
+    let data = dir.join("d.csv");
+    let excite = |with: bool| {
+        let o = run(&[
+            "excite",
+            s(&urdf),
+            "--restarts",
+            "1",
+            "--evaluations",
+            "5",
+            "--with-tau",
+            "-o",
+            s(&data),
+        ]);
+        ok(&o);
+        assert_eq!(text(&o.stderr).contains("note: with the scene file"), with);
+        nbp(&text(&o.stderr))
+    };
+    let identify = |with: bool| {
+        let o = run(&["identify", s(&urdf), s(&data)]);
+        ok(&o);
+        assert_eq!(text(&o.stderr).contains("note: with the scene file"), with);
+        nbp(&text(&o.stdout))
+    };
+    let plain = (excite(false), identify(false));
+    std::fs::write(dir.join("arm.scene.toml"), "[scene]\nfriction = true\n").unwrap();
+    let with = (excite(true), identify(true));
+    assert_eq!(plain.0, plain.1);
+    assert_eq!(with.0, with.1);
+    assert!(with.1 > plain.1, "{plain:?} {with:?}");
+}
