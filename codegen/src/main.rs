@@ -357,7 +357,7 @@ fn main() -> ExitCode {
     let text = out.code;
     match &cli.output {
         Some(path) => {
-            if let Err(e) = codegen::build_script::write_if_changed(path, &text) {
+            if let Err(e) = cli::write_output(path, &text) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

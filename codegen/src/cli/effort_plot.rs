@@ -78,7 +78,7 @@ impl EffortPlot<'_> {
     /// Write the SVG file (unchanged bytes are not rewritten).
     pub fn write(&self, path: &Path) -> Result<(), String> {
         let svg = self.svg().map_err(|e| format!("{}: {e}", path.display()))?;
-        codegen::build_script::write_if_changed(path, &svg).map_err(|e| e.to_string())
+        super::write_output(path, &svg)
     }
 
     fn draw(&self, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {

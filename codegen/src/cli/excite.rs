@@ -405,7 +405,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     );
     match &args.output {
         Some(p) => {
-            if let Err(e) = codegen::build_script::write_if_changed(p, &csv) {
+            if let Err(e) = super::write_output(p, &csv) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

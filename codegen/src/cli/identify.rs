@@ -219,7 +219,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
                 fit.std[k]
             ));
         }
-        if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
+        if let Err(e) = super::write_output(path, &csv) {
             eprintln!("error: {e}");
             return ExitCode::from(1);
         }
@@ -451,7 +451,7 @@ fn write_update(
             "physical consistency: every body of the updated spec has mass >= 0 and a positive definite inertia that satisfies the triangle inequality"
         );
     }
-    if let Err(e) = codegen::build_script::write_if_changed(path, &up.text) {
+    if let Err(e) = super::write_output(path, &up.text) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
     }

@@ -456,3 +456,41 @@ fn identify_and_excite_read_a_urdf_scene_file_as_generation_does() {
     assert_eq!(with.0, with.1);
     assert!(with.1 > plain.1, "{plain:?} {with:?}");
 }
+
+/// An output that is a named pipe (or a device: `/dev/stdout` into a pipe, `/dev/full`) was
+/// first read to compare it with the new text: the read of a pipe waited for a writer that
+/// never came (a hang), `/dev/full` was read without end (memory until the process was
+/// killed). Such targets are now only written into.
+#[cfg(unix)]
+#[test]
+fn outputs_into_a_pipe_are_written_not_read() {
+    let dir = scratch("abuse_fifo");
+    for (k, args) in [
+        vec![TWO_R],
+        vec!["excite", TWO_R, "--restarts", "1", "--evaluations", "3"],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let fifo = dir.join(format!("out{k}"));
+        let made = Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo runs");
+        assert!(made.success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+        };
+        let mut a = args.clone();
+        a.push("-o");
+        a.push(s(&fifo));
+        let o = run_for(&a, Duration::from_secs(30)).expect("ends within 30 s");
+        ok(&o);
+        let got = String::from_utf8(reader.join().unwrap()).unwrap();
+        assert!(
+            got.starts_with(if k == 0 { "// @generated" } else { "t," }),
+            "{got:.100}"
+        );
+    }
+}
