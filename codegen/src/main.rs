@@ -95,7 +95,7 @@ struct Cli {
     fma: bool,
     /// Also emit `<function>_lanes` of a tree's dynamics functions, evaluating N states per
     /// call (`4` fills an AVX2 register in `f64`, `8` in `f32`).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = lane_count)]
     lanes: Option<usize>,
     /// With `--lanes`: `sin` and `cos` of all lanes at once by a polynomial that vectorizes
     /// (within 2 ulp; no longer bit for bit the scalar functions).
@@ -128,6 +128,18 @@ fn snap_tolerance(s: &str) -> Result<f64, String> {
             "the tolerance must be in (0, {}] (as `[scene] snap`)",
             codegen::spec::MAX_SNAP
         ))
+    }
+}
+
+/// `--lanes`: 2 to [`codegen::lanes::MAX`] states per call.
+fn lane_count(s: &str) -> Result<usize, String> {
+    let range = 2..=codegen::lanes::MAX;
+    match s.trim().parse::<usize>() {
+        Ok(n) if range.contains(&n) => Ok(n),
+        _ => Err(format!(
+            "the states per call must be a whole number from 2 to {}",
+            codegen::lanes::MAX
+        )),
     }
 }
 
@@ -247,6 +259,30 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    if let Some(lanes) = cli.lanes {
+        if cli.emit == EmitArg::C {
+            eprintln!("error: --lanes {lanes}: the C wrapper crate (--emit c) takes no lanes");
+            return ExitCode::from(2);
+        }
+        let overrides = codegen::spec::SceneOverrides {
+            sidecar: sidecar.clone(),
+            ..Default::default()
+        };
+        // A spec that does not load is reported by `compile` below, at its place.
+        if let Ok(loaded) = codegen::spec::load(&name, &source, &overrides) {
+            let kind = match loaded.mechanism {
+                codegen::spec::Mechanism::Tree(_) => None,
+                codegen::spec::Mechanism::Parallel(_) => Some("a parallel mechanism"),
+                codegen::spec::Mechanism::Closed(_) => Some("a closed loop"),
+            };
+            if let Some(kind) = kind {
+                eprintln!(
+                    "error: --lanes {lanes}: many states per call are offered for trees only so far, and {name} is {kind} (leave out --lanes)"
+                );
+                return ExitCode::from(2);
+            }
+        }
+    }
     if cli.emit == EmitArg::C {
         if cli.output.is_none() {
             eprintln!("error: --emit c writes a crate: give its directory with -o DIR");
@@ -326,7 +362,7 @@ fn main() -> ExitCode {
     let text = out.code;
     match &cli.output {
         Some(path) => {
-            if let Err(e) = codegen::build_script::write_if_changed(path, &text) {
+            if let Err(e) = cli::write_output(path, &text) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

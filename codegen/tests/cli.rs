@@ -761,3 +761,31 @@ fn emit_c_writes_a_crate() {
         "nothing written for an invalid spec"
     );
 }
+
+/// A hand-written URDF whose joint names its child with a typo (`l33` for `l3`): the typo was
+/// reported as link `l3` "not connected to the root link", pointing at the link, not at the
+/// typo. Now the error is at the attribute, with the closest link name.
+#[test]
+fn a_urdf_joint_naming_no_link_is_an_error_at_the_name() {
+    let dir = scratch("urdf_typo");
+    let urdf = dir.join("typo.urdf");
+    std::fs::write(
+        &urdf,
+        r#"<robot name="typo">
+  <link name="world"/>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l3"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="world"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l33"/><axis xyz="0 0 1"/></joint>
+</robot>
+"#,
+    )
+    .unwrap();
+    let o = run(&[path_str(&urdf), "--check"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("unknown child body \"l33\""), "{err}");
+    assert!(err.contains("typo.urdf:6:68"), "{err}");
+    assert!(err.contains("did you mean \"l3\"?"), "{err}");
+    assert!(!err.contains("not connected"), "{err}");
+}

@@ -528,3 +528,7 @@ mod platform;
 // Closed loops: the four-bar and Andrews' squeezer.
 #[path = "cli_identify/closed.rs"]
 mod closed;
+
+// Bad input found by driving the binary by hand (hangs, panics, NaN, overwritten inputs).
+#[path = "cli_identify/abuse.rs"]
+mod abuse;

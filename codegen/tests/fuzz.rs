@@ -23,8 +23,18 @@
 //! left, the `--stats` table); all but the first must be 0. The first failing inputs are kept
 //! in `target/tmp/fuzz_cli`.
 //!
+//! `binary::data::identify_and_excite_never_crash_hang_or_print_nan` drives `identify` and
+//! `excite` the same way: measurements made by `excite --with-tau` for a tree, a closed loop
+//! and a platform, mutated (hostile cells, lost, doubled, renamed and extra columns, positions
+//! only, time that stalls or runs back, constant rows, cut files, CRLF, BOM, Latin-1 and NUL
+//! bytes, far-scaled columns), with random flags (`--weights`, `--cutoff`, `--max-rel-std`,
+//! absurd `excite` options) and output files (fresh, existing, a directory, a missing
+//! directory, the data file or the spec itself). No panic, crash, timeout, NaN, overwritten
+//! input, unlocated error, incomplete output or temporary file.
+//!
 //! Budget: `NOCDYN_FUZZ_CASES` cases per generator (default 2,000), `NOCDYN_FUZZ_CLI_CASES`
-//! binary runs (default 1,500, about 20 s); `NOCDYN_FUZZ_SEED` (a number) changes the RNG
+//! binary runs (default 1,500, about 20 s), `NOCDYN_FUZZ_DATA_CASES` runs of `identify` and
+//! `excite` (default 300, about 8 s); `NOCDYN_FUZZ_SEED` (a number) changes the RNG
 //! seed; `NOCDYN_FUZZ_BIN` drives another binary (e.g. `target/release/codegen`). The
 //! numbers are printed (`--nocapture`). A longer run:
 //! `NOCDYN_FUZZ_CLI_CASES=20000 cargo test -p codegen --test fuzz binary -- --nocapture`.
@@ -923,6 +933,25 @@ mod binary {
             push(m);
             *bad |= !ok;
         }
+        if rng.chance(10) {
+            push("--fma");
+        }
+        if rng.chance(10) {
+            // Platforms and closed loops refuse valid counts too, naming the flag.
+            let (n, ok) = *rng.pick(&[
+                ("2", true),
+                ("4", true),
+                ("16", true),
+                ("0", false),
+                ("1", false),
+                ("17", false),
+                ("99999", false),
+                ("-1", false),
+                ("abc", false),
+            ]);
+            push(&format!("--lanes={n}"));
+            *bad |= !ok;
+        }
         if rng.chance(3) {
             push("--bogus");
             *bad = true;
@@ -987,8 +1016,13 @@ mod binary {
     impl Tally {
         fn fail(&mut self, kind: &str, c: &Case, dir: &Path, detail: &str) {
             if self.failures.len() < 8 {
-                // Kept for reproduction: the spec file stays in its directory under this name.
-                let keep = dir.join(format!("failure-{}-{}", self.failures.len(), c.file));
+                // Kept for reproduction beside the case's directory (which the next case
+                // empties).
+                let keep = dir.parent().unwrap_or(dir).join(format!(
+                    "failure-{}-{}",
+                    self.failures.len(),
+                    c.file
+                ));
                 let _ = std::fs::write(&keep, &c.bytes);
                 self.failures.push(format!(
                     "{kind} ({}, {}, flags {:?}, out {:?}; input kept in {}):\n{detail:.2000}",
@@ -1106,7 +1140,9 @@ mod binary {
             tally.wrong += 1;
             return tally.fail(&format!("exit {code}"), c, dir, &err);
         }
-        if code == 2 && !c.bad_args && !located(&err, &c.file) {
+        let flag_named =
+            c.flags.iter().any(|f| f.starts_with("--lanes")) && err.contains("error: --lanes");
+        if code == 2 && !c.bad_args && !located(&err, &c.file) && !flag_named {
             tally.unlocated += 1;
             return tally.fail("unlocated error", c, dir, &err);
         }
@@ -1220,5 +1256,671 @@ mod binary {
             (0, 0, 0, 0, 0),
             "(panics, crashes by signal, timeouts, unlocated errors, other failures); see above"
         );
+    }
+
+    /// `identify` and `excite` driven the same way: measurement files made by `excite
+    /// --with-tau` for a tree, a closed loop and a platform, mutated (hostile cells, lost,
+    /// doubled, renamed and extra columns, positions only, time that stalls or runs back,
+    /// constant rows, cut files, CRLF, a byte-order mark, Latin-1 and NUL bytes, scaled columns)
+    /// and run with random flags and output files (fresh, existing, a directory, a missing
+    /// directory, the data file or the spec itself); `excite` with absurd options.
+    mod data {
+        use std::path::{Path, PathBuf};
+        use std::process::{Command, Stdio};
+        use std::time::Instant;
+
+        use super::{Rng, cli_timeout, listing};
+
+        /// Runs (default 300, one in six of `excite`; `NOCDYN_FUZZ_DATA_CASES`).
+        fn data_cases() -> usize {
+            std::env::var("NOCDYN_FUZZ_DATA_CASES")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(300)
+        }
+
+        /// A spec and the measurements `excite` made for it.
+        struct Source {
+            spec: &'static str,
+            bytes: Vec<u8>,
+            csv: String,
+            joints: Vec<&'static str>,
+        }
+
+        /// Where an output flag points.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        enum Target {
+            Fresh,
+            Existing,
+            Directory,
+            NoDir,
+            /// The data file (identify) or the spec: must be refused, the input untouched.
+            Input,
+        }
+
+        #[derive(Debug)]
+        struct Run {
+            what: String,
+            args: Vec<String>,
+            csv: Option<Vec<u8>>,
+            spec: &'static str,
+            spec_bytes: Vec<u8>,
+            /// (flag, target, file name) of each output.
+            outputs: Vec<(&'static str, Target, &'static str)>,
+            bad_args: bool,
+        }
+
+        fn spec_path(name: &str) -> PathBuf {
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../mechanisms/specs")
+                .join(name)
+        }
+
+        /// One `excite --with-tau` run per spec (a short search).
+        fn sources(dir: &Path) -> Vec<Source> {
+            std::fs::create_dir_all(dir).unwrap();
+            [
+                ("planar_2r.toml", vec!["j1", "j2"]),
+                ("four_bar.toml", vec!["crank_joint"]),
+                ("delta_rl5.toml", vec![]),
+            ]
+            .into_iter()
+            .map(|(spec, joints)| {
+                let out = dir.join(format!("{spec}.csv"));
+                let o = Command::new(super::binary())
+                    .args(["excite", spec_path(spec).to_str().unwrap()])
+                    .args(["--restarts", "1", "--evaluations", "4", "--search-samples"])
+                    .args(["40", "--samples", "120", "--with-tau", "--noise", "0.01"])
+                    .arg("-o")
+                    .arg(&out)
+                    .output()
+                    .expect("excite runs");
+                assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+                Source {
+                    spec,
+                    bytes: std::fs::read(spec_path(spec)).unwrap(),
+                    csv: std::fs::read_to_string(&out).unwrap(),
+                    joints,
+                }
+            })
+            .collect()
+        }
+
+        const CELLS: &[&str] = &[
+            "NaN",
+            "nan",
+            "inf",
+            "-inf",
+            "1e308",
+            "-1e308",
+            "1e300",
+            "1e160",
+            "4.9e-324",
+            "1e-310",
+            "",
+            " ",
+            "x",
+            "0x10",
+            "1e",
+            "--1",
+            "1.2.3",
+            "\"1\"",
+            "1_0",
+            "+0",
+            "-0",
+            "١",
+            "\u{0}",
+            "１",
+            "9999999999999999999999",
+        ];
+
+        /// 0–2 random mutations of `csv` (bytes: some leave UTF-8).
+        fn mutate(rng: &mut Rng, src: &Source) -> (String, Vec<u8>) {
+            let mut lines: Vec<String> = src.csv.lines().map(str::to_owned).collect();
+            let mut names = Vec::new();
+            let mut bytes_edit: Option<u8> = None;
+            // A third unchanged, so that the outputs of successful runs are checked too.
+            for _ in 0..rng.below(3) {
+                if lines.is_empty() {
+                    break;
+                }
+                let header: Vec<String> = lines
+                    .first()
+                    .map(|h| h.split(',').map(str::to_owned).collect())
+                    .unwrap_or_default();
+                let cols = header.len().max(1);
+                let row = 1 + rng.below(lines.len().saturating_sub(1).max(1));
+                let kind = rng.below(15);
+                names.push(kind.to_string());
+                match kind {
+                    0 | 1 => {
+                        // A hostile cell.
+                        if let Some(l) = lines.get_mut(row) {
+                            let mut f: Vec<String> = l.split(',').map(str::to_owned).collect();
+                            let c = rng.below(f.len());
+                            f[c] = (*rng.pick(CELLS)).to_owned();
+                            *l = f.join(",");
+                        }
+                    }
+                    2 => {
+                        // A column renamed: by joint name, upper case, empty, or another's.
+                        let c = rng.below(cols);
+                        let to = match rng.below(4) {
+                            0 if !src.joints.is_empty() => {
+                                format!("q_{}", rng.pick(&src.joints))
+                            }
+                            1 => header.get(c).map_or(String::new(), |h| h.to_uppercase()),
+                            2 => String::new(),
+                            _ if header.is_empty() => String::new(),
+                            _ => rng.pick(&header).clone(),
+                        };
+                        let mut h = header.clone();
+                        if let Some(x) = h.get_mut(c) {
+                            *x = to;
+                        }
+                        lines[0] = h.join(",");
+                    }
+                    3 => {
+                        // A column dropped or doubled, everywhere.
+                        let c = rng.below(cols);
+                        let double = rng.chance(50);
+                        for l in &mut lines {
+                            let mut f: Vec<&str> = l.split(',').collect();
+                            if c < f.len() {
+                                if double {
+                                    f.push(f[c]);
+                                } else {
+                                    f.remove(c);
+                                }
+                            }
+                            *l = f.join(",");
+                        }
+                    }
+                    4 => {
+                        // An extra column of labels (ignored), or a trailing comma.
+                        let label = rng.chance(50);
+                        for (k, l) in lines.iter_mut().enumerate() {
+                            l.push_str(match (k, label) {
+                                (0, true) => ",label",
+                                (_, true) => ",run A",
+                                _ => ",",
+                            });
+                        }
+                    }
+                    5 => {
+                        // Positions only: the speeds and accelerations dropped.
+                        let keep: Vec<usize> = (0..header.len())
+                            .filter(|&c| {
+                                let h = &header[c];
+                                !(h.starts_with("qd") || h.starts_with('u') || h.starts_with("ud"))
+                            })
+                            .collect();
+                        for l in &mut lines {
+                            let f: Vec<&str> = l.split(',').collect();
+                            *l = keep
+                                .iter()
+                                .filter_map(|&c| f.get(c).copied())
+                                .collect::<Vec<_>>()
+                                .join(",");
+                        }
+                    }
+                    6 => {
+                        // Time that stalls, runs back, or steps by a subnormal.
+                        let how = rng.below(3);
+                        for (k, l) in lines.iter_mut().enumerate().skip(1) {
+                            let mut f: Vec<String> = l.split(',').map(str::to_owned).collect();
+                            f[0] = match how {
+                                0 => "0".into(),
+                                1 => format!("{}", -(k as f64)),
+                                _ => format!("{:e}", k as f64 * 1e-320),
+                            };
+                            *l = f.join(",");
+                        }
+                    }
+                    7 => {
+                        // Lines lost, doubled or swapped.
+                        match rng.below(3) {
+                            0 if lines.len() > 1 => {
+                                let n = 1 + rng.below(lines.len() - 1);
+                                lines.truncate(n);
+                            }
+                            1 => {
+                                let l = lines[row.min(lines.len() - 1)].clone();
+                                lines.insert(row.min(lines.len()), l);
+                            }
+                            _ => {
+                                let (n, other) = (lines.len(), rng.below(lines.len()));
+                                lines.swap(row.min(n - 1), other);
+                            }
+                        }
+                    }
+                    8 => {
+                        // Every row the same (a regressor of rank deficit), or all zeros.
+                        let zeros = rng.chance(50);
+                        let first = lines.get(1).cloned().unwrap_or_default();
+                        for l in lines.iter_mut().skip(1) {
+                            *l = if zeros {
+                                vec!["0"; cols].join(",")
+                            } else {
+                                first.clone()
+                            };
+                        }
+                    }
+                    9 => {
+                        // A column scaled far out.
+                        let c = rng.below(cols);
+                        let by = *rng.pick(&[1e150, 1e200, 1e-300, -1e100]);
+                        for l in lines.iter_mut().skip(1) {
+                            let mut f: Vec<String> = l.split(',').map(str::to_owned).collect();
+                            if let Some(x) = f.get_mut(c)
+                                && let Ok(v) = x.parse::<f64>()
+                            {
+                                *x = format!("{:e}", v * by);
+                            }
+                            *l = f.join(",");
+                        }
+                    }
+                    10 => {
+                        // Comments and blank lines anywhere.
+                        lines.insert(row.min(lines.len()), "# a note".into());
+                        lines.insert(rng.below(lines.len() + 1), String::new());
+                    }
+                    11 => lines.truncate(rng.below(2)),
+                    12 => bytes_edit = Some(*rng.pick(&[0xe9u8, 0xff, 0x00, 0xc3])),
+                    _ => {}
+                }
+            }
+            let crlf = rng.chance(10);
+            let mut text = lines.join(if crlf { "\r\n" } else { "\n" });
+            if rng.chance(90) {
+                text.push('\n');
+            }
+            if rng.chance(10) {
+                text.insert(0, '\u{feff}');
+            }
+            let mut bytes = text.into_bytes();
+            if rng.chance(5) && !bytes.is_empty() {
+                let cut = rng.below(bytes.len());
+                bytes.truncate(cut);
+            }
+            if let Some(b) = bytes_edit
+                && !bytes.is_empty()
+            {
+                let at = rng.below(bytes.len());
+                bytes.insert(at, b);
+            }
+            (format!("csv edits {}", names.join("+")), bytes)
+        }
+
+        fn target(rng: &mut Rng) -> Target {
+            *rng.pick(&[
+                Target::Fresh,
+                Target::Fresh,
+                Target::Existing,
+                Target::Directory,
+                Target::NoDir,
+                Target::Input,
+            ])
+        }
+
+        fn identify_run(rng: &mut Rng, src: &Source) -> Run {
+            let (what, csv) = mutate(rng, src);
+            let mut args: Vec<String> =
+                vec!["identify".into(), "spec.toml".into(), "data.csv".into()];
+            let mut bad_args = false;
+            let mut outputs = Vec::new();
+            if rng.chance(25) {
+                let (w, ok) = *rng.pick(&[("auto", true), ("none", true), ("heavy", false)]);
+                args.extend(["--weights".into(), w.into()]);
+                bad_args |= !ok;
+            }
+            if rng.chance(25) {
+                let (c, ok) = *rng.pick(&[
+                    ("2", true),
+                    ("0.5", true),
+                    ("0", true),
+                    ("-1", true),
+                    ("nan", true),
+                    ("inf", true),
+                    ("1e-300", true),
+                    ("1e308", true),
+                    ("abc", false),
+                ]);
+                args.push(format!("--cutoff={c}"));
+                bad_args |= !ok;
+            }
+            if rng.chance(10) {
+                let m = *rng.pick(&["1", "1e-300", "1e308", "0", "nan"]);
+                args.push(format!("--max-rel-std={m}"));
+            }
+            for (flag, file) in [
+                ("--estimates", "est.csv"),
+                ("--plot", "plot.svg"),
+                ("--out", "updated.toml"),
+            ] {
+                if rng.chance(25) {
+                    outputs.push((flag, target(rng), file));
+                }
+            }
+            Run {
+                what,
+                args,
+                csv: Some(csv),
+                spec: src.spec,
+                spec_bytes: src.bytes.clone(),
+                outputs,
+                bad_args,
+            }
+        }
+
+        fn excite_run(rng: &mut Rng, src: &Source) -> Run {
+            let mut args: Vec<String> = vec!["excite".into(), "spec.toml".into()];
+            let mut bad_args = false;
+            // Each search stays short: a few evaluations, few restarts.
+            args.push(format!("--evaluations={}", rng.below(12)));
+            args.push(format!("--restarts={}", *rng.pick(&[0, 1, 1, 2])));
+            args.push(format!("--search-samples={}", *rng.pick(&[0, 5, 20, 40])));
+            args.push(format!("--samples={}", *rng.pick(&[0, 3, 50, 200])));
+            for (flag, values) in [
+                ("--harmonics", &["0", "1", "3", "51"][..]),
+                (
+                    "--period",
+                    &["0.5", "1e-4", "1e308", "nan", "1e5", "-1"][..],
+                ),
+                ("--q-max", &["0.5", "1e308", "0", "1,2", "1e-300"][..]),
+                ("--qd-max", &["0.5", "inf", "1,2,3"][..]),
+                ("--reach", &["0.01", "0", "1e3"][..]),
+                ("--turn", &["0.05", "10", "nan"][..]),
+                ("--seed", &["0", "18446744073709551615"][..]),
+            ] {
+                if rng.chance(30) {
+                    args.push(format!("{flag}={}", rng.pick(values)));
+                }
+            }
+            if rng.chance(40) {
+                args.push("--with-tau".into());
+                if rng.chance(50) {
+                    args.push(format!(
+                        "--noise={}",
+                        rng.pick(&["0.01", "1e308", "nan", "0,1"])
+                    ));
+                }
+            } else if rng.chance(5) {
+                // `--noise` without `--with-tau`: refused by the parser.
+                args.push("--noise=0.1".into());
+                bad_args = true;
+            }
+            if rng.chance(5) {
+                args.push("--period=abc".into());
+                bad_args = true;
+            }
+            let outputs = if rng.chance(70) {
+                vec![("-o", target(rng), "traj.csv")]
+            } else {
+                Vec::new()
+            };
+            Run {
+                what: "excite".into(),
+                args,
+                csv: None,
+                spec: src.spec,
+                spec_bytes: src.bytes.clone(),
+                outputs,
+                bad_args,
+            }
+        }
+
+        #[derive(Default)]
+        struct Tally {
+            tried: usize,
+            exits: [usize; 3],
+            bad: usize,
+            failures: Vec<String>,
+        }
+
+        impl Tally {
+            fn fail(&mut self, kind: &str, r: &Run, dir: &Path, err: &str) {
+                self.bad += 1;
+                if self.failures.len() < 8 {
+                    // Beside the case's directory, which the next case empties.
+                    let keep = dir
+                        .parent()
+                        .unwrap_or(dir)
+                        .join(format!("failure-{}.csv", self.failures.len()));
+                    if let Some(c) = &r.csv {
+                        let _ = std::fs::write(&keep, c);
+                    }
+                    self.failures.push(format!(
+                        "{kind} ({}, {}, args {:?}, outputs {:?}; data kept in {}):\n{err:.1500}",
+                        r.what,
+                        r.spec,
+                        r.args,
+                        r.outputs,
+                        keep.display()
+                    ));
+                }
+            }
+        }
+
+        const OLD: &str = "an older file\n";
+
+        fn run_one(r: &Run, dir: &Path, tally: &mut Tally) {
+            use std::os::unix::process::ExitStatusExt;
+            let _ = std::fs::remove_dir_all(dir);
+            let outs = dir.join("out");
+            std::fs::create_dir_all(&outs).unwrap();
+            std::fs::write(dir.join("spec.toml"), &r.spec_bytes).unwrap();
+            if let Some(c) = &r.csv {
+                std::fs::write(dir.join("data.csv"), c).unwrap();
+            }
+            let mut args = r.args.clone();
+            let mut refused = false;
+            let mut unwritable = false;
+            for (flag, t, file) in &r.outputs {
+                let p = outs.join(file);
+                let path = match t {
+                    Target::Fresh => p,
+                    Target::Existing => {
+                        std::fs::write(&p, OLD).unwrap();
+                        p
+                    }
+                    Target::Directory => {
+                        std::fs::create_dir(&p).unwrap();
+                        unwritable = true;
+                        p
+                    }
+                    Target::NoDir => {
+                        unwritable = true;
+                        outs.join("missing").join(file)
+                    }
+                    Target::Input => {
+                        refused = true;
+                        dir.join(if r.csv.is_some() && flag.len() % 2 == 1 {
+                            "data.csv"
+                        } else {
+                            "spec.toml"
+                        })
+                    }
+                };
+                args.push(flag.to_string());
+                args.push(path.to_str().unwrap().to_owned());
+            }
+            let before = listing(&outs);
+            let stdout = std::fs::File::create(dir.join("stdout")).unwrap();
+            let stderr = std::fs::File::create(dir.join("stderr")).unwrap();
+            let mut child = Command::new("sh")
+                .current_dir(dir)
+                .arg("-c")
+                .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
+                .arg(super::binary())
+                .args(&args)
+                .stdin(Stdio::null())
+                .stdout(stdout)
+                .stderr(stderr)
+                .spawn()
+                .expect("sh runs");
+            tally.tried += 1;
+            let start = Instant::now();
+            let status = loop {
+                if let Some(s) = child.try_wait().unwrap() {
+                    break Some(s);
+                }
+                if start.elapsed() > cli_timeout() {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    break None;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(2));
+            };
+            let out =
+                String::from_utf8_lossy(&std::fs::read(dir.join("stdout")).unwrap()).into_owned();
+            let err =
+                String::from_utf8_lossy(&std::fs::read(dir.join("stderr")).unwrap()).into_owned();
+            let Some(status) = status else {
+                return tally.fail("timeout", r, dir, &err);
+            };
+            let Some(code) = status.code() else {
+                let e = format!("signal {:?}\n{err}", status.signal());
+                return tally.fail("crash", r, dir, &e);
+            };
+            if code == 101 || err.contains("panicked") {
+                return tally.fail("panic", r, dir, &err);
+            }
+            if let Some(k) = tally.exits.get_mut(code as usize) {
+                *k += 1;
+            }
+            // The inputs are never written.
+            if std::fs::read(dir.join("spec.toml")).ok().as_deref() != Some(&r.spec_bytes[..])
+                || r.csv
+                    .as_ref()
+                    .is_some_and(|c| std::fs::read(dir.join("data.csv")).ok().as_ref() != Some(c))
+            {
+                return tally.fail("an input was overwritten", r, dir, &err);
+            }
+            let expected: &[i32] = if r.bad_args || refused {
+                &[2]
+            } else if unwritable {
+                &[1, 2]
+            } else {
+                &[0, 2]
+            };
+            if !expected.contains(&code) {
+                return tally.fail(&format!("exit {code}"), r, dir, &err);
+            }
+            // An error names the data file, the spec or a flag.
+            let named = err.lines().filter(|l| l.starts_with("error:")).any(|l| {
+                ["data.csv", "spec.toml", "--", " -o "]
+                    .iter()
+                    .any(|w| l.contains(w))
+            });
+            if code == 2 && !r.bad_args && !named {
+                return tally.fail("unlocated error", r, dir, &err);
+            }
+            if out.contains("NaN") || (r.csv.is_none() && out.contains("inf")) {
+                return tally.fail("NaN or inf printed", r, dir, &out);
+            }
+            // Outputs: complete where asked on success, old files untouched otherwise, no
+            // temporary files left.
+            for (flag, t, file) in &r.outputs {
+                let p = outs.join(file);
+                let got = std::fs::read(&p).ok();
+                let problem = match (code, t) {
+                    (0, Target::Fresh | Target::Existing) => {
+                        let text = String::from_utf8_lossy(got.as_deref().unwrap_or_default())
+                            .into_owned();
+                        let complete = match *flag {
+                            "--plot" => text.trim_end().ends_with("</svg>"),
+                            "--estimates" => text.starts_with("k,name,") && !text.contains("NaN"),
+                            "-o" => {
+                                text.starts_with("t,")
+                                    && text.lines().skip(1).all(|l| {
+                                        l.split(',')
+                                            .all(|v| v.parse::<f64>().is_ok_and(f64::is_finite))
+                                    })
+                            }
+                            _ => text.contains("[mechanism]"),
+                        };
+                        (!complete).then_some("missing or incomplete output")
+                    }
+                    (_, Target::Existing)
+                        if code != 0 && got.as_deref() != Some(OLD.as_bytes()) =>
+                    {
+                        Some("the old file was changed")
+                    }
+                    _ => None,
+                };
+                if let Some(p) = problem {
+                    return tally.fail(&format!("{p} ({flag})"), r, dir, &err);
+                }
+            }
+            let after = listing(&outs);
+            if after
+                .iter()
+                .any(|n| !before.contains(n) && !r.outputs.iter().any(|o| o.2 == n))
+            {
+                tally.fail("temporary files left behind", r, dir, &err);
+            }
+        }
+
+        /// No panic, crash, hang, NaN, overwritten input, unlocated error or half-written
+        /// output from `identify` and `excite` on mutated measurements and absurd flags.
+        #[test]
+        fn identify_and_excite_never_crash_hang_or_print_nan() {
+            let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz_data");
+            let _ = std::fs::remove_dir_all(&root);
+            let start = Instant::now();
+            let srcs = sources(&root.join("sources"));
+            let n = data_cases();
+            let seed: u64 = std::env::var("NOCDYN_FUZZ_SEED")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(7);
+            let tallies: Vec<Tally> = std::thread::scope(|s| {
+                let workers: Vec<_> = (0..2u64)
+                    .map(|w| {
+                        let srcs = &srcs;
+                        let dir = root.join(format!("w{w}"));
+                        s.spawn(move || {
+                            let mut rng = Rng(seed ^ (w << 40) ^ 0xda7a);
+                            let mut tally = Tally::default();
+                            for k in (w as usize..n).step_by(2) {
+                                let src = rng.pick(srcs);
+                                let r = if k % 6 == 5 {
+                                    excite_run(&mut rng, src)
+                                } else {
+                                    identify_run(&mut rng, src)
+                                };
+                                run_one(&r, &dir.join("case"), &mut tally);
+                            }
+                            tally
+                        })
+                    })
+                    .collect();
+                workers.into_iter().map(|w| w.join().unwrap()).collect()
+            });
+            let mut t = Tally::default();
+            for x in tallies {
+                t.tried += x.tried;
+                for k in 0..3 {
+                    t.exits[k] += x.exits[k];
+                }
+                t.bad += x.bad;
+                t.failures.extend(x.failures);
+            }
+            println!(
+                "fuzz identify/excite: {} runs in {:.1} s (exit 0: {}, 1: {}, 2: {}); {} failures",
+                t.tried,
+                start.elapsed().as_secs_f64(),
+                t.exits[0],
+                t.exits[1],
+                t.exits[2],
+                t.bad
+            );
+            for f in &t.failures {
+                println!("{f}\n");
+            }
+            assert_eq!(t.tried, n);
+            assert_eq!(t.bad, 0, "see above");
+        }
     }
 }

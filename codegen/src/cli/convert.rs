@@ -33,7 +33,7 @@ pub fn run(args: &ConvertArgs) -> ExitCode {
     }
     match &args.output {
         Some(path) => {
-            if let Err(e) = codegen::build_script::write_if_changed(path, &text) {
+            if let Err(e) = super::write_output(path, &text) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

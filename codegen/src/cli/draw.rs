@@ -34,7 +34,7 @@ pub fn run(args: &DrawArgs) -> ExitCode {
     }
     match &args.output {
         Some(path) => {
-            if let Err(e) = codegen::build_script::write_if_changed(path, &drawing.svg) {
+            if let Err(e) = super::write_output(path, &drawing.svg) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

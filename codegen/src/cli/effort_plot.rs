@@ -77,8 +77,8 @@ impl EffortPlot<'_> {
 
     /// Write the SVG file (unchanged bytes are not rewritten).
     pub fn write(&self, path: &Path) -> Result<(), String> {
-        let svg = self.svg()?;
-        codegen::build_script::write_if_changed(path, &svg).map_err(|e| e.to_string())
+        let svg = self.svg().map_err(|e| format!("{}: {e}", path.display()))?;
+        super::write_output(path, &svg)
     }
 
     fn draw(&self, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {

@@ -196,23 +196,45 @@ fn per_joint(v: &[f64], n: usize, what: &str) -> Result<Vec<f64>, String> {
     Ok(out)
 }
 
+/// The most `--samples` (a CSV of about 0.5 GB for six joints).
+const MAX_SAMPLES: usize = 1_000_000;
+/// The most `--search-samples`: each of the search's evaluations stacks and decomposes the
+/// regressor at that many states.
+const MAX_SEARCH_SAMPLES: usize = 10_000;
+/// The most states the reported condition number is taken over (evenly spaced over the
+/// period; all of them up to this many `--samples`): 10 million states of a Gough–Stewart
+/// would stack 42 GB.
+const CONDITION_STATES: usize = 20_000;
+
+/// The shortest `--period`, s.
+const MIN_PERIOD: f64 = 1e-3;
+/// The longest `--period`, s.
+const MAX_PERIOD: f64 = 1e5;
+
 /// Check the arguments; `Err` is the message (exit code 2).
 fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), String> {
     let n = reg.dof();
     if args.harmonics == 0 || args.harmonics > 50 {
         return Err("error: --harmonics must be in 1..=50".into());
     }
-    if !(args.period.is_finite() && args.period > 0.0) {
-        return Err("error: --period must be a positive number of seconds".into());
-    }
-    let min = reg.nbp() / n.max(1) + 1;
-    if args.samples < min || args.samples > 10_000_000 {
+    if !(MIN_PERIOD..=MAX_PERIOD).contains(&args.period) {
         return Err(format!(
-            "error: --samples must be in {min}..=10000000 (the regressor needs at least {min} states)"
+            "error: --period {:?}: must be in [{MIN_PERIOD}, {MAX_PERIOD:e}] s (beyond, the accelerations or the motion per sample are lost to rounding)",
+            args.period
         ));
     }
-    if args.search_samples < min || args.search_samples > 100_000 {
-        return Err(format!("error: --search-samples must be in {min}..=100000"));
+    let min = reg.nbp() / n.max(1) + 1;
+    if args.samples < min || args.samples > MAX_SAMPLES {
+        return Err(format!(
+            "error: --samples {}: must be in {min}..={MAX_SAMPLES} (the regressor needs at least {min} states)",
+            args.samples
+        ));
+    }
+    if args.search_samples < min || args.search_samples > MAX_SEARCH_SAMPLES {
+        return Err(format!(
+            "error: --search-samples {}: must be in {min}..={MAX_SEARCH_SAMPLES}",
+            args.search_samples
+        ));
     }
     if args.restarts == 0 || args.restarts > 1000 || args.evaluations > 10_000_000 {
         return Err("error: --restarts must be in 1..=1000 and --evaluations at most 1e7".into());
@@ -251,7 +273,13 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         Ok(r) => r,
         Err(c) => return c,
     };
-    let (reg, warnings) = match Regressor::compile(&name, &source) {
+    // A URDF's `ROBOT.scene.toml` applies here as in generation (friction, rotor inertia,
+    // locked joints change the parameters).
+    let sidecar = match super::sidecar(&args.spec, None) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -260,6 +288,18 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     if !warnings.is_empty() {
         eprint!("{warnings}");
+    }
+    if let Err(c) = super::distinct_outputs(
+        &[("the spec", &args.spec)],
+        &[("-o", args.output.as_deref())],
+    ) {
+        return c;
+    }
+    if name.ends_with(".urdf") && source.contains("<limit") {
+        eprintln!(
+            "note: {name}: the URDF's <limit> elements are not read (joint limits are not part of the model): the trajectory keeps within --q-max {:?} and --qd-max {:?}",
+            args.q_max, args.qd_max
+        );
     }
     let (q_max, qd_max) = match check(args, &reg) {
         Ok(b) => b,
@@ -295,7 +335,8 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     };
     let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
     let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
-    let cond = match stacked(&reg, &best, args.samples) {
+    let cond_states = args.samples.min(CONDITION_STATES);
+    let cond = match stacked(&reg, &best, cond_states) {
         Ok(w) => condition(&w),
         Err(t) => {
             eprintln!(
@@ -330,6 +371,13 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
                 }
             }));
         }
+        if let Some(v) = row.iter().find(|v| !v.is_finite()) {
+            eprintln!(
+                "error: at t = {t} s a value of the trajectory is {v} (--noise {:?}, --q-max, --qd-max or --period too large)",
+                args.noise
+            );
+            return ExitCode::from(2);
+        }
         from = Some(q);
         for i in 0..n {
             mq[i] = mq[i].max(d[i].abs());
@@ -340,11 +388,16 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         csv.push('\n');
     }
     eprintln!(
-        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}; max |{}| {}; max |{}| {}",
+        "excite: {}: {} harmonics, period {} s, {} samples: condition number of the stacked base regressor {cond:.4e}{}; max |{}| {}; max |{}| {}",
         reg.mechanism(),
         args.harmonics,
         args.period,
         args.samples,
+        if cond_states < args.samples {
+            format!(" (over {cond_states} evenly spaced states)")
+        } else {
+            String::new()
+        },
         if reg.turns(0).is_some() { "d" } else { "q" },
         fmt_list(&mq),
         if reg.turns(0).is_some() { "dd" } else { "qd" },
@@ -352,7 +405,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     );
     match &args.output {
         Some(p) => {
-            if let Err(e) = codegen::build_script::write_if_changed(p, &csv) {
+            if let Err(e) = super::write_output(p, &csv) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

@@ -57,7 +57,7 @@ pub fn run(args: &FixHomeArgs) -> ExitCode {
     let target = args.output.clone().unwrap_or_else(|| args.spec.clone());
     if target.as_os_str() == "-" {
         out!("{text}");
-    } else if let Err(e) = codegen::build_script::write_if_changed(&target, &text) {
+    } else if let Err(e) = super::write_output(&target, &text) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
     }

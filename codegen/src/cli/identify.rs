@@ -54,6 +54,13 @@ pub struct IdentifyArgs {
     pub plot: Option<PathBuf>,
 }
 
+/// The largest data file `identify` reads (a 50 MB file of a 6-joint arm takes 0.8 GB and
+/// 4 s).
+const MAX_DATA_BYTES: u64 = 256 << 20;
+
+/// The largest magnitude of a regressor entry or an effort that `identify` takes.
+const MAX_MAGNITUDE: f64 = 1e150;
+
 /// Run `identify`.
 pub fn run(args: &IdentifyArgs) -> ExitCode {
     let (name, source) = match super::read_spec(&args.spec) {
@@ -68,13 +75,29 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         eprintln!("error: --cutoff must be a positive frequency in Hz");
         return ExitCode::from(2);
     }
+    if let Err(c) = super::distinct_outputs(
+        &[("the spec", &args.spec), ("the data file", &args.data)],
+        &[
+            ("--out", args.out.as_deref()),
+            ("--estimates", args.estimates.as_deref()),
+            ("--plot", args.plot.as_deref()),
+        ],
+    ) {
+        return c;
+    }
     if args.out.is_some() && name.ends_with(".urdf") {
         eprintln!(
             "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
         );
         return ExitCode::from(2);
     }
-    let (reg, warnings) = match Regressor::compile(&name, &source) {
+    // A URDF's `ROBOT.scene.toml` applies here as in generation (friction, rotor inertia,
+    // locked joints change the parameters).
+    let sidecar = match super::sidecar(&args.spec, None) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -85,11 +108,30 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         eprint!("{warnings}");
     }
     let data_name = args.data.to_string_lossy().into_owned();
-    let text = match std::fs::read(&args.data) {
+    let read = std::fs::File::open(&args.data).and_then(|f| {
+        use std::io::Read;
+        let mut b = Vec::new();
+        f.take(MAX_DATA_BYTES + 1).read_to_end(&mut b).map(|_| b)
+    });
+    if read.as_ref().is_ok_and(|b| b.len() as u64 > MAX_DATA_BYTES) {
+        eprintln!(
+            "error: {data_name}: larger than {} MiB (an endless device such as /dev/zero, or more samples than identify holds in memory: subsample the file)",
+            MAX_DATA_BYTES >> 20
+        );
+        return ExitCode::from(2);
+    }
+    let text = match read {
         Ok(b) => match String::from_utf8(b) {
             Ok(t) => t,
-            Err(_) => {
-                eprintln!("error: {data_name}: not UTF-8 text");
+            Err(e) => {
+                let ok = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+                let line = ok.iter().filter(|b| **b == b'\n').count() + 1;
+                let start = ok.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+                let column = String::from_utf8_lossy(&ok[start..]).chars().count() + 1;
+                eprintln!(
+                    "error: {data_name}:{line}:{column}: not UTF-8 text (byte 0x{:02x}; save the file as UTF-8)",
+                    e.as_bytes()[ok.len()]
+                );
                 return ExitCode::from(2);
             }
         },
@@ -130,6 +172,19 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             );
             return ExitCode::from(2);
         }
+        // Squares of larger numbers overflow in the least squares (and the SVD does not
+        // return on what follows): no unit makes such values measurements.
+        if let Some(v) = y
+            .iter()
+            .chain(&data.tau[s])
+            .find(|v| v.is_nan() || v.abs() > MAX_MAGNITUDE)
+        {
+            eprintln!(
+                "error: {data_name}:{}: the regressor or the efforts reach {v:e} at this state, beyond {MAX_MAGNITUDE:e} (check the columns' order and units)",
+                data.lines[s]
+            );
+            return ExitCode::from(2);
+        }
         for i in 0..n {
             for k in 0..nbp {
                 w[(s * n + i, k)] = y[i * nbp + k];
@@ -139,6 +194,19 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     }
     let stacked = Stacked { w, tau, n };
     let fit = wls::fit(&stacked, args.weights == Weights::Auto);
+    if !fit
+        .estimate
+        .iter()
+        .chain(&fit.std)
+        .chain(&fit.residual_rms)
+        .chain(&fit.sigma)
+        .all(|v| v.is_finite())
+    {
+        eprintln!(
+            "error: {data_name}: the least squares of these data overflow (values too far apart in magnitude: check the columns' units)"
+        );
+        return ExitCode::from(2);
+    }
     report(&reg, &name, &data_name, rows, &data.note, &fit, args);
     if let Some(path) = &args.estimates {
         let mut csv = String::from("k,name,spec,estimate,std\n");
@@ -151,7 +219,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
                 fit.std[k]
             ));
         }
-        if let Err(e) = codegen::build_script::write_if_changed(path, &csv) {
+        if let Err(e) = super::write_output(path, &csv) {
             eprintln!("error: {e}");
             return ExitCode::from(1);
         }
@@ -184,7 +252,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             panels: &panels,
         };
         if let Err(e) = plot.write(path) {
-            eprintln!("error: {}: {e}", path.display());
+            eprintln!("error: {e}");
             return ExitCode::from(1);
         }
     }
@@ -206,9 +274,11 @@ fn report(
 ) {
     let (n, nbp) = (reg.dof(), reg.nbp());
     outln!(
-        "identify: {} ({name}) from {data_name}: {rows} samples x {n} {}s, {nbp} base parameters, {}",
+        "identify: {} ({name}) from {data_name}: {rows} sample{} x {n} {}{}, {nbp} base parameters, {}",
         reg.mechanism(),
+        if rows == 1 { "" } else { "s" },
         reg.effort_kind(),
+        if n == 1 { "" } else { "s" },
         match args.weights {
             Weights::Auto =>
                 "rows weighted by 1/sigma_j per joint (sigma_j from an ordinary least-squares pass)",
@@ -309,14 +379,22 @@ fn write_update(
     let identified: Vec<bool> = fit.unidentifiable.iter().map(|u| !u).collect();
     let up = match super::spec_update::update(reg, name, source, &fit.estimate, &identified) {
         Ok(u) => u,
-        Err(e) => {
+        Err(e) if e.starts_with("error:") => {
             eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            // A body no rigid body can be (`body `b`: mass -0.3 kg < 0`).
+            eprintln!(
+                "error: --out {}: the estimates give {e}: no spec can hold them (no file written; see the warnings above)",
+                path.display()
+            );
             return ExitCode::from(2);
         }
     };
     for s in &up.skipped {
         eprintln!(
-            "note: {s} has values that are not plain numbers (expressions, angle strings): left unchanged"
+            "note: {s}: not plain numbers (expressions, angle strings), which the update cannot rewrite: the body is left unchanged (write its mass, com and inertia as numbers to have it updated)"
         );
     }
     let reproduced: Vec<bool> = (0..identified.len())
@@ -373,7 +451,7 @@ fn write_update(
             "physical consistency: every body of the updated spec has mass >= 0 and a positive definite inertia that satisfies the triangle inequality"
         );
     }
-    if let Err(e) = codegen::build_script::write_if_changed(path, &up.text) {
+    if let Err(e) = super::write_output(path, &up.text) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
     }

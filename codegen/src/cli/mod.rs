@@ -351,6 +351,94 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     Ok((lo, hi))
 }
 
+/// Write `text` to the output file `path` as `codegen::build_script::write_if_changed` does (a
+/// temporary file renamed into place, untouched when equal), except that a device, FIFO or
+/// socket (`/dev/stdout`, `/dev/full`, a named pipe) is only written into: the comparison with
+/// the old content read such a target first, without end (`/dev/zero`, `/dev/full`: memory
+/// until the process was killed) or waiting on itself (`/dev/stdout` into a pipe).
+pub fn write_output(path: &std::path::Path, text: &str) -> Result<(), String> {
+    use std::io::Write;
+    let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    if special {
+        return std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .and_then(|mut f| f.write_all(text.as_bytes()))
+            .map_err(|e| format!("{}: {e}", path.display()));
+    }
+    codegen::build_script::write_if_changed(path, text).map_err(|e| e.to_string())
+}
+
+/// The file a path names, for comparing paths: the canonical path when it exists, else its
+/// directory's canonical path joined with its name (a file about to be written), else the path.
+fn file_identity(p: &std::path::Path) -> std::path::PathBuf {
+    if let Ok(c) = std::fs::canonicalize(p) {
+        return c;
+    }
+    let dir = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    match (std::fs::canonicalize(dir), p.file_name()) {
+        (Ok(d), Some(n)) => d.join(n),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// Refuse output files that would overwrite an input or another output (`(flag, path)` each,
+/// the inputs' flag being what names them in the message, e.g. `"the spec"`): exit code 2
+/// before any work, so that a slip of the shell never replaces the measurements with a plot;
+/// and outputs onto a directory or into a missing one: exit code 1, nothing written.
+pub fn distinct_outputs(
+    inputs: &[(&str, &std::path::Path)],
+    outputs: &[(&str, Option<&std::path::Path>)],
+) -> Result<(), ExitCode> {
+    let outputs: Vec<(&str, &std::path::Path)> = outputs
+        .iter()
+        .filter_map(|(f, p)| p.map(|p| (*f, p)))
+        .collect();
+    for (k, (flag, path)) in outputs.iter().enumerate() {
+        let id = file_identity(path);
+        let clash = inputs
+            .iter()
+            .find(|(_, q)| file_identity(q) == id)
+            .map(|(what, _)| what.to_string())
+            .or_else(|| {
+                outputs[..k]
+                    .iter()
+                    .find(|(_, q)| file_identity(q) == id)
+                    .map(|(f, _)| format!("the file of {f}"))
+            });
+        if let Some(what) = clash {
+            eprintln!(
+                "error: {flag} {}: that is {what}, which it would overwrite: write to another file",
+                path.display()
+            );
+            return Err(ExitCode::from(2));
+        }
+    }
+    // Where a file cannot go, no other is written either (I/O error, exit code 1, before
+    // any work).
+    for (flag, path) in &outputs {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => std::path::Path::new("."),
+        };
+        let why = if path.is_dir() {
+            Some("is a directory")
+        } else if !dir.is_dir() {
+            Some("its directory does not exist")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            eprintln!("error: {flag} {}: {why}", path.display());
+            return Err(ExitCode::from(1));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -418,7 +418,7 @@ fn write_output(args: &ReduceArgs, source: &str, level: &Level) -> ExitCode {
     match &args.output {
         Some(p) => {
             // Replaced atomically, as the generator's `-o`.
-            if let Err(e) = codegen::build_script::write_if_changed(p, &out) {
+            if let Err(e) = super::write_output(p, &out) {
                 eprintln!("error: {e}");
                 return ExitCode::from(1);
             }

@@ -22,11 +22,19 @@ pub enum Regressor {
 }
 
 impl Regressor {
-    /// Load a spec's text (with its `[scene]`): its regressor and the loader's rendered
-    /// warnings. The error is rendered text (exit code 2).
-    pub fn compile(name: &str, source: &str) -> Result<(Regressor, String), String> {
-        let loaded = codegen::spec::load(name, source, &codegen::spec::SceneOverrides::default())
-            .map_err(|d| d.render())?;
+    /// Load a spec's text (with its `[scene]`, or for a URDF the `sidecar` scene file, as
+    /// generation reads it): its regressor and the loader's rendered warnings. The error is
+    /// rendered text (exit code 2).
+    pub fn compile(
+        name: &str,
+        source: &str,
+        sidecar: Option<codegen::spec::SceneFile>,
+    ) -> Result<(Regressor, String), String> {
+        let overrides = codegen::spec::SceneOverrides {
+            sidecar,
+            ..Default::default()
+        };
+        let loaded = codegen::spec::load(name, source, &overrides).map_err(|d| d.render())?;
         let warnings = if loaded.warnings.is_empty() {
             String::new()
         } else {

@@ -62,13 +62,30 @@ impl Columns {
     }
 }
 
-/// Where column `kind` number `i` is, if anywhere: `kind{i+1}` or `kind_{name}`.
-fn find(header: &[String], kind: &str, i: usize, name: Option<&String>) -> Option<usize> {
+/// Where column `kind` number `i` is, if anywhere: `kind{i+1}` or `kind_{name}`; `Err` (the
+/// two columns) when the header has both.
+fn find(
+    header: &[String],
+    kind: &str,
+    i: usize,
+    name: Option<&String>,
+) -> Result<Option<usize>, (usize, usize)> {
     let a = format!("{kind}{}", i + 1);
     let b = name.map(|n| format!("{kind}_{n}"));
-    header
+    let mut at = header
         .iter()
-        .position(|h| *h == a || b.as_ref().is_some_and(|b| h == b))
+        .enumerate()
+        .filter(|(_, h)| **h == a || b.as_ref().is_some_and(|b| *h == b))
+        .map(|(c, _)| c);
+    match (at.next(), at.next()) {
+        (Some(x), Some(y)) => Err((x, y)),
+        (x, _) => Ok(x),
+    }
+}
+
+/// `n` and the noun, plural unless `n` is 1.
+fn count(n: usize, noun: &str) -> String {
+    format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
 }
 
 /// Read `text` (the file `file`) with columns `columns`, needing at least `min_rows` samples
@@ -94,8 +111,11 @@ pub fn read(
         ));
     };
     let header: Vec<String> = header.split(',').map(|h| h.trim().to_string()).collect();
+    // A set, not a scan of the columns before: a header of 200,000 columns took minutes.
+    let mut seen = std::collections::HashSet::new();
     for (c, h) in header.iter().enumerate() {
-        if header[..c].contains(h) {
+        // Unnamed columns (a trailing comma) are ignored like any other unknown one.
+        if !h.is_empty() && !seen.insert(h.as_str()) {
             return Err(format!(
                 "error: {file}:{}:{}: column `{h}` appears twice",
                 hline + 1,
@@ -105,11 +125,26 @@ pub fn read(
     }
     let mut cols: Vec<Vec<Option<usize>>> = Vec::new();
     for (k, kind) in kinds.iter().enumerate() {
-        cols.push(
-            (0..columns.counts[k])
-                .map(|i| find(&header, kind, i, columns.names[k].get(i)))
-                .collect(),
-        );
+        let mut of_kind = Vec::new();
+        for i in 0..columns.counts[k] {
+            let name = columns.names[k].get(i);
+            match find(&header, kind, i, name) {
+                Ok(c) => of_kind.push(c),
+                Err((a, b)) => {
+                    return Err(format!(
+                        "error: {file}:{}:{}: columns `{}` (column {}) and `{}` both give {kind}{}{}: keep one",
+                        hline + 1,
+                        b + 1,
+                        header[a],
+                        a + 1,
+                        header[b],
+                        i + 1,
+                        name.map_or(String::new(), |n| format!(" (joint `{n}`)"))
+                    ));
+                }
+            }
+        }
+        cols.push(of_kind);
     }
     let t_col = header.iter().position(|h| h == "t");
     let has = |k: usize| cols[k].iter().all(Option::is_some);
@@ -140,7 +175,13 @@ pub fn read(
             let expected: Vec<String> = kinds
                 .iter()
                 .zip(columns.counts)
-                .map(|(k, c)| format!("{k}1..{k}{c}"))
+                .map(|(k, c)| {
+                    if c == 1 {
+                        format!("{k}1")
+                    } else {
+                        format!("{k}1..{k}{c}")
+                    }
+                })
                 .collect();
             let alternatives = if columns.differentiable {
                 format!(
@@ -159,6 +200,12 @@ pub fn read(
             ));
         }
     }
+    // Only the columns read are parsed: the others ("other columns are ignored") may hold
+    // anything, labels or nothing.
+    let mut used = vec![false; header.len()];
+    for c in cols.iter().flatten().flatten().chain(t_col.as_ref()) {
+        used[*c] = true;
+    }
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut line_of = Vec::new();
     for (ln, line) in lines {
@@ -166,33 +213,34 @@ pub fn read(
         let fields: Vec<&str> = line.split(',').collect();
         if fields.len() != header.len() {
             return Err(format!(
-                "error: {file}:{}: {} fields, the header has {}",
+                "error: {file}:{}:{}: {}, the header has {}",
                 ln + 1,
-                fields.len(),
+                fields.len().min(header.len()) + 1,
+                count(fields.len(), "field"),
                 header.len()
             ));
         }
-        let mut row = Vec::with_capacity(fields.len());
-        for (c, f) in fields.iter().enumerate() {
-            let v = f.trim().parse::<f64>().map_err(|_| {
+        let mut row = vec![0.0; fields.len()];
+        for (c, f) in fields.iter().enumerate().filter(|(c, _)| used[*c]) {
+            let cell = f.trim();
+            let v = cell.parse::<f64>().map_err(|_| {
                 format!(
                     "error: {file}:{}:{}: column `{}`: `{}` is not a number",
                     ln + 1,
                     c + 1,
                     header[c],
-                    f.trim()
+                    cell.escape_debug()
                 )
             })?;
             if !v.is_finite() {
                 return Err(format!(
-                    "error: {file}:{}:{}: column `{}`: `{}` is not finite",
+                    "error: {file}:{}:{}: column `{}`: `{cell}` is not finite",
                     ln + 1,
                     c + 1,
                     header[c],
-                    f.trim()
                 ));
             }
-            row.push(v);
+            row[c] = v;
         }
         rows.push(row);
     }
@@ -202,25 +250,32 @@ pub fn read(
     let mut s = Samples::default();
     if positions_only {
         let t: Vec<f64> = rows.iter().map(|r| r[t_col.unwrap_or(0)]).collect();
-        let dt = uniform_step(file, &t)?;
+        let dt = uniform_step(file, &t, t_col.unwrap_or(0), &line_of)?;
         let fs = 1.0 / dt;
         if !(filtering.cutoff > 0.0 && filtering.cutoff < 0.5 * fs) {
             return Err(format!(
-                "error: --cutoff {} Hz: must be in (0, {}) (half the sample rate of {file})",
+                "error: --cutoff {:?} Hz: must be in (0, {:?}) (half the sample rate of {file})",
                 filtering.cutoff,
                 0.5 * fs
             ));
         }
         // Dropped at each end: the filter's transient (about one cutoff period) and the ends of
-        // the differences.
-        let edge = ((fs / filtering.cutoff).ceil() as usize).max(2);
-        if rows.len() < 2 * edge + min_rows {
+        // the differences. Compared as a float first: a cutoff far below the sample rate makes
+        // it larger than any file.
+        let edge = (fs / filtering.cutoff).ceil().max(2.0);
+        if 2.0 * edge + min_rows as f64 > rows.len() as f64 {
             return Err(format!(
-                "error: {file}: {} rows: too few to filter and differentiate (need {} samples after dropping {edge} at each end)",
-                rows.len(),
-                min_rows
+                "error: {file}: {}: too few to filter and differentiate at --cutoff {:?} Hz (need {min_rows} samples after dropping {} at each end: a cutoff period of samples)",
+                count(rows.len(), "row"),
+                filtering.cutoff,
+                if edge < 1e12 {
+                    format!("{edge:.0}")
+                } else {
+                    format!("{edge:.3e}")
+                },
             ));
         }
+        let edge = edge as usize;
         let mut q_cols = vec![Vec::new(); n];
         let mut qd_cols = vec![Vec::new(); n];
         let mut qdd_cols = vec![Vec::new(); n];
@@ -251,8 +306,8 @@ pub fn read(
     } else {
         if rows.len() < min_rows {
             return Err(format!(
-                "error: {file}: {} rows: too few (the regressor needs at least {min_rows} samples)",
-                rows.len()
+                "error: {file}: {}: too few (the regressor needs at least {min_rows} samples)",
+                count(rows.len(), "row")
             ));
         }
         s.lines = line_of;
@@ -269,21 +324,36 @@ pub fn read(
     Ok(s)
 }
 
-/// The sampling step of `t`, which must increase uniformly (within 1e-6 of the mean step).
-fn uniform_step(file: &str, t: &[f64]) -> Result<f64, String> {
+/// The sampling step of `t` (column `col`, 0-based; `lines`: the file line of each sample),
+/// which must increase uniformly (within 1e-6 of the mean step).
+fn uniform_step(file: &str, t: &[f64], col: usize, lines: &[usize]) -> Result<f64, String> {
     if t.len() < 3 {
-        return Err(format!("error: {file}: too few rows to differentiate"));
+        return Err(format!(
+            "error: {file}: {}: too few to differentiate",
+            count(t.len(), "row")
+        ));
+    }
+    let at = |k: usize| format!("{file}:{}:{}", lines[k], col + 1);
+    if let Some(k) = t.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(format!(
+            "error: {}: column `t`: {} s after {} s: time must increase (positions-only data are differentiated in time)",
+            at(k + 1),
+            t[k + 1],
+            t[k]
+        ));
     }
     let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    if dt.is_nan() || dt <= 0.0 {
-        return Err(format!("error: {file}: column `t` does not increase"));
+    if !(dt > 0.0 && dt.is_finite() && (1.0 / dt).is_finite()) {
+        return Err(format!(
+            "error: {}: column `t`: a mean step of {dt:e} s cannot be differentiated over",
+            at(t.len() - 1)
+        ));
     }
     for (k, w) in t.windows(2).enumerate() {
         if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt {
             return Err(format!(
-                "error: {file}: column `t`: the step between samples {} and {} is {} s, not the mean {dt} s (positions-only data must be sampled uniformly)",
-                k + 1,
-                k + 2,
+                "error: {}: column `t`: the step from the row before is {} s, not the mean {dt} s (positions-only data must be sampled uniformly)",
+                at(k + 1),
                 w[1] - w[0]
             ));
         }
@@ -317,7 +387,7 @@ mod tests {
         let e = |t: &str| read("d.csv", t, &Columns::joints(&joints()), 1, F).unwrap_err();
         assert!(e("").contains("empty"));
         assert!(e("q1,q2\n").contains("missing columns qd1, qd2"));
-        assert!(e(&format!("{h}0,1,2,3,4,5,6,7\n")).contains("d.csv:2: 8 fields"));
+        assert!(e(&format!("{h}0,1,2,3,4,5,6,7\n")).contains("d.csv:2:9: 8 fields"));
         assert!(e(&format!("{h}0,1,2,3,x,5,6,7,8\n")).contains("d.csv:2:5: column `qd2`"));
         assert!(e(&format!("{h}# c\n0,1,2,3,4,NaN,6,7,8\n")).contains("d.csv:3:6"));
         assert!(e(h).contains("too few"));

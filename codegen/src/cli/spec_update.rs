@@ -142,6 +142,34 @@ fn body_parameters(t: &dyn toml_edit::TableLike) -> Option<[f64; 10]> {
     Some(codegen::dynamics::body_standard_parameters(mass, &com, &ic))
 }
 
+/// The keys of body table `t` that `body_parameters` cannot read as plain numbers, as
+/// `` (`com` = ["l/2", 0, 0]) `` for the note on a body left unchanged.
+fn unwritable_keys(t: &dyn toml_edit::TableLike) -> String {
+    let plain = |v: &toml_edit::Value| v.as_float().is_some() || v.as_integer().is_some();
+    let keys: Vec<String> = ["mass", "com", "inertia", "inertia_rpy"]
+        .into_iter()
+        .filter_map(|k| {
+            let item = t.get(k)?;
+            let ok = match item {
+                Item::Value(toml_edit::Value::Array(a)) => a.iter().all(plain),
+                Item::Value(v) if k == "mass" => plain(v),
+                _ => item
+                    .as_table_like()
+                    .is_some_and(|it| it.iter().all(|(_, x)| x.as_value().is_some_and(plain))),
+            };
+            (!ok).then(|| {
+                let text = item.to_string();
+                format!("`{k}` = {}", text.trim())
+            })
+        })
+        .collect();
+    if keys.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", keys.join(", "))
+    }
+}
+
 /// `(mass, com, inertia about the com)` of standard parameters `p`; `Err` when no body has them
 /// (a negative mass, or a first moment without mass).
 fn from_standard(p: &[f64; 10]) -> Result<(f64, Vec3, Mat3), String> {
@@ -304,7 +332,7 @@ pub fn update(
                         names.push(format!("body `{name}`"));
                     }
                 }
-                None => skipped.push(format!("body `{name}`")),
+                None => skipped.push(format!("body `{name}`{}", unwritable_keys(t))),
             }
         }
     }
@@ -431,7 +459,7 @@ pub fn update(
     let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c].clone()).collect();
     let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
     let out = apply(&doc, &sub_u, &sub_z).map_err(|e| {
-        format!("error: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
+        format!("error: --out: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
     })?;
     let text = out.to_string();
     let written = base_of(reg, file, &text)?;
@@ -503,9 +531,14 @@ fn physics(m: f64, ic: &Mat3) -> Vec<String> {
                 ev[0], ev[1], ev[2]
             ));
         } else if ev[0] + ev[1] < ev[2] * (1.0 - 1e-12) {
+            // The shortfall too: a flat plate's `a + b = c`, identified to rounding, would
+            // otherwise read `1.0000e-2 + 1.0000e-2 < 2.0000e-2`.
             what.push(format!(
-                "principal moments {:.4e} + {:.4e} < {:.4e} kg·m² (triangle inequality)",
-                ev[0], ev[1], ev[2]
+                "principal moments {:.4e} + {:.4e} < {:.4e} kg·m² by {:.2e} of the largest (triangle inequality)",
+                ev[0],
+                ev[1],
+                ev[2],
+                (ev[2] - ev[0] - ev[1]) / scale
             ));
         }
         what

@@ -18,7 +18,40 @@ pub(super) fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, V
     for &j in &joints {
         check_joint(doc, j, diags);
     }
+    check_ends(doc, &links, &joints, diags);
     (links, joints)
+}
+
+/// Each joint's `<parent link>` and `<child link>` name a link of the file: a typo is an error
+/// at the attribute, with the closest name (it was reported as the intended link "not
+/// connected to the root link", pointing away from the typo, when that link was in the file).
+fn check_ends(doc: &Doc<'_>, links: &[usize], joints: &[usize], diags: &mut Diagnostics) {
+    let names: Vec<&str> = links
+        .iter()
+        .filter_map(|&l| doc.tags[l].attr("name").map(|a| a.value))
+        .collect();
+    for &j in joints {
+        let name = doc.tags[j].attr("name").map_or("", |a| a.value);
+        for end in ["parent", "child"] {
+            let Some(a) = doc.child(j, end).and_then(|e| doc.tags[e].attr("link")) else {
+                continue;
+            };
+            if names.contains(&a.value) {
+                continue;
+            }
+            // Worded as the loader's check of a TOML joint's ends, which a URDF reaches only
+            // when no link is left disconnected.
+            diags.push(
+                Diagnostic::error(format!("unknown {end} body \"{}\"", a.value))
+                    .with_key(format!("joint \"{name}\".{end}"))
+                    .with_span(a.span.clone())
+                    .with_hint(
+                        suggest_hint(a.value, &names)
+                            .unwrap_or_else(|| format!("the {end} must be the name of a body")),
+                    ),
+            );
+        }
+    }
 }
 
 /// The name lengths of `<robot>`, then of the links, then of the joints.
