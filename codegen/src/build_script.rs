@@ -332,7 +332,11 @@ pub fn read_spec(path: &Path) -> std::io::Result<Vec<u8>> {
 /// temporary file is removed. An existing file's permissions are kept.
 pub fn write_if_changed(path: &Path, content: &str) -> Result<(), Error> {
     use std::io::Write;
-    if std::fs::read(path).is_ok_and(|old| old == content.as_bytes()) {
+    // Compared only when a regular file is there: reading a device (`/dev/zero`) or a FIFO
+    // would never end or block.
+    if std::fs::metadata(path).is_ok_and(|m| m.is_file())
+        && std::fs::read(path).is_ok_and(|old| old == content.as_bytes())
+    {
         return Ok(());
     }
     let err = |e: std::io::Error| Error::Io(path.to_path_buf(), e);
@@ -377,6 +381,27 @@ pub fn write_if_changed(path: &Path, content: &str) -> Result<(), Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A device that reads forever (`/dev/zero`) is written into without being read first
+    /// (the comparison read never ended): the call returns within seconds.
+    #[cfg(unix)]
+    #[test]
+    fn an_endless_device_is_not_read() {
+        let zero = Path::new("/dev/zero");
+        if !zero.exists() {
+            return;
+        }
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(write_if_changed(zero, "fn f() {}\n").is_ok());
+        });
+        let ok = rx.recv_timeout(std::time::Duration::from_secs(10));
+        assert_eq!(
+            ok,
+            Ok(true),
+            "writing into /dev/zero did not return within 10 s"
+        );
+    }
 
     /// `-o /dev/null` writes into the device and leaves it a device (a rename would replace
     /// it with a regular file, and every later reader of `/dev/null` would read what it holds).

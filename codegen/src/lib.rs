@@ -187,25 +187,30 @@ pub fn compile(
     cfg: &Config,
 ) -> Result<Generated, diag::Diagnostics> {
     let loaded = spec::load(file_name, source, &cfg.scene)?;
-    let mut out = generate(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| {
+    let error = |msg: String, key: Option<&str>| {
         let mut d = diag::Diagnostics::new(file_name, source);
-        d.push(diag::Diagnostic::error(msg).with_key("platform"));
+        let e = diag::Diagnostic::error(msg);
+        d.push(match key {
+            Some(k) => e.with_key(k),
+            None => e,
+        });
         d
-    })?;
+    };
+    // An option that does not fit the mechanism is the configuration's error, not the spec's.
+    check_options(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| error(msg, None))?;
+    // What is left is a mechanism singular for every input: a platform's legs, or loops.
+    let key = matches!(loaded.mechanism, spec::Mechanism::Parallel(_)).then_some("platform");
+    let mut out = generate(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| error(msg, key))?;
     out.warnings = loaded.warnings;
     Ok(out)
 }
 
-/// Generate the module of a loaded mechanism of any kind, in the precision of `cfg`. An
-/// `Err` is a mechanism that is singular for every input. A panic while generating is a
-/// generator bug; inside someone's build it must still come out as an error, not as an
-/// aborted build script or macro.
-pub fn generate(
+/// The options of `cfg` that do not fit `mechanism` (or each other).
+fn check_options(
     mechanism: &spec::Mechanism,
     scene: &spec::Scene,
     cfg: &Config,
-) -> Result<Generated, String> {
-    let single = cfg.float == Float::F32;
+) -> Result<(), String> {
     if cfg.implement.is_some() {
         implement::check(mechanism, scene)?;
     }
@@ -232,6 +237,20 @@ pub fn generate(
             return Err("the C wrapper crate (`emit c`) takes no `lanes`".into());
         }
     }
+    Ok(())
+}
+
+/// Generate the module of a loaded mechanism of any kind, in the precision of `cfg`. An
+/// `Err` is a mechanism that is singular for every input. A panic while generating is a
+/// generator bug; inside someone's build it must still come out as an error, not as an
+/// aborted build script or macro.
+pub fn generate(
+    mechanism: &spec::Mechanism,
+    scene: &spec::Scene,
+    cfg: &Config,
+) -> Result<Generated, String> {
+    let single = cfg.float == Float::F32;
+    check_options(mechanism, scene, cfg)?;
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || {
             fma::with(cfg.fma, || match mechanism {

@@ -28,9 +28,10 @@ pub enum Site {
     /// Closed loops in joint coordinates: loop-closure equation `k` is violated by more than
     /// its tolerance (the joint positions `x` do not close the loops).
     Closure(usize),
-    /// Closed loops in joint coordinates: pivot `i` of the constraint Jacobian's dependent
-    /// block `Φ_d` (a configuration where the independent coordinates do not determine the
-    /// others: a change of mobility or a bifurcation).
+    /// The coordinates stop determining the mechanism. Closed loops in joint coordinates:
+    /// pivot `i` of the constraint Jacobian's dependent block `Φ_d` (a change of mobility or a
+    /// bifurcation). Translational and Schönflies platforms: pivot `i` of the legs' constraint
+    /// couples (they no longer hold the platform's orientation, which gains a rotation).
     Constraint(usize),
     /// Spring `k` has (nearly) zero length: the direction of its force is undefined.
     Spring(usize),
@@ -91,7 +92,7 @@ impl fmt::Display for Site {
             ),
             Site::Constraint(i) => write!(
                 f,
-                "pivot {i} of the constraint Jacobian's dependent block (the independent coordinates do not determine the others)"
+                "pivot {i} of the constraints (the loops' dependent block, or the legs' constraint couples: the coordinates do not determine the mechanism)"
             ),
             Site::Spring(k) => write!(f, "spring {k} (zero length: no direction)"),
         }
