@@ -3,7 +3,11 @@
 # Needs network access for pip. Usage: bash tools/pinocchio_check/run.sh
 set -euo pipefail
 cd "$(dirname "$0")"
-python3 -m pip install --quiet pin example-robot-data cmeel-eigen cmeel-urdfdom-headers
+# cmeel-cppad / cmeel-cppadcodegen: CppAD (with its configured cppad/configure.hpp) and
+# CppADCodeGen, header-only, into the same cmeel prefix as Pinocchio, for bench_cg.cpp. Pinned to
+# the releases checked here with Pinocchio 4.1.0.
+python3 -m pip install --quiet pin example-robot-data cmeel-eigen cmeel-urdfdom-headers \
+  cmeel-cppad==20250000.2 cmeel-cppadcodegen==2.4.3
 D=$(python3 -c "import site; print(site.getsitepackages()[0])")/cmeel.prefix/share/example-robot-data/robots
 mkdir -p urdf data
 cp "$D/ur_description/urdf/ur5_robot.urdf" urdf/ur5.urdf
@@ -25,7 +29,12 @@ cp "$D/allegro_hand_description/urdf/allegro_right_hand.urdf" urdf/allegro.urdf
 # read beside NAME.urdf by codegen::build_script).
 cp scenes/*.scene.toml urdf/
 python3 gen.py
-cargo run --release
+# The generated code, built for this CPU (plain `a*b + c` stays two roundings: Rust never contracts;
+# the FMA modules' `mul_add` becomes one instruction). Timings pinned to core 1 when taskset exists.
+PIN=""; command -v taskset >/dev/null && PIN="taskset -c 1"
+mkdir -p out
+RUSTFLAGS="-C target-cpu=native" cargo build --release
+$PIN ./target/release/pinocchio-check | tee out/rust.txt
 # Pinocchio's own timing of the same URDFs (header-only build, -O3, the defines of its CMake
 # config), to set beside the `ns:` columns above.
 P=$(python3 -c "import site; print(site.getsitepackages()[0])")/cmeel.prefix
@@ -38,3 +47,18 @@ g++ -O3 -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS -DBOOST_MPL_
 ./pinocchio_bench urdf/ur5.urdf urdf/ur10.urdf urdf/panda.urdf urdf/z1.urdf urdf/kinova.urdf \
   urdf/xarm7.urdf urdf/iiwa14.urdf urdf/talos_left_arm.urdf urdf/baxter.urdf urdf/pr2.urdf \
   urdf/icub.urdf urdf/tiago.urdf urdf/anymal.urdf urdf/talos_full.urdf urdf/allegro.urdf
+# Pinocchio's code generation (CppADCodeGen) beside plain Pinocchio on the arms: bench_cg.cpp
+# tapes, generates C, compiles it with gcc "$CG_FLAGS" and loads it; the program itself and so
+# its plain Pinocchio are built with -O3 -march=native too. The libraries go to cg_libs/ (rebuilt
+# each run unless KEEP_CG_LIBS=1).
+CG_FLAGS="-O3 -march=native"
+g++ -O3 -march=native -DNDEBUG -std=c++17 -DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS -DBOOST_MPL_LIMIT_LIST_SIZE=30 \
+  -DBOOST_MPL_LIMIT_VECTOR_SIZE=30 -DBOOST_FUSION_INVOKE_MAX_ARITY=12 -DPINOCCHIO_WITH_URDFDOM \
+  -DPINOCCHIO_URDFDOM_HEADERS_MAJOR_VERSION=3 -DPINOCCHIO_URDFDOM_HEADERS_MINOR_VERSION=0 \
+  -DPINOCCHIO_URDFDOM_HEADERS_PATCH_VERSION=0 bench_cg.cpp -I"$P/include" -I"$P/include/eigen3" \
+  -I"$P/include/urdfdom_headers" -L"$P/lib" -lpinocchio_default -lpinocchio_parsers -lurdfdom_model \
+  -lboost_filesystem -ldl -Wl,-rpath,"$P/lib" -o pinocchio_bench_cg
+[ "${KEEP_CG_LIBS:-0}" = 1 ] || rm -rf cg_libs
+$PIN ./pinocchio_bench_cg "$CG_FLAGS" cg_libs urdf/ur5.urdf urdf/ur10.urdf urdf/panda.urdf urdf/z1.urdf \
+  urdf/kinova.urdf urdf/xarm7.urdf urdf/iiwa14.urdf urdf/talos_left_arm.urdf | tee out/cg.txt
+python3 tables.py out/rust.txt out/cg.txt | tee out/tables.md
