@@ -143,6 +143,87 @@ macro_rules! check_deriv {
     }};
 }
 
+/// Generated code without and with fused multiply-adds (`robots::NAME`, `robots::fma::NAME`) on
+/// the arms, for the table beside Pinocchio's CppADCodeGen code (`bench_cg.cpp`): the FMA
+/// variant's worst relative error against Pinocchio (ID, M, ∂ID), then ns per call of
+/// inverse_dynamics, mass_matrix, inverse_dynamics_derivatives and forward_dynamics_derivatives
+/// of each (median of 31 batches over the 200 states of `data/NAME.deriv.txt`, the whole result
+/// through `black_box`).
+macro_rules! compare_fma {
+    ($m:ident) => {{
+        use robots::$m as g;
+        use robots::fma::$m as f;
+        const N: usize = g::DOF;
+        assert_eq!(g::JOINT_NAMES, f::JOINT_NAMES);
+        let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".txt")).unwrap();
+        let mut lines = text.lines();
+        let pin_names: Vec<&str> = lines.next().unwrap().split(' ').collect();
+        let perm: Vec<usize> = pin_names.iter().map(|n| g::JOINT_NAMES.iter().position(|m| m == n).expect("name")).collect();
+        let (mut eid, mut emm) = (0.0f64, 0.0f64);
+        for line in lines {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            let take = |k: usize| -> [f64; N] {
+                let mut o = [0.0; N];
+                for i in 0..N { o[perm[i]] = v[k * N + i]; }
+                o
+            };
+            let (q, qd, qdd, tau) = (take(0), take(1), take(2), take(3));
+            let mut mp = [[0.0; N]; N];
+            for i in 0..N { for j in 0..N { mp[perm[i]][perm[j]] = v[4 * N + i * N + j]; } }
+            eid = eid.max(rel(&f::inverse_dynamics(&q, &qd, &qdd), &tau));
+            emm = emm.max(rel(f::mass_matrix(&q).as_flattened(), mp.as_flattened()));
+        }
+        let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".deriv.txt")).unwrap();
+        let mut states: Vec<([f64; N], [f64; N], [f64; N], [f64; N])> = Vec::new();
+        let mut edid = 0.0f64;
+        for line in text.lines().skip(1) {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            let take = |k: usize| -> [f64; N] {
+                let mut o = [0.0; N];
+                for i in 0..N { o[perm[i]] = v[k * N + i]; }
+                o
+            };
+            let mat = |k: usize| -> [[f64; N]; N] {
+                let off = 4 * N + k * N * N;
+                let mut o = [[0.0; N]; N];
+                for i in 0..N { for j in 0..N { o[perm[i]][perm[j]] = v[off + i * N + j]; } }
+                o
+            };
+            let (q, qd, qdd, t2) = (take(0), take(1), take(2), take(3));
+            let (dq, dv) = f::inverse_dynamics_derivatives(&q, &qd, &qdd);
+            edid = edid.max(rel(dq.as_flattened(), mat(0).as_flattened())).max(rel(dv.as_flattened(), mat(1).as_flattened()));
+            states.push((q, qd, qdd, t2));
+        }
+        let time = |h: &dyn Fn(&([f64; N], [f64; N], [f64; N], [f64; N])) -> f64| {
+            let mut t: Vec<f64> = (0..31)
+                .map(|_| {
+                    let t0 = std::time::Instant::now();
+                    let mut sink = 0.0;
+                    for s in &states { sink += h(std::hint::black_box(s)); }
+                    std::hint::black_box(sink);
+                    t0.elapsed().as_nanos() as f64 / states.len() as f64
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[15]
+        };
+        let ns = [
+            time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics(q, qd, qdd))[0]),
+            time(&|(q, qd, qdd, _)| std::hint::black_box(f::inverse_dynamics(q, qd, qdd))[0]),
+            time(&|(q, _, _, _)| std::hint::black_box(g::mass_matrix(q))[0][0]),
+            time(&|(q, _, _, _)| std::hint::black_box(f::mass_matrix(q))[0][0]),
+            time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]),
+            time(&|(q, qd, qdd, _)| std::hint::black_box(f::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]),
+            time(&|(q, qd, _, t2)| std::hint::black_box(g::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)),
+            time(&|(q, qd, _, t2)| std::hint::black_box(f::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)),
+        ];
+        println!(
+            "fma {:16} dof {:2}  FMA errors: ID {:.1e} M {:.1e} dID {:.1e}  ns plain/fma: ID {:.0} {:.0}  M {:.0} {:.0}  IDD {:.0} {:.0}  FDD {:.0} {:.0}",
+            stringify!($m), N, eid, emm, edid, ns[0], ns[1], ns[2], ns[3], ns[4], ns[5], ns[6], ns[7]
+        );
+    }};
+}
+
 fn main() {
     check!(ur5);
     check!(ur10);
@@ -170,4 +251,13 @@ fn main() {
     check_deriv!(talos_left_arm);
     check_deriv!(anymal);
     check_deriv!(allegro);
+    // Without and with FMA (the arms of build.rs's FMA_ARMS), beside bench_cg.cpp.
+    compare_fma!(ur5);
+    compare_fma!(ur10);
+    compare_fma!(panda);
+    compare_fma!(z1);
+    compare_fma!(kinova);
+    compare_fma!(xarm7);
+    compare_fma!(iiwa14);
+    compare_fma!(talos_left_arm);
 }
