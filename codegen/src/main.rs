@@ -99,7 +99,7 @@ struct Cli {
     lanes: Option<usize>,
     /// With `--lanes`: `sin` and `cos` of all lanes at once by a polynomial that vectorizes
     /// (within 2 ulp; no longer bit for bit the scalar functions).
-    #[arg(long)]
+    #[arg(long, requires = "lanes")]
     vector_sin_cos: bool,
     /// Apply the joints' viscous and Coulomb friction (as `[scene] friction = true`; for a URDF,
     /// its `<dynamics damping friction>`).

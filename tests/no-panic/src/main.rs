@@ -268,6 +268,51 @@ frames!(
     iiwa14_tool: iiwa14::{tool_pose, tool_jacobian, tool_jacobian_dot_qd},
 );
 
+/// The PUMA 560 generated with `lanes = 4` and `vector_sin_cos` (`build.rs`).
+#[allow(dead_code)]
+mod puma560_lanes {
+    include!(concat!(env!("OUT_DIR"), "/puma560.rs"));
+}
+
+/// Its `_lanes` functions, each under its own `#[no_panic]`; `LANES` calls each once.
+macro_rules! lanes {
+    ($($name:ident($($arg:ident),*) -> $out:ty;)*) => {
+        $(
+            #[cfg_attr(feature = "prove", no_panic::no_panic)]
+            #[inline(never)]
+            pub fn $name($($arg: &[[F; puma560_lanes::LANES]; puma560_lanes::DOF]),*) -> $out {
+                puma560_lanes::$name($($arg),*)
+            }
+        )*
+    };
+}
+
+type Lanes6 = [[F; puma560_lanes::LANES]; puma560_lanes::DOF];
+lanes! {
+    inverse_dynamics_lanes(q, qd, qdd) -> Lanes6;
+    mass_matrix_lanes(q) -> [Lanes6; puma560_lanes::DOF];
+    coriolis_lanes(q, qd) -> Lanes6;
+    gravity_lanes(q) -> Lanes6;
+    forward_dynamics_lanes(q, qd, tau)
+        -> (Lanes6, [Result<(), puma560_lanes::Singular>; puma560_lanes::LANES]);
+}
+
+/// Every `_lanes` wrapper, called once on opaque inputs (angles up to ±4 rad; a seed-dependent
+/// state may also put a lane beyond the vector `sin_cos`'s range: scale 1e6).
+pub const LANES: &[(&str, fn(&mut u64) -> F)] = &[("puma560_lanes", |seed| {
+    let mut state = |scale: F| -> Lanes6 {
+        core::array::from_fn(|_| inputs::<{ puma560_lanes::LANES }>(seed, scale))
+    };
+    let (q, far, qd, qdd) = (state(4.0), state(1e6), state(1.0), state(1.0));
+    let tau = inverse_dynamics_lanes(&q, &qd, &qdd);
+    let (a, status) = forward_dynamics_lanes(&q, &qd, &tau);
+    tau[0][0]
+        + mass_matrix_lanes(&far)[0][0][0]
+        + coriolis_lanes(&q, &qd)[1][0]
+        + gravity_lanes(&q)[2][0]
+        + if status[0].is_ok() { a[0][0] } else { 0.0 }
+})];
+
 /// A function that can panic (index out of bounds): `--features canary` must fail to link.
 #[cfg(feature = "canary")]
 #[no_panic::no_panic]
@@ -280,7 +325,7 @@ fn main() {
     let mut seed = black_box(0x9e37_79b9_7f4a_7c15_u64);
     #[cfg(feature = "canary")]
     println!("canary: {}", canary(&black_box([1.0; 4]), black_box(7)));
-    for (name, run) in MECHANISMS.iter().chain(FRAMES) {
+    for (name, run) in MECHANISMS.iter().chain(FRAMES).chain(LANES) {
         let s = run(&mut seed);
         println!("{name}: checksum {s:e}");
     }

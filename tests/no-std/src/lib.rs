@@ -1,6 +1,7 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
-//! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
+//! generated with `lanes`, `fma` and `vector_sin_cos` (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
@@ -170,3 +171,30 @@ pub mod single {
         t + g + f
     }
 }
+
+macro_rules! export_lanes {
+    ($($m:ident: $dir:literal, $f:ty);* $(;)?) => {
+        $(
+            pub mod $m {
+                include!(concat!(env!("OUT_DIR"), "/", $dir, "/puma560.rs"));
+                /// Calls every `_lanes` function once; returns a checksum.
+                #[unsafe(no_mangle)]
+                pub extern "C" fn $m(
+                    q: &[[$f; LANES]; DOF],
+                    qd: &[[$f; LANES]; DOF],
+                    x: &[[$f; LANES]; DOF],
+                ) -> $f {
+                    let (a, status) = forward_dynamics_lanes(q, qd, x);
+                    let ok = if status[0].is_ok() { a[0][0] } else { 0.0 };
+                    inverse_dynamics_lanes(q, qd, x)[0][0]
+                        + mass_matrix_lanes(q)[0][0][0]
+                        + coriolis_lanes(q, qd)[0][0]
+                        + gravity_lanes(q)[0][0]
+                        + ok
+                }
+            }
+        )*
+    };
+}
+
+export_lanes!(puma560_lanes: "f64", f64; puma560_lanes_f32: "f32", f32);

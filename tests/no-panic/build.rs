@@ -1,0 +1,19 @@
+//! The PUMA 560 with `_lanes` functions (4 states per call) and the vector `sin_cos`: options
+//! whose code the bundled `mechanisms` crate does not hold, proved here too. Not `fma`: with
+//! the `libm` crate (no std) its `fma` on x86 picks the instruction or a fallback at run time
+//! through a function pointer, an indirect call the proof cannot see through (it reports a
+//! possible panic); docs/performance.md, "Fused multiply–add".
+
+fn main() {
+    let spec = "../../mechanisms/specs/puma560.toml";
+    println!("cargo:rerun-if-changed={spec}");
+    let out = std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    codegen::build_script::Builder::new()
+        .spec(spec)
+        .math(codegen::MathBackend::Runtime("runtime".into()))
+        .lanes(Some(4))
+        .vector_sin_cos(true)
+        .out_dir(out)
+        .compile()
+        .unwrap_or_else(|e| panic!("\n{e}"));
+}

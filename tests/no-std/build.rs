@@ -1,0 +1,26 @@
+//! The PUMA 560 with `_lanes` functions (4 states per call in `f64`, 8 in `f32`), fused
+//! multiply–adds and the vector `sin_cos`: the options whose code the bundled `mechanisms`
+//! crate does not hold, linked here without std as well.
+
+fn main() {
+    let spec = "../../mechanisms/specs/puma560.toml";
+    println!("cargo:rerun-if-changed={spec}");
+    let out = std::path::PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    for (dir, lanes, float) in [
+        ("f64", 4, codegen::Float::F64),
+        ("f32", 8, codegen::Float::F32),
+    ] {
+        let dir = out.join(dir);
+        std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        codegen::build_script::Builder::new()
+            .spec(spec)
+            .math(codegen::MathBackend::Runtime("runtime".into()))
+            .float(float)
+            .fma(true)
+            .lanes(Some(lanes))
+            .vector_sin_cos(true)
+            .out_dir(&dir)
+            .compile()
+            .unwrap_or_else(|e| panic!("\n{e}"));
+    }
+}
