@@ -698,6 +698,38 @@ mod binary {
             .unwrap_or_else(|_| env!("CARGO_BIN_EXE_codegen").to_owned())
     }
 
+    /// Runs the binary in `dir` with `args` as a user would (no stdin, a 2 GB address-space
+    /// limit), its stdout and stderr to files `stdout` and `stderr` there. The status, `None`
+    /// when it ran past `cli_timeout()` and was killed, and what it wrote to stdout.
+    fn run_binary(dir: &Path, args: &[String]) -> (Option<std::process::ExitStatus>, Vec<u8>) {
+        let stdout = std::fs::File::create(dir.join("stdout")).unwrap();
+        let stderr = std::fs::File::create(dir.join("stderr")).unwrap();
+        let mut child = Command::new("sh")
+            .current_dir(dir)
+            .arg("-c")
+            .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
+            .arg(binary())
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(stdout)
+            .stderr(stderr)
+            .spawn()
+            .expect("sh runs");
+        let start = Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break Some(s);
+            }
+            if start.elapsed() > cli_timeout() {
+                let _ = child.kill();
+                let _ = child.wait();
+                break None;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        (status, std::fs::read(dir.join("stdout")).unwrap())
+    }
+
     /// SplitMix64: the few random choices of the binary runs.
     struct Rng(u64);
 
@@ -1080,33 +1112,8 @@ mod binary {
             args.push("-o".into());
             args.push(t.to_str().unwrap().into());
         }
-        let stdout = std::fs::File::create(dir.join("stdout")).unwrap();
-        let stderr = std::fs::File::create(dir.join("stderr")).unwrap();
-        let mut child = Command::new("sh")
-            .current_dir(dir)
-            .arg("-c")
-            .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
-            .arg(binary())
-            .args(&args)
-            .stdin(Stdio::null())
-            .stdout(stdout)
-            .stderr(stderr)
-            .spawn()
-            .expect("sh runs");
         tally.tried += 1;
-        let start = Instant::now();
-        let status = loop {
-            if let Some(s) = child.try_wait().unwrap() {
-                break Some(s);
-            }
-            if start.elapsed() > cli_timeout() {
-                let _ = child.kill();
-                let _ = child.wait();
-                break None;
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        };
-        let out = std::fs::read(dir.join("stdout")).unwrap();
+        let (status, out) = run_binary(dir, &args);
         let err = String::from_utf8_lossy(&std::fs::read(dir.join("stderr")).unwrap()).into_owned();
         let Some(status) = status else {
             tally.timeouts += 1;
@@ -1266,10 +1273,10 @@ mod binary {
     /// directory, the data file or the spec itself); `excite` with absurd options.
     mod data {
         use std::path::{Path, PathBuf};
-        use std::process::{Command, Stdio};
+        use std::process::Command;
         use std::time::Instant;
 
-        use super::{Rng, cli_timeout, listing};
+        use super::{Rng, listing};
 
         /// Runs (default 300, one in six of `excite`; `NOCDYN_FUZZ_DATA_CASES`).
         fn data_cases() -> usize {
@@ -1746,34 +1753,9 @@ mod binary {
                 args.push(path.to_str().unwrap().to_owned());
             }
             let before = listing(&outs);
-            let stdout = std::fs::File::create(dir.join("stdout")).unwrap();
-            let stderr = std::fs::File::create(dir.join("stderr")).unwrap();
-            let mut child = Command::new("sh")
-                .current_dir(dir)
-                .arg("-c")
-                .arg("ulimit -v 2000000 && exec \"$0\" \"$@\"")
-                .arg(super::binary())
-                .args(&args)
-                .stdin(Stdio::null())
-                .stdout(stdout)
-                .stderr(stderr)
-                .spawn()
-                .expect("sh runs");
             tally.tried += 1;
-            let start = Instant::now();
-            let status = loop {
-                if let Some(s) = child.try_wait().unwrap() {
-                    break Some(s);
-                }
-                if start.elapsed() > cli_timeout() {
-                    let _ = child.kill();
-                    let _ = child.wait();
-                    break None;
-                }
-                std::thread::sleep(std::time::Duration::from_millis(2));
-            };
-            let out =
-                String::from_utf8_lossy(&std::fs::read(dir.join("stdout")).unwrap()).into_owned();
+            let (status, out) = super::run_binary(dir, &args);
+            let out = String::from_utf8_lossy(&out).into_owned();
             let err =
                 String::from_utf8_lossy(&std::fs::read(dir.join("stderr")).unwrap()).into_owned();
             let Some(status) = status else {
