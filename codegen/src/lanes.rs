@@ -7,7 +7,7 @@
 //! operations in the same order, so lane `k` of the result is bit for bit what the scalar
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
 //! backend once per lane. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
-//! polynomial over all lanes ([`sin_cos`]), no longer bit for bit the backend's.
+//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's.
 //!
 //! Arguments and results are structures of arrays, lane last: `q: &[[f64; LANES]; DOF]`, where
 //! `q[i][k]` is coordinate `i` of state `k`, and `[[f64; LANES]; DOF]` out (a matrix
