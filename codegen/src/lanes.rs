@@ -118,8 +118,12 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             quote!(let #p = #call;)
         })
         .collect();
+    let backend = quote! {
+        #(#per_lane)*
+        (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
+    };
     let (sin_cos_doc, sin_cos, kernel) = if cfg.vector_sin_cos {
-        let (body, kernel) = sin_cos::body_and_kernel(&idx, &pairs, &per_lane);
+        let (body, kernel) = sin_cos::body_and_kernel(&idx, backend);
         (
             " `(sin, cos)` of every lane at once (a polynomial; the backend per lane beyond \
              |x| = 2¹⁹·π/2 or for a non-finite lane).",
@@ -127,14 +131,7 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             kernel,
         )
     } else {
-        (
-            " `(sin, cos)` per lane.",
-            quote! {
-                #(#per_lane)*
-                (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
-            },
-            TokenStream::new(),
-        )
+        (" `(sin, cos)` per lane.", backend, TokenStream::new())
     };
     let select = idx.iter().map(
         |i| quote!(if #real::abs(self.0[#i]) > #real::abs(b.0[#i]) { x.0[#i] } else { y.0[#i] }),

@@ -200,7 +200,8 @@ pub fn compile(
     check_options(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| error(msg, None))?;
     // What is left is a mechanism singular for every input: a platform's legs, or loops.
     let key = matches!(loaded.mechanism, spec::Mechanism::Parallel(_)).then_some("platform");
-    let mut out = generate(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| error(msg, key))?;
+    let mut out =
+        generate_checked(&loaded.mechanism, &loaded.scene, cfg).map_err(|msg| error(msg, key))?;
     out.warnings = loaded.warnings;
     Ok(out)
 }
@@ -249,8 +250,17 @@ pub fn generate(
     scene: &spec::Scene,
     cfg: &Config,
 ) -> Result<Generated, String> {
-    let single = cfg.float == Float::F32;
     check_options(mechanism, scene, cfg)?;
+    generate_checked(mechanism, scene, cfg)
+}
+
+/// [`generate`] once `cfg`'s options are known to fit the mechanism.
+fn generate_checked(
+    mechanism: &spec::Mechanism,
+    scene: &spec::Scene,
+    cfg: &Config,
+) -> Result<Generated, String> {
+    let single = cfg.float == Float::F32;
     let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         scalar::with_precision(single, || {
             fma::with(cfg.fma, || match mechanism {

@@ -50,27 +50,23 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
         module.extend(crate::lanes::items(plan.graph, cfg, &plan.functions, l));
     }
     let mut header = plan.header.clone();
-    if let Some(l) = cfg.lanes {
+    // The options are named right after the math backend (the table follows), each inserted
+    // there, so the last one inserted comes first.
+    let mut after_math_backend = |line: String| {
         let at = header
             .iter()
             .position(|h| h.starts_with("Math backend"))
             .map_or(header.len(), |i| i + 1);
-        header.insert(
-            at,
-            format!(
-                "Lanes: {l} states per call in the `_lanes` functions ({}).",
-                crate::lanes::FUNCTIONS.join(", ")
-            ),
-        );
+        header.insert(at, line);
+    };
+    if let Some(l) = cfg.lanes {
+        after_math_backend(format!(
+            "Lanes: {l} states per call in the `_lanes` functions ({}).",
+            crate::lanes::FUNCTIONS.join(", ")
+        ));
     }
     if cfg.fma {
-        // Named right after the math backend (the table follows).
-        let at = header
-            .iter()
-            .position(|h| h.starts_with("Math backend"))
-            .map_or(header.len(), |i| i + 1);
-        header.insert(
-            at,
+        after_math_backend(
             "Fused multiply–add: on (`mul_add`, one rounding; `fma` column: each is 2 flops)."
                 .into(),
         );

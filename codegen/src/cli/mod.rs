@@ -351,21 +351,11 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     Ok((lo, hi))
 }
 
-/// Write `text` to the output file `path` as `codegen::build_script::write_if_changed` does (a
-/// temporary file renamed into place, untouched when equal), except that a device, FIFO or
-/// socket (`/dev/stdout`, `/dev/full`, a named pipe) is only written into: the comparison with
-/// the old content read such a target first, without end (`/dev/zero`, `/dev/full`: memory
-/// until the process was killed) or waiting on itself (`/dev/stdout` into a pipe).
+/// Write `text` to the output file `path` (`codegen::build_script::write_if_changed`: a
+/// temporary file renamed into place, untouched when equal; a device, FIFO or socket such as
+/// `/dev/stdout`, `/dev/full` or a named pipe only written into, never read first), the error
+/// as its message.
 pub fn write_output(path: &std::path::Path, text: &str) -> Result<(), String> {
-    use std::io::Write;
-    let special = std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir());
-    if special {
-        return std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .and_then(|mut f| f.write_all(text.as_bytes()))
-            .map_err(|e| format!("{}: {e}", path.display()));
-    }
     codegen::build_script::write_if_changed(path, text).map_err(|e| e.to_string())
 }
 

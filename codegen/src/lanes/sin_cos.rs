@@ -19,7 +19,7 @@
 //! where `|sin|` or `|cos| ≥ 2⁻²⁰`; near their zeros the reduction's error dominates, absolute
 //! (within 2⁻⁵³), not relative. Not bit for bit the backend's: an option of its own.
 
-use proc_macro2::{Ident, Literal, TokenStream};
+use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use crate::emit;
@@ -27,13 +27,10 @@ use crate::emit;
 /// The largest `|x|` the reduction takes: `2¹⁹·π/2` rounded down.
 const RANGE: f64 = 823_549.0;
 
-/// The body of `Lanes::sin_cos` (`self` is the `Lanes`) and, after it, the per-lane kernel
+/// The body of `Lanes::sin_cos` (`self` is the `Lanes`; `backend` the body that calls the math
+/// backend per lane, for lanes out of range) and, after it, the per-lane kernel
 /// `lane_sin_cos(x: f64) -> (f64, f64)` as a module item.
-pub(super) fn body_and_kernel(
-    idx: &[Literal],
-    pairs: &[Ident],
-    per_lane: &[TokenStream],
-) -> (TokenStream, TokenStream) {
+pub(super) fn body_and_kernel(idx: &[Literal], backend: TokenStream) -> (TokenStream, TokenStream) {
     let real = emit::real();
     // An `f32` lane is widened to `f64` and rounded back; an `f64` one needs no cast.
     let (widen, narrow) = if crate::scalar::single() {
@@ -56,8 +53,7 @@ pub(super) fn body_and_kernel(
             }
             (Lanes(s), Lanes(c))
         } else {
-            #(#per_lane)*
-            (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
+            #backend
         }
     };
     let kernel = quote! {
