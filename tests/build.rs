@@ -153,7 +153,10 @@ fn main() {
     let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
-    generate(&out, "gs_params", &p, |_| {});
+    // With the `Dynamics` impl: `tests/tests/implement.rs` reads its frames through the trait.
+    generate(&out, "gs_params", &p, |b| {
+        b.implement("runtime");
+    });
     let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
     let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_GS));
     let p = write(&out, "gs_inertia", &src);
@@ -167,7 +170,9 @@ fn main() {
     let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_CLOSED}");
     let p = write(&out, "closed_params", &src);
-    generate(&out, "closed_params", &p, |_| {});
+    generate(&out, "closed_params", &p, |b| {
+        b.implement("runtime");
+    });
     let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
     let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_CLOSED));
     let p = write(&out, "closed_inertia", &src);

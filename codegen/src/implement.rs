@@ -14,14 +14,17 @@
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::quote;
 
+use crate::spec::frame_ident;
 use crate::spec::{Kind, Mechanism, Scene};
 
-/// The functions every implementing module must have (a tree has identities for the rest).
-const NEEDED: [&str; 4] = [
+/// The functions every implementing module must have (a tree has identities for the rest;
+/// the kinematics the others always emit are not listed).
+const NEEDED: [&str; 5] = [
     "mass_matrix",
     "inverse_dynamics",
     "forward_dynamics",
     "actuator_mass_matrix",
+    "actuator_rates",
 ];
 
 /// `Err` when `scene` leaves out a function the trait needs (with `implement` set).
@@ -32,6 +35,8 @@ pub(crate) fn check(mechanism: &Mechanism, scene: &Scene) -> Result<(), String> 
         // A tree's `actuator_mass_matrix` is its `mass_matrix`; closed loops emit it with
         // `mass_matrix`.
         .filter(|f| !(*f == "actuator_mass_matrix" && kind != Kind::Parallel))
+        // A tree's `actuator_rates` is the identity; closed loops always emit it.
+        .filter(|f| !(*f == "actuator_rates" && kind != Kind::Parallel))
         .filter(|f| !scene.functions.wants(kind, f))
         .collect();
     if missing.is_empty() {
@@ -61,6 +66,8 @@ struct Items {
     fns: Vec<(String, Callee)>,
     consts: Vec<String>,
     types: Vec<String>,
+    /// The values of `FRAME_NAMES` (the frames' names as the spec writes them).
+    frames: Vec<String>,
 }
 
 impl Items {
@@ -73,6 +80,7 @@ impl Items {
             fns: Vec::new(),
             consts: Vec::new(),
             types: Vec::new(),
+            frames: Vec::new(),
         };
         let public = |v: &syn::Visibility| matches!(v, syn::Visibility::Public(_));
         for item in &file.items {
@@ -90,7 +98,12 @@ impl Items {
                         .fns
                         .push((f.sig.ident.to_string(), Callee { fallible, params }));
                 }
-                syn::Item::Const(c) if public(&c.vis) => items.consts.push(c.ident.to_string()),
+                syn::Item::Const(c) if public(&c.vis) => {
+                    if c.ident == "FRAME_NAMES" {
+                        items.frames = string_literals(&c.expr);
+                    }
+                    items.consts.push(c.ident.to_string());
+                }
                 syn::Item::Struct(s) if public(&s.vis) => items.types.push(s.ident.to_string()),
                 _ => {}
             }
@@ -100,6 +113,24 @@ impl Items {
 
     fn function(&self, name: &str) -> Option<&Callee> {
         self.fns.iter().find(|(n, _)| n == name).map(|(_, c)| c)
+    }
+}
+
+/// The string literals of an array expression (`["a", "b"]`).
+fn string_literals(e: &syn::Expr) -> Vec<String> {
+    match e {
+        syn::Expr::Array(a) => a
+            .elems
+            .iter()
+            .filter_map(|e| match e {
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Str(s),
+                    ..
+                }) => Some(s.value()),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
     }
 }
 
@@ -218,6 +249,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             ) -> Option<Result<([[#real; DOF]; DOF], [[#real; DOF]; DOF], [[#real; DOF]; DOF]), Singular>>
         },
     );
+    let frames = calls.frames(&real, &nx);
     quote! {
         #module_struct
         impl #runtime::Dynamics<#nx, DOF> for Module {
@@ -267,6 +299,7 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             #friction
             #id_derivatives
             #fd_derivatives
+            #frames
         }
     }
 }
@@ -362,6 +395,73 @@ impl Calls<'_> {
         }
     }
 
+    /// `FRAME_NAMES` and the frame methods, each a `match` over the frames' indices calling
+    /// frame `F`'s function (`F` the name in lower snake case, [`frame_ident`]): the pose
+    /// `F_pose_at` (closed loops, at `x`) or `F_pose`, `F_jacobian`, and `F_jacobian_dot_qd`
+    /// (trees) or `F_jacobian_dot_u` (platforms); `None` for an index out of range or a
+    /// function the module does not have. Nothing without frames (the trait's defaults).
+    fn frames(&self, real: &Ident, nx: &TokenStream) -> TokenStream {
+        if self.items.frames.is_empty() {
+            return quote!();
+        }
+        let arms = |suffixes: &[&str], args: TokenStream| -> Vec<TokenStream> {
+            let mut arms = Vec::new();
+            for (i, name) in self.items.frames.iter().enumerate() {
+                let f = frame_ident(name);
+                let call = suffixes
+                    .iter()
+                    .find_map(|s| self.call(&format!("{f}_{s}"), args.clone()));
+                if let Some(call) = call {
+                    let i = proc_macro2::Literal::usize_unsuffixed(i);
+                    arms.push(quote!(#i => Some(#call),));
+                }
+            }
+            arms
+        };
+        let method = |arms: Vec<TokenStream>, sig: TokenStream| {
+            if arms.is_empty() {
+                quote!()
+            } else {
+                quote! {
+                    #sig {
+                        match frame {
+                            #(#arms)*
+                            _ => None,
+                        }
+                    }
+                }
+            }
+        };
+        let pose = method(
+            arms(&["pose_at", "pose"], quote!(x)),
+            quote! {
+                #[allow(clippy::type_complexity)]
+                fn frame_pose(&self, frame: usize, x: &[#real; #nx])
+                    -> Option<Result<([[#real; 3]; 3], [#real; 3]), Singular>>
+            },
+        );
+        let jacobian = method(
+            arms(&["jacobian"], quote!(x)),
+            quote! {
+                fn frame_jacobian(&self, frame: usize, x: &[#real; #nx])
+                    -> Option<Result<[[#real; DOF]; 6], Singular>>
+            },
+        );
+        let jacobian_dot = method(
+            arms(&["jacobian_dot_qd", "jacobian_dot_u"], quote!(x, u)),
+            quote! {
+                fn frame_jacobian_dot(&self, frame: usize, x: &[#real; #nx], u: &[#real; DOF])
+                    -> Option<Result<[#real; 6], Singular>>
+            },
+        );
+        quote! {
+            const FRAME_NAMES: &'static [&'static str] = &FRAME_NAMES;
+            #pose
+            #jacobian
+            #jacobian_dot
+        }
+    }
+
     /// The method `sig` returning `Some(f(args))` where the module has `f`, else nothing (the
     /// trait's default, `None`).
     fn optional(&self, f: &str, args: TokenStream, sig: TokenStream) -> TokenStream {
@@ -414,5 +514,27 @@ axis = [0.0, 1.0, 0.0]
         let code = compile("").expect("the default scene has every function");
         assert!(code.contains("impl runtime::Dynamics<DOF, DOF> for Module"));
         assert!(code.contains("const NAME: &'static str = \"pendulum\";"));
+    }
+
+    /// A platform without `actuator_rates` (which the impl calls) is refused at the scene, not
+    /// with an internal error while generating.
+    #[test]
+    fn a_platform_without_actuator_rates_is_refused() {
+        let spec = include_str!("../../mechanisms/specs/planar_five_bar.toml");
+        let cfg = crate::Config {
+            implement: Some("runtime".into()),
+            ..crate::Config::default()
+        };
+        let scene = "[scene]\nfunctions = [\"inverse_dynamics\", \"mass_matrix\", \"actuator_mass_matrix\", \"forward_dynamics\"]\n\n[mechanism]";
+        let src = spec.replacen("[mechanism]", scene, 1);
+        let err = crate::compile("f.toml", &src, &cfg)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("needs `actuator_rates`"), "{err}");
+        let src = src.replace(
+            "\"forward_dynamics\"]",
+            "\"forward_dynamics\", \"actuator_rates\"]",
+        );
+        assert!(crate::compile("f.toml", &src, &cfg).is_ok());
     }
 }

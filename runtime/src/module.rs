@@ -99,6 +99,53 @@ pub trait Dynamics<const NX: usize, const DOF: usize> {
         tau: &[Self::Scalar; DOF],
     ) -> Result<[Self::Scalar; DOF], Self::Singular>;
 
+    /// The names of the frames whose kinematics the module offers (its `FRAME_NAMES`, as the
+    /// spec writes them; `[scene] frames`), in the order of the `frame` argument of
+    /// [`Dynamics::frame_pose`], [`Dynamics::frame_jacobian`] and
+    /// [`Dynamics::frame_jacobian_dot`]. Empty for a module without frames.
+    const FRAME_NAMES: &'static [&'static str] = &[];
+
+    /// The pose of frame `FRAME_NAMES[frame]` at `x`: the rotation base ← frame and the
+    /// frame's origin in the base frame (its `F_pose`; a closed loop's `F_pose_at`, at the
+    /// tree joint positions `x`). `None` when `frame` is out of range. A tree's and a closed
+    /// loop's cannot fail (`Ok`); a platform's fails where its pose does.
+    #[allow(clippy::type_complexity)]
+    fn frame_pose(
+        &self,
+        frame: usize,
+        x: &[Self::Scalar; NX],
+    ) -> Option<Result<([[Self::Scalar; 3]; 3], [Self::Scalar; 3]), Self::Singular>> {
+        let _ = (frame, x);
+        None
+    }
+
+    /// The Jacobian of frame `FRAME_NAMES[frame]` at `x` (its `F_jacobian`): the map of the
+    /// speeds `u` to the frame's twist `[ω; v]`, angular first, both in base-frame components,
+    /// `v` the velocity of the frame's origin. `None` when `frame` is out of range, and for
+    /// closed loops (which offer poses only).
+    #[allow(clippy::type_complexity)]
+    fn frame_jacobian(
+        &self,
+        frame: usize,
+        x: &[Self::Scalar; NX],
+    ) -> Option<Result<[[Self::Scalar; DOF]; 6], Self::Singular>> {
+        let _ = (frame, x);
+        None
+    }
+
+    /// `J̇ u` of frame `FRAME_NAMES[frame]` at `(x, u)` (a tree's `F_jacobian_dot_qd`, a
+    /// platform's `F_jacobian_dot_u`), so that the frame's classical acceleration is
+    /// `[ω̇; p̈] = J u̇ + J̇ u`. `None` as for [`Dynamics::frame_jacobian`].
+    fn frame_jacobian_dot(
+        &self,
+        frame: usize,
+        x: &[Self::Scalar; NX],
+        u: &[Self::Scalar; DOF],
+    ) -> Option<Result<[Self::Scalar; 6], Self::Singular>> {
+        let _ = (frame, x, u);
+        None
+    }
+
     /// Closed loops: every joint's rate `ẋ = S u` (`joint_rates`). `None` elsewhere.
     fn joint_rates(
         &self,

@@ -1,6 +1,8 @@
 //! The PUMA 560 with `_lanes` functions (4 states per call in `f64`, 8 in `f32`), fused
 //! multiply–adds and the vector `sin_cos`: the options whose code the bundled `mechanisms`
-//! crate does not hold, linked here without std as well.
+//! crate does not hold, linked here without std as well; and a platform and a closed loop with
+//! frames (the bundled specs have none) and the `Dynamics` impl, whose frames `lib.rs` reads
+//! through the trait.
 
 fn main() {
     let spec = "../../mechanisms/specs/puma560.toml";
@@ -19,6 +21,35 @@ fn main() {
             .fma(true)
             .lanes(Some(lanes))
             .vector_sin_cos(true)
+            .out_dir(&dir)
+            .compile()
+            .unwrap_or_else(|e| panic!("\n{e}"));
+    }
+    let dir = out.join("frames");
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    for (spec, functions) in [
+        (
+            "gough_stewart",
+            r#""inverse_dynamics", "mass_matrix", "actuator_mass_matrix", "forward_dynamics", "actuator_rates""#,
+        ),
+        (
+            "tripod_3prs",
+            r#""inverse_dynamics", "mass_matrix", "forward_dynamics""#,
+        ),
+    ] {
+        let path = format!("../../mechanisms/specs/{spec}.toml");
+        println!("cargo:rerun-if-changed={path}");
+        let src = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let scene = format!(
+            "[scene]\nframes = [\"platform\"]\nfunctions = [{functions}, \"frames\"]\n\n[mechanism]"
+        );
+        let file = dir.join(format!("{spec}.toml"));
+        codegen::build_script::write_if_changed(&file, &src.replacen("[mechanism]", &scene, 1))
+            .unwrap_or_else(|e| panic!("{e}"));
+        codegen::build_script::Builder::new()
+            .spec(&file)
+            .math(codegen::MathBackend::Runtime("runtime".into()))
+            .implement("runtime")
             .out_dir(&dir)
             .compile()
             .unwrap_or_else(|e| panic!("\n{e}"));

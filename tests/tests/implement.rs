@@ -1,6 +1,9 @@
 //! The `Dynamics` impl of a generated module (`codegen::Config::implement`) agrees with the
 //! module's free functions, bit for bit, on states whose inputs all differ (so a swapped or
-//! dropped argument in the forwarding changes a result): one module of each kind.
+//! dropped argument in the forwarding changes a result): one module of each kind, and the
+//! frames through the trait (`frame_pose`, `frame_jacobian`, `frame_jacobian_dot`), frame `i`
+//! the free functions of `FRAME_NAMES[i]`, on modules with two frames each (so a swapped index
+//! changes a result).
 
 use mechanisms::Dynamics;
 
@@ -136,4 +139,91 @@ fn closed_agrees() {
         Some(g::joint_rates(&open, &[1.0]))
     );
     assert!(g::joint_rates(&open, &[1.0]).is_err());
+}
+
+#[test]
+fn tree_frames_agree() {
+    use mechanisms::planar_2r as g;
+    let m = g::Module;
+    assert_eq!(
+        <g::Module as Dynamics<2, 2>>::FRAME_NAMES,
+        &g::FRAME_NAMES[..]
+    );
+    assert_eq!(g::FRAME_NAMES, ["link2"]);
+    for s in [0.5, 1.0, 2.0] {
+        let (q, qd) = (distinct(0, s), distinct(1, s));
+        assert_eq!(m.frame_pose(0, &q), Some(Ok(g::link2_pose(&q))));
+        assert_eq!(m.frame_jacobian(0, &q), Some(Ok(g::link2_jacobian(&q))));
+        assert_eq!(
+            m.frame_jacobian_dot(0, &q, &qd),
+            Some(Ok(g::link2_jacobian_dot_qd(&q, &qd)))
+        );
+        assert_ne!(
+            m.frame_jacobian_dot(0, &q, &qd),
+            m.frame_jacobian_dot(0, &qd, &q)
+        );
+        assert_eq!(m.frame_pose(1, &q), None);
+        assert_eq!(m.frame_jacobian(1, &q), None);
+        assert_eq!(m.frame_jacobian_dot(1, &q, &qd), None);
+    }
+    // A module without frames has the trait's defaults.
+    use mechanisms::gough_stewart as gs;
+    assert!(<gs::Module as Dynamics<{ gs::NX }, { gs::DOF }>>::FRAME_NAMES.is_empty());
+    assert_eq!(gs::Module.frame_pose(0, &gs::HOME), None);
+}
+
+#[test]
+fn platform_frames_agree() {
+    use tests::variants::gs_params as g;
+    const NX: usize = g::NX;
+    const N: usize = g::DOF;
+    let m = g::Module(g::Params::DEFAULT);
+    assert_eq!(
+        <g::Module as Dynamics<NX, N>>::FRAME_NAMES,
+        ["platform", "tool"]
+    );
+    let mut x = g::HOME;
+    x[0] += 0.02;
+    x[3..7].copy_from_slice(&[0.05f64.cos(), 0.05f64.sin() * 0.6, 0.05f64.sin() * 0.8, 0.0]);
+    let u = distinct::<N>(1, 0.1);
+    assert_eq!(m.frame_pose(0, &x), Some(g::platform_pose(&x)));
+    assert_eq!(m.frame_pose(1, &x), Some(g::tool_pose(&x)));
+    assert_ne!(m.frame_pose(0, &x), m.frame_pose(1, &x));
+    assert_eq!(m.frame_jacobian(0, &x), Some(g::platform_jacobian(&x)));
+    assert_eq!(m.frame_jacobian(1, &x), Some(g::tool_jacobian(&x)));
+    assert_eq!(
+        m.frame_jacobian_dot(0, &x, &u),
+        Some(g::platform_jacobian_dot_u(&x, &u))
+    );
+    assert_eq!(
+        m.frame_jacobian_dot(1, &x, &u),
+        Some(g::tool_jacobian_dot_u(&x, &u))
+    );
+    assert!(m.frame_jacobian_dot(1, &x, &u).unwrap().is_ok());
+    assert_eq!(m.frame_pose(2, &x), None);
+    // A platform's frame fails where its pose does (a zero quaternion), as the free function.
+    let mut bad = x;
+    bad[3..7].copy_from_slice(&[0.0; 4]);
+    assert!(g::tool_pose(&bad).is_err());
+    assert_eq!(m.frame_pose(1, &bad), Some(g::tool_pose(&bad)));
+}
+
+#[test]
+fn closed_frames_agree() {
+    use tests::variants::closed_params as g;
+    const NX: usize = g::NX;
+    const N: usize = g::DOF;
+    let m = g::Module(g::Params::DEFAULT);
+    assert_eq!(
+        <g::Module as Dynamics<NX, N>>::FRAME_NAMES,
+        ["distal_a", "proximal_b"]
+    );
+    // The poses at the joint positions `x` (no closure check), the Jacobians not offered.
+    let x = distinct::<NX>(0, 1.0);
+    assert_eq!(m.frame_pose(0, &x), Some(Ok(g::distal_a_pose_at(&x))));
+    assert_eq!(m.frame_pose(1, &x), Some(Ok(g::proximal_b_pose_at(&x))));
+    assert_ne!(m.frame_pose(0, &x), m.frame_pose(1, &x));
+    assert_eq!(m.frame_pose(2, &x), None);
+    assert_eq!(m.frame_jacobian(0, &x), None);
+    assert_eq!(m.frame_jacobian_dot(0, &x, &[0.1; N]), None);
 }

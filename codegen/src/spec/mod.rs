@@ -41,6 +41,7 @@ use crate::diag::{Diagnostic, Diagnostics};
 
 pub use fix::apply_fixes;
 pub use frames::Frame;
+pub(crate) use frames::frame_ident;
 pub use function::{Function, FunctionSet, Kind};
 pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use input::{

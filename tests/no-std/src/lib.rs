@@ -1,7 +1,8 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
 //! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
-//! generated with `lanes`, `fma` and `vector_sin_cos` (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! generated with `lanes`, `fma` and `vector_sin_cos`, and of a platform and a closed loop with
+//! frames read through the `Dynamics` trait (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
@@ -198,3 +199,56 @@ macro_rules! export_lanes {
 }
 
 export_lanes!(puma560_lanes: "f64", f64; puma560_lanes_f32: "f32", f32);
+
+/// A platform and a closed loop with a frame on the platform (`build.rs`), every frame read
+/// through the `Dynamics` trait.
+pub mod frames {
+    use runtime::Dynamics;
+
+    /// The Gough–Stewart platform with `frames = ["platform"]`.
+    pub mod gough_stewart {
+        include!(concat!(env!("OUT_DIR"), "/frames/gough_stewart.rs"));
+    }
+    /// The 3-PRS tripod in joint coordinates with `frames = ["platform"]`.
+    pub mod tripod_3prs {
+        include!(concat!(env!("OUT_DIR"), "/frames/tripod_3prs.rs"));
+    }
+
+    /// Every frame's pose, Jacobian and `J̇ u` (where the module offers them); a checksum.
+    fn frames<M, const NX: usize, const DOF: usize>(m: &M, x: &[f64; NX], u: &[f64; DOF]) -> f64
+    where
+        M: Dynamics<NX, DOF, Scalar = f64>,
+    {
+        let mut s = 0.0;
+        for i in 0..M::FRAME_NAMES.len() {
+            if let Some(Ok((r, p))) = m.frame_pose(i, x) {
+                s += r[0][0] + p[2];
+            }
+            if let Some(Ok(j)) = m.frame_jacobian(i, x) {
+                s += j[5][0];
+            }
+            if let Some(Ok(d)) = m.frame_jacobian_dot(i, x, u) {
+                s += d[3];
+            }
+        }
+        s + m.inverse_dynamics(x, u, u).map_or(0.0, |t| t[0])
+    }
+
+    /// The Gough–Stewart platform's frames.
+    #[unsafe(no_mangle)]
+    pub extern "C" fn gough_stewart_frames(
+        x: &[f64; gough_stewart::NX],
+        u: &[f64; gough_stewart::DOF],
+    ) -> f64 {
+        frames(&gough_stewart::Module, x, u)
+    }
+
+    /// The 3-PRS tripod's frames.
+    #[unsafe(no_mangle)]
+    pub extern "C" fn tripod_3prs_frames(
+        x: &[f64; tripod_3prs::NX],
+        u: &[f64; tripod_3prs::DOF],
+    ) -> f64 {
+        frames(&tripod_3prs::Module, x, u)
+    }
+}
