@@ -532,3 +532,7 @@ mod closed;
 // Bad input found by driving the binary by hand (hangs, panics, NaN, overwritten inputs).
 #[path = "cli_identify/abuse.rs"]
 mod abuse;
+
+// `--out` on what the spec update writes beyond bodies: a Delta's rods.
+#[path = "cli_identify/out.rs"]
+mod out;

@@ -412,7 +412,7 @@ fn write_update(
     );
     if !up.unreachable.is_empty() {
         eprintln!(
-            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a massless body the loader adds (a U joint's cross), a parallelogram's rods, or a drive",
+            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a massless body the loader adds (a U joint's cross), what a parallelogram's symmetric rods cannot have (a first moment across them, products of inertia), or a drive",
             if up.unreachable.len() == 1 { "" } else { "s" },
             up.unreachable
                 .iter()

@@ -15,9 +15,10 @@
 //! A platform's legs are usually one `[[pattern]]` whose bodies every copy shares: their
 //! unknowns are per copy (the values the spec's text gives each copy, patterns expanded), and a
 //! changed pattern body is written as expressions indexing per-copy arrays that the update adds
-//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). Base parameters that no written
-//! number moves (a massless U joint's cross, a parallelogram's rods) keep the spec's values and
-//! are reported.
+//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). A parallelogram's rods are
+//! three numbers per entry (or copy), linear in their body's standard parameters
+//! ([`rods`]). Base parameters that no written number moves (a massless U joint's cross alone)
+//! keep the spec's values and are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
@@ -28,6 +29,8 @@ use super::regressor::Regressor;
 
 mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
+mod rods;
+use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -54,6 +57,9 @@ enum Unknown {
         copy: usize,
         key: &'static str,
     },
+    /// Linear rod parameter `k` (`M`, `H`, `J`: [`rods`]) of copy `copy` (from 1; 1 for a
+    /// top-level entry) of the parallelogram entry `at`.
+    Rods { at: RodsAt, copy: usize, k: usize },
 }
 
 /// The outcome of an update.
@@ -226,8 +232,16 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     let mut copies: std::collections::BTreeMap<(usize, usize), Copies> = Default::default();
     type Drives = std::collections::BTreeMap<usize, f64>;
     let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
+    type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
+    let mut rods: std::collections::BTreeMap<RodsAt, Rods> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::Rods { at, copy, k } => {
+                rods.entry(*at)
+                    .or_default()
+                    .entry(*copy)
+                    .or_insert([0.0; 3])[*k] = v
+            }
             Unknown::CopyDrive {
                 pattern,
                 joint,
@@ -290,6 +304,10 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     for ((pattern, joint, key), c) in drives {
         let c: Vec<f64> = c.into_values().collect();
         patterns::set_copy_drives(&mut d, pattern, joint, key, &c)?;
+    }
+    for (at, c) in rods {
+        let c: Vec<[f64; 3]> = c.into_values().collect();
+        set_rods(&mut d, at, &c)?;
     }
     Ok(d)
 }
@@ -380,6 +398,14 @@ pub fn update(
             &mut names,
             &mut skipped,
         );
+        rod_unknowns(
+            &doc,
+            &written,
+            &mut unknowns,
+            &mut z0,
+            &mut names,
+            &mut skipped,
+        );
     }
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
@@ -401,6 +427,9 @@ pub fn update(
                 0 | 3 | 5 | 9 => 1.0,
                 _ => 0.0,
             };
+        }
+        if let Unknown::Rods { k, .. } = u {
+            *r = rods::REFERENCE[*k];
         }
     }
     let ref_doc = apply(&doc, &unknowns, &reference)?;
@@ -465,6 +494,7 @@ pub fn update(
     let written = base_of(reg, file, &text)?;
     let mut violations = consistency(&out, &unknowns, &p);
     violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
+    violations.extend(rods_consistency(&unknowns, &z, &names, &changed, &p));
     Ok(Update {
         text,
         written,

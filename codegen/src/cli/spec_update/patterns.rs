@@ -71,7 +71,10 @@ pub(super) fn set_copies(
 }
 
 /// Per-copy arrays into `[parameters]` (made if absent).
-fn put_arrays(d: &mut DocumentMut, arrays: Vec<(String, Vec<f64>)>) -> Result<(), String> {
+pub(super) fn put_arrays(
+    d: &mut DocumentMut,
+    arrays: Vec<(String, Vec<f64>)>,
+) -> Result<(), String> {
     if !d.contains_key("parameters") {
         d["parameters"] = Item::Table(toml_edit::Table::new());
     }
@@ -89,7 +92,7 @@ fn put_arrays(d: &mut DocumentMut, arrays: Vec<(String, Vec<f64>)>) -> Result<()
 }
 
 /// The `identified_<stem>` prefix of a pattern entry's arrays.
-fn stem(template: &str) -> String {
+pub(super) fn stem(template: &str) -> String {
     let s: String = template
         .replace("{i}", "")
         .chars()
