@@ -427,7 +427,7 @@ fn bad_input_is_exit_code_2_without_a_panic() {
             "../mechanisms/specs/iiwa14.urdf",
             "x.csv",
             "--out",
-            "y.toml",
+            "y.toml", // the update of a URDF is a URDF
         ],
         vec!["identify", PUMA, "x.csv", "--weights", "heavy"],
     ] {

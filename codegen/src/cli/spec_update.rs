@@ -31,6 +31,8 @@ mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
 mod rods;
 use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
+mod urdf;
+mod xml_scan;
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -314,23 +316,26 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
 
 /// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
 fn base_of(reg: &Regressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
-    reg.base_of_spec(file, text)
+    reg.base_of_spec(file, text, None)
 }
 
-/// The update of `source` whose model has base parameters `target` where `fit[k]` (elsewhere
-/// the spec's).
+/// A URDF as the loader tells one: by its name, or an XML text (`robot.xml`).
+pub fn is_urdf(file: &str, source: &str) -> bool {
+    file.to_ascii_lowercase().ends_with(".urdf") || source.trim_start().starts_with('<')
+}
+
+/// The update of `source` (a TOML spec, or a URDF with its scene file `sidecar`) whose model
+/// has base parameters `target` where `fit[k]` (elsewhere the spec's).
 pub fn update(
     reg: &Regressor,
     file: &str,
     source: &str,
+    sidecar: Option<&codegen::spec::SceneFile>,
     target: &[f64],
     fit: &[bool],
 ) -> Result<Update, String> {
-    if file.ends_with(".urdf") {
-        return Err(
-            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
-                .into(),
-        );
+    if is_urdf(file, source) {
+        return urdf::update(reg, file, source, sidecar, target, fit);
     }
     let doc: DocumentMut = source
         .parse()
@@ -418,69 +423,24 @@ pub fn update(
         ));
     }
     // The columns of P: each unknown moved from a reference point where every body is valid.
-    let nbp = reg.nbp();
-    let mut p = DMatrix::zeros(nbp, unknowns.len());
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
         if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } = u {
-            *r = match k {
-                0 | 3 | 5 | 9 => 1.0,
-                _ => 0.0,
-            };
+            *r = REFERENCE[*k];
         }
         if let Unknown::Rods { k, .. } = u {
             *r = rods::REFERENCE[*k];
         }
     }
-    let ref_doc = apply(&doc, &unknowns, &reference)?;
-    let pi_ref = base_of(reg, file, &ref_doc.to_string())?;
-    for c in 0..unknowns.len() {
-        let mut z = reference.clone();
-        z[c] += 1.0;
-        let d = apply(&doc, &unknowns, &z)?;
-        let pi = base_of(reg, file, &d.to_string())?;
-        for r in 0..nbp {
-            p[(r, c)] = pi[r] - pi_ref[r];
-        }
-    }
-    // Rounding noise of the differences (the exact entries are sums of grouping coefficients).
-    let pmax = p.amax();
-    p.apply(|x| {
-        if x.abs() <= 1e-12 * pmax {
-            *x = 0.0
-        }
-    });
-    let unreachable: Vec<usize> = (0..nbp)
-        .filter(|&r| p.row(r).iter().all(|x| *x == 0.0))
-        .collect();
-    let d = DVector::from_fn(nbp, |k, _| {
-        if fit[k] && !unreachable.contains(&k) {
-            target[k] - pi0[k]
-        } else {
-            0.0
-        }
-    });
-    let dz = p
-        .clone()
-        .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
-        .map_err(|e| format!("error: the update's least squares failed: {e}"))?
-        * d;
-    // An unknown that moves no base parameter stays as written (the SVD leaves rounding
-    // noise there).
-    let mut dz = dz;
-    for c in 0..unknowns.len() {
-        if p.column(c).iter().all(|x| *x == 0.0) {
-            dz[c] = 0.0;
-        }
-    }
-    let z: Vec<f64> = z0.iter().zip(dz.iter()).map(|(a, b)| a + b).collect();
-    let mut changed: Vec<String> = Vec::new();
-    let largest = dz.amax();
-    for (c, name) in names.iter().enumerate() {
-        if dz[c].abs() > 1e-13 * largest && !changed.contains(name) {
-            changed.push(name.clone());
-        }
-    }
+    let Change {
+        p,
+        z,
+        dz,
+        unreachable,
+    } = minimum_norm_change(reg.nbp(), &z0, &reference, &pi0, target, fit, &mut |z| {
+        base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string())
+    })?;
+    let changed = changed_names(&names, &dz);
     // Only the entries that change are rewritten; the others keep their text.
     let touched: Vec<usize> = (0..unknowns.len())
         .filter(|&c| changed.contains(&names[c]))
@@ -503,6 +463,96 @@ pub fn update(
         changed,
         unreachable,
     })
+}
+
+/// A body's standard parameters at the reference point of the update's columns: unit mass and
+/// unit principal moments about the origin (a valid body; one unit more on any is one too).
+const REFERENCE: [f64; 10] = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+
+/// The minimum-norm change of the unknowns and the map it was found on.
+struct Change {
+    /// `P`: base parameters per unit of each unknown.
+    p: DMatrix<f64>,
+    /// The unknowns changed.
+    z: Vec<f64>,
+    /// The change.
+    dz: DVector<f64>,
+    /// The base parameters that no unknown moves.
+    unreachable: Vec<usize>,
+}
+
+/// The base parameters of the spec with its unknowns set to the values given.
+type BaseOf<'a> = dyn FnMut(&[f64]) -> Result<Vec<f64>, String> + 'a;
+
+/// `Δ = P⁺ (π̂ − π0)` over the `fit` base parameters, `P` by moving each unknown by one from
+/// `reference` (`base` gives the base parameters of the spec with the unknowns set).
+fn minimum_norm_change(
+    nbp: usize,
+    z0: &[f64],
+    reference: &[f64],
+    pi0: &[f64],
+    target: &[f64],
+    fit: &[bool],
+    base: &mut BaseOf<'_>,
+) -> Result<Change, String> {
+    let mut p = DMatrix::zeros(nbp, z0.len());
+    let pi_ref = base(reference)?;
+    for c in 0..z0.len() {
+        let mut z = reference.to_vec();
+        z[c] += 1.0;
+        let pi = base(&z)?;
+        for r in 0..nbp {
+            p[(r, c)] = pi[r] - pi_ref[r];
+        }
+    }
+    // Rounding noise of the differences (the exact entries are sums of grouping coefficients).
+    let pmax = p.amax();
+    p.apply(|x| {
+        if x.abs() <= 1e-12 * pmax {
+            *x = 0.0
+        }
+    });
+    let unreachable: Vec<usize> = (0..nbp)
+        .filter(|&r| p.row(r).iter().all(|x| *x == 0.0))
+        .collect();
+    let d = DVector::from_fn(nbp, |k, _| {
+        if fit[k] && !unreachable.contains(&k) {
+            target[k] - pi0[k]
+        } else {
+            0.0
+        }
+    });
+    let mut dz = p
+        .clone()
+        .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
+        .map_err(|e| format!("error: the update's least squares failed: {e}"))?
+        * d;
+    // An unknown that moves no base parameter stays as written (the SVD leaves rounding
+    // noise there).
+    for c in 0..z0.len() {
+        if p.column(c).iter().all(|x| *x == 0.0) {
+            dz[c] = 0.0;
+        }
+    }
+    let z: Vec<f64> = z0.iter().zip(dz.iter()).map(|(a, b)| a + b).collect();
+    Ok(Change {
+        p,
+        z,
+        dz,
+        unreachable,
+    })
+}
+
+/// The names (bodies, joints, entries) whose unknowns change.
+fn changed_names(names: &[String], dz: &DVector<f64>) -> Vec<String> {
+    let mut changed: Vec<String> = Vec::new();
+    let largest = dz.amax();
+    for (c, name) in names.iter().enumerate() {
+        if dz[c].abs() > 1e-13 * largest && !changed.contains(name) {
+            changed.push(name.clone());
+        }
+    }
+    changed
 }
 
 /// The bodies of `doc` whose numbers break positive mass, a positive definite inertia or the

@@ -82,3 +82,250 @@ fn delta_out_writes_rods_and_reproduces_every_base_parameter() {
     );
     assert!(id_err <= 1e-9, "{id_err:e}");
 }
+
+/// The URDF's numbers moved in its text: every `<mass value>` and `<inertia …>` (scaled whole)
+/// by `f()`, each `<inertial>`'s `<origin xyz>` entry by `0.05 (f() − 1)` m, every
+/// `<dynamics damping>` by `f()`.
+fn perturbed_urdf(source: &str, rel: f64, seed: u64) -> String {
+    let mut r = Rng(seed);
+    let mut f = move || 1.0 + rel * (2.0 * r.uniform() - 1.0);
+    let mut out = String::new();
+    let mut inertial = false;
+    for line in source.split_inclusive('\n') {
+        let t = line.trim_start();
+        inertial |= t.starts_with("<inertial>");
+        let mut l = line.to_string();
+        let scale = |l: &mut String, attrs: &[&str], f: f64, d: f64| {
+            for a in attrs {
+                let key = format!(" {a}=\"");
+                let Some(at) = l.find(&key) else { continue };
+                let v0 = at + key.len();
+                let v1 = v0 + l[v0..].find('"').unwrap();
+                let vals: Vec<String> = l[v0..v1]
+                    .split_whitespace()
+                    .map(|x| format!("{}", x.parse::<f64>().unwrap() * f + d))
+                    .collect();
+                l.replace_range(v0..v1, &vals.join(" "));
+            }
+        };
+        if t.starts_with("<mass ") || t.starts_with("<dynamics ") {
+            scale(&mut l, &["value", "damping"], f(), 0.0);
+        } else if t.starts_with("<inertia ") {
+            scale(
+                &mut l,
+                &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"],
+                f(),
+                0.0,
+            );
+        } else if inertial && t.starts_with("<origin ") {
+            scale(&mut l, &["xyz"], 1.0, 0.05 * (f() - 1.0));
+        }
+        inertial &= !t.starts_with("</inertial>");
+        out.push_str(&l);
+    }
+    out
+}
+
+/// `BASE_PARAMETERS` of the module generated for a URDF with its scene file.
+fn urdf_base_parameters(name: &str, source: &str, scene: Option<&str>) -> Vec<f64> {
+    let config = codegen::Config {
+        scene: codegen::spec::SceneOverrides {
+            sidecar: scene.map(|t| codegen::spec::SceneFile {
+                name: "scene.toml".into(),
+                text: t.into(),
+            }),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let code = codegen::compile(name, source, &config)
+        .unwrap_or_else(|d| panic!("{}", d.render()))
+        .code;
+    let at = code
+        .find("pub const BASE_PARAMETERS: [f64; NBP] = [")
+        .unwrap();
+    let rest = &code[at + "pub const BASE_PARAMETERS: [f64; NBP] = [".len()..];
+    rest[..rest.find(']').unwrap()]
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+/// A URDF's tree model with its scene file.
+fn urdf_model(name: &str, source: &str, scene: Option<&str>) -> runtime::model::Model {
+    let overrides = codegen::spec::SceneOverrides {
+        sidecar: scene.map(|t| codegen::spec::SceneFile {
+            name: "scene.toml".into(),
+            text: t.into(),
+        }),
+        ..Default::default()
+    };
+    match codegen::spec::load(name, source, &overrides) {
+        Ok(l) => match l.mechanism {
+            codegen::spec::Mechanism::Tree(m) => m,
+            _ => panic!("a tree"),
+        },
+        Err(d) => panic!("{}", d.render()),
+    }
+}
+
+/// Inverse dynamics with the drive law (the runtime's spatial RNEA).
+fn effort(m: &runtime::model::Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
+    let tau = runtime::rnea::inverse_dynamics(m, q, qd, qdd);
+    (0..q.len())
+        .map(|i| tau[i] + m.joints[i].drive.effort(qd[i], qdd[i]))
+        .collect()
+}
+
+/// The text without its `<inertial>` blocks and `<dynamics …/>` elements: what `--out` must
+/// leave byte for byte.
+fn outside_inertials(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    loop {
+        let a = rest.find("<inertial>");
+        let d = rest.find("<dynamics ");
+        let (at, end) = match (a, d) {
+            (Some(a), Some(d)) if d < a => (d, "/>"),
+            (Some(a), _) => (a, "</inertial>"),
+            (None, Some(d)) => (d, "/>"),
+            (None, None) => break,
+        };
+        out.push_str(&rest[..at]);
+        let close = at + rest[at..].find(end).unwrap() + end.len();
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A perturbed iiwa 14 URDF (and `scene`, its scene file), noise-free: the written URDF's
+/// module has the estimates as its `BASE_PARAMETERS` and its model the true inverse dynamics;
+/// nothing outside `<inertial>` and `<dynamics>` changes.
+fn urdf_out(test: &str, scene: Option<&str>) {
+    let dir = scratch(test);
+    let nominal = bundled("../mechanisms/specs/iiwa14.urdf");
+    let spec = dir.join("iiwa.urdf");
+    std::fs::write(&spec, &nominal).unwrap();
+    if let Some(t) = scene {
+        std::fs::write(dir.join("iiwa.scene.toml"), t).unwrap();
+    }
+    let truth_src = perturbed_urdf(&nominal, 0.2, 0x1ee7);
+    let truth = urdf_model("truth.urdf", &truth_src, scene);
+    let true_base = urdf_base_parameters("truth.urdf", &truth_src, scene);
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(&spec),
+        "--restarts",
+        "1",
+        "--evaluations",
+        "30",
+        "--samples",
+        "500",
+        "--seed",
+        "3",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (header, rows) = super::csv_rows(&traj);
+    let n = truth.dof();
+    assert_eq!(header.len(), 1 + 3 * n);
+    let mut csv = header.join(",");
+    csv.push_str(&(1..=n).map(|i| format!(",tau{i}")).collect::<String>());
+    csv.push('\n');
+    for row in &rows {
+        let (q, qd, qdd) = (&row[1..1 + n], &row[1 + n..1 + 2 * n], &row[1 + 2 * n..]);
+        let tau = effort(&truth, q, qd, qdd);
+        let cells: Vec<String> = row.iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("exact.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.urdf"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(!stderr.contains("cannot reproduce"), "{stderr}");
+    // A URDF has no number for a rotor's inertia: only the `IA_` parameters that no link's
+    // inertia groups with (zero in the truth, as every URDF's) may be kept at the spec's values.
+    let kept = super::platform::listed(
+        &stderr,
+        "note: no number the update writes moves",
+        " (kept at",
+    );
+    let (e, _) = estimates(&est);
+    let names: Vec<String> = std::fs::read_to_string(&est)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split('"').nth(1).unwrap().to_string())
+        .collect();
+    for &k in &kept {
+        assert!(
+            names[k].starts_with("IA_") && scene.is_some(),
+            "{}",
+            names[k]
+        );
+    }
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let written_src = std::fs::read_to_string(&out).unwrap();
+    // The scene file comes along, unchanged.
+    let written_scene = std::fs::read_to_string(dir.join("updated.scene.toml")).ok();
+    assert_eq!(written_scene.as_deref(), scene);
+    assert_eq!(outside_inertials(&written_src), outside_inertials(&nominal));
+    assert_ne!(written_src, nominal);
+    let written = urdf_base_parameters("updated.urdf", &written_src, scene);
+    assert_eq!(written.len(), e.len());
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!(
+        "{test}: NBP {}: the written URDF's BASE_PARAMETERS vs the estimates {err:.2e}, estimates vs truth {err_truth:.2e}",
+        e.len()
+    );
+    assert!(err <= 1e-9, "{err:e}");
+    let model = urdf_model("updated.urdf", &written_src, scene);
+    let mut r = Rng(5);
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for _ in 0..50 {
+        let mut v = || {
+            (0..n)
+                .map(|_| 2.0 * r.uniform() - 1.0)
+                .collect::<Vec<f64>>()
+        };
+        let (q, qd, qdd) = (v(), v(), v());
+        let a = effort(&model, &q, &qd, &qdd);
+        let b = effort(&truth, &q, &qd, &qdd);
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "{test}: inverse dynamics of the written URDF vs the truth {id_err:.2e} (relative 2-norm, 50 random states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+#[test]
+fn urdf_out_replaces_inertials_and_keeps_every_other_byte() {
+    urdf_out("urdf_out", None);
+}
+
+#[test]
+fn urdf_out_with_friction_writes_dynamics_and_the_scene_file() {
+    urdf_out("urdf_out_friction", Some("[scene]\nfriction = true\n"));
+}
