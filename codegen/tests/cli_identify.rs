@@ -536,3 +536,7 @@ mod abuse;
 // `--out` on what the spec update writes beyond bodies: a Delta's rods.
 #[path = "cli_identify/out.rs"]
 mod out;
+
+// Positions-only data of a platform.
+#[path = "cli_identify/positions.rs"]
+mod positions;

@@ -156,10 +156,16 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     };
     let (n, nbp) = (reg.dof(), reg.nbp());
+    // A platform's positions-only data (`t, x, tau`): `x` filtered and differentiated as a
+    // tree's positions, then its rates turned into the speeds (`platform_rates`).
+    let mut columns = reg.columns_of(&text);
+    if matches!(reg, Regressor::Platform(_)) {
+        columns.differentiable = true;
+    }
     let mut data = match samples::read(
         &data_name,
         &text,
-        &reg.columns_of(&text),
+        &columns,
         nbp / n.max(1) + 1,
         Filtering {
             cutoff: args.cutoff,
@@ -171,6 +177,17 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Regressor::Platform(r) = &reg
+        && data.note.is_some()
+    {
+        if let Err(e) = super::platform_rates::speeds(r.model.motion, &data_name, &mut data) {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+        if let Some(note) = &mut data.note {
+            note.push_str(super::platform_rates::NOTE);
+        }
+    }
     if let Err(e) = reg.assemble_positions(&data_name, &mut data) {
         eprintln!("{e}");
         return ExitCode::from(2);
