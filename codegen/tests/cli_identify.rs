@@ -540,3 +540,7 @@ mod out;
 // Positions-only data of a platform.
 #[path = "cli_identify/positions.rs"]
 mod positions;
+
+// The 3-sigma claim over many noise seeds.
+#[path = "cli_identify/coverage.rs"]
+mod coverage;
