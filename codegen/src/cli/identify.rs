@@ -471,8 +471,14 @@ fn write_update(
         );
     }
     for (body, what, involved) in &up.violations {
+        // `[scene] payload` is named as written, the bodies as `body `…``.
+        let body = if body.starts_with('[') {
+            body.clone()
+        } else {
+            format!("body `{body}`")
+        };
         eprintln!(
-            "warning: body `{body}` of the updated spec is not physical: {what}; base parameters involved: {}",
+            "warning: {body} of the updated spec is not physical: {what}; base parameters involved: {}",
             involved
                 .iter()
                 .map(|k| format!("{k} ({})", reg.names()[*k]))

@@ -29,6 +29,8 @@ use super::regressor::Regressor;
 
 mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
+mod payload;
+use payload::{payload_unknowns, set_payload};
 mod rods;
 use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
 mod urdf;
@@ -62,6 +64,8 @@ enum Unknown {
     /// Linear rod parameter `k` (`M`, `H`, `J`: [`rods`]) of copy `copy` (from 1; 1 for a
     /// top-level entry) of the parallelogram entry `at`.
     Rods { at: RodsAt, copy: usize, k: usize },
+    /// Standard parameter `k` of the `[scene] payload`.
+    Payload { k: usize },
 }
 
 /// The outcome of an update.
@@ -236,8 +240,10 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
     type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
     let mut rods: std::collections::BTreeMap<RodsAt, Rods> = Default::default();
+    let mut payload: Option<[f64; 10]> = None;
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::Payload { k } => payload.get_or_insert([0.0; 10])[*k] = v,
             Unknown::Rods { at, copy, k } => {
                 rods.entry(*at)
                     .or_default()
@@ -310,6 +316,9 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     for (at, c) in rods {
         let c: Vec<[f64; 3]> = c.into_values().collect();
         set_rods(&mut d, at, &c)?;
+    }
+    if let Some(p) = payload {
+        set_payload(&mut d, &p)?;
     }
     Ok(d)
 }
@@ -412,6 +421,7 @@ pub fn update(
             &mut skipped,
         );
     }
+    payload_unknowns(&doc, &mut unknowns, &mut z0, &mut names, &mut skipped);
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
     let pi0 = base_of(reg, file, &norm.to_string())?;
@@ -425,7 +435,7 @@ pub fn update(
     // The columns of P: each unknown moved from a reference point where every body is valid.
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
-        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } = u {
+        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } | Unknown::Payload { k } = u {
             *r = REFERENCE[*k];
         }
         if let Unknown::Rods { k, .. } = u {
@@ -437,9 +447,19 @@ pub fn update(
         z,
         dz,
         unreachable,
-    } = minimum_norm_change(reg.nbp(), &z0, &reference, &pi0, target, fit, &mut |z| {
-        base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string())
-    })?;
+    } = minimum_norm_change(
+        reg.nbp(),
+        &z0,
+        &reference,
+        &pi0,
+        target,
+        fit,
+        &unknowns
+            .iter()
+            .map(|u| matches!(u, Unknown::Payload { .. }))
+            .collect::<Vec<_>>(),
+        &mut |z| base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string()),
+    )?;
     let changed = changed_names(&names, &dz);
     // Only the entries that change are rewritten; the others keep their text.
     let touched: Vec<usize> = (0..unknowns.len())
@@ -485,7 +505,10 @@ struct Change {
 type BaseOf<'a> = dyn FnMut(&[f64]) -> Result<Vec<f64>, String> + 'a;
 
 /// `Δ = P⁺ (π̂ − π0)` over the `fit` base parameters, `P` by moving each unknown by one from
-/// `reference` (`base` gives the base parameters of the spec with the unknowns set).
+/// `reference` (`base` gives the base parameters of the spec with the unknowns set). The `late`
+/// unknowns (a payload) take only what the others leave: the others' minimum-norm change
+/// first, then theirs on the rest.
+#[allow(clippy::too_many_arguments)]
 fn minimum_norm_change(
     nbp: usize,
     z0: &[f64],
@@ -493,6 +516,7 @@ fn minimum_norm_change(
     pi0: &[f64],
     target: &[f64],
     fit: &[bool],
+    late: &[bool],
     base: &mut BaseOf<'_>,
 ) -> Result<Change, String> {
     let mut p = DMatrix::zeros(nbp, z0.len());
@@ -522,11 +546,33 @@ fn minimum_norm_change(
             0.0
         }
     });
-    let mut dz = p
-        .clone()
-        .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
-        .map_err(|e| format!("error: the update's least squares failed: {e}"))?
-        * d;
+    let mut dz = DVector::zeros(z0.len());
+    // What the first stage leaves to rounding is nothing for the second to take up.
+    let tiny = 1e-10 * d.amax();
+    let mut rest = d;
+    for stage in [false, true] {
+        let mut ps = p.clone();
+        for (c, &l) in late.iter().enumerate() {
+            if l != stage {
+                ps.column_mut(c).fill(0.0);
+            }
+        }
+        if ps.amax() == 0.0 {
+            continue;
+        }
+        let step = ps
+            .clone()
+            .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
+            .map_err(|e| format!("error: the update's least squares failed: {e}"))?
+            * &rest;
+        rest -= &ps * &step;
+        rest.apply(|x| {
+            if x.abs() <= tiny {
+                *x = 0.0
+            }
+        });
+        dz += step;
+    }
     // An unknown that moves no base parameter stays as written (the SVD leaves rounding
     // noise there).
     for c in 0..z0.len() {
@@ -563,6 +609,25 @@ fn consistency(
     p: &DMatrix<f64>,
 ) -> Vec<(String, String, Vec<usize>)> {
     let mut out = Vec::new();
+    let payload = doc
+        .get("scene")
+        .and_then(|s| s.get("payload"))
+        .and_then(Item::as_table_like)
+        .and_then(body_parameters)
+        .and_then(|sp| from_standard(&sp).ok());
+    if let Some((m, _, ic)) = payload {
+        let what = physics(m, &ic);
+        if !what.is_empty() {
+            let involved: Vec<usize> = (0..p.nrows())
+                .filter(|&r| {
+                    unknowns.iter().enumerate().any(|(c, u)| {
+                        matches!(u, Unknown::Payload { .. }) && p[(r, c)].abs() > 1e-12
+                    })
+                })
+                .collect();
+            out.push(("[scene] payload".into(), what.join("; "), involved));
+        }
+    }
     let Some(a) = doc.get("body").and_then(Item::as_array_of_tables) else {
         return out;
     };

@@ -329,3 +329,80 @@ fn urdf_out_replaces_inertials_and_keeps_every_other_byte() {
 fn urdf_out_with_friction_writes_dynamics_and_the_scene_file() {
     urdf_out("urdf_out_friction", Some("[scene]\nfriction = true\n"));
 }
+
+/// The planar 2R of `mechanisms/specs/` with its second link written with expressions (which
+/// `--out` leaves alone) and a payload on it.
+fn payload_spec(m2: f64, payload_mass: f64, payload_x: f64) -> String {
+    let nominal = bundled("../mechanisms/specs/planar_2r.toml");
+    let body = "name = \"link2\"\nmass = 1.0\ncom = [0.4, 0.0, 0.0]";
+    assert!(nominal.contains(body));
+    let src = nominal.replace(
+        body,
+        "name = \"link2\"\nmass = \"m2\"\ncom = [\"l2 / 2\", 0.0, 0.0]",
+    );
+    format!(
+        "{src}\n[parameters]\nm2 = {m2}\nl2 = 0.8\n\n[scene]\npayload = {{ body = \"link2\", mass = {payload_mass}, com = [{payload_x}, 0.0, 0.0], inertia = {{ ixx = 0.001, iyy = 0.002, izz = 0.002 }} }}\n"
+    )
+}
+
+/// A body `--out` cannot rewrite (expressions) with a payload on it: the payload takes the
+/// change the body cannot, and the written spec reproduces every base parameter.
+#[test]
+fn a_payload_takes_what_its_body_cannot() {
+    let dir = scratch("payload_out");
+    let src = payload_spec(1.0, 0.5, 0.8);
+    let spec = dir.join("planar.toml");
+    std::fs::write(&spec, &src).unwrap();
+    let truth_src = payload_spec(1.1, 0.62, 0.74);
+    let truth = super::tree("truth.toml", &truth_src);
+    let true_base = generated_base_parameters("truth.toml", &truth_src);
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(&spec),
+        "--seed",
+        "2",
+        "--restarts",
+        "1",
+        "--evaluations",
+        "40",
+        "--samples",
+        "300",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (_, rows) = super::csv_rows(&traj);
+    let mut csv = String::from("q1,q2,qd1,qd2,qdd1,qdd2,tau1,tau2\n");
+    for r in &rows {
+        let tau = effort(&truth, &r[1..3], &r[3..5], &r[5..7]);
+        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("data.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
+    assert!(stdout.contains("[scene] payload"), "{stdout}");
+    assert!(stderr.contains("note: body `link2`"), "{stderr}");
+    assert!(!stderr.contains("note: no number"), "{stderr}");
+    let (e, _) = estimates(&est);
+    assert!(rel_floor(&e, &true_base, 1e-3) <= 1e-8);
+    let written_src = std::fs::read_to_string(&out).unwrap();
+    assert!(written_src.contains("mass = \"m2\"\ncom = [\"l2 / 2\", 0.0, 0.0]"));
+    let written = generated_base_parameters("updated.toml", &written_src);
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!("payload --out: BASE_PARAMETERS of the written spec vs the estimates {err:.2e}");
+    assert!(err <= 1e-9, "{err:e}");
+}

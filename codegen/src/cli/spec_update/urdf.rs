@@ -322,9 +322,16 @@ pub(super) fn update(
         z,
         dz,
         unreachable,
-    } = minimum_norm_change(reg.nbp(), &z0, &reference, &pi0, target, fit, &mut |z| {
-        base(&write(z)?)
-    })?;
+    } = minimum_norm_change(
+        reg.nbp(),
+        &z0,
+        &reference,
+        &pi0,
+        target,
+        fit,
+        &vec![false; z0.len()],
+        &mut |z| base(&write(z)?),
+    )?;
     let changed = changed_names(&names, &dz);
     let touched: Vec<usize> = (0..unknowns.len())
         .filter(|&c| changed.contains(&names[c]))
