@@ -104,6 +104,23 @@ fn value(v: impl Into<Value>) -> Item {
     Item::Value(v.into())
 }
 
+/// Set `key` of `t` to `item`, keeping the key's text around it (a comment on the line above,
+/// the layout) and the old value's (a comment after it): `insert` would replace both.
+fn set(t: &mut dyn toml_edit::TableLike, key: &str, item: Item) {
+    match t.get_mut(key) {
+        Some(old) => {
+            let mut item = item;
+            if let (Some(o), Some(n)) = (old.as_value(), item.as_value_mut()) {
+                *n.decor_mut() = o.decor().clone();
+            }
+            *old = item;
+        }
+        None => {
+            t.insert(key, item);
+        }
+    }
+}
+
 fn num(item: Option<&Item>) -> Option<f64> {
     let v = item?.as_value()?;
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
@@ -208,12 +225,12 @@ fn from_standard(p: &[f64; 10]) -> Result<(f64, Vec3, Mat3), String> {
 /// Write a body's numbers (`inertia_rpy` removed: the inertia is written in body axes).
 fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), String> {
     let (m, c, ic) = from_standard(p)?;
-    t.insert("mass", value(number(m)));
+    set(t, "mass", value(number(m)));
     let mut com = toml_edit::Array::new();
     for x in c {
         com.push(number(x));
     }
-    t.insert("com", value(com));
+    set(t, "com", value(com));
     let mut it = InlineTable::new();
     for (k, (r, c)) in [
         ("ixx", (0, 0)),
@@ -225,7 +242,7 @@ fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), Strin
     ] {
         it.insert(k, number(ic[r][c]));
     }
-    t.insert("inertia", value(it));
+    set(t, "inertia", value(it));
     t.remove("inertia_rpy");
     Ok(())
 }
@@ -279,7 +296,7 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
                     .as_array_of_tables_mut()
                     .and_then(|a| a.get_mut(*index))
                 {
-                    t.insert(key, value(number(v)));
+                    set(t, key, value(number(v)));
                 }
             }
             Unknown::Drive { index, key } => {
@@ -287,7 +304,7 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
                     .as_array_of_tables_mut()
                     .and_then(|a| a.get_mut(*index))
                 {
-                    t.insert(key, value(number(v)));
+                    set(t, key, value(number(v)));
                 }
             }
         }
@@ -719,6 +736,22 @@ mod tests {
             from_standard(&massless)
                 .unwrap_err()
                 .contains("without mass")
+        );
+    }
+
+    #[test]
+    fn a_rewritten_key_keeps_its_comments() {
+        let mut doc: DocumentMut = "[[body]]\n# measured\nmass = 1.0 # kg\n".parse().unwrap();
+        let t = doc["body"]
+            .as_array_of_tables_mut()
+            .unwrap()
+            .get_mut(0)
+            .unwrap();
+        set(t, "mass", value(number(2.5)));
+        set(t, "com", value(number(0.1)));
+        assert_eq!(
+            doc.to_string(),
+            "[[body]]\n# measured\nmass = 2.5 # kg\ncom = 0.1\n"
         );
     }
 

@@ -18,7 +18,7 @@ use toml_edit::{DocumentMut, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::{Unknown, number, value};
+use super::{Unknown, number, set, value};
 
 /// Where a parallelogram entry is: a top-level `[[parallelogram]]` (`pattern` `None`) or a
 /// `[[pattern.parallelogram]]` of `[[pattern]]` element `pattern`.
@@ -194,8 +194,8 @@ pub(super) fn set_rods(d: &mut DocumentMut, at: RodsAt, copies: &[[f64; 3]]) -> 
             .and_then(|a| a.get_mut(at.index)),
     }
     .ok_or("a parallelogram entry vanished")?;
-    t.insert("rod_mass", value(mass));
-    t.insert("rod_com", value(com));
+    set(t, "rod_mass", value(mass));
+    set(t, "rod_com", value(com));
     let mut it = t
         .get("rod_inertia")
         .and_then(|i| i.as_value())
@@ -204,7 +204,7 @@ pub(super) fn set_rods(d: &mut DocumentMut, at: RodsAt, copies: &[[f64; 3]]) -> 
         .unwrap_or_default();
     it.insert("iyy", inertia.clone());
     it.insert("izz", inertia);
-    t.insert("rod_inertia", value(it));
+    set(t, "rod_inertia", value(it));
     Ok(())
 }
 
