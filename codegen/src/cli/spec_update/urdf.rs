@@ -152,13 +152,16 @@ fn link_parameters(text: &str, tags: &[Tag], l: &Link) -> Option<[f64; 10]> {
     Some(codegen::dynamics::body_standard_parameters(mass, &com, &ic))
 }
 
-/// Set attribute `a` of tag `t` (replaced, or added).
-fn set_attr(edits: &mut Vec<(Range<usize>, String)>, t: &Tag, a: &str, v: String) {
+/// Set attribute `a` of tag `t` to the numbers `v` (replaced, or added); an attribute that
+/// reads as these numbers already keeps its text (`0.0` stays `0.0`).
+fn set_attr(edits: &mut Vec<(Range<usize>, String)>, text: &str, t: &Tag, a: &str, v: &[f64]) {
+    let new = v.iter().map(|x| fmt(*x)).collect::<Vec<_>>().join(" ");
     match t.attr(a) {
-        Some(r) => edits.push((r, v)),
+        Some(r) if numbers(&text[r.clone()]).is_some_and(|old| old == v) => {}
+        Some(r) => edits.push((r, new)),
         None => {
             let at = t.attr_insert_at();
-            edits.push((at..at, format!(" {a}=\"{v}\"")));
+            edits.push((at..at, format!(" {a}=\"{new}\"")));
         }
     }
 }
@@ -205,18 +208,18 @@ fn apply(
             }
         };
         match l.mass {
-            Some(t) => set_attr(&mut edits, &tags[t], "value", fmt(m)),
+            Some(t) => set_attr(&mut edits, text, &tags[t], "value", &[m]),
             None => add(format!("<mass value=\"{}\"/>", fmt(m)), &mut edits),
         }
         let xyz = format!("{} {} {}", fmt(c[0]), fmt(c[1]), fmt(c[2]));
         match l.origin {
-            Some(t) => set_attr(&mut edits, &tags[t], "xyz", xyz),
+            Some(t) => set_attr(&mut edits, text, &tags[t], "xyz", &c),
             None => add(format!("<origin xyz=\"{xyz}\" rpy=\"0 0 0\"/>"), &mut edits),
         }
         match l.inertia {
             Some(t) => {
                 for (a, (r, c)) in INERTIA {
-                    set_attr(&mut edits, &tags[t], a, fmt(i[r][c]));
+                    set_attr(&mut edits, text, &tags[t], a, &[i[r][c]]);
                 }
             }
             None => {
@@ -236,7 +239,7 @@ fn apply(
         match j.dynamics {
             Some(t) => {
                 for (key, v) in values {
-                    set_attr(&mut edits, &tags[t], key, fmt(v));
+                    set_attr(&mut edits, text, &tags[t], key, &[v]);
                 }
             }
             None => {
