@@ -427,7 +427,7 @@ fn bad_input_is_exit_code_2_without_a_panic() {
             "../mechanisms/specs/iiwa14.urdf",
             "x.csv",
             "--out",
-            "y.toml",
+            "y.toml", // the update of a URDF is a URDF
         ],
         vec!["identify", PUMA, "x.csv", "--weights", "heavy"],
     ] {
@@ -532,3 +532,15 @@ mod closed;
 // Bad input found by driving the binary by hand (hangs, panics, NaN, overwritten inputs).
 #[path = "cli_identify/abuse.rs"]
 mod abuse;
+
+// `--out` on what the spec update writes beyond bodies: a Delta's rods.
+#[path = "cli_identify/out.rs"]
+mod out;
+
+// Positions-only data of a platform.
+#[path = "cli_identify/positions.rs"]
+mod positions;
+
+// The 3-sigma claim over many noise seeds.
+#[path = "cli_identify/coverage.rs"]
+mod coverage;

@@ -37,13 +37,32 @@ fn pass(c: &[f64; 5], x: &mut [f64]) {
     }
 }
 
-/// Zero-phase low-pass of `x` (forward, then backward).
+/// Zero-phase low-pass of `x` (forward, then backward). Each end is first extended by its
+/// odd reflection, `2 x₀ − x_k` over three cutoff periods of samples (Gustafsson 1996, SciPy's
+/// `filtfilt` padding): the extension continues the signal's value and slope, so the passes,
+/// started in the steady state of the extension's first sample, meet the data without the
+/// transient that a signal starting on a slope leaves (which differentiating twice amplifies:
+/// on the Delta's positions-only test it cut the accelerations' worst error in the kept
+/// samples from 0.25 to 2e-3 m/s² and the estimates' error tenfold).
 pub fn filtfilt(x: &mut [f64], fc: f64, fs: f64) {
+    let n = x.len();
+    let pad = if n < 2 {
+        0
+    } else {
+        (3.0 * fs / fc).ceil().min((n - 1) as f64) as usize
+    };
+    let mut e: Vec<f64> = Vec::with_capacity(n + 2 * pad);
+    if let (Some(&first), Some(&last)) = (x.first(), x.last()) {
+        e.extend((1..=pad).rev().map(|k| 2.0 * first - x[k]));
+        e.extend_from_slice(x);
+        e.extend((1..=pad).map(|k| 2.0 * last - x[n - 1 - k]));
+    }
     let c = butterworth(fc, fs);
-    pass(&c, x);
-    x.reverse();
-    pass(&c, x);
-    x.reverse();
+    pass(&c, &mut e);
+    e.reverse();
+    pass(&c, &mut e);
+    e.reverse();
+    x.copy_from_slice(&e[pad..pad + n]);
 }
 
 /// Central differences of uniformly sampled `x` (step `dt`): `(ẋ, ẍ)`, second order inside;
@@ -82,6 +101,36 @@ mod tests {
         filtfilt(&mut hf, 20.0, fs);
         let inner = &hf[200..1800];
         assert!(inner.iter().all(|v| v.abs() < 1e-3), "{:e}", inner[500]);
+    }
+
+    /// A ramp (a signal that starts and ends on a slope) passes unchanged up to its ends,
+    /// which the odd extension continues exactly: the transient where the extension starts has
+    /// decayed over its three cutoff periods to 1.3e-8 at the data (bound 1e-7), where the
+    /// passes started at the first and last samples leave 1.1e-2 (more than 1e-3).
+    #[test]
+    fn a_ramp_passes_to_its_ends() {
+        let fs = 200.0;
+        let mut x: Vec<f64> = (0..400).map(|k| 0.3 + 0.25 * k as f64 / fs).collect();
+        let want = x.clone();
+        filtfilt(&mut x, 5.0, fs);
+        let worst = x
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        // Unpadded, the passes started at the first and last samples.
+        let c = butterworth(5.0, fs);
+        let mut y = want.clone();
+        pass(&c, &mut y);
+        y.reverse();
+        pass(&c, &mut y);
+        y.reverse();
+        let unpadded = y
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-7 && unpadded > 1e-3, "{worst:e} {unpadded:e}");
     }
 
     #[test]

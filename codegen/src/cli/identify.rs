@@ -33,8 +33,9 @@ pub struct IdentifyArgs {
     /// platform's `t,x1..,u1..,ud1..,tau1..`; a closed loop's `t,q1..,u1..,ud1..,tau1..` (the
     /// independent coordinates) or `t,x1..xNX,u1..,ud1..,tau1..`.
     pub data: PathBuf,
-    /// Write the spec updated to the identified base parameters here (TOML specs only).
-    #[arg(long, value_name = "UPDATED.toml")]
+    /// Write the spec updated to the identified base parameters here (a URDF's: the URDF with
+    /// its `<inertial>` and `<dynamics>` values replaced, and its scene file beside it).
+    #[arg(long, value_name = "UPDATED.toml|UPDATED.urdf")]
     pub out: Option<PathBuf>,
     /// Row weights.
     #[arg(long, value_enum, default_value = "auto")]
@@ -75,21 +76,35 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         eprintln!("error: --cutoff must be a positive frequency in Hz");
         return ExitCode::from(2);
     }
+    // A URDF's update is a URDF: the tools tell a spec's format by its name.
+    if let Some(out) = &args.out
+        && super::spec_update::is_urdf(&name, &source)
+        && !out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        eprintln!(
+            "error: --out {}: the update of a URDF is a URDF: name it `….urdf` (the tools tell a spec's format by its name)",
+            out.display()
+        );
+        return ExitCode::from(2);
+    }
+    // A URDF's `--out` takes its scene file beside it.
+    let scene_out = args
+        .out
+        .as_ref()
+        .filter(|_| codegen::build_script::scene_beside(&args.spec).is_some())
+        .map(|o| o.with_extension("scene.toml"));
     if let Err(c) = super::distinct_outputs(
         &[("the spec", &args.spec), ("the data file", &args.data)],
         &[
             ("--out", args.out.as_deref()),
+            ("--out's scene file", scene_out.as_deref()),
             ("--estimates", args.estimates.as_deref()),
             ("--plot", args.plot.as_deref()),
         ],
     ) {
         return c;
-    }
-    if args.out.is_some() && name.ends_with(".urdf") {
-        eprintln!(
-            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
-        );
-        return ExitCode::from(2);
     }
     // A URDF's `ROBOT.scene.toml` applies here as in generation (friction, rotor inertia,
     // locked joints change the parameters).
@@ -97,7 +112,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         Ok(s) => s,
         Err(c) => return c,
     };
-    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar) {
+    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar.clone()) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -141,10 +156,16 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     };
     let (n, nbp) = (reg.dof(), reg.nbp());
+    // A platform's positions-only data (`t, x, tau`): `x` filtered and differentiated as a
+    // tree's positions, then its rates turned into the speeds (`platform_rates`).
+    let mut columns = reg.columns_of(&text);
+    if matches!(reg, Regressor::Platform(_)) {
+        columns.differentiable = true;
+    }
     let mut data = match samples::read(
         &data_name,
         &text,
-        &reg.columns_of(&text),
+        &columns,
         nbp / n.max(1) + 1,
         Filtering {
             cutoff: args.cutoff,
@@ -156,6 +177,17 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Regressor::Platform(r) = &reg
+        && data.note.is_some()
+    {
+        if let Err(e) = super::platform_rates::speeds(r.model.motion, &data_name, &mut data) {
+            eprintln!("{e}");
+            return ExitCode::from(2);
+        }
+        if let Some(note) = &mut data.note {
+            note.push_str(super::platform_rates::NOTE);
+        }
+    }
     if let Err(e) = reg.assemble_positions(&data_name, &mut data) {
         eprintln!("{e}");
         return ExitCode::from(2);
@@ -257,7 +289,7 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         }
     }
     if let Some(path) = &args.out {
-        return write_update(&reg, &name, &source, &fit, path);
+        return write_update(&reg, &name, &source, sidecar.as_ref(), &fit, path);
     }
     ExitCode::SUCCESS
 }
@@ -373,11 +405,13 @@ fn write_update(
     reg: &Regressor,
     name: &str,
     source: &str,
+    sidecar: Option<&codegen::spec::SceneFile>,
     fit: &wls::Fit,
     path: &std::path::Path,
 ) -> ExitCode {
     let identified: Vec<bool> = fit.unidentifiable.iter().map(|u| !u).collect();
-    let up = match super::spec_update::update(reg, name, source, &fit.estimate, &identified) {
+    let update = super::spec_update::update(reg, name, source, sidecar, &fit.estimate, &identified);
+    let up = match update {
         Ok(u) => u,
         Err(e) if e.starts_with("error:") => {
             eprintln!("{e}");
@@ -412,7 +446,7 @@ fn write_update(
     );
     if !up.unreachable.is_empty() {
         eprintln!(
-            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a massless body the loader adds (a U joint's cross), a parallelogram's rods, or a drive",
+            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a massless body the loader adds (a U joint's cross), what a parallelogram's symmetric rods cannot have (a first moment across them, products of inertia), or a drive",
             if up.unreachable.len() == 1 { "" } else { "s" },
             up.unreachable
                 .iter()
@@ -437,8 +471,14 @@ fn write_update(
         );
     }
     for (body, what, involved) in &up.violations {
+        // `[scene] payload` is named as written, the bodies as `body `…``.
+        let body = if body.starts_with('[') {
+            body.clone()
+        } else {
+            format!("body `{body}`")
+        };
         eprintln!(
-            "warning: body `{body}` of the updated spec is not physical: {what}; base parameters involved: {}",
+            "warning: {body} of the updated spec is not physical: {what}; base parameters involved: {}",
             involved
                 .iter()
                 .map(|k| format!("{k} ({})", reg.names()[*k]))
@@ -454,6 +494,20 @@ fn write_update(
     if let Err(e) = super::write_output(path, &up.text) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
+    }
+    // A URDF's scene file goes beside the written URDF, where the tools look for it
+    // (`ROBOT.scene.toml`): the written model is the URDF with that scene.
+    if let Some(scene) = sidecar {
+        let beside = path.with_extension("scene.toml");
+        if let Err(e) = super::write_output(&beside, &scene.text) {
+            eprintln!("error: {e}");
+            return ExitCode::from(1);
+        }
+        outln!(
+            "scene file: {} (the scene of {}, which the updated URDF's model needs)",
+            beside.display(),
+            scene.name
+        );
     }
     ExitCode::SUCCESS
 }

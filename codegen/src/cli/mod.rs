@@ -25,6 +25,7 @@ pub mod identify;
 pub mod isotropy;
 pub mod map;
 pub mod platform_path;
+pub mod platform_rates;
 pub mod platform_regressor;
 pub mod reduce;
 pub mod regressor;

@@ -279,10 +279,18 @@ impl Regressor {
     }
 
     /// The base parameters of another spec text of the same structure (its `[scene]`
-    /// applied), on this regressor's grouping.
-    pub fn base_of_spec(&self, file: &str, text: &str) -> Result<Vec<f64>, String> {
-        let loaded = codegen::spec::load(file, text, &codegen::spec::SceneOverrides::default())
-            .map_err(|d| d.render())?;
+    /// applied, or a URDF's `sidecar`), on this regressor's grouping.
+    pub fn base_of_spec(
+        &self,
+        file: &str,
+        text: &str,
+        sidecar: Option<&codegen::spec::SceneFile>,
+    ) -> Result<Vec<f64>, String> {
+        let overrides = codegen::spec::SceneOverrides {
+            sidecar: sidecar.cloned(),
+            ..Default::default()
+        };
+        let loaded = codegen::spec::load(file, text, &overrides).map_err(|d| d.render())?;
         match (self, loaded.mechanism) {
             (Regressor::Tree(r), Mechanism::Tree(m)) => Ok(r.base_of(&m)),
             (Regressor::Platform(r), Mechanism::Parallel(m)) => Ok(r.base_of(&m)),

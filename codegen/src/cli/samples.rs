@@ -183,7 +183,12 @@ pub fn read(
                     }
                 })
                 .collect();
-            let alternatives = if columns.differentiable {
+            let alternatives = if columns.differentiable && columns.names[0].is_empty() {
+                format!(
+                    ", or {}_<actuated joint>; or t, {} and {} only, to filter and differentiate",
+                    kinds[3], kinds[0], kinds[3]
+                )
+            } else if columns.differentiable {
                 format!(
                     ", or {}_<joint> … by joint name; or t, {} and {} only, to filter and differentiate",
                     kinds[0], kinds[0], kinds[3]
@@ -276,32 +281,46 @@ pub fn read(
             ));
         }
         let edge = edge as usize;
-        let mut q_cols = vec![Vec::new(); n];
-        let mut qd_cols = vec![Vec::new(); n];
-        let mut qdd_cols = vec![Vec::new(); n];
+        // A platform has more positions (`x`, a quaternion's four) than efforts: `qd` and
+        // `qdd` are then the rates of every position, which the caller turns into speeds.
+        let nq = columns.counts[0];
+        let mut q_cols = vec![Vec::new(); nq];
+        let mut qd_cols = vec![Vec::new(); nq];
+        let mut qdd_cols = vec![Vec::new(); nq];
         let mut tau_cols = vec![Vec::new(); n];
-        for i in 0..n {
+        for i in 0..nq {
             let mut q: Vec<f64> = rows.iter().map(|r| pick(0, r)[i]).collect();
-            let mut tau: Vec<f64> = rows.iter().map(|r| pick(3, r)[i]).collect();
             filtfilt(&mut q, filtering.cutoff, fs);
-            filtfilt(&mut tau, filtering.cutoff, fs);
             let (d, dd) = differentiate(&q, dt);
             q_cols[i] = q;
             qd_cols[i] = d;
             qdd_cols[i] = dd;
-            tau_cols[i] = tau;
+        }
+        for (i, col) in tau_cols.iter_mut().enumerate() {
+            let mut tau: Vec<f64> = rows.iter().map(|r| pick(3, r)[i]).collect();
+            filtfilt(&mut tau, filtering.cutoff, fs);
+            *col = tau;
         }
         for k in edge..rows.len() - edge {
-            s.q.push((0..n).map(|i| q_cols[i][k]).collect());
-            s.qd.push((0..n).map(|i| qd_cols[i][k]).collect());
-            s.qdd.push((0..n).map(|i| qdd_cols[i][k]).collect());
+            s.q.push((0..nq).map(|i| q_cols[i][k]).collect());
+            s.qd.push((0..nq).map(|i| qd_cols[i][k]).collect());
+            s.qdd.push((0..nq).map(|i| qdd_cols[i][k]).collect());
             s.tau.push((0..n).map(|i| tau_cols[i][k]).collect());
             s.lines.push(line_of[k]);
             s.t.push(t[k]);
         }
         s.note = Some(format!(
-            "positions only: q and tau low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling), qd and qdd by central differences; {edge} samples dropped at each end",
-            filtering.cutoff, fs
+            "positions only: {} and {} low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling), {} and {} by central differences; {edge} samples dropped at each end",
+            kinds[0],
+            kinds[3],
+            filtering.cutoff,
+            fs,
+            if kinds[0] == "x" { "their rates" } else { "qd" },
+            if kinds[0] == "x" {
+                "second rates"
+            } else {
+                "qdd"
+            },
         ));
     } else {
         if rows.len() < min_rows {

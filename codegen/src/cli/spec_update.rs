@@ -15,9 +15,10 @@
 //! A platform's legs are usually one `[[pattern]]` whose bodies every copy shares: their
 //! unknowns are per copy (the values the spec's text gives each copy, patterns expanded), and a
 //! changed pattern body is written as expressions indexing per-copy arrays that the update adds
-//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). Base parameters that no written
-//! number moves (a massless U joint's cross, a parallelogram's rods) keep the spec's values and
-//! are reported.
+//! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). A parallelogram's rods are
+//! three numbers per entry (or copy), linear in their body's standard parameters
+//! ([`rods`]). Base parameters that no written number moves (a massless U joint's cross alone)
+//! keep the spec's values and are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
@@ -28,6 +29,12 @@ use super::regressor::Regressor;
 
 mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
+mod payload;
+use payload::{payload_unknowns, set_payload};
+mod rods;
+use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
+mod urdf;
+mod xml_scan;
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -54,6 +61,11 @@ enum Unknown {
         copy: usize,
         key: &'static str,
     },
+    /// Linear rod parameter `k` (`M`, `H`, `J`: [`rods`]) of copy `copy` (from 1; 1 for a
+    /// top-level entry) of the parallelogram entry `at`.
+    Rods { at: RodsAt, copy: usize, k: usize },
+    /// Standard parameter `k` of the `[scene] payload`.
+    Payload { k: usize },
 }
 
 /// The outcome of an update.
@@ -90,6 +102,23 @@ fn number(v: f64) -> Value {
 
 fn value(v: impl Into<Value>) -> Item {
     Item::Value(v.into())
+}
+
+/// Set `key` of `t` to `item`, keeping the key's text around it (a comment on the line above,
+/// the layout) and the old value's (a comment after it): `insert` would replace both.
+fn set(t: &mut dyn toml_edit::TableLike, key: &str, item: Item) {
+    match t.get_mut(key) {
+        Some(old) => {
+            let mut item = item;
+            if let (Some(o), Some(n)) = (old.as_value(), item.as_value_mut()) {
+                *n.decor_mut() = o.decor().clone();
+            }
+            *old = item;
+        }
+        None => {
+            t.insert(key, item);
+        }
+    }
 }
 
 fn num(item: Option<&Item>) -> Option<f64> {
@@ -196,12 +225,12 @@ fn from_standard(p: &[f64; 10]) -> Result<(f64, Vec3, Mat3), String> {
 /// Write a body's numbers (`inertia_rpy` removed: the inertia is written in body axes).
 fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), String> {
     let (m, c, ic) = from_standard(p)?;
-    t.insert("mass", value(number(m)));
+    set(t, "mass", value(number(m)));
     let mut com = toml_edit::Array::new();
     for x in c {
         com.push(number(x));
     }
-    t.insert("com", value(com));
+    set(t, "com", value(com));
     let mut it = InlineTable::new();
     for (k, (r, c)) in [
         ("ixx", (0, 0)),
@@ -213,7 +242,7 @@ fn set_body(t: &mut dyn toml_edit::TableLike, p: &[f64; 10]) -> Result<(), Strin
     ] {
         it.insert(k, number(ic[r][c]));
     }
-    t.insert("inertia", value(it));
+    set(t, "inertia", value(it));
     t.remove("inertia_rpy");
     Ok(())
 }
@@ -226,8 +255,18 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     let mut copies: std::collections::BTreeMap<(usize, usize), Copies> = Default::default();
     type Drives = std::collections::BTreeMap<usize, f64>;
     let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
+    type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
+    let mut rods: std::collections::BTreeMap<RodsAt, Rods> = Default::default();
+    let mut payload: Option<[f64; 10]> = None;
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::Payload { k } => payload.get_or_insert([0.0; 10])[*k] = v,
+            Unknown::Rods { at, copy, k } => {
+                rods.entry(*at)
+                    .or_default()
+                    .entry(*copy)
+                    .or_insert([0.0; 3])[*k] = v
+            }
             Unknown::CopyDrive {
                 pattern,
                 joint,
@@ -257,7 +296,7 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
                     .as_array_of_tables_mut()
                     .and_then(|a| a.get_mut(*index))
                 {
-                    t.insert(key, value(number(v)));
+                    set(t, key, value(number(v)));
                 }
             }
             Unknown::Drive { index, key } => {
@@ -265,7 +304,7 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
                     .as_array_of_tables_mut()
                     .and_then(|a| a.get_mut(*index))
                 {
-                    t.insert(key, value(number(v)));
+                    set(t, key, value(number(v)));
                 }
             }
         }
@@ -291,28 +330,38 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
         let c: Vec<f64> = c.into_values().collect();
         patterns::set_copy_drives(&mut d, pattern, joint, key, &c)?;
     }
+    for (at, c) in rods {
+        let c: Vec<[f64; 3]> = c.into_values().collect();
+        set_rods(&mut d, at, &c)?;
+    }
+    if let Some(p) = payload {
+        set_payload(&mut d, &p)?;
+    }
     Ok(d)
 }
 
 /// The base parameters of a spec text (its `[scene]` applied), on `reg`'s grouping.
 fn base_of(reg: &Regressor, file: &str, text: &str) -> Result<Vec<f64>, String> {
-    reg.base_of_spec(file, text)
+    reg.base_of_spec(file, text, None)
 }
 
-/// The update of `source` whose model has base parameters `target` where `fit[k]` (elsewhere
-/// the spec's).
+/// A URDF as the loader tells one: by its name, or an XML text (`robot.xml`).
+pub fn is_urdf(file: &str, source: &str) -> bool {
+    file.to_ascii_lowercase().ends_with(".urdf") || source.trim_start().starts_with('<')
+}
+
+/// The update of `source` (a TOML spec, or a URDF with its scene file `sidecar`) whose model
+/// has base parameters `target` where `fit[k]` (elsewhere the spec's).
 pub fn update(
     reg: &Regressor,
     file: &str,
     source: &str,
+    sidecar: Option<&codegen::spec::SceneFile>,
     target: &[f64],
     fit: &[bool],
 ) -> Result<Update, String> {
-    if file.ends_with(".urdf") {
-        return Err(
-            "error: --out writes TOML specs only (convert the URDF first: `codegen convert`)"
-                .into(),
-        );
+    if is_urdf(file, source) {
+        return urdf::update(reg, file, source, sidecar, target, fit);
     }
     let doc: DocumentMut = source
         .parse()
@@ -380,7 +429,16 @@ pub fn update(
             &mut names,
             &mut skipped,
         );
+        rod_unknowns(
+            &doc,
+            &written,
+            &mut unknowns,
+            &mut z0,
+            &mut names,
+            &mut skipped,
+        );
     }
+    payload_unknowns(&doc, &mut unknowns, &mut z0, &mut names, &mut skipped);
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
     let pi0 = base_of(reg, file, &norm.to_string())?;
@@ -392,24 +450,98 @@ pub fn update(
         ));
     }
     // The columns of P: each unknown moved from a reference point where every body is valid.
-    let nbp = reg.nbp();
-    let mut p = DMatrix::zeros(nbp, unknowns.len());
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
-        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } = u {
-            *r = match k {
-                0 | 3 | 5 | 9 => 1.0,
-                _ => 0.0,
-            };
+        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } | Unknown::Payload { k } = u {
+            *r = REFERENCE[*k];
+        }
+        if let Unknown::Rods { k, .. } = u {
+            *r = rods::REFERENCE[*k];
         }
     }
-    let ref_doc = apply(&doc, &unknowns, &reference)?;
-    let pi_ref = base_of(reg, file, &ref_doc.to_string())?;
-    for c in 0..unknowns.len() {
-        let mut z = reference.clone();
+    let Change {
+        p,
+        z,
+        dz,
+        unreachable,
+    } = minimum_norm_change(
+        reg.nbp(),
+        &z0,
+        &reference,
+        &pi0,
+        target,
+        fit,
+        &unknowns
+            .iter()
+            .map(|u| matches!(u, Unknown::Payload { .. }))
+            .collect::<Vec<_>>(),
+        &mut |z| base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string()),
+    )?;
+    let changed = changed_names(&names, &dz);
+    // Only the entries that change are rewritten; the others keep their text.
+    let touched: Vec<usize> = (0..unknowns.len())
+        .filter(|&c| changed.contains(&names[c]))
+        .collect();
+    let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c].clone()).collect();
+    let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
+    let out = apply(&doc, &sub_u, &sub_z).map_err(|e| {
+        format!("error: --out: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
+    })?;
+    let text = out.to_string();
+    let written = base_of(reg, file, &text)?;
+    let mut violations = consistency(&out, &unknowns, &p);
+    violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
+    violations.extend(rods_consistency(&unknowns, &z, &names, &changed, &p));
+    Ok(Update {
+        text,
+        written,
+        violations,
+        skipped,
+        changed,
+        unreachable,
+    })
+}
+
+/// A body's standard parameters at the reference point of the update's columns: unit mass and
+/// unit principal moments about the origin (a valid body; one unit more on any is one too).
+const REFERENCE: [f64; 10] = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+
+/// The minimum-norm change of the unknowns and the map it was found on.
+struct Change {
+    /// `P`: base parameters per unit of each unknown.
+    p: DMatrix<f64>,
+    /// The unknowns changed.
+    z: Vec<f64>,
+    /// The change.
+    dz: DVector<f64>,
+    /// The base parameters that no unknown moves.
+    unreachable: Vec<usize>,
+}
+
+/// The base parameters of the spec with its unknowns set to the values given.
+type BaseOf<'a> = dyn FnMut(&[f64]) -> Result<Vec<f64>, String> + 'a;
+
+/// `Δ = P⁺ (π̂ − π0)` over the `fit` base parameters, `P` by moving each unknown by one from
+/// `reference` (`base` gives the base parameters of the spec with the unknowns set). The `late`
+/// unknowns (a payload) take only what the others leave: the others' minimum-norm change
+/// first, then theirs on the rest.
+#[allow(clippy::too_many_arguments)]
+fn minimum_norm_change(
+    nbp: usize,
+    z0: &[f64],
+    reference: &[f64],
+    pi0: &[f64],
+    target: &[f64],
+    fit: &[bool],
+    late: &[bool],
+    base: &mut BaseOf<'_>,
+) -> Result<Change, String> {
+    let mut p = DMatrix::zeros(nbp, z0.len());
+    let pi_ref = base(reference)?;
+    for c in 0..z0.len() {
+        let mut z = reference.to_vec();
         z[c] += 1.0;
-        let d = apply(&doc, &unknowns, &z)?;
-        let pi = base_of(reg, file, &d.to_string())?;
+        let pi = base(&z)?;
         for r in 0..nbp {
             p[(r, c)] = pi[r] - pi_ref[r];
         }
@@ -431,20 +563,51 @@ pub fn update(
             0.0
         }
     });
-    let dz = p
-        .clone()
-        .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
-        .map_err(|e| format!("error: the update's least squares failed: {e}"))?
-        * d;
+    let mut dz = DVector::zeros(z0.len());
+    // What the first stage leaves to rounding is nothing for the second to take up.
+    let tiny = 1e-10 * d.amax();
+    let mut rest = d;
+    for stage in [false, true] {
+        let mut ps = p.clone();
+        for (c, &l) in late.iter().enumerate() {
+            if l != stage {
+                ps.column_mut(c).fill(0.0);
+            }
+        }
+        if ps.amax() == 0.0 {
+            continue;
+        }
+        let step = ps
+            .clone()
+            .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
+            .map_err(|e| format!("error: the update's least squares failed: {e}"))?
+            * &rest;
+        rest -= &ps * &step;
+        rest.apply(|x| {
+            if x.abs() <= tiny {
+                *x = 0.0
+            }
+        });
+        dz += step;
+    }
     // An unknown that moves no base parameter stays as written (the SVD leaves rounding
     // noise there).
-    let mut dz = dz;
-    for c in 0..unknowns.len() {
+    for c in 0..z0.len() {
         if p.column(c).iter().all(|x| *x == 0.0) {
             dz[c] = 0.0;
         }
     }
     let z: Vec<f64> = z0.iter().zip(dz.iter()).map(|(a, b)| a + b).collect();
+    Ok(Change {
+        p,
+        z,
+        dz,
+        unreachable,
+    })
+}
+
+/// The names (bodies, joints, entries) whose unknowns change.
+fn changed_names(names: &[String], dz: &DVector<f64>) -> Vec<String> {
     let mut changed: Vec<String> = Vec::new();
     let largest = dz.amax();
     for (c, name) in names.iter().enumerate() {
@@ -452,27 +615,7 @@ pub fn update(
             changed.push(name.clone());
         }
     }
-    // Only the entries that change are rewritten; the others keep their text.
-    let touched: Vec<usize> = (0..unknowns.len())
-        .filter(|&c| changed.contains(&names[c]))
-        .collect();
-    let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c].clone()).collect();
-    let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
-    let out = apply(&doc, &sub_u, &sub_z).map_err(|e| {
-        format!("error: --out: the identified parameters are no spec: {e} (the base parameters are printed above; no file written)")
-    })?;
-    let text = out.to_string();
-    let written = base_of(reg, file, &text)?;
-    let mut violations = consistency(&out, &unknowns, &p);
-    violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
-    Ok(Update {
-        text,
-        written,
-        violations,
-        skipped,
-        changed,
-        unreachable,
-    })
+    changed
 }
 
 /// The bodies of `doc` whose numbers break positive mass, a positive definite inertia or the
@@ -483,6 +626,25 @@ fn consistency(
     p: &DMatrix<f64>,
 ) -> Vec<(String, String, Vec<usize>)> {
     let mut out = Vec::new();
+    let payload = doc
+        .get("scene")
+        .and_then(|s| s.get("payload"))
+        .and_then(Item::as_table_like)
+        .and_then(body_parameters)
+        .and_then(|sp| from_standard(&sp).ok());
+    if let Some((m, _, ic)) = payload {
+        let what = physics(m, &ic);
+        if !what.is_empty() {
+            let involved: Vec<usize> = (0..p.nrows())
+                .filter(|&r| {
+                    unknowns.iter().enumerate().any(|(c, u)| {
+                        matches!(u, Unknown::Payload { .. }) && p[(r, c)].abs() > 1e-12
+                    })
+                })
+                .collect();
+            out.push(("[scene] payload".into(), what.join("; "), involved));
+        }
+    }
     let Some(a) = doc.get("body").and_then(Item::as_array_of_tables) else {
         return out;
     };
@@ -574,6 +736,22 @@ mod tests {
             from_standard(&massless)
                 .unwrap_err()
                 .contains("without mass")
+        );
+    }
+
+    #[test]
+    fn a_rewritten_key_keeps_its_comments() {
+        let mut doc: DocumentMut = "[[body]]\n# measured\nmass = 1.0 # kg\n".parse().unwrap();
+        let t = doc["body"]
+            .as_array_of_tables_mut()
+            .unwrap()
+            .get_mut(0)
+            .unwrap();
+        set(t, "mass", value(number(2.5)));
+        set(t, "com", value(number(0.1)));
+        assert_eq!(
+            doc.to_string(),
+            "[[body]]\n# measured\nmass = 2.5 # kg\ncom = 0.1\n"
         );
     }
 

@@ -7,13 +7,13 @@
 use std::path::Path;
 
 use super::{
-    Rng, csv_rows, estimates, generated_base_parameters, ok, rel, rel_floor, run, s, scratch, text,
+    Rng, csv_rows, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text,
 };
 
 const GS: &str = "../mechanisms/specs/gough_stewart.toml";
-const DELTA: &str = "../mechanisms/specs/delta_rl5.toml";
+pub(super) const DELTA: &str = "../mechanisms/specs/delta_rl5.toml";
 
-fn platform(name: &str, source: &str) -> runtime::parallel::ParallelModel {
+pub(super) fn platform(name: &str, source: &str) -> runtime::parallel::ParallelModel {
     match codegen::spec::load(name, source, &Default::default()) {
         Ok(l) => match l.mechanism {
             codegen::spec::Mechanism::Parallel(m) => m,
@@ -67,7 +67,7 @@ pub(super) fn perturb_body(t: &mut toml_edit::Table, prefix: &str, f: &mut dyn F
 
 /// Every body's (the `[[body]]`s, the patterns' bodies and parallelograms' rods) mass, mass
 /// centre and inertia moved by up to ±`rel` in the spec's text (inertias scaled whole).
-fn perturbed_platform(source: &str, rel: f64, seed: u64) -> String {
+pub(super) fn perturbed_platform(source: &str, rel: f64, seed: u64) -> String {
     let mut doc: toml_edit::DocumentMut = source.parse().unwrap();
     let mut r = Rng(seed);
     let mut f = move || 1.0 + rel * (2.0 * r.uniform() - 1.0);
@@ -97,7 +97,7 @@ fn perturbed_platform(source: &str, rel: f64, seed: u64) -> String {
 }
 
 /// `excite` on a platform (a short search): its states `(x, u, u̇)`.
-fn platform_trajectory(
+pub(super) fn platform_trajectory(
     dir: &Path,
     spec: &Path,
     m: &runtime::parallel::ParallelModel,
@@ -145,7 +145,7 @@ fn platform_trajectory(
 
 /// A platform's measurement file: the states with the true model's efforts (the runtime's
 /// `f64` evaluator) plus noise `sigma`.
-fn measure_platform(
+pub(super) fn measure_platform(
     path: &Path,
     states: &[[Vec<f64>; 3]],
     m: &runtime::parallel::ParallelModel,
@@ -264,8 +264,14 @@ fn platform_end_to_end(
             " (worst relative",
         );
         let names = estimate_names(&est);
+        // With noise, also a Delta rod's base parameters: its three numbers (mass, mass centre,
+        // transverse inertia) cannot follow noise in all four that they move.
         for &k in &fitted {
-            assert!(names[k].starts_with("FV_u"), "{k} {}", names[k]);
+            assert!(
+                names[k].starts_with("FV_u") || (case == "noisy" && names[k].contains("_rods")),
+                "{k} {}",
+                names[k]
+            );
         }
         let src = std::fs::read_to_string(&out).unwrap();
         let regenerated = generated_base_parameters("updated.toml", &src);
@@ -278,7 +284,9 @@ fn platform_end_to_end(
             });
             got.push(regenerated[k]);
         }
-        let err = rel(&got, &want);
+        // Relative; parameters below a millionth of the largest (zero in every such platform,
+        // rounding in the spec's and the written spec's constants) against that.
+        let err = rel_floor(&got, &want, 1e-6);
         eprintln!(
             "{test}: {case}: --out spec's BASE_PARAMETERS vs estimates {err:.2e} ({} kept at the spec's values, {} least-squares fits)",
             kept.len(),

@@ -9,7 +9,7 @@ use toml_edit::{DocumentMut, InlineTable, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::{Unknown, from_standard, number, physics, value};
+use super::{Unknown, from_standard, number, physics, set, value};
 
 /// A pattern body's copies as per-copy arrays in `[parameters]`, which its entries index
 /// (`inertia_rpy` removed).
@@ -55,23 +55,26 @@ pub(super) fn set_copies(
         arrays.push((key(k), per.iter().map(|b| b.2[r][c]).collect()));
     }
     let at = |k: &str| Value::from(format!("{k}[i]"));
-    t.insert("mass", value(at(&key("mass"))));
+    set(t, "mass", value(at(&key("mass"))));
     let mut com = toml_edit::Array::new();
     for axis in ["x", "y", "z"] {
         com.push(at(&key(&format!("com_{axis}"))));
     }
-    t.insert("com", value(com));
+    set(t, "com", value(com));
     let mut it = InlineTable::new();
     for (k, _) in entries {
         it.insert(k, at(&key(k)));
     }
-    t.insert("inertia", value(it));
+    set(t, "inertia", value(it));
     t.remove("inertia_rpy");
     put_arrays(d, arrays)
 }
 
 /// Per-copy arrays into `[parameters]` (made if absent).
-fn put_arrays(d: &mut DocumentMut, arrays: Vec<(String, Vec<f64>)>) -> Result<(), String> {
+pub(super) fn put_arrays(
+    d: &mut DocumentMut,
+    arrays: Vec<(String, Vec<f64>)>,
+) -> Result<(), String> {
     if !d.contains_key("parameters") {
         d["parameters"] = Item::Table(toml_edit::Table::new());
     }
@@ -83,13 +86,13 @@ fn put_arrays(d: &mut DocumentMut, arrays: Vec<(String, Vec<f64>)>) -> Result<()
         for v in values {
             a.push(number(v));
         }
-        params.insert(&name, value(a));
+        set(params, &name, value(a));
     }
     Ok(())
 }
 
 /// The `identified_<stem>` prefix of a pattern entry's arrays.
-fn stem(template: &str) -> String {
+pub(super) fn stem(template: &str) -> String {
     let s: String = template
         .replace("{i}", "")
         .chars()
@@ -120,7 +123,7 @@ pub(super) fn set_copy_drives(
         return Err(format!("joint `{template}`: {key} {v} < 0"));
     }
     let name = format!("{}_{key}", stem(template));
-    t.insert(key, value(Value::from(format!("{name}[i]"))));
+    set(t, key, value(Value::from(format!("{name}[i]"))));
     put_arrays(d, vec![(name, copies.to_vec())])
 }
 

@@ -1,0 +1,408 @@
+//! `identify --out` writes every base parameter the spec can carry back: a Delta's
+//! parallelogram rods included. The "true" Delta is the bundled spec with its bodies' and rods'
+//! numbers moved in its text (`perturbed_platform`); its efforts come from the runtime's `f64`
+//! evaluator; the written spec is checked by the generator's `BASE_PARAMETERS` of its module
+//! and by the runtime's inverse dynamics of its model against the true model's.
+
+use super::platform::{
+    DELTA, bundled, measure_platform, perturbed_platform, platform, platform_trajectory,
+};
+use super::{Rng, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text};
+
+/// Noise-free data of a perturbed Delta: the written spec's module has the estimates as its
+/// `BASE_PARAMETERS`, all 37, and its model the true model's inverse dynamics.
+#[test]
+fn delta_out_writes_rods_and_reproduces_every_base_parameter() {
+    use runtime::parallel::noc;
+    let dir = scratch("delta_out");
+    let nominal = bundled(DELTA);
+    let spec = dir.join("spec.toml");
+    std::fs::write(&spec, &nominal).unwrap();
+    let truth_src = perturbed_platform(&nominal, 0.2, 0x0bad_5eed);
+    let truth = platform("truth.toml", &truth_src);
+    let true_base = generated_base_parameters("truth.toml", &truth_src);
+    let states = platform_trajectory(&dir, &spec, &truth, 0.25, 0.1);
+    let data = dir.join("exact.csv");
+    measure_platform(&data, &states, &truth, 0.0, 1);
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(
+        !stderr.contains("cannot reproduce"),
+        "noise-free estimates are a Delta the spec can write:\n{stderr}"
+    );
+    let (e, _) = estimates(&est);
+    assert_eq!(e.len(), 37);
+    // The estimates are the truth (an independent check of the data: the generator's constants
+    // of the true spec).
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let src = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        src.contains("rod_mass = \"identified_forearm_rod_mass[i]\""),
+        "the rods are written per copy:\n{src}"
+    );
+    let written = generated_base_parameters("updated.toml", &src);
+    // Relative per parameter; those below a thousandth of the largest (the products of inertia
+    // and first moments that are zero in every Delta) against the largest.
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!("delta --out: BASE_PARAMETERS of the written spec vs the 37 estimates {err:.2e}");
+    assert!(err <= 1e-9, "{err:e}");
+    // Its dynamics are the true Delta's on fresh states: the trajectory's positions with
+    // random speeds and accelerations.
+    let model = platform("updated.toml", &src);
+    let (pw, pt) = (
+        noc::Plan::new(&model).unwrap(),
+        noc::Plan::new(&truth).unwrap(),
+    );
+    let mut r = Rng(99);
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for [x, _, _] in states.iter().step_by(23) {
+        let u: Vec<f64> = (0..3).map(|_| 0.5 * r.gauss()).collect();
+        let ud: Vec<f64> = (0..3).map(|_| 2.0 * r.gauss()).collect();
+        let a = noc::inverse_dynamics(&pw, x, &u, &ud).unwrap();
+        let b = noc::inverse_dynamics(&pt, x, &u, &ud).unwrap();
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "delta --out: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over 27 states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+/// The URDF's numbers moved in its text: every `<mass value>` and `<inertia …>` (scaled whole)
+/// by `f()`, each `<inertial>`'s `<origin xyz>` entry by `0.05 (f() − 1)` m, every
+/// `<dynamics damping>` by `f()`.
+fn perturbed_urdf(source: &str, rel: f64, seed: u64) -> String {
+    let mut r = Rng(seed);
+    let mut f = move || 1.0 + rel * (2.0 * r.uniform() - 1.0);
+    let mut out = String::new();
+    let mut inertial = false;
+    for line in source.split_inclusive('\n') {
+        let t = line.trim_start();
+        inertial |= t.starts_with("<inertial>");
+        let mut l = line.to_string();
+        let scale = |l: &mut String, attrs: &[&str], f: f64, d: f64| {
+            for a in attrs {
+                let key = format!(" {a}=\"");
+                let Some(at) = l.find(&key) else { continue };
+                let v0 = at + key.len();
+                let v1 = v0 + l[v0..].find('"').unwrap();
+                let vals: Vec<String> = l[v0..v1]
+                    .split_whitespace()
+                    .map(|x| format!("{}", x.parse::<f64>().unwrap() * f + d))
+                    .collect();
+                l.replace_range(v0..v1, &vals.join(" "));
+            }
+        };
+        if t.starts_with("<mass ") || t.starts_with("<dynamics ") {
+            scale(&mut l, &["value", "damping"], f(), 0.0);
+        } else if t.starts_with("<inertia ") {
+            scale(
+                &mut l,
+                &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"],
+                f(),
+                0.0,
+            );
+        } else if inertial && t.starts_with("<origin ") {
+            scale(&mut l, &["xyz"], 1.0, 0.05 * (f() - 1.0));
+        }
+        inertial &= !t.starts_with("</inertial>");
+        out.push_str(&l);
+    }
+    out
+}
+
+/// `BASE_PARAMETERS` of the module generated for a URDF with its scene file.
+fn urdf_base_parameters(name: &str, source: &str, scene: Option<&str>) -> Vec<f64> {
+    let config = codegen::Config {
+        scene: codegen::spec::SceneOverrides {
+            sidecar: scene.map(|t| codegen::spec::SceneFile {
+                name: "scene.toml".into(),
+                text: t.into(),
+            }),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let code = codegen::compile(name, source, &config)
+        .unwrap_or_else(|d| panic!("{}", d.render()))
+        .code;
+    let at = code
+        .find("pub const BASE_PARAMETERS: [f64; NBP] = [")
+        .unwrap();
+    let rest = &code[at + "pub const BASE_PARAMETERS: [f64; NBP] = [".len()..];
+    rest[..rest.find(']').unwrap()]
+        .split(',')
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+/// A URDF's tree model with its scene file.
+fn urdf_model(name: &str, source: &str, scene: Option<&str>) -> runtime::model::Model {
+    let overrides = codegen::spec::SceneOverrides {
+        sidecar: scene.map(|t| codegen::spec::SceneFile {
+            name: "scene.toml".into(),
+            text: t.into(),
+        }),
+        ..Default::default()
+    };
+    match codegen::spec::load(name, source, &overrides) {
+        Ok(l) => match l.mechanism {
+            codegen::spec::Mechanism::Tree(m) => m,
+            _ => panic!("a tree"),
+        },
+        Err(d) => panic!("{}", d.render()),
+    }
+}
+
+/// Inverse dynamics with the drive law (the runtime's spatial RNEA).
+fn effort(m: &runtime::model::Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
+    let tau = runtime::rnea::inverse_dynamics(m, q, qd, qdd);
+    (0..q.len())
+        .map(|i| tau[i] + m.joints[i].drive.effort(qd[i], qdd[i]))
+        .collect()
+}
+
+/// The text without its `<inertial>` blocks and `<dynamics …/>` elements: what `--out` must
+/// leave byte for byte.
+fn outside_inertials(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    loop {
+        let a = rest.find("<inertial>");
+        let d = rest.find("<dynamics ");
+        let (at, end) = match (a, d) {
+            (Some(a), Some(d)) if d < a => (d, "/>"),
+            (Some(a), _) => (a, "</inertial>"),
+            (None, Some(d)) => (d, "/>"),
+            (None, None) => break,
+        };
+        out.push_str(&rest[..at]);
+        let close = at + rest[at..].find(end).unwrap() + end.len();
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A perturbed iiwa 14 URDF (and `scene`, its scene file), noise-free: the written URDF's
+/// module has the estimates as its `BASE_PARAMETERS` and its model the true inverse dynamics;
+/// nothing outside `<inertial>` and `<dynamics>` changes.
+fn urdf_out(test: &str, scene: Option<&str>) {
+    let dir = scratch(test);
+    let nominal = bundled("../mechanisms/specs/iiwa14.urdf");
+    let spec = dir.join("iiwa.urdf");
+    std::fs::write(&spec, &nominal).unwrap();
+    if let Some(t) = scene {
+        std::fs::write(dir.join("iiwa.scene.toml"), t).unwrap();
+    }
+    let truth_src = perturbed_urdf(&nominal, 0.2, 0x1ee7);
+    let truth = urdf_model("truth.urdf", &truth_src, scene);
+    let true_base = urdf_base_parameters("truth.urdf", &truth_src, scene);
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(&spec),
+        "--restarts",
+        "1",
+        "--evaluations",
+        "30",
+        "--samples",
+        "500",
+        "--seed",
+        "3",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (header, rows) = super::csv_rows(&traj);
+    let n = truth.dof();
+    assert_eq!(header.len(), 1 + 3 * n);
+    let mut csv = header.join(",");
+    csv.push_str(&(1..=n).map(|i| format!(",tau{i}")).collect::<String>());
+    csv.push('\n');
+    for row in &rows {
+        let (q, qd, qdd) = (&row[1..1 + n], &row[1 + n..1 + 2 * n], &row[1 + 2 * n..]);
+        let tau = effort(&truth, q, qd, qdd);
+        let cells: Vec<String> = row.iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("exact.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.urdf"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(!stderr.contains("cannot reproduce"), "{stderr}");
+    // A URDF has no number for a rotor's inertia: only the `IA_` parameters that no link's
+    // inertia groups with (zero in the truth, as every URDF's) may be kept at the spec's values.
+    let kept = super::platform::listed(
+        &stderr,
+        "note: no number the update writes moves",
+        " (kept at",
+    );
+    let (e, _) = estimates(&est);
+    let names: Vec<String> = std::fs::read_to_string(&est)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split('"').nth(1).unwrap().to_string())
+        .collect();
+    for &k in &kept {
+        assert!(
+            names[k].starts_with("IA_") && scene.is_some(),
+            "{}",
+            names[k]
+        );
+    }
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let written_src = std::fs::read_to_string(&out).unwrap();
+    // The scene file comes along, unchanged.
+    let written_scene = std::fs::read_to_string(dir.join("updated.scene.toml")).ok();
+    assert_eq!(written_scene.as_deref(), scene);
+    assert_eq!(outside_inertials(&written_src), outside_inertials(&nominal));
+    assert_ne!(written_src, nominal);
+    let written = urdf_base_parameters("updated.urdf", &written_src, scene);
+    assert_eq!(written.len(), e.len());
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!(
+        "{test}: NBP {}: the written URDF's BASE_PARAMETERS vs the estimates {err:.2e}, estimates vs truth {err_truth:.2e}",
+        e.len()
+    );
+    assert!(err <= 1e-9, "{err:e}");
+    let model = urdf_model("updated.urdf", &written_src, scene);
+    let mut r = Rng(5);
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for _ in 0..50 {
+        let mut v = || {
+            (0..n)
+                .map(|_| 2.0 * r.uniform() - 1.0)
+                .collect::<Vec<f64>>()
+        };
+        let (q, qd, qdd) = (v(), v(), v());
+        let a = effort(&model, &q, &qd, &qdd);
+        let b = effort(&truth, &q, &qd, &qdd);
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "{test}: inverse dynamics of the written URDF vs the truth {id_err:.2e} (relative 2-norm, 50 random states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+#[test]
+fn urdf_out_replaces_inertials_and_keeps_every_other_byte() {
+    urdf_out("urdf_out", None);
+}
+
+#[test]
+fn urdf_out_with_friction_writes_dynamics_and_the_scene_file() {
+    urdf_out("urdf_out_friction", Some("[scene]\nfriction = true\n"));
+}
+
+/// The planar 2R of `mechanisms/specs/` with its second link written with expressions (which
+/// `--out` leaves alone) and a payload on it.
+fn payload_spec(m2: f64, payload_mass: f64, payload_x: f64) -> String {
+    let nominal = bundled("../mechanisms/specs/planar_2r.toml");
+    let body = "name = \"link2\"\nmass = 1.0\ncom = [0.4, 0.0, 0.0]";
+    assert!(nominal.contains(body));
+    let src = nominal.replace(
+        body,
+        "name = \"link2\"\nmass = \"m2\"\ncom = [\"l2 / 2\", 0.0, 0.0]",
+    );
+    format!(
+        "{src}\n[parameters]\nm2 = {m2}\nl2 = 0.8\n\n[scene]\npayload = {{ body = \"link2\", mass = {payload_mass}, com = [{payload_x}, 0.0, 0.0], inertia = {{ ixx = 0.001, iyy = 0.002, izz = 0.002 }} }}\n"
+    )
+}
+
+/// A body `--out` cannot rewrite (expressions) with a payload on it: the payload takes the
+/// change the body cannot, and the written spec reproduces every base parameter.
+#[test]
+fn a_payload_takes_what_its_body_cannot() {
+    let dir = scratch("payload_out");
+    let src = payload_spec(1.0, 0.5, 0.8);
+    let spec = dir.join("planar.toml");
+    std::fs::write(&spec, &src).unwrap();
+    let truth_src = payload_spec(1.1, 0.62, 0.74);
+    let truth = super::tree("truth.toml", &truth_src);
+    let true_base = generated_base_parameters("truth.toml", &truth_src);
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(&spec),
+        "--seed",
+        "2",
+        "--restarts",
+        "1",
+        "--evaluations",
+        "40",
+        "--samples",
+        "300",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (_, rows) = super::csv_rows(&traj);
+    let mut csv = String::from("q1,q2,qd1,qd2,qdd1,qdd2,tau1,tau2\n");
+    for r in &rows {
+        let tau = effort(&truth, &r[1..3], &r[3..5], &r[5..7]);
+        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("data.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
+    assert!(stdout.contains("[scene] payload"), "{stdout}");
+    assert!(stderr.contains("note: body `link2`"), "{stderr}");
+    assert!(!stderr.contains("note: no number"), "{stderr}");
+    let (e, _) = estimates(&est);
+    assert!(rel_floor(&e, &true_base, 1e-3) <= 1e-8);
+    let written_src = std::fs::read_to_string(&out).unwrap();
+    assert!(written_src.contains("mass = \"m2\"\ncom = [\"l2 / 2\", 0.0, 0.0]"));
+    let written = generated_base_parameters("updated.toml", &written_src);
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!("payload --out: BASE_PARAMETERS of the written spec vs the estimates {err:.2e}");
+    assert!(err <= 1e-9, "{err:e}");
+}
