@@ -79,7 +79,9 @@ impl Stack<'_> {
     /// State `s`'s `Y` (`DOF × NBP`, row-major), or why it has none.
     pub fn rows(&mut self, s: usize) -> Result<&[f64], NoRegressor> {
         let count = self.states[0].len();
-        assert!(s < count, "state {s} of {count}");
+        if s >= count {
+            return Err(NoRegressor("no such state"));
+        }
         if !(self.start..self.start + self.status.len()).contains(&s) {
             self.start = s;
             self.evaluate(BLOCK.min(count - s));
@@ -199,5 +201,13 @@ mod tests {
         assert!(failed > count / 20 && failed < count / 5, "{failed}");
         assert_eq!(check("four_bar.toml", BLOCK + 5, 0.3, 0.3), 0);
         assert_eq!(check("four_bar.toml", 1, 0.3, 0.3), 0);
+        let (p, v, a) = (vec![vec![0.0; 6]], vec![vec![0.0; 6]], vec![vec![0.0; 6]]);
+        let text = std::fs::read_to_string(format!(
+            "{}/../mechanisms/specs/puma560.toml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .expect("bundled spec");
+        let (reg, _) = Regressor::compile("puma560.toml", &text, None).expect("compiles");
+        assert!(reg.stack(&p, &v, &a).rows(1).is_err(), "past the states");
     }
 }
