@@ -225,8 +225,8 @@ fn at(
 /// ([`Regressor::stack`]), each bit for bit what it is alone.
 fn stacked(reg: &Regressor, f: &Fourier, phases: &Phases) -> Result<DMatrix<f64>, f64> {
     let (n, nbp, m) = (reg.dof(), reg.nbp(), phases.times.len());
-    let (mut p, mut v, mut a) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::new());
-    a.reserve(m);
+    let mut p: Vec<Vec<f64>> = Vec::with_capacity(m);
+    let (mut v, mut a) = (Vec::with_capacity(m), Vec::with_capacity(m));
     let mut end = None;
     for k in 0..m {
         match at(reg, f, phases, k, p.last().map(Vec::as_slice)) {
