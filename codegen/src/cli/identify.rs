@@ -195,15 +195,17 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     let rows = data.q.len();
     let mut w = DMatrix::zeros(rows * n, nbp);
     let mut tau = DVector::zeros(rows * n);
-    let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
+    let mut stack = reg.stack(&data.q, &data.qd, &data.qdd);
     for s in 0..rows {
-        if let Err(e) = reg.rows(&data.q[s], &data.qd[s], &data.qdd[s], &mut buf, &mut y) {
+        let y = stack.rows(s);
+        if let Err(e) = &y {
             eprintln!(
                 "error: {data_name}:{}: no regressor at this state: {} (remove the row, or check the columns' order and units)",
                 data.lines[s], e.0
             );
             return ExitCode::from(2);
         }
+        let y = y.unwrap_or_default();
         // Squares of larger numbers overflow in the least squares (and the SVD does not
         // return on what follows): no unit makes such values measurements.
         if let Some(v) = y
