@@ -498,15 +498,22 @@ fn write_update(
         return ExitCode::from(1);
     }
     // A URDF's scene file goes beside the written URDF, where the tools look for it
-    // (`ROBOT.scene.toml`): the written model is the URDF with that scene.
+    // (`ROBOT.scene.toml`): the written model is the URDF with that scene (its `armature`
+    // updated).
     if let Some(scene) = sidecar {
         let beside = path.with_extension("scene.toml");
-        if let Err(e) = super::write_output(&beside, &scene.text) {
+        let text = up.scene.as_deref().unwrap_or(&scene.text);
+        if let Err(e) = super::write_output(&beside, text) {
             eprintln!("error: {e}");
             return ExitCode::from(1);
         }
+        let what = if text == scene.text {
+            "the scene"
+        } else {
+            "the scene, its armature updated,"
+        };
         outln!(
-            "scene file: {} (the scene of {}, which the updated URDF's model needs)",
+            "scene file: {} ({what} of {}, which the updated URDF's model needs)",
             beside.display(),
             scene.name
         );
