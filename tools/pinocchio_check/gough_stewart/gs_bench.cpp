@@ -1,7 +1,7 @@
 // The bundled Gough-Stewart's actuator forces by Pinocchio on the opened tree, checked against the
 // generated `inverse_dynamics` (data/VARIANT.txt from src/main.rs: x, u, ud, q, tau per line) and
 // timed. Header-only Pinocchio (no libpinocchio_*: the model is built here, not parsed), so the
-// whole program is built with -O3 -march=native. The equations: ../README.md, "Gough-Stewart".
+// whole program is built with -O3 -march=native. The equations: ../README.md, "Gough–Stewart".
 //
 // Tree (Pinocchio): joint 1 a free-flyer carrying the platform; leg k (0..5): RUBX (unbounded
 // revolute about x, q = (cos, sin)) at the U centre b_k with the U frame R0_k, RUBY (the cylinder),
@@ -10,12 +10,16 @@
 // leg 0 (α̇, β̇, ḋ); ...], nv = 24.
 //
 // Routes, each from (x, u, ud) to the six actuator forces:
-//   "pinocchio-jac": closed-form leg IK; computeJointJacobians + getFrameJacobian (LOCAL_WORLD_ALIGNED)
-//     of each leg tip, a 3x3 solve per leg for the leg rates; forwardKinematics(q, v, 0) +
+//   "jac": closed-form leg IK; computeJointJacobians + getFrameJacobian (LOCAL_WORLD_ALIGNED) of
+//     each leg tip, a 3x3 solve per leg for the leg rates; forwardKinematics(q, v, 0) +
 //     getFrameClassicalAcceleration for each tip's drift J̇θ̇ and a 3x3 solve for the leg
-//     accelerations; rnea; the projection f = A⁻ᵀ Tᵀ τ with the legs' J⁻ᵀ.
-//   "pinocchio-closed": the same with the leg Jacobians, their inverses and drifts in closed form
-//     (the U's columns are orthogonal): Pinocchio's only work is one rnea.
+//     accelerations; rnea; the projection f = A⁻ᵀ Tᵀ τ with the legs' J⁻ᵀ (Eigen PartialPivLU).
+//   "closed": the same with the leg Jacobians, their inverses and drifts in closed form (the U's
+//     columns are orthogonal): Pinocchio's only work is one rnea.
+//   "cg": "closed" with Pinocchio's CodeGenRNEA (CppADCodeGen) of the same tree for the rnea.
+//   "cg-whole": "closed" written for any scalar (forces_t) and taped whole on Pinocchio's AD model
+//     (a CodeGenBase, as CodeGenRNEA is built): one generated C function (x, u, ud) -> forces.
+// Usage: gs_bench "GCC FLAGS" LIBDIR (the flags for CppADCodeGen's C; libraries in LIBDIR/VARIANT).
 #include <pinocchio/codegen/cppadcg.hpp>  // before the other Pinocchio headers
 #include <pinocchio/codegen/cppadcg-algo.hpp>
 #include <pinocchio/multibody.hpp>

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The bundled Gough-Stewart's actuator forces: generated code against Pinocchio routes on the
-# opened tree (../README.md, "Gough-Stewart"). Needs Pinocchio 4.1 with CppAD and CppADCodeGen in
+# opened tree (../README.md, "Gough–Stewart"). Needs Pinocchio 4.1 with CppAD and CppADCodeGen in
 # its cmeel prefix (../run.sh installs them and then runs this). Usage: bash run.sh
 set -euo pipefail
 cd "$(dirname "$0")"
