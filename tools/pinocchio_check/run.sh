@@ -65,3 +65,6 @@ CG_FLAGS="-O3 -march=native"
 $PIN ./pinocchio_bench_cg "$CG_FLAGS" cg_libs urdf/ur5.urdf urdf/ur10.urdf urdf/panda.urdf urdf/z1.urdf \
   urdf/kinova.urdf urdf/xarm7.urdf urdf/iiwa14.urdf urdf/talos_left_arm.urdf | tee out/cg.txt
 python3 tables.py out/rust.txt out/cg.txt | tee out/tables.md
+# The bundled Gough-Stewart's actuator forces against Pinocchio routes on its opened tree
+# (README.md, "Gough–Stewart"; its own crate and program in gough_stewart/).
+bash gough_stewart/run.sh
