@@ -52,7 +52,10 @@ fn states(home: &[f64; 7], seed: u64) -> Vec<State> {
 
 fn rel(a: &[f64], b: &[f64]) -> f64 {
     let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
 }
 
 #[repr(C)]
@@ -97,7 +100,11 @@ fn time(st: &[State], f: &dyn Fn(&State) -> f64) -> (f64, f64) {
 
 /// The `inverse_dynamics` row of a module's operation-count header.
 fn flops(header: &str) -> String {
-    header.lines().find(|l| l.starts_with("// | inverse_dynamics |")).map(|l| l[3..].to_string()).unwrap_or_default()
+    header
+        .lines()
+        .find(|l| l.starts_with("// | inverse_dynamics |"))
+        .map(|l| l[3..].to_string())
+        .unwrap_or_default()
 }
 
 macro_rules! variant {
