@@ -13,6 +13,7 @@
 mod angle;
 mod child_frame;
 mod closed;
+mod cross;
 mod expr;
 mod fix;
 mod frames;
