@@ -94,10 +94,7 @@ fn max_abs(v: &[f64]) -> f64 {
 fn the_cross_key_is_the_explicit_cross_body() {
     let a = tree("a.toml", WITH_KEY);
     let b = tree("b.toml", EXPLICIT);
-    let massless = tree(
-        "c.toml",
-        &WITH_KEY.replace("cross = {", "# cross = {"),
-    );
+    let massless = tree("c.toml", &WITH_KEY.replace("cross = {", "# cross = {"));
     assert_eq!(a.dof(), 2);
     let mut s = 7u64;
     let (mut worst, mut effect) = (0.0f64, f64::INFINITY);
@@ -115,7 +112,9 @@ fn the_cross_key_is_the_explicit_cross_body() {
         worst = worst.max(max_abs(&d) / scale);
         effect = effect.min(max_abs(&e) / scale);
     }
-    eprintln!("with the key vs explicit: {worst:e}; the cross's effect: {effect:e} (max-norm relative)");
+    eprintln!(
+        "with the key vs explicit: {worst:e}; the cross's effect: {effect:e} (max-norm relative)"
+    );
     assert!(worst <= 1e-12, "with the key vs explicit: {worst:e}");
     // The cross matters: without it every state's efforts differ.
     assert!(effect > 1e-4, "the cross changes nothing: {effect:e}");
@@ -207,7 +206,10 @@ fn a_bad_cross_is_reported_at_its_key_like_a_body() {
         e.contains("`cross` is for universal joints, not a revolute joint"),
         "{e}"
     );
-    assert!(e.contains(&format!("bad.toml:{}:", line_of(&on_revolute, "cross = {"))), "{e}");
+    assert!(
+        e.contains(&format!("bad.toml:{}:", line_of(&on_revolute, "cross = {"))),
+        "{e}"
+    );
 }
 
 #[test]
@@ -217,13 +219,19 @@ fn a_non_physical_cross_inertia_warns_at_its_key() {
     let w = warnings.render();
     assert!(w.contains("triangle"), "{w}");
     assert!(w.contains("joint \"u\".cross.inertia"), "{w}");
-    assert!(w.contains(&format!("w.toml:{}:", line_of(&src, "cross = {"))), "{w}");
+    assert!(
+        w.contains(&format!("w.toml:{}:", line_of(&src, "cross = {"))),
+        "{w}"
+    );
 }
 
 /// A 3-UPU's universal joint into the platform is a constraint, with no cross body.
 #[test]
 fn a_cross_on_the_joint_into_the_platform_is_refused() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../mechanisms/specs/tsai_3upu.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../mechanisms/specs/tsai_3upu.toml"
+    );
     let src = std::fs::read_to_string(path).unwrap();
     let bad = src.replacen(
         "child = \"platform\"",

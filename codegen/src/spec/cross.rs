@@ -42,3 +42,40 @@ pub(super) fn check_skipped(spec: &Spec, skip: &Skip, diags: &mut Diagnostics) {
         );
     }
 }
+
+/// The crosses a spec's model has, as its text gives them (patterns expanded, expressions
+/// evaluated): per universal joint whose expansion makes a body `<joint>_cross` (a leg's or a
+/// tree's; not a joint into a platform, not a loop-closing one), `(joint name, mass, mass
+/// centre, inertia about it)` in the cross's frame, zeros where `cross` is not written. For
+/// `codegen identify --out`; `None` when the spec does not load.
+pub fn written_crosses(
+    file_name: &str,
+    source: &str,
+) -> Option<Vec<(String, f64, runtime::model::Vec3, runtime::model::Mat3)>> {
+    let mut d = Diagnostics::new(file_name, source);
+    let spec = super::read_ir(file_name, source, &mut d)?;
+    if d.has_errors() {
+        return None;
+    }
+    let (mechanism, _) = super::load_mechanism(file_name, source).ok()?;
+    let names: Vec<&str> = match &mechanism {
+        super::Mechanism::Tree(m) => m.bodies.iter().map(|b| b.name.as_str()).collect(),
+        super::Mechanism::Parallel(p) => p
+            .legs
+            .iter()
+            .flat_map(|l| l.bodies.iter().map(|b| b.name.as_str()))
+            .collect(),
+        super::Mechanism::Closed(c) => c.tree.bodies.iter().map(|b| b.name.as_str()).collect(),
+    };
+    Some(
+        spec.joints
+            .iter()
+            .filter(|j| j.kind == super::ir::Kind::Universal)
+            .filter(|j| names.contains(&format!("{}_cross", j.name).as_str()))
+            .map(|j| match &j.cross {
+                Some(c) => (j.name.clone(), c.mass, c.com, c.inertia),
+                None => (j.name.clone(), 0.0, [0.0; 3], [[0.0; 3]; 3]),
+            })
+            .collect(),
+    )
+}

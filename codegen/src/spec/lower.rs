@@ -150,7 +150,11 @@ pub(super) fn check_values(spec: &Spec, diags: &mut Diagnostics) -> Axes {
         }
     }
     // A universal joint's cross is checked as a body is (docs/spec.md, "Joint kinds").
-    for b in spec.bodies.iter().chain(spec.joints.iter().filter_map(|j| j.cross.as_ref())) {
+    for b in spec
+        .bodies
+        .iter()
+        .chain(spec.joints.iter().filter_map(|j| j.cross.as_ref()))
+    {
         check_body(b, diags);
     }
     spec.joints.iter().map(|j| joint_axes(j, diags)).collect()

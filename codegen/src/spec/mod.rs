@@ -40,6 +40,7 @@ use runtime::parallel::ParallelModel;
 
 use crate::diag::{Diagnostic, Diagnostics};
 
+pub use cross::written_crosses;
 pub use fix::apply_fixes;
 pub use frames::Frame;
 pub(crate) use frames::frame_ident;

@@ -5,7 +5,8 @@
 //! and by the runtime's inverse dynamics of its model against the true model's.
 
 use super::platform::{
-    DELTA, bundled, measure_platform, perturbed_platform, platform, platform_trajectory,
+    DELTA, GS, bundled, estimate_names, measure_platform, perturbed_platform, platform,
+    platform_trajectory,
 };
 use super::{Rng, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text};
 
@@ -79,6 +80,106 @@ fn delta_out_writes_rods_and_reproduces_every_base_parameter() {
     let id_err = (diff / norm).sqrt();
     eprintln!(
         "delta --out: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over 27 states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+/// Noise-free data of a perturbed Gough–Stewart whose U joints' crosses have mass (a `cross`
+/// key on the pattern's `u{i}`, different per copy), identified with the bundled spec (no
+/// `cross` key): `--out` adds the key, and the written spec's module has every estimate as its
+/// `BASE_PARAMETERS`, the six `MZ_u<i>_cross` that only a cross moves included, and its model
+/// the true model's inverse dynamics.
+#[test]
+fn gough_stewart_out_writes_the_crosses() {
+    use runtime::parallel::noc;
+    let dir = scratch("gs_cross_out");
+    let nominal = bundled(GS);
+    let spec = dir.join("spec.toml");
+    std::fs::write(&spec, &nominal).unwrap();
+    let with_crosses = nominal.replace(
+        "name = \"u{i}\"\nkind = \"U\"\n",
+        "name = \"u{i}\"\nkind = \"U\"\ncross = { mass = \"0.08 + 0.01 * i\", com = [0.01, -0.02, \"0.04 + 0.01 * i\"], inertia = { ixx = 2e-4, iyy = \"3e-4 + 1e-5 * i\", izz = 1e-4, ixy = 1e-5 } }\n",
+    );
+    assert_ne!(with_crosses, nominal);
+    let truth_src = perturbed_platform(&with_crosses, 0.2, 0x0c05_5e5);
+    std::fs::write(dir.join("truth.toml"), &truth_src).unwrap();
+    let truth = platform("truth.toml", &truth_src);
+    let true_base = generated_base_parameters("truth.toml", &truth_src);
+    let nominal_base = generated_base_parameters("spec.toml", &nominal);
+    let states = platform_trajectory(&dir, &spec, &truth, 0.2, 0.25);
+    let data = dir.join("exact.csv");
+    measure_platform(&data, &states, &truth, 0.0, 1);
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(
+        !stderr.contains("_cross") || !stderr.contains("no number the update writes moves"),
+        "every cross parameter is written:\n{stderr}"
+    );
+    let (e, _) = estimates(&est);
+    let names = estimate_names(&est);
+    // The estimates are the truth (the generator's constants of the true spec).
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let mz: Vec<usize> = (0..names.len())
+        .filter(|&k| names[k].starts_with("MZ_u") && names[k].ends_with("_cross"))
+        .collect();
+    assert_eq!(mz.len(), 6, "{names:?}");
+    for &k in &mz {
+        // The crosses' first moments are the truth's, not the spec's (zero).
+        assert!(
+            nominal_base[k] == 0.0 && e[k].abs() > 1e-3,
+            "{}: {}",
+            names[k],
+            e[k]
+        );
+    }
+    let src = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        src.contains("cross = { mass = \"identified_u_cross_mass[i]\""),
+        "the crosses are written per copy:\n{src}"
+    );
+    let written = generated_base_parameters("updated.toml", &src);
+    let err = rel_floor(&written, &e, 1e-3);
+    let err_mz = mz
+        .iter()
+        .map(|&k| (written[k] - e[k]).abs() / e[k].abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "gough_stewart cross --out: BASE_PARAMETERS of the written spec vs the {} estimates {err:.2e}, the six MZ_u<i>_cross {err_mz:.2e} (relative)",
+        e.len()
+    );
+    assert!(err <= 1e-9 && err_mz <= 1e-9, "{err:e} {err_mz:e}");
+    let model = platform("updated.toml", &src);
+    let (pw, pt) = (
+        noc::Plan::new(&model).unwrap(),
+        noc::Plan::new(&truth).unwrap(),
+    );
+    let mut r = Rng(98);
+    let (mut diff, mut norm, mut count) = (0.0f64, 0.0f64, 0);
+    for [x, _, _] in states.iter().step_by(23) {
+        let u: Vec<f64> = (0..6).map(|_| 0.5 * r.gauss()).collect();
+        let ud: Vec<f64> = (0..6).map(|_| 2.0 * r.gauss()).collect();
+        let a = noc::inverse_dynamics(&pw, x, &u, &ud).unwrap();
+        let b = noc::inverse_dynamics(&pt, x, &u, &ud).unwrap();
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+        count += 1;
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "gough_stewart cross --out: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over {count} states)"
     );
     assert!(id_err <= 1e-9, "{id_err:e}");
 }
