@@ -101,7 +101,7 @@ fn gough_stewart_out_writes_the_crosses() {
         "name = \"u{i}\"\nkind = \"U\"\ncross = { mass = \"0.08 + 0.01 * i\", com = [0.01, -0.02, \"0.04 + 0.01 * i\"], inertia = { ixx = 2e-4, iyy = \"3e-4 + 1e-5 * i\", izz = 1e-4, ixy = 1e-5 } }\n",
     );
     assert_ne!(with_crosses, nominal);
-    let truth_src = perturbed_platform(&with_crosses, 0.2, 0x0c05_5e5);
+    let truth_src = perturbed_platform(&with_crosses, 0.2, 0x00c0_55e5);
     std::fs::write(dir.join("truth.toml"), &truth_src).unwrap();
     let truth = platform("truth.toml", &truth_src);
     let true_base = generated_base_parameters("truth.toml", &truth_src);
