@@ -492,6 +492,10 @@ pub fn update(
             *r = rods::REFERENCE[*k];
         }
     }
+    let late: Vec<bool> = unknowns
+        .iter()
+        .map(|u| matches!(u, Unknown::Payload { .. } | Unknown::Cross { .. }))
+        .collect();
     let Change {
         p,
         mut z,
@@ -504,13 +508,10 @@ pub fn update(
         &pi0,
         target,
         fit,
-        &unknowns
-            .iter()
-            .map(|u| matches!(u, Unknown::Payload { .. } | Unknown::Cross { .. }))
-            .collect::<Vec<_>>(),
+        &late,
         &mut |z| base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string()),
     )?;
-    free_masses(&unknowns, &mut z, &mut dz, &p);
+    free_masses(&unknowns, &late, &mut z, &mut dz, &p);
     let changed = changed_names(&names, &dz);
     // Only the entries that change are rewritten; the others keep their text.
     let touched: Vec<usize> = (0..unknowns.len())

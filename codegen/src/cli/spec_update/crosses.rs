@@ -9,10 +9,12 @@
 //! as numbers, a pattern joint's as expressions indexing per-copy arrays in `[parameters]`
 //! (`mass = "identified_u_cross_mass[i]"`), the key added where absent.
 //!
-//! A cross at a fixed point (a U joint on the base) moves no base parameter with its mass: the
-//! mass is then free, and where the identified first moment needs one ([`free_masses`]) the
-//! update takes twice the least mass that makes the cross physical, `2 hᵀ Σ⁻¹ h` (`h` the first
-//! moment, `Σ` the second moment of mass about the cross's origin).
+//! A cross's mass sits at the joint's centre, so it moves nothing (a U joint on the base) or
+//! what the parent body's numbers can move too: the minimum-norm change leaves it near its old
+//! value, often zero, while its first moment changes. Where that is no body ([`free_masses`])
+//! the update takes twice the least mass that makes the cross physical, `2 hᵀ Σ⁻¹ h` (`h` the
+//! first moment, `Σ` the second moment of mass about the cross's origin), the parent's numbers
+//! taking up the difference.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item};
@@ -166,13 +168,17 @@ pub(super) fn set_crosses(
     }
 }
 
-/// The crosses whose mass moves no base parameter (column `M` of `p` zero: a cross at a fixed
-/// point) and whose numbers in `z` are no body (a first moment without mass, or not physical
-/// with the mass they have): their mass becomes `2 hᵀ Σ⁻¹ h`, twice the least with which the
-/// cross is physical (its second moment `Σ` about its origin positive definite; else
-/// `2 |h|² / λ_max(Σ)`, or `|h|` per metre when `Σ` has no positive direction). `dz` follows.
+/// The crosses whose numbers in `z` are no body (a first moment without mass, or not physical
+/// with the mass they have) get the mass `2 hᵀ Σ⁻¹ h`, twice the least with which the cross is
+/// physical (its second moment `Σ` about its origin positive definite; else `2 |h|² / λ_max(Σ)`,
+/// or `|h|` per metre when `Σ` has no positive direction), where that leaves the base
+/// parameters as they are: at once when the mass moves none (a cross at a fixed point, column
+/// `M` of `p` zero), else when the other unknowns that are not `late` (the bodies and drives)
+/// take up what it moves (a cross's mass sits at the joint's centre, fixed in the parent body,
+/// so the parent's numbers can: docs/method.md, regrouping). `z` and `dz` follow.
 pub(super) fn free_masses(
     unknowns: &[Unknown],
+    late: &[bool],
     z: &mut [f64],
     dz: &mut DVector<f64>,
     p: &DMatrix<f64>,
@@ -182,9 +188,6 @@ pub(super) fn free_masses(
             continue;
         }
         let m = c + 9;
-        if p.column(m).iter().any(|x| *x != 0.0) {
-            continue;
-        }
         let sp: [f64; 10] = std::array::from_fn(|k| z[c + k]);
         let h = [sp[6], sp[7], sp[8]];
         if h.iter().all(|x| *x == 0.0) {
@@ -193,9 +196,33 @@ pub(super) fn free_masses(
         if from_standard(&sp).is_ok_and(|(m, _, ic)| physics(m, &ic).is_empty()) {
             continue;
         }
-        let mass = least_mass(&sp);
-        dz[m] += mass - z[m];
-        z[m] = mass;
+        let delta = least_mass(&sp) - z[m];
+        let moved = p.column(m) * delta;
+        if moved.amax() > 0.0 {
+            // The others' minimum-norm change that cancels what the mass moves.
+            let others: Vec<usize> = (0..unknowns.len()).filter(|&k| !late[k]).collect();
+            if others.is_empty() {
+                continue;
+            }
+            let po = DMatrix::from_fn(p.nrows(), others.len(), |r, k| p[(r, others[k])]);
+            let Ok(pinv) = po
+                .clone()
+                .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
+            else {
+                continue;
+            };
+            let x = pinv * (-&moved);
+            let rest = &po * &x + &moved;
+            if rest.amax() > 1e-10 * moved.amax() {
+                continue;
+            }
+            for (k, &o) in others.iter().enumerate() {
+                z[o] += x[k];
+                dz[o] += x[k];
+            }
+        }
+        dz[m] += delta;
+        z[m] += delta;
     }
 }
 
