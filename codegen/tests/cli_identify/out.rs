@@ -1,5 +1,6 @@
 //! `identify --out` writes every base parameter the spec can carry back: a Delta's
-//! parallelogram rods included. The "true" Delta is the bundled spec with its bodies' and rods'
+//! parallelogram rods and universal joints' crosses (a Gough–Stewart's, a tree's) included. The
+//! "true" Delta is the bundled spec with its bodies' and rods'
 //! numbers moved in its text (`perturbed_platform`); its efforts come from the runtime's `f64`
 //! evaluator; the written spec is checked by the generator's `BASE_PARAMETERS` of its module
 //! and by the runtime's inverse dynamics of its model against the true model's.
