@@ -249,3 +249,32 @@ fn a_cross_on_the_joint_into_the_platform_is_refused() {
     );
     assert!(load_mechanism("ok.toml", &good).is_ok());
 }
+
+/// In a closed loop written in joint coordinates (the 3-UPU with its platform on the first
+/// leg), the tree's U joints take a cross, and it is part of the tree's model.
+#[test]
+fn a_closed_loop_tree_joint_takes_a_cross() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/tsai_3upu_joints.toml"
+    );
+    let src = std::fs::read_to_string(path).unwrap();
+    let with = src.replacen(
+        "child = \"cylinder1\"",
+        "child = \"cylinder1\"\ncross = { mass = 0.25, com = [0.0, 0.0, 0.01] }",
+        1,
+    );
+    assert_ne!(with, src);
+    let cross_mass = |s: &str| match load_mechanism("c.toml", s) {
+        Ok((Mechanism::Closed(c), _)) => c
+            .tree
+            .bodies
+            .iter()
+            .find(|b| b.name == "base_u1_cross")
+            .map(|b| b.mass),
+        Ok(_) => panic!("a closed loop"),
+        Err(d) => panic!("{d}"),
+    };
+    assert_eq!(cross_mass(&src), Some(0.0));
+    assert_eq!(cross_mass(&with), Some(0.25));
+}
