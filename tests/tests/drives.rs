@@ -392,3 +392,91 @@ fn parallel_actuator_drives() {
     };
     assert!(flops(true) > flops(false));
 }
+
+/// `[scene] armature = { joint = I_a }`: a URDF (which has no place for rotor inertia) gets it
+/// from its scene. Checked by the identity it must satisfy, not by the code that adds it: the
+/// rotor adds exactly `I_a q̈` to the joint's effort (the runtime's inverse dynamics, with and
+/// without), and
+/// only with `rotor_inertia = true`. The PUMA 560's armature moved from its joints into the scene
+/// gives the same drives. Bad entries are errors at the key.
+#[test]
+fn scene_armature() {
+    let urdf = r#"<robot name="p">
+  <link name="world"/>
+  <link name="rod"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
+    <inertia ixx="0.01" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="world"/><child link="rod"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="tip"/>
+  <joint name="tip_mount" type="fixed"><parent link="rod"/><child link="tip"/></joint>
+</robot>"#;
+    let load = |scene: &str| {
+        let o = codegen::spec::SceneOverrides {
+            sidecar: Some(codegen::spec::SceneFile {
+                name: "p.scene.toml".into(),
+                text: format!("[scene]\n{scene}\n"),
+            }),
+            ..Default::default()
+        };
+        codegen::spec::load("p.urdf", urdf, &o).map(|l| match l.mechanism {
+            codegen::spec::Mechanism::Tree(m) => m,
+            _ => panic!("not a tree"),
+        })
+    };
+    let m = load("rotor_inertia = true\narmature = { j = 0.3 }").unwrap();
+    let off = load("armature = { j = 0.3 }").unwrap();
+    let (q, qd) = ([0.4], [0.7]);
+    for qdd in [0.0, 1.0, -2.5] {
+        let with = runtime::noc::inverse_dynamics(&m, &q, &qd, &[qdd])[0];
+        let without = runtime::noc::inverse_dynamics(&off, &q, &qd, &[qdd])[0];
+        assert!(
+            (with - without - 0.3 * qdd).abs() <= 1e-14,
+            "{with} {without}"
+        );
+    }
+    assert_eq!(m.joints[0].drive.armature, 0.3);
+    assert!(off.joints[0].drive.is_none());
+    for (scene, message) in [
+        ("armature = { jj = 0.3 }", "unknown joint \"jj\""),
+        (
+            "armature = { j = -0.3 }",
+            "not a finite, non-negative number",
+        ),
+        ("armature = { tip_mount = 0.3 }", "joint has no armature"),
+        ("armature = 0.3", "scene.armature"),
+    ] {
+        let err = load(scene).unwrap_err().render();
+        assert!(err.contains(message), "{scene}: {err}");
+        assert!(err.contains("p.scene.toml"), "{scene}: {err}");
+    }
+    // The PUMA 560: its joints' armature, or the same numbers in the scene instead.
+    let values: Vec<f64> = puma("rotor_inertia = true")
+        .joints
+        .iter()
+        .map(|j| j.drive.armature)
+        .collect();
+    assert!(values.iter().all(|&a| a > 0.1), "{values:?}");
+    let stripped: String = PUMA
+        .lines()
+        .filter(|l| !l.starts_with("armature"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let table: Vec<String> = values
+        .iter()
+        .enumerate()
+        .map(|(k, a)| format!("j{} = {a:?}", k + 1))
+        .collect();
+    let src = format!(
+        "{stripped}\n[scene]\nrotor_inertia = true\narmature = {{ {} }}\n",
+        table.join(", ")
+    );
+    let moved = codegen::spec::load_tree("puma560.toml", &src).unwrap().0;
+    assert!(puma("").joints.iter().all(|j| j.drive.armature == 0.0));
+    for (a, b) in moved
+        .joints
+        .iter()
+        .zip(&puma("rotor_inertia = true").joints)
+    {
+        assert_eq!(a.drive.armature, b.drive.armature);
+    }
+}

@@ -15,6 +15,7 @@ use runtime::closed::noc::{self, Plan};
 use super::grouping::Grouping;
 use super::platform_regressor::NoRegressor;
 use super::tape::GuardedTape;
+use super::tape_lanes::LaneScratch;
 
 /// The base regressor of a closed-loop spec.
 pub struct ClosedRegressor {
@@ -72,11 +73,6 @@ impl ClosedRegressor {
         self.plan.nx()
     }
 
-    /// Number of base parameters.
-    pub fn nbp(&self) -> usize {
-        self.values.len()
-    }
-
     /// The independent (actuated) joints' names.
     pub fn independent(&self) -> Vec<String> {
         self.plan
@@ -111,15 +107,35 @@ impl ClosedRegressor {
         buf: &mut Vec<f64>,
         out: &mut [f64],
     ) -> Result<(), NoRegressor> {
-        let (n, nbp) = (self.dof(), self.nbp());
-        let all = self.tape.eval(x, u, ud, buf).ok_or(NoRegressor(
-            "the configuration does not close the loops, or the constraints are singular there",
-        ))?;
-        if !all.iter().all(|v| v.is_finite()) {
-            return Err(NoRegressor("the regressor is not finite there"));
-        }
-        out[..n * nbp].copy_from_slice(&all);
+        let all = self.tape.eval(x, u, ud, buf).ok_or(NOT_CLOSED)?;
+        finite(&all)?;
+        out[..all.len()].copy_from_slice(&all);
         Ok(())
+    }
+
+    /// `F_b` at `L` states (lane last: `x[i][k]` coordinate `i` of state `k`) into `out` (`L`
+    /// blocks of `DOF × NBP`, row-major, state after state): each lane as [`Self::rows`] gives
+    /// it, bit for bit.
+    pub fn rows_lanes<const L: usize>(
+        &self,
+        x: &[[f64; L]],
+        u: &[[f64; L]],
+        ud: &[[f64; L]],
+        scratch: &mut LaneScratch<L>,
+        out: &mut [f64],
+    ) -> [Result<(), NoRegressor>; L] {
+        let (all, ok) = self.tape.eval_lanes(x, u, ud, scratch);
+        let size = all.len();
+        std::array::from_fn(|k| {
+            if !ok[k] {
+                return Err(NOT_CLOSED);
+            }
+            let lane = &mut out[k * size..(k + 1) * size];
+            for (o, v) in lane.iter_mut().zip(all) {
+                *o = v[k];
+            }
+            finite(lane)
+        })
     }
 
     /// Efforts of the independent coordinates by the runtime's `f64` evaluator (independent
@@ -132,6 +148,20 @@ impl ClosedRegressor {
     /// (standard values read by name; a name the model lacks counts 0).
     pub fn base_of(&self, model: &ClosedModel) -> Vec<f64> {
         self.grouping.apply(&standard_values(model))
+    }
+}
+
+/// A state where a guard fails.
+const NOT_CLOSED: NoRegressor = NoRegressor(
+    "the configuration does not close the loops, or the constraints are singular there",
+);
+
+/// `Err` where a value of the regressor is not finite.
+fn finite(all: &[f64]) -> Result<(), NoRegressor> {
+    if all.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(NoRegressor("the regressor is not finite there"))
     }
 }
 

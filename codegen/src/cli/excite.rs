@@ -95,15 +95,64 @@ pub struct Fourier {
     pub w: f64,
 }
 
+/// `sin` and `cos` of each harmonic's phase `l ω_f t` at given times: the series' only
+/// transcendental part, the same for every joint and every candidate of a search (which
+/// evaluates the series on the same grids over and over), so taken once per time.
+#[derive(Clone, Debug)]
+pub struct Phases {
+    /// The times, s.
+    times: Vec<f64>,
+    /// Harmonics.
+    l: usize,
+    /// `(sin, cos)` of harmonic `h` (from 1) at time `k`: `sc[k * l + h - 1]`.
+    sc: Vec<(f64, f64)>,
+}
+
+impl Phases {
+    /// At the times `t`, fundamental `w`, `l` harmonics.
+    fn new(w: f64, l: usize, times: Vec<f64>) -> Phases {
+        let sc = times
+            .iter()
+            .flat_map(|&t| {
+                (1..=l).map(move |h| {
+                    let wl = w * h as f64;
+                    (wl * t).sin_cos()
+                })
+            })
+            .collect();
+        Phases { times, l, sc }
+    }
+
+    /// At `count` equally spaced times over the period `2π / w`, from 0.
+    fn over_period(w: f64, l: usize, count: usize) -> Phases {
+        let period = 2.0 * std::f64::consts::PI / w;
+        let times = (0..count)
+            .map(|k| period * k as f64 / count as f64)
+            .collect();
+        Phases::new(w, l, times)
+    }
+
+    /// Time `k`'s phases.
+    fn at(&self, k: usize) -> &[(f64, f64)] {
+        &self.sc[k * self.l..(k + 1) * self.l]
+    }
+}
+
 impl Fourier {
     /// `(q, q̇, q̈)` of joint `i` at `t`.
+    #[cfg(test)]
     pub fn joint(&self, i: usize, t: f64) -> (f64, f64, f64) {
+        self.joint_at(i, Phases::new(self.w, self.l, vec![t]).at(0))
+    }
+
+    /// `(q, q̇, q̈)` of joint `i` at the time of the phases `sc` ([`Phases::at`]).
+    fn joint_at(&self, i: usize, sc: &[(f64, f64)]) -> (f64, f64, f64) {
         let (mut q, mut qd, mut qdd) = (0.0, 0.0, 0.0);
         let base = 2 * self.l * i;
         for h in 1..=self.l {
             let (a, b) = (self.c[base + h - 1], self.c[base + self.l + h - 1]);
             let wl = self.w * h as f64;
-            let (s, c) = (wl * t).sin_cos();
+            let (s, c) = sc[h - 1];
             q += (a * s - b * c) / wl;
             qd += a * c + b * s;
             qdd += wl * (b * c - a * s);
@@ -112,23 +161,35 @@ impl Fourier {
     }
 
     /// All joints at `t`.
+    #[cfg(test)]
     pub fn state(&self, t: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        self.state_at(Phases::new(self.w, self.l, vec![t]).at(0))
+    }
+
+    /// All joints at the time of the phases `sc`.
+    fn state_at(&self, sc: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut s = (vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]);
         for i in 0..self.n {
-            (s.0[i], s.1[i], s.2[i]) = self.joint(i, t);
+            (s.0[i], s.1[i], s.2[i]) = self.joint_at(i, sc);
         }
         s
     }
 
     /// Scale each joint's coefficients so that `|q_i| ≤ q_max_i` and `|q̇_i| ≤ q̇_max_i` on
     /// `grid` points per period, with a 0.1 % margin.
+    #[cfg(test)]
     fn feasible(&self, q_max: &[f64], qd_max: &[f64], grid: usize) -> Fourier {
+        self.feasible_on(q_max, qd_max, &Phases::over_period(self.w, self.l, grid))
+    }
+
+    /// [`Self::feasible`] on the grid of `phases` ([`Phases::over_period`] of this series'
+    /// fundamental and harmonics).
+    fn feasible_on(&self, q_max: &[f64], qd_max: &[f64], phases: &Phases) -> Fourier {
         let mut f = self.clone();
-        let period = 2.0 * std::f64::consts::PI / self.w;
         for i in 0..self.n {
             let (mut mq, mut mqd) = (0.0f64, 0.0f64);
-            for k in 0..grid {
-                let (q, qd, _) = self.joint(i, period * k as f64 / grid as f64);
+            for k in 0..phases.times.len() {
+                let (q, qd, _) = self.joint_at(i, phases.at(k));
                 mq = mq.max(q.abs());
                 mqd = mqd.max(qd.abs());
             }
@@ -145,38 +206,52 @@ impl Fourier {
     }
 }
 
-/// The mechanism's state at `t` on `f`; a closed loop assembled from the positions `from` of
-/// the state before (home when `None`). `None` where it does not assemble.
+/// The mechanism's state at time `k` of `phases` on `f`; a closed loop assembled from the
+/// positions `from` of the state before (home when `None`). `None` where it does not assemble.
 fn at(
     reg: &Regressor,
     f: &Fourier,
-    t: f64,
+    phases: &Phases,
+    k: usize,
     from: Option<&[f64]>,
 ) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
-    let (d, dd, ddd) = f.state(t);
+    let (d, dd, ddd) = f.state_at(phases.at(k));
     reg.state(&d, &dd, &ddd, from)
 }
 
-/// The base regressor stacked at `m` equally spaced times over a period; `Err(t)` at the first
-/// time where it has no value.
-fn stacked(reg: &Regressor, f: &Fourier, m: usize) -> Result<DMatrix<f64>, f64> {
-    let (n, nbp) = (reg.dof(), reg.nbp());
-    let period = 2.0 * std::f64::consts::PI / f.w;
-    let mut w = DMatrix::zeros(m * n, nbp);
-    let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
-    let mut from: Option<Vec<f64>> = None;
+/// The base regressor stacked at the times of `phases` ([`Phases::over_period`]); `Err(t)` at
+/// the first time where it has no value. The states are taken in order (a closed loop's each
+/// assembled from the one before), then the regressor at all of them over lanes
+/// ([`Regressor::stack`]), each bit for bit what it is alone.
+fn stacked(reg: &Regressor, f: &Fourier, phases: &Phases) -> Result<DMatrix<f64>, f64> {
+    let (n, nbp, m) = (reg.dof(), reg.nbp(), phases.times.len());
+    let mut p: Vec<Vec<f64>> = Vec::with_capacity(m);
+    let (mut v, mut a) = (Vec::with_capacity(m), Vec::with_capacity(m));
+    let mut end = None;
     for k in 0..m {
-        let t = period * k as f64 / m as f64;
-        let (p, v, a) = at(reg, f, t, from.as_deref()).ok_or(t)?;
-        reg.rows(&p, &v, &a, &mut buf, &mut y).map_err(|_| t)?;
-        from = Some(p);
-        for i in 0..n {
-            for p in 0..nbp {
-                w[(k * n + i, p)] = y[i * nbp + p];
+        match at(reg, f, phases, k, p.last().map(Vec::as_slice)) {
+            Some((pk, vk, ak)) => {
+                p.push(pk);
+                v.push(vk);
+                a.push(ak);
+            }
+            None => {
+                end = Some(phases.times[k]);
+                break;
             }
         }
     }
-    Ok(w)
+    let mut w = DMatrix::zeros(m * n, nbp);
+    let mut stack = reg.stack(&p, &v, &a);
+    for k in 0..p.len() {
+        let y = stack.rows(k).map_err(|_| phases.times[k])?;
+        for i in 0..n {
+            for c in 0..nbp {
+                w[(k * n + i, c)] = y[i * nbp + c];
+            }
+        }
+    }
+    end.map_or(Ok(w), Err)
 }
 
 /// One bound per joint from a list of one or `n` values.
@@ -336,7 +411,11 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     let mut noise = Rng::new(args.noise_seed.unwrap_or(args.seed) ^ 0x006e_6f69_7365);
     let (mut mq, mut mqd) = (vec![0.0f64; n], vec![0.0f64; n]);
     let cond_states = args.samples.min(CONDITION_STATES);
-    let cond = match stacked(&reg, &best, cond_states) {
+    let cond = match stacked(
+        &reg,
+        &best,
+        &Phases::over_period(best.w, best.l, cond_states),
+    ) {
         Ok(w) => condition(&w),
         Err(t) => {
             eprintln!(
@@ -348,9 +427,10 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     let mut from: Option<Vec<f64>> = None;
     for k in 0..args.samples {
         let t = args.period * k as f64 / args.samples as f64;
-        let (d, dd, _) = best.state(t);
+        let phases = Phases::new(best.w, best.l, vec![t]);
+        let (d, dd, _) = best.state_at(phases.at(0));
         // Assembled where `stacked` assembled it above (the same states in the same order).
-        let Some((q, qd, qdd)) = at(&reg, &best, t, from.as_deref()) else {
+        let Some((q, qd, qdd)) = at(&reg, &best, &phases, 0, from.as_deref()) else {
             eprintln!("error: the loops do not close at t = {t} s");
             return ExitCode::from(2);
         };
@@ -438,9 +518,14 @@ fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> 
     let mut rng = Rng::new(args.seed);
     // A coefficient's natural size: the velocity amplitude that reaches the bound.
     let unit: Vec<f64> = (0..n).map(|i| (q_max[i] * w).min(qd_max[i])).collect();
+    // The grids every candidate is evaluated on.
+    let (grid, samples) = (
+        Phases::over_period(w, l, GRID),
+        Phases::over_period(w, l, args.search_samples),
+    );
     // A trajectory where the regressor has no value somewhere is rejected.
     let cost = |f: &Fourier| {
-        let c = stacked(reg, f, args.search_samples).map_or(f64::MAX, |w| condition(&w));
+        let c = stacked(reg, f, &samples).map_or(f64::MAX, |w| condition(&w));
         if c.is_finite() { c } else { f64::MAX }
     };
     let mut best: Option<(f64, Fourier)> = None;
@@ -448,7 +533,7 @@ fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> 
         let c: Vec<f64> = (0..n * 2 * l)
             .map(|k| unit[k / (2 * l)] * rng.uniform(-1.0, 1.0))
             .collect();
-        let mut cur = Fourier { c, n, l, w }.feasible(q_max, qd_max, GRID);
+        let mut cur = Fourier { c, n, l, w }.feasible_on(q_max, qd_max, &grid);
         let mut fc = cost(&cur);
         let mut evals = 1;
         let mut h = 0.5;
@@ -462,7 +547,7 @@ fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> 
                     }
                     let mut t = cur.clone();
                     t.c[k] += sign * h * unit[k / (2 * l)];
-                    let t = t.feasible(q_max, qd_max, GRID);
+                    let t = t.feasible_on(q_max, qd_max, &grid);
                     let ft = cost(&t);
                     evals += 1;
                     if ft < fc {

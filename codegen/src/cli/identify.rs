@@ -195,15 +195,17 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
     let rows = data.q.len();
     let mut w = DMatrix::zeros(rows * n, nbp);
     let mut tau = DVector::zeros(rows * n);
-    let (mut buf, mut y) = (Vec::new(), vec![0.0; n * nbp]);
+    let mut stack = reg.stack(&data.q, &data.qd, &data.qdd);
     for s in 0..rows {
-        if let Err(e) = reg.rows(&data.q[s], &data.qd[s], &data.qdd[s], &mut buf, &mut y) {
+        let y = stack.rows(s);
+        if let Err(e) = &y {
             eprintln!(
                 "error: {data_name}:{}: no regressor at this state: {} (remove the row, or check the columns' order and units)",
                 data.lines[s], e.0
             );
             return ExitCode::from(2);
         }
+        let y = y.unwrap_or_default();
         // Squares of larger numbers overflow in the least squares (and the SVD does not
         // return on what follows): no unit makes such values measurements.
         if let Some(v) = y
@@ -496,15 +498,22 @@ fn write_update(
         return ExitCode::from(1);
     }
     // A URDF's scene file goes beside the written URDF, where the tools look for it
-    // (`ROBOT.scene.toml`): the written model is the URDF with that scene.
+    // (`ROBOT.scene.toml`): the written model is the URDF with that scene (its `armature`
+    // updated).
     if let Some(scene) = sidecar {
         let beside = path.with_extension("scene.toml");
-        if let Err(e) = super::write_output(&beside, &scene.text) {
+        let text = up.scene.as_deref().unwrap_or(&scene.text);
+        if let Err(e) = super::write_output(&beside, text) {
             eprintln!("error: {e}");
             return ExitCode::from(1);
         }
+        let what = if text == scene.text {
+            "the scene"
+        } else {
+            "the scene, its armature updated,"
+        };
         outln!(
-            "scene file: {} (the scene of {}, which the updated URDF's model needs)",
+            "scene file: {} ({what} of {}, which the updated URDF's model needs)",
             beside.display(),
             scene.name
         );

@@ -33,6 +33,7 @@ pub mod samples;
 pub mod spec_update;
 pub mod svg;
 pub mod tape;
+pub mod tape_lanes;
 pub mod tree_regressor;
 pub mod wls;
 

@@ -15,6 +15,7 @@ use runtime::parallel::noc::{self, Plan};
 
 use super::grouping::Grouping;
 use super::tape::GuardedTape;
+use super::tape_lanes::LaneScratch;
 
 /// The base regressor of a platform spec.
 pub struct PlatformRegressor {
@@ -33,6 +34,10 @@ pub struct PlatformRegressor {
     /// The guards, then `A` (row-major), then `F_b` (row-major).
     tape: GuardedTape,
 }
+
+/// A state where a guard of the kinematics fails.
+const KINEMATICS: NoRegressor =
+    NoRegressor("the kinematics fail there (out of reach, or a leg at a singularity)");
 
 /// A state with no regressor: the reason.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -99,10 +104,37 @@ impl PlatformRegressor {
         buf: &mut Vec<f64>,
         out: &mut [f64],
     ) -> Result<(), NoRegressor> {
+        let all = self.tape.eval(x, u, ud, buf).ok_or(KINEMATICS)?;
+        self.solve(&all, out)
+    }
+
+    /// `Y` at `L` states (lane last: `x[i][k]` coordinate `i` of state `k`) into `out` (`L`
+    /// blocks of `DOF × NBP`, row-major, state after state): each lane as [`Self::rows`] gives
+    /// it, bit for bit (the kernel over the lanes, then each lane's own solve).
+    pub fn rows_lanes<const L: usize>(
+        &self,
+        x: &[[f64; L]],
+        u: &[[f64; L]],
+        ud: &[[f64; L]],
+        scratch: &mut LaneScratch<L>,
+        out: &mut [f64],
+    ) -> [Result<(), NoRegressor>; L] {
+        let (all, ok) = self.tape.eval_lanes(x, u, ud, scratch);
+        let size = self.dof() * self.nbp();
+        let mut lane = Vec::with_capacity(all.len());
+        std::array::from_fn(|k| {
+            if !ok[k] {
+                return Err(KINEMATICS);
+            }
+            lane.clear();
+            lane.extend(all.iter().map(|v| v[k]));
+            self.solve(&lane, &mut out[k * size..(k + 1) * size])
+        })
+    }
+
+    /// `Y` from the kernel's outputs `all` (`A` then `F_b`, row-major): `Aᵀ Y = F_b` solved.
+    fn solve(&self, all: &[f64], out: &mut [f64]) -> Result<(), NoRegressor> {
         let (n, nbp) = (self.dof(), self.nbp());
-        let all = self.tape.eval(x, u, ud, buf).ok_or(NoRegressor(
-            "the kinematics fail there (out of reach, or a leg at a singularity)",
-        ))?;
         // `A` row-major; solve `Aᵀ Y = F_b`.
         let at_t = DMatrix::from_fn(n, n, |r, c| all[c * n + r]);
         let fb = DMatrix::from_row_slice(n, nbp, &all[n * n..]);

@@ -6,6 +6,8 @@
 
 use codegen::spec::Mechanism;
 
+mod stack;
+
 use super::closed_regressor::ClosedRegressor;
 use super::platform_regressor::{NoRegressor, PlatformRegressor};
 use super::samples::{Columns, Samples};

@@ -37,6 +37,7 @@ mod payload;
 use payload::{payload_unknowns, set_payload};
 mod rods;
 use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
+mod armature;
 mod urdf;
 mod xml_scan;
 
@@ -90,6 +91,8 @@ pub struct Update {
     pub changed: Vec<String>,
     /// The base parameters that no number of the update moves (kept at the spec's values).
     pub unreachable: Vec<usize>,
+    /// A URDF's scene file as the update writes it (its `armature`), `None` for a TOML spec.
+    pub scene: Option<String>,
 }
 
 /// A number as TOML: plain decimals between 1e-3 and 1e6, exponent form outside, always a
@@ -535,6 +538,7 @@ pub fn update(
         skipped,
         changed,
         unreachable,
+        scene: None,
     })
 }
 

@@ -5,8 +5,9 @@
 
 use codegen::sym::{Arg, ExprId, Graph, Node, TWO_SIDED};
 
+/// One operation: its operands are slots (indices of older operations).
 #[derive(Clone, Copy, Debug)]
-enum Op {
+pub(super) enum Op {
     Const(f64),
     Input(Arg, usize),
     Add(usize, usize),
@@ -25,8 +26,10 @@ enum Op {
 /// The roots of a graph, flattened.
 #[derive(Clone, Debug)]
 pub struct Tape {
-    ops: Vec<Op>,
-    roots: Vec<usize>,
+    /// The operations, one slot each, operands first.
+    pub(super) ops: Vec<Op>,
+    /// The slots of the roots.
+    pub(super) roots: Vec<usize>,
 }
 
 impl Tape {
@@ -141,9 +144,12 @@ mod tests {
 /// A kernel with guards, flattened: its guards, then its outputs, evaluated at `(x, u, u̇)`.
 #[derive(Clone, Debug)]
 pub struct GuardedTape {
-    tape: Tape,
-    guards: usize,
-    outputs: usize,
+    /// The guards' roots, then the outputs'.
+    pub(super) tape: Tape,
+    /// Number of guards.
+    pub(super) guards: usize,
+    /// Number of outputs.
+    pub(super) outputs: usize,
 }
 
 impl GuardedTape {

@@ -12,6 +12,7 @@ use runtime::model::Model;
 
 use super::grouping::Grouping;
 use super::tape::Tape;
+use super::tape_lanes::LaneScratch;
 
 /// The base regressor of a tree spec.
 pub struct TreeRegressor {
@@ -55,6 +56,32 @@ impl TreeRegressor {
             _ => f64::NAN,
         };
         self.tape.eval(&input, buf, out);
+    }
+
+    /// `Y` at `L` states (lane last: `q[i][k]` coordinate `i` of state `k`) into `out` (`L`
+    /// blocks of `DOF × NBP`, row-major, state after state): each lane as [`Self::rows`] gives
+    /// it, bit for bit.
+    pub fn rows_lanes<const L: usize>(
+        &self,
+        q: &[[f64; L]],
+        qd: &[[f64; L]],
+        qdd: &[[f64; L]],
+        scratch: &mut LaneScratch<L>,
+        out: &mut [f64],
+    ) {
+        let input = |a: Arg, i: usize| match a {
+            Arg::Q => q[i],
+            Arg::Qd => qd[i],
+            Arg::Qdd => qdd[i],
+            _ => [f64::NAN; L],
+        };
+        let lanes = self.tape.eval_lanes_in(&input, scratch);
+        let size = lanes.len();
+        for (k, block) in out.chunks_exact_mut(size).take(L).enumerate() {
+            for (o, v) in block.iter_mut().zip(lanes.iter()) {
+                *o = v[k];
+            }
+        }
     }
 
     /// Inverse dynamics by the runtime's RNEA (independent of the regressor) plus the drives.

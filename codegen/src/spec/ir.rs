@@ -81,6 +81,9 @@ pub(crate) struct SceneSpec {
     pub friction: bool,
     /// `rotor_inertia = true`: apply the joints' `armature` (reflected rotor inertia).
     pub rotor_inertia: bool,
+    /// `armature = { joint = value, … }`: the joints' reflected rotor inertia (kg·m² or kg),
+    /// replacing what the joint writes (a URDF has no place for it).
+    pub armature: Vec<(Named, f64)>,
     /// `coulomb_velocity`: the speed scale `v_s` of the regularized Coulomb law (rad/s or m/s).
     pub coulomb_velocity: f64,
     /// `snap = TOL`: take near-exact angles and offsets as exact (see `spec::snap`).
@@ -131,6 +134,7 @@ impl SceneSpec {
             n(&mut p.body);
         }
         self.locked.iter_mut().for_each(|(named, _)| n(named));
+        self.armature.iter_mut().for_each(|(named, _)| n(named));
         s(&mut self.runtime_params_span);
         if let Some((r, span)) = &mut self.runtime_inertia {
             s(span);
@@ -184,6 +188,7 @@ impl Default for SceneSpec {
             locked: Vec::new(),
             friction: false,
             rotor_inertia: false,
+            armature: Vec::new(),
             coulomb_velocity: COULOMB_VELOCITY,
             snap: None,
             runtime_params: false,

@@ -67,6 +67,19 @@ pub(super) fn no_drive(j: &ir::JointSpec, role: &str, hint: &str, diags: &mut Di
     }
 }
 
+/// The error of a scene key naming joint `n`, which `joints` does not have (with the closest
+/// name as hint).
+fn unknown_joint(n: &ir::Named, joints: &[ir::JointSpec]) -> Diagnostic {
+    let names: Vec<&str> = joints.iter().map(|j| j.name.as_str()).collect();
+    let d = Diagnostic::error(format!("unknown joint {:?}", n.name))
+        .with_key(n.key.clone())
+        .with_span(n.span.clone());
+    match suggest_hint(&n.name, &names) {
+        Some(h) => d.with_hint(h),
+        None => d,
+    }
+}
+
 /// The passes between reading and lowering: the overrides on top of the spec's `[scene]`,
 /// snapping, then the scene's changes to the bodies and joints.
 pub(super) fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &mut Diagnostics) {
@@ -150,17 +163,25 @@ pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
             b.inertia = c.inertia;
         }
     }
+    // The scene's armature replaces the joints' own (before any joint is locked).
+    for (n, value) in &scene.armature {
+        match spec.joints.iter_mut().find(|j| j.name == n.name) {
+            Some(j) if matches!(j.kind, ir::Kind::Revolute | ir::Kind::Prismatic) => {
+                j.drive.armature = *value;
+            }
+            Some(j) => diags.push(
+                Diagnostic::error(format!("a {} joint has no armature", j.kind.word()))
+                    .with_key(n.key.clone())
+                    .with_span(n.span.clone())
+                    .with_hint("rotor inertia applies to revolute and prismatic joints"),
+            ),
+            None => diags.push(unknown_joint(n, &spec.joints)),
+        }
+    }
     // Locked joints become fixed joints placed at their value.
     for (n, value) in &scene.locked {
         let Some(j) = spec.joints.iter_mut().find(|j| j.name == n.name) else {
-            let names: Vec<&str> = spec.joints.iter().map(|j| j.name.as_str()).collect();
-            let mut d = Diagnostic::error(format!("unknown joint {:?}", n.name))
-                .with_key(n.key.clone())
-                .with_span(n.span.clone());
-            if let Some(h) = suggest_hint(&n.name, &names) {
-                d = d.with_hint(h);
-            }
-            diags.push(d);
+            diags.push(unknown_joint(n, &spec.joints));
             continue;
         };
         if !matches!(j.kind, ir::Kind::Revolute | ir::Kind::Prismatic) {

@@ -465,10 +465,11 @@ fn outside_inertials(text: &str) -> String {
     out
 }
 
-/// A perturbed iiwa 14 URDF (and `scene`, its scene file), noise-free: the written URDF's
-/// module has the estimates as its `BASE_PARAMETERS` and its model the true inverse dynamics;
-/// nothing outside `<inertial>` and `<dynamics>` changes.
-fn urdf_out(test: &str, scene: Option<&str>) {
+/// A perturbed iiwa 14 URDF (and `scene`, its scene file; the truth's is `truth_scene`, or the
+/// same), noise-free: the written URDF's module (with the written scene file) has the estimates
+/// as its `BASE_PARAMETERS` and its model the true inverse dynamics; nothing outside
+/// `<inertial>` and `<dynamics>` changes, and the scene file only where its `armature` must.
+fn urdf_out(test: &str, scene: Option<&str>, truth_scene: Option<&str>) {
     let dir = scratch(test);
     let nominal = bundled("../mechanisms/specs/iiwa14.urdf");
     let spec = dir.join("iiwa.urdf");
@@ -477,8 +478,9 @@ fn urdf_out(test: &str, scene: Option<&str>) {
         std::fs::write(dir.join("iiwa.scene.toml"), t).unwrap();
     }
     let truth_src = perturbed_urdf(&nominal, 0.2, 0x1ee7);
-    let truth = urdf_model("truth.urdf", &truth_src, scene);
-    let true_base = urdf_base_parameters("truth.urdf", &truth_src, scene);
+    let truth_scene = truth_scene.or(scene);
+    let truth = urdf_model("truth.urdf", &truth_src, truth_scene);
+    let true_base = urdf_base_parameters("truth.urdf", &truth_src, truth_scene);
     let traj = dir.join("traj.csv");
     let o = run(&[
         "excite",
@@ -523,8 +525,10 @@ fn urdf_out(test: &str, scene: Option<&str>) {
     ok(&o);
     let stderr = text(&o.stderr);
     assert!(!stderr.contains("cannot reproduce"), "{stderr}");
-    // A URDF has no number for a rotor's inertia: only the `IA_` parameters that no link's
-    // inertia groups with (zero in the truth, as every URDF's) may be kept at the spec's values.
+    // A URDF has no number for a rotor's inertia: without `rotor_inertia` in its scene file, only
+    // the `IA_` parameters that no link's inertia groups with (zero in the truth) may be kept at
+    // the spec's values; with it, the scene file's `armature` moves them.
+    let rotors = scene.is_some_and(|t| t.contains("rotor_inertia = true"));
     let kept = super::platform::listed(
         &stderr,
         "note: no number the update writes moves",
@@ -539,7 +543,7 @@ fn urdf_out(test: &str, scene: Option<&str>) {
         .collect();
     for &k in &kept {
         assert!(
-            names[k].starts_with("IA_") && scene.is_some(),
+            names[k].starts_with("IA_") && scene.is_some() && !rotors,
             "{}",
             names[k]
         );
@@ -547,9 +551,17 @@ fn urdf_out(test: &str, scene: Option<&str>) {
     let err_truth = rel_floor(&e, &true_base, 1e-3);
     assert!(err_truth <= 1e-8, "{err_truth:e}");
     let written_src = std::fs::read_to_string(&out).unwrap();
-    // The scene file comes along, unchanged.
+    // The scene file comes along: unchanged, or with the rotors' `armature` (its other lines
+    // as they were).
     let written_scene = std::fs::read_to_string(dir.join("updated.scene.toml")).ok();
-    assert_eq!(written_scene.as_deref(), scene);
+    if rotors {
+        let w = written_scene.as_deref().unwrap();
+        assert!(w.starts_with(scene.unwrap()), "{w}");
+        assert!(w.contains("armature = {"), "{w}");
+    } else {
+        assert_eq!(written_scene.as_deref(), scene);
+    }
+    let scene = written_scene.as_deref();
     assert_eq!(outside_inertials(&written_src), outside_inertials(&nominal));
     assert_ne!(written_src, nominal);
     let written = urdf_base_parameters("updated.urdf", &written_src, scene);
@@ -586,12 +598,28 @@ fn urdf_out(test: &str, scene: Option<&str>) {
 
 #[test]
 fn urdf_out_replaces_inertials_and_keeps_every_other_byte() {
-    urdf_out("urdf_out", None);
+    urdf_out("urdf_out", None, None);
 }
 
 #[test]
 fn urdf_out_with_friction_writes_dynamics_and_the_scene_file() {
-    urdf_out("urdf_out_friction", Some("[scene]\nfriction = true\n"));
+    urdf_out(
+        "urdf_out_friction",
+        Some("[scene]\nfriction = true\n"),
+        None,
+    );
+}
+
+/// With rotor inertia on, the identified rotors' `armature` goes into the written scene file:
+/// every base parameter reproduced (the `IA_` of joints 3–7 too, which no link groups with).
+#[test]
+fn urdf_out_with_rotor_inertia_writes_the_scene_files_armature() {
+    let scene = "[scene]\nfriction = true\nrotor_inertia = true\n";
+    let rotors: Vec<String> = (1..=7)
+        .map(|k| format!("iiwa_joint_{k} = {}", 0.05 + 0.03 * k as f64))
+        .collect();
+    let truth = format!("{scene}armature = {{ {} }}\n", rotors.join(", "));
+    urdf_out("urdf_out_rotors", Some(scene), Some(&truth));
 }
 
 /// The planar 2R of `mechanisms/specs/` with its second link written with expressions (which

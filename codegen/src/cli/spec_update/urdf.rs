@@ -5,8 +5,8 @@
 //! `rpy` is kept), per moving joint its `<dynamics damping friction>` (which the loader applies
 //! with the scene's `friction`). Only the values that change are replaced (an attribute or an
 //! element the text lacks is added); every other byte of the file, comments included, stays.
-//! A URDF has no number for a rotor's inertia (`armature`), so a base parameter only it moves is
-//! reported as not reproduced, as a TOML spec's drive whose scene switch is off.
+//! A URDF has no number for a rotor's inertia: with a scene file, its `[scene] armature` entries
+//! are unknowns too, written into the scene file that goes beside the URDF ([`super::armature`]).
 
 use std::ops::Range;
 
@@ -14,6 +14,10 @@ use nalgebra::DMatrix;
 
 use runtime::model::Mat3;
 
+use codegen::spec::SceneFile;
+use toml_edit::DocumentMut;
+
+use super::armature::{armature, set_armature};
 use super::xml_scan::{Tag, children, closing, scan};
 use super::{
     Change, REFERENCE, Update, changed_names, from_standard, minimum_norm_change, physics,
@@ -43,6 +47,8 @@ enum Unknown {
     Link { link: usize, k: usize },
     /// `damping` or `friction` of joint `joint`.
     Drive { joint: usize, key: &'static str },
+    /// The scene file's `armature` of joint `joint`.
+    Armature { joint: usize },
 }
 
 /// Whitespace-separated numbers.
@@ -185,17 +191,28 @@ fn apply(
     tags: &[Tag],
     links: &[Link],
     joints: &[Joint],
+    scene: Option<&DocumentMut>,
     unknowns: &[Unknown],
     values: &[f64],
-) -> Result<String, String> {
+) -> Result<(String, Option<String>), String> {
     let mut bodies: std::collections::BTreeMap<usize, [f64; 10]> = Default::default();
     let mut drives: std::collections::BTreeMap<usize, Vec<(&str, f64)>> = Default::default();
+    let mut rotors: Vec<(&str, f64)> = Vec::new();
     for (u, &v) in unknowns.iter().zip(values) {
         match *u {
             Unknown::Link { link, k } => bodies.entry(link).or_insert([0.0; 10])[k] = v,
             Unknown::Drive { joint, key } => drives.entry(joint).or_default().push((key, v)),
+            Unknown::Armature { joint } => rotors.push((joints[joint].name.as_str(), v)),
         }
     }
+    let scene = match scene {
+        Some(doc) => {
+            let mut doc = doc.clone();
+            set_armature(&mut doc, &rotors)?;
+            Some(doc.to_string())
+        }
+        None => None,
+    };
     let mut edits: Vec<(Range<usize>, String)> = Vec::new();
     for (link, p) in bodies {
         let l = &links[link];
@@ -258,7 +275,7 @@ fn apply(
     for (r, v) in edits.into_iter().rev() {
         out.replace_range(r, &v);
     }
-    Ok(out)
+    Ok((out, scene))
 }
 
 /// The update of URDF `source` (with its scene file `sidecar`) whose model has base parameters
@@ -273,6 +290,14 @@ pub(super) fn update(
 ) -> Result<Update, String> {
     let tags = scan(source).map_err(|e| format!("error: {file}: {e}"))?;
     let (links, joints) = read(source, &tags);
+    let scene: Option<DocumentMut> = match sidecar {
+        Some(f) => Some(
+            f.text
+                .parse()
+                .map_err(|e| format!("error: {}: {e}", f.name))?,
+        ),
+        None => None,
+    };
     let (mut unknowns, mut z0, mut names, mut skipped) = (vec![], vec![], vec![], vec![]);
     for (link, l) in links.iter().enumerate() {
         match link_parameters(source, &tags, l) {
@@ -301,11 +326,28 @@ pub(super) fn update(
                 None => skipped.push(format!("joint `{}` ({key})", j.name)),
             }
         }
+        if let Some(doc) = &scene {
+            match armature(doc, &j.name) {
+                Some(v) => {
+                    unknowns.push(Unknown::Armature { joint });
+                    z0.push(v);
+                    names.push(format!("joint `{}`", j.name));
+                }
+                None => skipped.push(format!("joint `{}` (armature)", j.name)),
+            }
+        }
     }
-    let base = |text: &str| reg.base_of_spec(file, text, sidecar);
-    let write = |z: &[f64]| apply(source, &tags, &links, &joints, &unknowns, z);
+    // The base parameters of the URDF text and the scene file's text as written.
+    let base = |(text, scene_text): &(String, Option<String>)| {
+        let side = sidecar.zip(scene_text.as_ref()).map(|(f, t)| SceneFile {
+            name: f.name.clone(),
+            text: t.clone(),
+        });
+        reg.base_of_spec(file, text, side.as_ref())
+    };
+    let write = |z: &[f64]| apply(source, &tags, &links, &joints, scene.as_ref(), &unknowns, z);
     let pi0 = base(&write(&z0)?)?;
-    let pi_spec = base(source)?;
+    let pi_spec = reg.base_of_spec(file, source, sidecar)?;
     let drift = crate::cli::identify::relative_mismatch(&pi0, &pi_spec, &vec![true; pi0.len()]);
     if drift > 1e-9 {
         return Err(format!(
@@ -317,7 +359,7 @@ pub(super) fn update(
         .zip(&z0)
         .map(|(u, v)| match u {
             Unknown::Link { k, .. } => REFERENCE[*k],
-            Unknown::Drive { .. } => *v,
+            Unknown::Drive { .. } | Unknown::Armature { .. } => *v,
         })
         .collect();
     let Change {
@@ -341,10 +383,11 @@ pub(super) fn update(
         .collect();
     let sub_u: Vec<Unknown> = touched.iter().map(|&c| unknowns[c]).collect();
     let sub_z: Vec<f64> = touched.iter().map(|&c| z[c]).collect();
-    let text = apply(source, &tags, &links, &joints, &sub_u, &sub_z).map_err(|e| {
+    let out = apply(source, &tags, &links, &joints, scene.as_ref(), &sub_u, &sub_z).map_err(|e| {
         format!("error: --out: the identified parameters are no URDF: {e} (the base parameters are printed above; no file written)")
     })?;
-    let written = base(&text)?;
+    let written = base(&out)?;
+    let (text, scene) = out;
     let violations = consistency(&links, &unknowns, &z, &names, &changed, &p);
     Ok(Update {
         text,
@@ -353,6 +396,7 @@ pub(super) fn update(
         skipped,
         changed,
         unreachable,
+        scene,
     })
 }
 
@@ -424,7 +468,7 @@ mod tests {
         let mut values = p.to_vec();
         values[6] = 0.2; // a first moment: the mass centre at x = 0.1
         values.push(0.5);
-        let out = apply(text, &tags, &links, &joints, &unknowns, &values).unwrap();
+        let (out, _) = apply(text, &tags, &links, &joints, None, &unknowns, &values).unwrap();
         assert!(out.contains("<!-- keep -->\n      <mass value=\"2\"/>\n      <origin xyz=\"0.1 0 0\" rpy=\"0 0 0\"/>\n"), "{out}");
         assert!(out.contains("<inertia ixx=\"0\""), "{out}");
         assert!(
@@ -435,7 +479,7 @@ mod tests {
         );
         values[10] = -1.0;
         assert!(
-            apply(text, &tags, &links, &joints, &unknowns, &values)
+            apply(text, &tags, &links, &joints, None, &unknowns, &values)
                 .unwrap_err()
                 .contains("< 0")
         );

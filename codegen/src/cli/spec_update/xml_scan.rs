@@ -1,9 +1,11 @@
 //! A scan of an XML text into its tags with the byte ranges of their attribute values, for
 //! rewriting a URDF's numbers in place (everything between the values kept byte for byte,
-//! comments included). Comments, processing instructions, CDATA and declarations are skipped;
-//! the text is not validated (the spec loader has read it already).
+//! comments included). Comments, processing instructions, CDATA and declarations are skipped.
 
+use std::borrow::Cow;
 use std::ops::Range;
+
+use quick_xml::events::Event;
 
 /// A start, end or empty-element tag.
 #[derive(Clone, Debug)]
@@ -32,86 +34,62 @@ impl Tag {
     }
 }
 
-/// The tags of `text`, in order; `Err` for an unterminated comment or tag.
+/// The tags of `text`, in order (read by `quick-xml`, whose events borrow from `text`, so each
+/// tag's and each raw attribute value's place in it is known); `Err` for text that is not
+/// well-formed XML (an unterminated comment or tag, an unquoted value, …).
 pub(super) fn scan(text: &str) -> Result<Vec<Tag>, String> {
-    let b = text.as_bytes();
+    let mut reader = quick_xml::Reader::from_str(text);
+    let offset = |pos: u64| usize::try_from(pos).unwrap_or(usize::MAX).min(text.len());
     let mut tags = Vec::new();
-    let mut i = 0;
-    let find = |from: usize, pat: &str| text[from..].find(pat).map(|k| from + k);
-    while let Some(k) = find(i, "<") {
-        i = k;
-        let skip = [
-            ("<!--", "-->"),
-            ("<?", "?>"),
-            ("<![CDATA[", "]]>"),
-            ("<!", ">"),
-        ]
-        .iter()
-        .find(|(open, _)| text[i..].starts_with(open));
-        if let Some((_, close)) = skip {
-            i = find(i, close).ok_or("an unterminated comment or declaration")? + close.len();
-            continue;
-        }
-        let start = i;
-        i += 1;
-        let end = b.get(i) == Some(&b'/');
-        if end {
-            i += 1;
-        }
-        let name_start = i;
-        while i < b.len() && !b[i].is_ascii_whitespace() && b[i] != b'/' && b[i] != b'>' {
-            i += 1;
-        }
-        let name = text[name_start..i].to_string();
+    loop {
+        let start = offset(reader.buffer_position());
+        let event = reader
+            .read_event()
+            .map_err(|e| format!("not well-formed XML near byte {start}: {e}"))?;
+        let range = start..offset(reader.buffer_position());
+        let (e, end, empty) = match event {
+            Event::Eof => return Ok(tags),
+            Event::Start(e) => (e, false, false),
+            Event::Empty(e) => (e, false, true),
+            Event::End(e) => {
+                tags.push(Tag {
+                    name: String::from_utf8_lossy(e.name().as_ref()).into_owned(),
+                    range,
+                    end: true,
+                    empty: false,
+                    attrs: Vec::new(),
+                });
+                continue;
+            }
+            _ => continue,
+        };
+        let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
         let mut attrs = Vec::new();
-        let empty;
-        loop {
-            while i < b.len() && b[i].is_ascii_whitespace() {
-                i += 1;
-            }
-            match b.get(i) {
-                None => return Err(format!("an unterminated tag `<{name}`")),
-                Some(b'>') => {
-                    empty = false;
-                    i += 1;
-                    break;
-                }
-                Some(b'/') if b.get(i + 1) == Some(&b'>') => {
-                    empty = true;
-                    i += 2;
-                    break;
-                }
-                _ => {}
-            }
-            let a = i;
-            while i < b.len() && b[i] != b'=' && !b[i].is_ascii_whitespace() && b[i] != b'>' {
-                i += 1;
-            }
-            let attr = text[a..i].to_string();
-            while i < b.len() && (b[i].is_ascii_whitespace() || b[i] == b'=') {
-                i += 1;
-            }
-            let Some(&q) = b.get(i).filter(|q| **q == b'"' || **q == b'\'') else {
+        for a in e.attributes() {
+            let a = a.map_err(|err| format!("an attribute of `<{name}`: {err}"))?;
+            let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
+            // The raw value borrows from `text`: its place is the pointers' difference.
+            let Cow::Borrowed(v) = a.value else {
                 return Err(format!(
-                    "attribute `{attr}` of `<{name}` without a quoted value"
+                    "attribute `{key}` of `<{name}` could not be placed"
                 ));
             };
-            let v = i + 1;
-            let close = text[v..]
-                .find(q as char)
-                .ok_or_else(|| format!("an unterminated value of `{attr}`"))?;
-            attrs.push((attr, v..v + close));
-            i = v + close + 1;
+            let at = (v.as_ptr() as usize).wrapping_sub(text.as_ptr() as usize);
+            if at.checked_add(v.len()).is_none_or(|e| e > text.len()) {
+                return Err(format!(
+                    "attribute `{key}` of `<{name}` could not be placed"
+                ));
+            }
+            attrs.push((key, at..at + v.len()));
         }
         tags.push(Tag {
             name,
-            range: start..i,
+            range,
             end,
             empty,
             attrs,
         });
     }
-    Ok(tags)
 }
 
 /// The index of the end tag that closes start tag `open` (`None` for an empty element or
@@ -184,5 +162,27 @@ mod tests {
         assert!(tags[3].empty);
         assert!(scan("<a b=1/>").is_err());
         assert!(scan("<!-- open").is_err());
+    }
+
+    /// Markup inside CDATA, a DOCTYPE, a `>` inside a value, single quotes and an entity: the
+    /// ranges are the raw values' places in the text.
+    #[test]
+    fn raw_values_are_placed_in_the_text() {
+        let text = "<!DOCTYPE robot>\n<robot>\n<![CDATA[<link name=\"no\">]]>\n<link name='a&amp;b' x=\"1>2\"\n  y = \"3\"/>\n</robot>";
+        let tags = scan(text).unwrap();
+        let names: Vec<&str> = tags.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["robot", "link", "robot"]);
+        let link = &tags[1];
+        assert_eq!(&text[link.attr("name").unwrap()], "a&amp;b");
+        assert_eq!(&text[link.attr("x").unwrap()], "1>2");
+        assert_eq!(&text[link.attr("y").unwrap()], "3");
+        assert_eq!(
+            &text[link.range.clone()],
+            "<link name='a&amp;b' x=\"1>2\"\n  y = \"3\"/>"
+        );
+        assert!(link.empty);
+        assert_eq!(&text[link.attr_insert_at()..link.range.end], "/>");
+        assert_eq!(&text[tags[2].range.clone()], "</robot>");
+        assert!(scan("<robot><link></robot>").is_err());
     }
 }

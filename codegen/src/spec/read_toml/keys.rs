@@ -60,6 +60,7 @@ pub(super) const SCENE_KEYS: &[&str] = &[
     "locked",
     "friction",
     "rotor_inertia",
+    "armature",
     "coulomb_velocity",
     "snap",
     "parameters",

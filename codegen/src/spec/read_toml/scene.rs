@@ -38,6 +38,9 @@ impl Reader<'_> {
         if let Some(v) = get(t, "rotor_inertia") {
             scene.rotor_inertia = self.boolean(v, "scene.rotor_inertia").unwrap_or(false);
         }
+        if let Some(v) = get(t, "armature") {
+            self.armature(v, scene);
+        }
         if let Some(v) = get(t, "coulomb_velocity") {
             self.coulomb_velocity(v, scene);
         }
@@ -192,6 +195,36 @@ impl Reader<'_> {
                     x,
                 ));
             }
+        }
+    }
+
+    /// `scene.armature`: a table of joint names and non-negative numbers (kg·m² or kg).
+    fn armature(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
+        let Some(t) = self.table(v, "scene.armature") else {
+            return;
+        };
+        for (k, v) in t.iter() {
+            let key = format!("scene.armature.{}", k.get_ref());
+            let Some(x) = self.number(v, &key) else {
+                continue;
+            };
+            if !(x.is_finite() && x >= 0.0) {
+                self.diags.push(
+                    Diagnostic::error(format!("armature {x} is not a finite, non-negative number"))
+                        .with_key(key)
+                        .with_span(Some(v.span()))
+                        .with_hint("the rotor inertia reflected to the joint, I_a = J_rotor·N², in kg·m² (kg for a prismatic joint)"),
+                );
+                continue;
+            }
+            scene.armature.push((
+                Named {
+                    name: k.get_ref().to_string(),
+                    key,
+                    span: Some(k.span()),
+                },
+                x,
+            ));
         }
     }
 
