@@ -17,8 +17,10 @@
 //! changed pattern body is written as expressions indexing per-copy arrays that the update adds
 //! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). A parallelogram's rods are
 //! three numbers per entry (or copy), linear in their body's standard parameters
-//! ([`rods`]). Base parameters that no written number moves (a massless U joint's cross alone)
-//! keep the spec's values and are reported.
+//! ([`rods`]). A universal joint's `cross` is ten more unknowns per joint (or copy), solved
+//! for with the payload on what the bodies leave ([`crosses`]). Base parameters that no written
+//! number moves (a rod's asymmetric parameters, a parallelogram's elbow cross) keep the spec's
+//! values and are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
@@ -29,6 +31,8 @@ use super::regressor::Regressor;
 
 mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
+mod crosses;
+use crosses::{CrossAt, cross_consistency, cross_unknowns, free_masses, set_crosses};
 mod payload;
 use payload::{payload_unknowns, set_payload};
 mod rods;
@@ -67,6 +71,9 @@ enum Unknown {
     Rods { at: RodsAt, copy: usize, k: usize },
     /// Standard parameter `k` of the `[scene] payload`.
     Payload { k: usize },
+    /// Standard parameter `k` of the cross of copy `copy` (from 1; 1 for a top-level entry)
+    /// of the universal joint entry `at` ([`crosses`]).
+    Cross { at: CrossAt, copy: usize, k: usize },
 }
 
 /// The outcome of an update.
@@ -261,8 +268,16 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
     let mut rods: std::collections::BTreeMap<RodsAt, Rods> = Default::default();
     let mut payload: Option<[f64; 10]> = None;
+    let mut crosses: std::collections::BTreeMap<CrossAt, Copies> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
+            Unknown::Cross { at, copy, k } => {
+                crosses
+                    .entry(*at)
+                    .or_default()
+                    .entry(*copy)
+                    .or_insert([0.0; 10])[*k] = v
+            }
             Unknown::Payload { k } => payload.get_or_insert([0.0; 10])[*k] = v,
             Unknown::Rods { at, copy, k } => {
                 rods.entry(*at)
@@ -336,6 +351,10 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     for (at, c) in rods {
         let c: Vec<[f64; 3]> = c.into_values().collect();
         set_rods(&mut d, at, &c)?;
+    }
+    for (at, c) in crosses {
+        let c: Vec<[f64; 10]> = c.into_values().collect();
+        set_crosses(&mut d, at, &c)?;
     }
     if let Some(p) = payload {
         set_payload(&mut d, &p)?;
@@ -441,6 +460,16 @@ pub fn update(
             &mut skipped,
         );
     }
+    if let Some(written) = codegen::spec::written_crosses(file, source) {
+        cross_unknowns(
+            &doc,
+            &written,
+            &mut unknowns,
+            &mut z0,
+            &mut names,
+            &mut skipped,
+        );
+    }
     payload_unknowns(&doc, &mut unknowns, &mut z0, &mut names, &mut skipped);
     // The spec normalized (every body written from its standard parameters) must be the spec.
     let norm = apply(&doc, &unknowns, &z0)?;
@@ -455,17 +484,25 @@ pub fn update(
     // The columns of P: each unknown moved from a reference point where every body is valid.
     let mut reference = z0.clone();
     for (u, r) in unknowns.iter().zip(reference.iter_mut()) {
-        if let Unknown::Body { k, .. } | Unknown::Copy { k, .. } | Unknown::Payload { k } = u {
+        if let Unknown::Body { k, .. }
+        | Unknown::Copy { k, .. }
+        | Unknown::Payload { k }
+        | Unknown::Cross { k, .. } = u
+        {
             *r = REFERENCE[*k];
         }
         if let Unknown::Rods { k, .. } = u {
             *r = rods::REFERENCE[*k];
         }
     }
+    let late: Vec<bool> = unknowns
+        .iter()
+        .map(|u| matches!(u, Unknown::Payload { .. } | Unknown::Cross { .. }))
+        .collect();
     let Change {
         p,
-        z,
-        dz,
+        mut z,
+        mut dz,
         unreachable,
     } = minimum_norm_change(
         reg.nbp(),
@@ -474,12 +511,10 @@ pub fn update(
         &pi0,
         target,
         fit,
-        &unknowns
-            .iter()
-            .map(|u| matches!(u, Unknown::Payload { .. }))
-            .collect::<Vec<_>>(),
+        &late,
         &mut |z| base_of(reg, file, &apply(&doc, &unknowns, z)?.to_string()),
     )?;
+    free_masses(&unknowns, &late, &mut z, &mut dz, &p);
     let changed = changed_names(&names, &dz);
     // Only the entries that change are rewritten; the others keep their text.
     let touched: Vec<usize> = (0..unknowns.len())
@@ -495,6 +530,7 @@ pub fn update(
     let mut violations = consistency(&out, &unknowns, &p);
     violations.extend(copy_consistency(&unknowns, &z, &names, &changed, &p));
     violations.extend(rods_consistency(&unknowns, &z, &names, &changed, &p));
+    violations.extend(cross_consistency(&unknowns, &z, &names, &changed, &p));
     Ok(Update {
         text,
         written,
@@ -587,11 +623,13 @@ fn minimum_norm_change(
             .map_err(|e| format!("error: the update's least squares failed: {e}"))?
             * &rest;
         rest -= &ps * &step;
-        rest.apply(|x| {
-            if x.abs() <= tiny {
-                *x = 0.0
+        // Only where this stage reached: a row it cannot move keeps its target whole, however
+        // small (a cross's first moment identified near zero).
+        for r in 0..nbp {
+            if rest[r].abs() <= tiny && ps.row(r).iter().any(|x| *x != 0.0) {
+                rest[r] = 0.0;
             }
-        });
+        }
         dz += step;
     }
     // An unknown that moves no base parameter stays as written (the SVD leaves rounding

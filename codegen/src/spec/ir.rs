@@ -379,6 +379,10 @@ pub(crate) struct JointSpec {
     pub home_span: Span,
     /// Friction and rotor inertia as written (applied only when `[scene]` says so).
     pub drive: DriveSpec,
+    /// A universal joint's `cross`: the inertial data of its body `<name>_cross`, in that body's
+    /// frame (the joint frame carried by the first rotation); `None`: massless
+    /// (docs/spec.md, "Joint kinds").
+    pub cross: Option<BodySpec>,
 }
 
 /// The name of the fixed world in `parent`.

@@ -149,7 +149,12 @@ pub(super) fn check_values(spec: &Spec, diags: &mut Diagnostics) -> Axes {
             );
         }
     }
-    for b in &spec.bodies {
+    // A universal joint's cross is checked as a body is (docs/spec.md, "Joint kinds").
+    for b in spec
+        .bodies
+        .iter()
+        .chain(spec.joints.iter().filter_map(|j| j.cross.as_ref()))
+    {
         check_body(b, diags);
     }
     spec.joints.iter().map(|j| joint_axes(j, diags)).collect()
@@ -273,6 +278,7 @@ pub(super) fn check_topology(spec: &Spec, diags: &mut Diagnostics, skip: &Skip) 
     // Unique names.
     let body_index = unique_body_names(spec, diags);
     check_unique_joint_names(spec, diags);
+    super::cross::check_skipped(spec, skip, diags);
 
     // Resolve parent and child.
     let mut links = Links::new(spec, skip, body_index);
@@ -740,7 +746,14 @@ pub(super) fn build(spec: &Spec, topo: &Topo, axes: &Axes, diags: &mut Diagnosti
                         axis: ax[k],
                         drive: spec.scene.drive(&j.drive),
                     };
-                    parent = Some(m.add(joint, bname, ji));
+                    let i = m.add(joint, bname, ji);
+                    // The cross, in its body's frame (the joint frame after the first turn).
+                    if k == 0
+                        && let Some(c) = super::cross::props(j)
+                    {
+                        m.parts[i].push(c);
+                    }
+                    parent = Some(i);
                     o = Transform::IDENTITY;
                 }
                 Attach {

@@ -13,6 +13,7 @@
 mod angle;
 mod child_frame;
 mod closed;
+mod cross;
 mod expr;
 mod fix;
 mod frames;
@@ -39,6 +40,7 @@ use runtime::parallel::ParallelModel;
 
 use crate::diag::{Diagnostic, Diagnostics};
 
+pub use cross::written_crosses;
 pub use fix::apply_fixes;
 pub use frames::Frame;
 pub(crate) use frames::frame_ident;

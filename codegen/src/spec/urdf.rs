@@ -506,6 +506,7 @@ fn joint(
             friction: j.dynamics.as_ref().map_or(0.0, |d| d.friction.max(0.0)),
             armature: 0.0,
         },
+        cross: None,
     }
 }
 

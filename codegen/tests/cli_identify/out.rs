@@ -1,11 +1,13 @@
 //! `identify --out` writes every base parameter the spec can carry back: a Delta's
-//! parallelogram rods included. The "true" Delta is the bundled spec with its bodies' and rods'
+//! parallelogram rods and universal joints' crosses (a Gough–Stewart's, a tree's) included. The
+//! "true" Delta is the bundled spec with its bodies' and rods'
 //! numbers moved in its text (`perturbed_platform`); its efforts come from the runtime's `f64`
 //! evaluator; the written spec is checked by the generator's `BASE_PARAMETERS` of its module
 //! and by the runtime's inverse dynamics of its model against the true model's.
 
 use super::platform::{
-    DELTA, bundled, measure_platform, perturbed_platform, platform, platform_trajectory,
+    DELTA, GS, bundled, estimate_names, measure_platform, perturbed_platform, platform,
+    platform_trajectory,
 };
 use super::{Rng, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text};
 
@@ -79,6 +81,268 @@ fn delta_out_writes_rods_and_reproduces_every_base_parameter() {
     let id_err = (diff / norm).sqrt();
     eprintln!(
         "delta --out: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over 27 states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+/// Noise-free data of a perturbed Gough–Stewart whose U joints' crosses have mass (a `cross`
+/// key on the pattern's `u{i}`, different per copy), identified with the bundled spec (no
+/// `cross` key): `--out` adds the key as per-copy arrays, and the written spec reproduces every
+/// base parameter, the six `MZ_u<i>_cross` that only a cross moves included.
+#[test]
+fn gough_stewart_out_writes_the_crosses() {
+    let nominal = bundled(GS);
+    let with_crosses = nominal.replace(
+        "name = \"u{i}\"\nkind = \"U\"\n",
+        "name = \"u{i}\"\nkind = \"U\"\ncross = { mass = \"0.08 + 0.01 * i\", com = [0.01, -0.02, \"0.04 + 0.01 * i\"], inertia = { ixx = 2e-4, iyy = \"3e-4 + 1e-5 * i\", izz = 1e-4, ixy = 1e-5 } }\n",
+    );
+    assert_ne!(with_crosses, nominal);
+    let truth_src = perturbed_platform(&with_crosses, 0.2, 0x00c0_55e5);
+    cross_out(
+        "gs_cross_out",
+        &nominal,
+        &truth_src,
+        (0.2, 0.25),
+        "cross = { mass = \"identified_u_cross_mass[i]\"",
+    );
+}
+
+/// A tree: a turntable carrying an arm on a U joint, whose cross moves with the turntable (its
+/// mass enters the dynamics). The true arm's cross has mass; the spec's has none (no key).
+fn u_arm(cross: &str, m1: f64, m2: f64, c2: f64) -> String {
+    format!(
+        r#"[mechanism]
+name = "u_arm"
+gravity = [0.0, 0.0, -9.81]
+
+[[body]]
+name = "turntable"
+mass = {m1}
+com = [0.1, 0.02, 0.2]
+inertia = {{ ixx = 0.02, iyy = 0.03, izz = 0.01 }}
+
+[[body]]
+name = "arm"
+mass = {m2}
+com = [0.01, 0.02, {c2}]
+inertia = {{ ixx = 0.024, iyy = 0.025, izz = 0.003, ixz = 0.001 }}
+
+[[joint]]
+name = "j1"
+kind = "revolute"
+parent = "base"
+child = "turntable"
+axis = [0.0, 0.0, 1.0]
+
+[[joint]]
+name = "u"
+kind = "universal"
+parent = "turntable"
+child = "arm"
+origin = {{ xyz = [0.3, 0.0, 0.4], rpy = [0.0, 0.2, 0.0] }}
+axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+{cross}"#
+    )
+}
+
+/// `--out` on a tree writes a top-level U joint's cross as numbers (the key added where the
+/// spec has none, rewritten in place where it has one, its comment kept), and the written spec
+/// reproduces every base parameter and the true tree's inverse dynamics.
+#[test]
+fn a_tree_out_writes_a_cross_as_numbers() {
+    tree_cross_out("tree_cross_out", "");
+    tree_cross_out(
+        "tree_cross_rewritten",
+        "cross = { mass = 0.2, com = [0.0, 0.0, 0.02], inertia = { ixx = 3e-4, iyy = 3e-4, izz = 4e-4 } } # measured\n",
+    );
+}
+
+fn tree_cross_out(test: &str, cross: &str) {
+    let dir = scratch(test);
+    let src = u_arm(cross, 2.0, 1.0, -0.3);
+    let spec = dir.join("u_arm.toml");
+    std::fs::write(&spec, &src).unwrap();
+    let truth_src = u_arm(
+        "cross = { mass = 0.3, com = [0.01, -0.02, 0.03], inertia = { ixx = 4e-4, iyy = 3e-4, izz = 5e-4, ixy = 2e-5 } }\n",
+        2.3,
+        0.85,
+        -0.33,
+    );
+    let truth = super::tree("truth.toml", &truth_src);
+    let true_base = generated_base_parameters("truth.toml", &truth_src);
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(&spec),
+        "--seed",
+        "3",
+        "--restarts",
+        "1",
+        "--evaluations",
+        "40",
+        "--samples",
+        "300",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (_, rows) = super::csv_rows(&traj);
+    let mut csv = String::from("q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,tau1,tau2,tau3\n");
+    for r in &rows {
+        let tau = effort(&truth, &r[1..4], &r[4..7], &r[7..10]);
+        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("data.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(!stderr.contains("note: no number"), "{stderr}");
+    let (e, _) = estimates(&est);
+    let names = estimate_names(&est);
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let only_cross: Vec<usize> = (0..names.len())
+        .filter(|&k| names[k].ends_with("_cross") && !names[k].contains(' '))
+        .collect();
+    assert!(!only_cross.is_empty(), "{names:?}");
+    let written_src = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        written_src.contains("cross = { mass = "),
+        "the cross is written:\n{written_src}"
+    );
+    assert_eq!(written_src.matches("cross = ").count(), 1);
+    if !cross.is_empty() {
+        assert!(written_src.contains("} # measured\n"), "{written_src}");
+        assert!(!written_src.contains(cross), "{written_src}");
+    }
+    let written = generated_base_parameters("updated.toml", &written_src);
+    let err = rel_floor(&written, &e, 1e-3);
+    eprintln!(
+        "{test}: BASE_PARAMETERS of the written spec vs the {} estimates {err:.2e} ({} only the cross moves: {:?})",
+        e.len(),
+        only_cross.len(),
+        only_cross.iter().map(|&k| &names[k]).collect::<Vec<_>>()
+    );
+    assert!(err <= 1e-9, "{err:e}");
+    let model = super::tree("updated.toml", &written_src);
+    let mut r = Rng(5);
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for _ in 0..50 {
+        let q: Vec<f64> = (0..3).map(|_| 2.0 * r.gauss()).collect();
+        let qd: Vec<f64> = (0..3).map(|_| r.gauss()).collect();
+        let qdd: Vec<f64> = (0..3).map(|_| 3.0 * r.gauss()).collect();
+        let a = effort(&model, &q, &qd, &qdd);
+        let b = effort(&truth, &q, &qd, &qdd);
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "{test}: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over 50 random states)"
+    );
+    assert!(id_err <= 1e-9, "{id_err:e}");
+}
+
+/// Noise-free data of the true spec `truth_src` (crosses with mass), identified with `nominal`
+/// and `--out`: the estimates are the truth's base parameters, those that only a cross moves
+/// (`MZ_…_cross`) are not the spec's, the written spec (which contains `marker`) has every
+/// estimate as its `BASE_PARAMETERS` (≤ 1e-9 relative) and the truth's inverse dynamics.
+fn cross_out(test: &str, nominal: &str, truth_src: &str, (reach, turn): (f64, f64), marker: &str) {
+    use runtime::parallel::noc;
+    let dir = scratch(test);
+    let spec = dir.join("spec.toml");
+    std::fs::write(&spec, nominal).unwrap();
+    std::fs::write(dir.join("truth.toml"), truth_src).unwrap();
+    let truth = platform("truth.toml", truth_src);
+    let true_base = generated_base_parameters("truth.toml", truth_src);
+    let nominal_base = generated_base_parameters("spec.toml", nominal);
+    let states = platform_trajectory(&dir, &spec, &truth, reach, turn);
+    let data = dir.join("exact.csv");
+    measure_platform(&data, &states, &truth, 0.0, 1);
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(&spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    let stderr = text(&o.stderr);
+    assert!(
+        !stderr.contains("no number the update writes moves"),
+        "every base parameter is written:\n{stderr}"
+    );
+    let (e, _) = estimates(&est);
+    let names = estimate_names(&est);
+    // The estimates are the truth (the generator's constants of the true spec).
+    let err_truth = rel_floor(&e, &true_base, 1e-3);
+    assert!(err_truth <= 1e-8, "{err_truth:e}");
+    let mz: Vec<usize> = (0..names.len())
+        .filter(|&k| names[k].starts_with("MZ_") && names[k].ends_with("_cross"))
+        .collect();
+    assert!(mz.len() >= 3, "{names:?}");
+    for &k in &mz {
+        // The crosses' first moments are the truth's, not the spec's (zero).
+        assert!(
+            nominal_base[k] == 0.0 && e[k].abs() > 1e-3,
+            "{}: {}",
+            names[k],
+            e[k]
+        );
+    }
+    let src = std::fs::read_to_string(&out).unwrap();
+    assert!(src.contains(marker), "the crosses are written:\n{src}");
+    let written = generated_base_parameters("updated.toml", &src);
+    let err = rel_floor(&written, &e, 1e-3);
+    let err_mz = mz
+        .iter()
+        .map(|&k| (written[k] - e[k]).abs() / e[k].abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "{test}: BASE_PARAMETERS of the written spec vs the {} estimates {err:.2e}, the {} MZ_…_cross {err_mz:.2e} (relative)",
+        e.len(),
+        mz.len()
+    );
+    assert!(err <= 1e-9 && err_mz <= 1e-9, "{err:e} {err_mz:e}");
+    let model = platform("updated.toml", &src);
+    let (pw, pt) = (
+        noc::Plan::new(&model).unwrap(),
+        noc::Plan::new(&truth).unwrap(),
+    );
+    let mut r = Rng(98);
+    let n = truth.dof();
+    let (mut diff, mut norm, mut count) = (0.0f64, 0.0f64, 0);
+    for [x, _, _] in states.iter().step_by(23) {
+        let u: Vec<f64> = (0..n).map(|_| 0.5 * r.gauss()).collect();
+        let ud: Vec<f64> = (0..n).map(|_| 2.0 * r.gauss()).collect();
+        let a = noc::inverse_dynamics(&pw, x, &u, &ud).unwrap();
+        let b = noc::inverse_dynamics(&pt, x, &u, &ud).unwrap();
+        for (a, b) in a.iter().zip(&b) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+        count += 1;
+    }
+    let id_err = (diff / norm).sqrt();
+    eprintln!(
+        "{test}: inverse dynamics of the written spec vs the truth {id_err:.2e} (relative 2-norm over {count} states)"
     );
     assert!(id_err <= 1e-9, "{id_err:e}");
 }

@@ -10,7 +10,7 @@ use super::{
     Rng, csv_rows, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text,
 };
 
-const GS: &str = "../mechanisms/specs/gough_stewart.toml";
+pub(super) const GS: &str = "../mechanisms/specs/gough_stewart.toml";
 pub(super) const DELTA: &str = "../mechanisms/specs/delta_rl5.toml";
 
 pub(super) fn platform(name: &str, source: &str) -> runtime::parallel::ParallelModel {
@@ -200,7 +200,7 @@ pub(super) fn listed(stderr: &str, start: &str, end: &str) -> Vec<usize> {
 }
 
 /// The `name` column of `identify --estimates`.
-fn estimate_names(path: &Path) -> Vec<String> {
+pub(super) fn estimate_names(path: &Path) -> Vec<String> {
     let t = std::fs::read_to_string(path).unwrap();
     t.lines()
         .skip(1)

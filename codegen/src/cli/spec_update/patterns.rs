@@ -28,12 +28,29 @@ pub(super) fn set_copies(
     else {
         return Ok(());
     };
-    let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("body");
-    let stem = stem(template);
+    let template = t
+        .get("name")
+        .and_then(|n| n.as_str())
+        .unwrap_or("body")
+        .to_string();
+    let arrays = per_copy_keys(t, &stem(&template), &format!("body `{template}`"), copies)?;
+    put_arrays(d, arrays)
+}
+
+/// Body numbers per copy (`copies`, standard parameters) into table `t` (a pattern body, or a
+/// pattern joint's `cross`) as expressions indexing per-copy arrays `{stem}_mass`,
+/// `{stem}_com_x`, …, `{stem}_iyz` (`inertia_rpy` removed); returns the arrays for
+/// `[parameters]`. `what` names the entry in errors.
+pub(super) fn per_copy_keys(
+    t: &mut dyn toml_edit::TableLike,
+    stem: &str,
+    what: &str,
+    copies: &[[f64; 10]],
+) -> Result<Vec<(String, Vec<f64>)>, String> {
     let mut arrays: Vec<(String, Vec<f64>)> = Vec::new();
     let mut per = Vec::new();
     for (c, p) in copies.iter().enumerate() {
-        per.push(from_standard(p).map_err(|e| format!("body `{template}` copy {}: {e}", c + 1))?);
+        per.push(from_standard(p).map_err(|e| format!("{what} copy {}: {e}", c + 1))?);
     }
     let key = |what: &str| format!("{stem}_{what}");
     arrays.push((key("mass"), per.iter().map(|b| b.0).collect()));
@@ -67,7 +84,7 @@ pub(super) fn set_copies(
     }
     set(t, "inertia", value(it));
     t.remove("inertia_rpy");
-    put_arrays(d, arrays)
+    Ok(arrays)
 }
 
 /// Per-copy arrays into `[parameters]` (made if absent).

@@ -1,6 +1,7 @@
 //! `[[joint]]` entries: `name`, `kind`, `parent`, `child` (required), one placement (`origin`,
 //! `dh` or `mdh`), the axes the kind takes (`axis` or `axes`), `actuated`, the drive
-//! (`damping`, `friction`, `armature`) and `child_origin`, read in that order.
+//! (`damping`, `friction`, `armature`), `child_origin`, `home` and a universal joint's `cross`,
+//! read in that order.
 
 use std::ops::Range;
 
@@ -10,7 +11,7 @@ use toml::de::{DeTable, DeValue};
 use super::keys::{DH_KEYS, JOINT_KEYS};
 use super::{Reader, Val, get, key_span};
 use crate::diag::Diagnostic;
-use crate::spec::ir::{AxisSpec, Dh, DriveSpec, JointSpec, Kind, Placement};
+use crate::spec::ir::{AxisSpec, BodySpec, Dh, DriveSpec, JointSpec, Kind, Placement};
 use crate::spec::suggest_hint;
 
 /// The joint entry being read: its table, its key path (`joint "name"` or `joint[i]`) and its
@@ -70,6 +71,7 @@ impl Reader<'_> {
         let child_origin = self.joint_child_origin(e);
         let home_span = e.get("home").map(|v| v.span());
         let home = self.joint_home(e, kind);
+        let cross = self.joint_cross(e, kind, name.as_deref());
         let (Some((parent, parent_span)), Some((child, child_span))) = (parent, child) else {
             self.joints_incomplete = true;
             return None;
@@ -93,7 +95,38 @@ impl Reader<'_> {
             home,
             home_span,
             drive,
+            cross,
         })
+    }
+
+    /// `cross`: a universal joint's cross body (docs/spec.md, "Joint kinds"); `None` when not
+    /// written (massless) or after an error (reported).
+    fn joint_cross(
+        &mut self,
+        e: Entry<'_, '_>,
+        kind: Option<Kind>,
+        name: Option<&str>,
+    ) -> Option<BodySpec> {
+        let v = e.get("cross")?;
+        let key = e.key("cross");
+        match kind {
+            Some(Kind::Universal) => {}
+            Some(k) => {
+                self.err(
+                    format!("`cross` is for universal joints, not a {} joint", k.word()),
+                    &key,
+                    v.span(),
+                )
+                .hint = Some(
+                    "`cross` gives the mass of a universal joint's cross; put a body's mass on its [[body]] entry"
+                        .into(),
+                );
+                return None;
+            }
+            None => return None,
+        }
+        let t = self.table(v, &key)?;
+        Some(self.cross(name.unwrap_or("joint"), t, key, v.span()))
     }
 
     /// `home`: the coordinate at home, an angle (revolute) or a length (prismatic); 0 when not

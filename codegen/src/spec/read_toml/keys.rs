@@ -73,6 +73,8 @@ pub(super) const PAYLOAD_KEYS: &[&str] = &["body", "mass", "com", "inertia"];
 pub(super) const PLATFORM_KEYS: &[&str] = &["body", "coordinates", "home", "centre"];
 pub(super) const MECH_KEYS: &[&str] = &["name", "gravity", "source"];
 pub(super) const BODY_KEYS: &[&str] = &["name", "mass", "com", "inertia", "inertia_rpy"];
+/// A universal joint's `cross`: a body's inertial keys.
+pub(super) const CROSS_KEYS: &[&str] = &["mass", "com", "inertia", "inertia_rpy"];
 pub(super) const INERTIA_KEYS: &[&str] = &["ixx", "iyy", "izz", "ixy", "ixz", "iyz"];
 pub(super) const JOINT_KEYS: &[&str] = &[
     "name",
@@ -90,6 +92,7 @@ pub(super) const JOINT_KEYS: &[&str] = &[
     "damping",
     "friction",
     "armature",
+    "cross",
 ];
 pub(super) const ORIGIN_KEYS: &[&str] = &["xyz", "rpy", "quat", "matrix", "axis_angle"];
 /// The ways an origin gives its rotation (at most one).

@@ -416,6 +416,7 @@ impl Reader<'_> {
             home: 0.0,
             home_span: None,
             drive: DriveSpec::default(),
+            cross: None,
         };
         let mut u = joint(
             format!("{}_elbow", pg.name),
