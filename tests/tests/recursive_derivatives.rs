@@ -135,9 +135,8 @@ fn recursive_route_equals_forward_mode_on_every_bundled_tree() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The recursive route needs fewer flops on the 7-joint arms (the iiwa's module uses it; the
-/// 7-joint chain's keeps forward mode, which does not read the last joint's angle): flops of
-/// the two routes' outputs.
+/// The recursive route needs fewer flops on the 7-joint arms (so that their modules use it):
+/// flops of the two routes' outputs.
 #[test]
 fn recursive_route_is_cheaper_on_seven_joint_arms() {
     for file in ["chain7.toml", "iiwa14.urdf"] {

@@ -82,9 +82,8 @@ pub fn forward_dynamics_derivatives(
 /// recursive route is built on a copy of the graph, kept only when chosen. `fd` are forward
 /// dynamics' outputs. The choice depends on the tree alone: deterministic.
 ///
-/// The recursive route is also left out when it reads an input that forward mode does not (the
-/// angle of a last joint whose body is symmetric about its axis, say, which it turns through):
-/// the derivatives would then fail on a non-finite value that `forward_dynamics` ignores.
+/// The recursive route is also left out when it reads an input that forward mode does not: the
+/// derivatives would then fail on a non-finite value that `forward_dynamics` ignores.
 pub fn prefer_recursive_derivatives(
     g: &mut Graph,
     tree: &Tree,

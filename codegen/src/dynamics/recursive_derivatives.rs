@@ -55,17 +55,29 @@ pub fn recursive_inverse_dynamics_derivatives(g: &mut Graph, tree: &Tree) -> Vec
     let gv = tree.gravity;
     let a0 = s.cv(&[-gv[0], -gv[1], -gv[2]]);
     let mo = forward_sweep(&mut s, &qd, &qdd, a0);
+    // A last body symmetric about its revolute axis is resolved in its joint frame (its inertia
+    // is the same there), so that its joint angle, which inverse dynamics never reads, is not
+    // read here either; every other body in its body frame.
+    let joint_frame = joint_frames(tree);
     // Spatial velocity and acceleration of every body.
     let mut vel: Vec<Sv> = Vec::with_capacity(n);
     let mut acc: Vec<Sv> = Vec::with_capacity(n);
     for i in 0..n {
         let l = &tree.links[i];
+        let r0 = s.cm(&l.rot);
+        let to_frame = |s: &mut Sym<'_>, v: V3| {
+            if joint_frame[i] {
+                s.mat_t_vec(&r0, v)
+            } else {
+                s.child_frame(i, v)
+            }
+        };
         let v = match l.parent {
             Some(p) => {
                 let off = s.offset(i);
                 let wp = s.cross(vel[p].a, off);
                 let vp = s.add3(vel[p].l, wp);
-                s.child_frame(i, vp)
+                to_frame(&mut s, vp)
             }
             None => s.zero3(),
         };
@@ -73,16 +85,26 @@ pub fn recursive_inverse_dynamics_derivatives(g: &mut Graph, tree: &Tree) -> Vec
             JointKind::Revolute => v,
             JointKind::Prismatic => [v[0], v[1], s.g.add(v[2], qd[i])],
         };
-        vel.push(Sv {
-            a: mo.omega[i],
-            l: v,
-        });
-        let wv = s.cross(mo.omega[i], v);
-        let al = sub3(&mut s, mo.acc[i], wv);
-        acc.push(Sv {
-            a: mo.omegad[i],
-            l: al,
-        });
+        let (w, wd, a) = if joint_frame[i] {
+            // The origin's acceleration, `a_p + U_p p` in the parent's frame.
+            let ao = match l.parent {
+                Some(p) => {
+                    let u = s.u_matrix(mo.omega[p], mo.omegad[p]);
+                    let off = s.offset(i);
+                    let up = s.mat_vec(&u, off);
+                    s.add3(mo.acc[p], up)
+                }
+                None => a0,
+            };
+            let a = to_frame(&mut s, ao);
+            (mo.omega_j[i], mo.omegad_j[i], a)
+        } else {
+            (mo.omega[i], mo.omegad[i], mo.acc[i])
+        };
+        vel.push(Sv { a: w, l: v });
+        let wv = s.cross(w, v);
+        let al = sub3(&mut s, a, wv);
+        acc.push(Sv { a: wd, l: al });
     }
     let bodies = body_inertias(&mut s);
     let comp = composite_bodies(&mut s);
@@ -109,9 +131,9 @@ pub fn recursive_inverse_dynamics_derivatives(g: &mut Graph, tree: &Tree) -> Vec
     }
     for i in (0..n).rev() {
         if let Some(p) = tree.links[i].parent {
-            let h = force_to_parent(&mut s, i, mom[i]);
+            let h = force_to_parent(&mut s, i, joint_frame[i], mom[i]);
             mom[p] = add6(&mut s, mom[p], h);
-            let f = force_to_parent(&mut s, i, wr[i]);
+            let f = force_to_parent(&mut s, i, joint_frame[i], wr[i]);
             wr[p] = add6(&mut s, wr[p], f);
         }
     }
@@ -171,7 +193,7 @@ pub fn recursive_inverse_dynamics_derivatives(g: &mut Graph, tree: &Tree) -> Vec
                 dqd[a * n + d] = dot6(&mut s, sa, z);
             }
             let Some(p) = tree.links[a].parent else { break };
-            f = f.map(|v| force_to_parent(&mut s, a, v));
+            f = f.map(|v| force_to_parent(&mut s, a, joint_frame[a], v));
             a = p;
         }
     }
@@ -267,10 +289,45 @@ fn inertia_times(s: &mut Sym<'_>, c: &Composite, x: Sv) -> Sv {
     }
 }
 
-/// A force vector of body `i`'s frame in its parent's.
-fn force_to_parent(s: &mut Sym<'_>, i: usize, f: Sv) -> Sv {
-    let fp = s.parent_frame(i, f.l);
-    let np = s.parent_frame(i, f.a);
+/// Which bodies are resolved in their joint frames: revolute, without children or run-time
+/// inertia, and symmetric about the axis (`h_x = h_y = 0`, `J_xz = J_yz = J_xy = 0`,
+/// `J_xx = J_yy`), so that `Rz(q) I Rz(q)ᵀ = I`.
+fn joint_frames(tree: &Tree) -> Vec<bool> {
+    let n = tree.dof();
+    let mut leaf = vec![true; n];
+    for l in &tree.links {
+        if let Some(p) = l.parent {
+            leaf[p] = false;
+        }
+    }
+    let rigid = tree.params.as_ref().map_or(&[][..], |p| &p.rigid[..]);
+    for &(b, _) in rigid {
+        leaf[b] = false;
+    }
+    (0..n)
+        .map(|i| {
+            let l = &tree.links[i];
+            let (h, j) = (l.h, l.j);
+            leaf[i]
+                && l.kind == JointKind::Revolute
+                && h[0] == 0.0
+                && h[1] == 0.0
+                && j[0][1] == 0.0
+                && j[0][2] == 0.0
+                && j[1][2] == 0.0
+                && j[0][0] == j[1][1]
+        })
+        .collect()
+}
+
+/// A force vector of body `i`'s frame (its joint frame when `joint`) in its parent's.
+fn force_to_parent(s: &mut Sym<'_>, i: usize, joint: bool, f: Sv) -> Sv {
+    let (fp, np) = if joint {
+        let r0 = s.cm(&s.tree.links[i].rot);
+        (s.mat_vec(&r0, f.l), s.mat_vec(&r0, f.a))
+    } else {
+        (s.parent_frame(i, f.l), s.parent_frame(i, f.a))
+    };
     let off = s.offset(i);
     let pf = s.cross(off, fp);
     Sv {
