@@ -60,7 +60,10 @@
 //! * `composite`: [`mass_matrix`], `TᵀMT` by composite bodies;
 //! * `forward`: [`forward_dynamics`] by an `Lᵀ D L` factorization;
 //! * `derivatives`: [`inverse_dynamics_derivatives`] and [`forward_dynamics_derivatives`],
-//!   by differentiating the inverse-dynamics DAG and solving with forward dynamics' factors;
+//!   by differentiating the inverse-dynamics DAG (or by `recursive_derivatives` where that is
+//!   cheaper, [`prefer_recursive_derivatives`]) and solving with forward dynamics' factors;
+//! * `recursive_derivatives`: [`recursive_inverse_dynamics_derivatives`], `∂τ/∂q` and `∂τ/∂q̇`
+//!   from composite quantities per body and dot products per pair of joints;
 //! * `drives`: joint friction and rotor inertia;
 //! * `kinematics`: [`frame_kinematics`], the pose, Jacobian and `J̇ q̇` of the frames
 //!   `[scene] frames` names;
@@ -82,6 +85,7 @@ mod frames;
 mod inverse;
 mod kinematics;
 mod links;
+mod recursive_derivatives;
 mod regressor;
 mod regroup;
 mod runtime_params;
@@ -90,12 +94,15 @@ use crate::sym::ExprId;
 
 pub use base_parameters::{Base, Regressor, State, Stream, base_parameters_with, regressor};
 pub use composite::mass_matrix;
-pub use derivatives::{forward_dynamics_derivatives, inverse_dynamics_derivatives};
+pub use derivatives::{
+    forward_dynamics_derivatives, inverse_dynamics_derivatives, prefer_recursive_derivatives,
+};
 pub use drives::{add_drive_efforts, friction_effort};
 pub use forward::{PIVOT_TOLERANCE, forward_dynamics};
 pub use inverse::{Terms, inverse_dynamics};
 pub use kinematics::{FramePart, frame_kinematics};
 pub use links::Tree;
+pub use recursive_derivatives::recursive_inverse_dynamics_derivatives;
 pub use regressor::{BODY_PARAMETERS, Standard, body_standard_parameters};
 pub use runtime_params::{ParamKind, body_param_index, param_count, param_count_with, param_index};
 

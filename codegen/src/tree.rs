@@ -112,9 +112,9 @@ pub fn symbolic_with_frames(
         });
     // Built last, so that the nodes (and the emitted text) of the functions above stay as
     // they were without them.
-    let inverse_dynamics_derivatives =
+    let mut inverse_dynamics_derivatives =
         dynamics::inverse_dynamics_derivatives(&mut g, &inverse_dynamics);
-    let forward_dynamics_derivatives = dynamics::forward_dynamics_derivatives(
+    let mut forward_dynamics_derivatives = dynamics::forward_dynamics_derivatives(
         &mut g,
         &tree,
         &inverse_dynamics_derivatives,
@@ -141,6 +141,19 @@ pub fn symbolic_with_frames(
             .map(|part| dynamics::frame_kinematics(&mut g, &tree, f.body, &f.placement, part))
         })
         .collect();
+    // The recursive derivatives where they are cheaper, after everything else (same reason).
+    dynamics::prefer_recursive_derivatives(
+        &mut g,
+        &tree,
+        &mut inverse_dynamics_derivatives,
+        &mut forward_dynamics_derivatives,
+        &forward_dynamics,
+    );
+    let guards = g.take_guards();
+    debug_assert!(
+        guards.is_empty() || guards == forward_dynamics_guards,
+        "the derivatives test what forward dynamics tests"
+    );
     Symbolic {
         graph: g,
         dof: tree.dof(),

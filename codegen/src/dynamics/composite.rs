@@ -13,10 +13,10 @@ use super::{M3, V3};
 
 /// Composite inertia of a subtree about its root body's origin, in its frame.
 #[derive(Clone, Copy)]
-struct Composite {
-    m: ExprId,
-    h: V3,
-    j: M3,
+pub(super) struct Composite {
+    pub(super) m: ExprId,
+    pub(super) h: V3,
+    pub(super) j: M3,
 }
 
 /// `I = TᵀMT` (eq. 21) by composite bodies; the full symmetric matrix, row-major.
@@ -39,11 +39,22 @@ pub fn mass_matrix(g: &mut Graph, tree: &Tree) -> Vec<Vec<ExprId>> {
     h
 }
 
-/// The composite body of every joint: each body's (regrouped) inertia plus its run-time payload
-/// or body, then each subtree lumped into its parent, from the tips.
-fn composite_bodies(s: &mut Sym<'_>) -> Vec<Composite> {
+/// The composite body of every joint: each body's inertia ([`body_inertias`]), then each
+/// subtree lumped into its parent, from the tips.
+pub(super) fn composite_bodies(s: &mut Sym<'_>) -> Vec<Composite> {
+    let mut comp = body_inertias(s);
+    for i in (0..s.tree.dof()).rev() {
+        if let Some(p) = s.tree.links[i].parent {
+            comp[p] = add_to_parent(s, i, comp[i], comp[p]);
+        }
+    }
+    comp
+}
+
+/// Each body's (regrouped) inertia about its origin, in its frame, plus its run-time payload or
+/// body.
+pub(super) fn body_inertias(s: &mut Sym<'_>) -> Vec<Composite> {
     let tree = s.tree;
-    let n = tree.dof();
     let mut comp: Vec<Composite> = tree
         .links
         .iter()
@@ -69,11 +80,6 @@ fn composite_bodies(s: &mut Sym<'_>) -> Vec<Composite> {
             h: hs,
             j: js,
         };
-    }
-    for i in (0..n).rev() {
-        if let Some(p) = tree.links[i].parent {
-            comp[p] = add_to_parent(s, i, comp[i], comp[p]);
-        }
     }
     comp
 }

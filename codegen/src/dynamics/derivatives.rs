@@ -1,19 +1,22 @@
 //! Derivatives of the dynamics: `∂τ/∂q`, `∂τ/∂q̇` of inverse dynamics by forward-mode
-//! differentiation of its DAG ([`crate::sym::derivative`]), and those of forward dynamics from
-//! them: `q̈ = FD(q, q̇, τ)` solves `ID(q, q̇, q̈) = τ`, so
+//! differentiation of its DAG ([`crate::sym::derivative`]) or by the recursive analytic route
+//! ([`recursive_inverse_dynamics_derivatives`]), whichever needs fewer operations for the tree
+//! ([`prefer_recursive_derivatives`]), and those of forward dynamics from them: `q̈ = FD(q, q̇, τ)` solves `ID(q, q̇, q̈) = τ`, so
 //! `∂q̈/∂x = −I⁻¹ ∂ID/∂x` at `q̈ = FD(q, q̇, τ)` (`x` = `q` or `q̇`) and `∂q̈/∂τ = I⁻¹`, every
 //! solve through forward dynamics' own `Lᵀ D L` factorization and its guards.
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 use crate::sym::derivative::{Derivative, substitute};
-use crate::sym::{Arg, ExprId, Graph};
+use crate::sym::{Arg, ExprId, Graph, Node};
 
+use super::flops::{Paid, marginal_flops};
 use super::forward::{factor, solve};
+use super::recursive_derivatives::recursive_inverse_dynamics_derivatives;
 use super::{Tree, mass_matrix};
 
-/// `(∂τ/∂q, ∂τ/∂q̇)` of the inverse-dynamics outputs `id`: `2n²` nodes, each matrix row-major
-/// (`[i][j] = ∂τ_i/∂x_j`).
+/// `(∂τ/∂q, ∂τ/∂q̇)` of the inverse-dynamics outputs `id` by forward mode, one direction per
+/// `q_j` and `q̇_j`: `2n²` nodes, each matrix row-major (`[i][j] = ∂τ_i/∂x_j`).
 pub fn inverse_dynamics_derivatives(g: &mut Graph, id: &[ExprId]) -> Vec<ExprId> {
     let n = id.len();
     let mut out = vec![g.zero(); 2 * n * n];
@@ -68,6 +71,52 @@ pub fn forward_dynamics_derivatives(
         for j in 0..n {
             out[n + 2 * n * n + i * n + j] = cols[i.min(j)][i.max(j)];
         }
+    }
+    out
+}
+
+/// Replaces `did` (forward mode, [`inverse_dynamics_derivatives`]) and `fdd`
+/// ([`forward_dynamics_derivatives`] from it) by the recursive route's when its `∂τ/∂q`, `∂τ/∂q̇`
+/// need fewer operations (forward mode stays on a tie). Called after every other function of the
+/// module is built, so that their nodes (and emitted text) are those they have without it; the
+/// recursive route is built on a copy of the graph, kept only when chosen. `fd` are forward
+/// dynamics' outputs. The choice depends on the tree alone: deterministic.
+///
+/// The recursive route is also left out when it reads an input that forward mode does not: the
+/// derivatives would then fail on a non-finite value that `forward_dynamics` ignores.
+pub fn prefer_recursive_derivatives(
+    g: &mut Graph,
+    tree: &Tree,
+    did: &mut Vec<ExprId>,
+    fdd: &mut Vec<ExprId>,
+    fd: &[ExprId],
+) {
+    let mut rg = g.clone();
+    let recursive = recursive_inverse_dynamics_derivatives(&mut rg, tree);
+    let none = Paid::default();
+    if marginal_flops(&rg, &recursive, &none) >= marginal_flops(g, did, &none)
+        || !inputs(&rg, &recursive).is_subset(&inputs(g, did))
+    {
+        return;
+    }
+    *fdd = forward_dynamics_derivatives(&mut rg, tree, &recursive, fd);
+    *did = recursive;
+    *g = rg;
+}
+
+/// The inputs that `roots` read.
+fn inputs(g: &Graph, roots: &[ExprId]) -> BTreeSet<(Arg, u16)> {
+    let mut seen: HashSet<ExprId> = HashSet::new();
+    let mut stack = roots.to_vec();
+    let mut out = BTreeSet::new();
+    while let Some(id) = stack.pop() {
+        if !seen.insert(id) {
+            continue;
+        }
+        if let Node::Input(a, i) = g.node(id) {
+            out.insert((a, i));
+        }
+        stack.extend(g.operands(id));
     }
     out
 }

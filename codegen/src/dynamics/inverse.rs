@@ -57,9 +57,9 @@ pub(super) struct Motion {
     /// Acceleration of the body-frame origin, body frame.
     pub(super) acc: Vec<V3>,
     /// ω resolved in the joint frame (the body frame before the joint's own rotation).
-    omega_j: Vec<V3>,
+    pub(super) omega_j: Vec<V3>,
     /// ω̇ resolved in the joint frame.
-    omegad_j: Vec<V3>,
+    pub(super) omegad_j: Vec<V3>,
 }
 
 /// Body wrenches about the body-frame origins, one per body.
