@@ -715,6 +715,21 @@ fn consistency(
     out
 }
 
+/// What the ten standard parameters `sp` break as a body (`None`: a physical body, or numbers
+/// that are no body at all, which [`from_standard`] reports where they are written).
+fn broken(sp: &[f64; 10]) -> Option<String> {
+    let (m, _, ic) = from_standard(sp).ok()?;
+    let what = physics(m, &ic);
+    (!what.is_empty()).then(|| what.join("; "))
+}
+
+/// The base parameters (rows of `p`) that the unknowns `cols` move.
+fn involved(p: &DMatrix<f64>, cols: std::ops::Range<usize>) -> Vec<usize> {
+    (0..p.nrows())
+        .filter(|&r| cols.clone().any(|k| p[(r, k)].abs() > 1e-12))
+        .collect()
+}
+
 /// What a body of mass `m` and central inertia `ic` breaks (empty: nothing).
 fn physics(m: f64, ic: &Mat3) -> Vec<String> {
     {

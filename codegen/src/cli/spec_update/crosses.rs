@@ -22,7 +22,9 @@ use toml_edit::{DocumentMut, InlineTable, Item};
 use runtime::model::{Mat3, Vec3};
 
 use super::patterns::{per_copy_keys, put_arrays, stem};
-use super::{Unknown, body_parameters, from_standard, physics, set_body, unwritable_keys};
+use super::{
+    Unknown, body_parameters, broken, from_standard, involved, physics, set_body, unwritable_keys,
+};
 
 /// Where a universal joint entry is: a top-level `[[joint]]` (`pattern` `None`) or a
 /// `[[pattern.joint]]` of `[[pattern]]` element `pattern`.
@@ -268,16 +270,9 @@ pub(super) fn cross_consistency(
             continue;
         }
         let sp: [f64; 10] = std::array::from_fn(|k| z[c + k]);
-        let Ok((m, _, ic)) = from_standard(&sp) else {
+        let Some(what) = broken(&sp) else {
             continue;
         };
-        let what = physics(m, &ic);
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| (c..c + 10).any(|k| p[(r, k)].abs() > 1e-12))
-            .collect();
         let joint = names[c]
             .trim_start_matches("joint `")
             .trim_end_matches("` cross");
@@ -286,7 +281,7 @@ pub(super) fn cross_consistency(
         } else {
             joint.to_string()
         };
-        out.push((format!("{joint}_cross"), what.join("; "), involved));
+        out.push((format!("{joint}_cross"), what, involved(p, c..c + 10)));
     }
     out
 }

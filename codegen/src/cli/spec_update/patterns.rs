@@ -9,7 +9,7 @@ use toml_edit::{DocumentMut, InlineTable, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::{Unknown, from_standard, number, physics, set, value};
+use super::{Unknown, broken, from_standard, involved, number, set, value};
 
 /// A pattern body's copies as per-copy arrays in `[parameters]`, which its entries index
 /// (`inertia_rpy` removed).
@@ -251,21 +251,14 @@ pub(super) fn copy_consistency(
         if !changed.contains(&names[cols.start]) {
             continue;
         }
-        let Ok((m, _, ic)) = from_standard(&sp) else {
+        let Some(what) = broken(&sp) else {
             continue;
         };
-        let what = physics(m, &ic);
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| cols.clone().any(|k| p[(r, k)].abs() > 1e-12))
-            .collect();
         let name = names[cols.start]
             .trim_start_matches("body `")
             .trim_end_matches('`')
             .replace("{i}", &copy.to_string());
-        out.push((name, what.join("; "), involved));
+        out.push((name, what, involved(p, cols)));
     }
     out
 }

@@ -18,7 +18,7 @@ use toml_edit::{DocumentMut, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::{Unknown, number, set, value};
+use super::{Unknown, involved, number, set, value};
 
 /// Where a parallelogram entry is: a top-level `[[parallelogram]]` (`pattern` `None`) or a
 /// `[[pattern.parallelogram]]` of `[[pattern]]` element `pattern`.
@@ -231,9 +231,6 @@ pub(super) fn rods_consistency(
         if i >= 0.0 {
             continue;
         }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| (c..c + 3).any(|k| p[(r, k)].abs() > 1e-12))
-            .collect();
         let name = names[c]
             .trim_start_matches("parallelogram `")
             .trim_end_matches('`');
@@ -245,7 +242,7 @@ pub(super) fn rods_consistency(
         out.push((
             format!("{name}_rods"),
             format!("rod transverse inertia {i:.4e} kg·m² < 0"),
-            involved,
+            involved(p, c..c + 3),
         ));
     }
     out

@@ -20,7 +20,7 @@ use toml_edit::DocumentMut;
 use super::armature::{armature, set_armature};
 use super::xml_scan::{Tag, children, closing, scan};
 use super::{
-    Change, REFERENCE, Update, changed_names, from_standard, minimum_norm_change, physics,
+    Change, REFERENCE, Update, broken, changed_names, from_standard, involved, minimum_norm_change,
 };
 use crate::cli::regressor::Regressor;
 
@@ -418,17 +418,10 @@ fn consistency(
             continue;
         }
         let sp: [f64; 10] = std::array::from_fn(|k| z[c + k]);
-        let Ok((m, _, ic)) = from_standard(&sp) else {
+        let Some(what) = broken(&sp) else {
             continue;
         };
-        let what = physics(m, &ic);
-        if what.is_empty() {
-            continue;
-        }
-        let involved: Vec<usize> = (0..p.nrows())
-            .filter(|&r| (c..c + 10).any(|k| p[(r, k)].abs() > 1e-12))
-            .collect();
-        out.push((links[link].name.clone(), what.join("; "), involved));
+        out.push((links[link].name.clone(), what, involved(p, c..c + 10)));
     }
     out
 }
