@@ -32,14 +32,43 @@ use super::regressor::Regressor;
 mod patterns;
 use patterns::{copy_consistency, pattern_unknowns, set_copies};
 mod crosses;
-use crosses::{CrossAt, cross_consistency, cross_unknowns, free_masses, set_crosses};
+use crosses::{cross_consistency, cross_unknowns, free_masses, set_crosses};
 mod payload;
 use payload::{payload_unknowns, set_payload};
 mod rods;
-use rods::{RodsAt, rod_unknowns, rods_consistency, set_rods};
+use rods::{rod_unknowns, rods_consistency, set_rods};
 mod armature;
 mod urdf;
 mod xml_scan;
+
+/// Where an entry of a spec array (`[[joint]]`, `[[parallelogram]]`) is: top-level (`pattern`
+/// `None`) or in `[[pattern]]` element `pattern` (`[[pattern.joint]]`, …), element `index`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) struct EntryAt {
+    pub pattern: Option<usize>,
+    pub index: usize,
+}
+
+impl EntryAt {
+    /// The entry's table in `d`, in the array named `array`.
+    fn table_mut<'d>(
+        self,
+        d: &'d mut DocumentMut,
+        array: &str,
+    ) -> Option<&'d mut toml_edit::Table> {
+        let outer = match self.pattern {
+            None => d.as_table_mut(),
+            Some(p) => d
+                .get_mut("pattern")
+                .and_then(Item::as_array_of_tables_mut)
+                .and_then(|a| a.get_mut(p))?,
+        };
+        outer
+            .get_mut(array)
+            .and_then(Item::as_array_of_tables_mut)
+            .and_then(|a| a.get_mut(self.index))
+    }
+}
 
 /// One unknown of the update.
 #[derive(Clone, Debug)]
@@ -68,12 +97,12 @@ enum Unknown {
     },
     /// Linear rod parameter `k` (`M`, `H`, `J`: [`rods`]) of copy `copy` (from 1; 1 for a
     /// top-level entry) of the parallelogram entry `at`.
-    Rods { at: RodsAt, copy: usize, k: usize },
+    Rods { at: EntryAt, copy: usize, k: usize },
     /// Standard parameter `k` of the `[scene] payload`.
     Payload { k: usize },
     /// Standard parameter `k` of the cross of copy `copy` (from 1; 1 for a top-level entry)
     /// of the universal joint entry `at` ([`crosses`]).
-    Cross { at: CrossAt, copy: usize, k: usize },
+    Cross { at: EntryAt, copy: usize, k: usize },
 }
 
 /// The outcome of an update.
@@ -266,9 +295,9 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     type Drives = std::collections::BTreeMap<usize, f64>;
     let mut drives: std::collections::BTreeMap<(usize, usize, &str), Drives> = Default::default();
     type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
-    let mut rods: std::collections::BTreeMap<RodsAt, Rods> = Default::default();
+    let mut rods: std::collections::BTreeMap<EntryAt, Rods> = Default::default();
     let mut payload: Option<[f64; 10]> = None;
-    let mut crosses: std::collections::BTreeMap<CrossAt, Copies> = Default::default();
+    let mut crosses: std::collections::BTreeMap<EntryAt, Copies> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
             Unknown::Cross { at, copy, k } => {

@@ -170,43 +170,7 @@ fn tree_cross_out(test: &str, cross: &str) {
     );
     let truth = super::tree("truth.toml", &truth_src);
     let true_base = generated_base_parameters("truth.toml", &truth_src);
-    let traj = dir.join("traj.csv");
-    let o = run(&[
-        "excite",
-        s(&spec),
-        "--seed",
-        "3",
-        "--restarts",
-        "1",
-        "--evaluations",
-        "40",
-        "--samples",
-        "300",
-        "-o",
-        s(&traj),
-    ]);
-    ok(&o);
-    let (_, rows) = super::csv_rows(&traj);
-    let mut csv = String::from("q1,q2,q3,qd1,qd2,qd3,qdd1,qdd2,qdd3,tau1,tau2,tau3\n");
-    for r in &rows {
-        let tau = effort(&truth, &r[1..4], &r[4..7], &r[7..10]);
-        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
-        csv.push_str(&cells.join(","));
-        csv.push('\n');
-    }
-    let data = dir.join("data.csv");
-    std::fs::write(&data, csv).unwrap();
-    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
-    ok(&o);
+    let (o, est, out) = identify_exact(&dir, &spec, &truth, "3");
     let stderr = text(&o.stderr);
     assert!(!stderr.contains("note: no number"), "{stderr}");
     let (e, _) = estimates(&est);
@@ -435,6 +399,65 @@ fn urdf_model(name: &str, source: &str, scene: Option<&str>) -> runtime::model::
     }
 }
 
+/// `excite` on the tree `spec` (seed `seed`, 40 evaluations, 300 samples), the efforts of
+/// `truth` at its states (noise-free), then `identify --estimates --out`, which must succeed:
+/// its output and the paths of the estimates and of the written spec.
+fn identify_exact(
+    dir: &std::path::Path,
+    spec: &std::path::Path,
+    truth: &runtime::model::Model,
+    seed: &str,
+) -> (std::process::Output, std::path::PathBuf, std::path::PathBuf) {
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        s(spec),
+        "--seed",
+        seed,
+        "--restarts",
+        "1",
+        "--evaluations",
+        "40",
+        "--samples",
+        "300",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+    let (_, rows) = super::csv_rows(&traj);
+    let n = truth.dof();
+    let columns: Vec<String> = ["q", "qd", "qdd", "tau"]
+        .iter()
+        .flat_map(|c| (1..=n).map(move |i| format!("{c}{i}")))
+        .collect();
+    let mut csv = columns.join(",") + "\n";
+    for r in &rows {
+        let tau = effort(
+            truth,
+            &r[1..1 + n],
+            &r[1 + n..1 + 2 * n],
+            &r[1 + 2 * n..1 + 3 * n],
+        );
+        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let data = dir.join("data.csv");
+    std::fs::write(&data, csv).unwrap();
+    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let o = run(&[
+        "identify",
+        s(spec),
+        s(&data),
+        "--estimates",
+        s(&est),
+        "--out",
+        s(&out),
+    ]);
+    ok(&o);
+    (o, est, out)
+}
+
 /// Inverse dynamics with the drive law (the runtime's spatial RNEA).
 fn effort(m: &runtime::model::Model, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
     let tau = runtime::rnea::inverse_dynamics(m, q, qd, qdd);
@@ -648,43 +671,7 @@ fn a_payload_takes_what_its_body_cannot() {
     let truth_src = payload_spec(1.1, 0.62, 0.74);
     let truth = super::tree("truth.toml", &truth_src);
     let true_base = generated_base_parameters("truth.toml", &truth_src);
-    let traj = dir.join("traj.csv");
-    let o = run(&[
-        "excite",
-        s(&spec),
-        "--seed",
-        "2",
-        "--restarts",
-        "1",
-        "--evaluations",
-        "40",
-        "--samples",
-        "300",
-        "-o",
-        s(&traj),
-    ]);
-    ok(&o);
-    let (_, rows) = super::csv_rows(&traj);
-    let mut csv = String::from("q1,q2,qd1,qd2,qdd1,qdd2,tau1,tau2\n");
-    for r in &rows {
-        let tau = effort(&truth, &r[1..3], &r[3..5], &r[5..7]);
-        let cells: Vec<String> = r[1..].iter().chain(&tau).map(|v| format!("{v}")).collect();
-        csv.push_str(&cells.join(","));
-        csv.push('\n');
-    }
-    let data = dir.join("data.csv");
-    std::fs::write(&data, csv).unwrap();
-    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
-    ok(&o);
+    let (o, est, out) = identify_exact(&dir, &spec, &truth, "2");
     let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
     assert!(stdout.contains("[scene] payload"), "{stdout}");
     assert!(stderr.contains("note: body `link2`"), "{stderr}");

@@ -23,33 +23,9 @@ use runtime::model::{Mat3, Vec3};
 
 use super::patterns::{per_copy_keys, put_arrays, stem};
 use super::{
-    Unknown, body_parameters, broken, from_standard, involved, physics, set_body, unwritable_keys,
+    EntryAt, Unknown, body_parameters, broken, from_standard, involved, physics, set_body,
+    unwritable_keys,
 };
-
-/// Where a universal joint entry is: a top-level `[[joint]]` (`pattern` `None`) or a
-/// `[[pattern.joint]]` of `[[pattern]]` element `pattern`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub(super) struct CrossAt {
-    pub pattern: Option<usize>,
-    pub index: usize,
-}
-
-/// The joint entry at `at` in `d`.
-fn entry_mut(d: &mut DocumentMut, at: CrossAt) -> Option<&mut toml_edit::Table> {
-    match at.pattern {
-        None => d
-            .get_mut("joint")
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(at.index)),
-        Some(p) => d
-            .get_mut("pattern")
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(p))
-            .and_then(|p| p.get_mut("joint"))
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(at.index)),
-    }
-}
 
 /// The unknowns of the crosses: per universal joint entry whose copies all have a cross body
 /// in the model (`written`), ten per copy. A top-level cross written with expressions keeps
@@ -62,10 +38,10 @@ pub(super) fn cross_unknowns(
     names: &mut Vec<String>,
     skipped: &mut Vec<String>,
 ) {
-    let mut entries: Vec<(CrossAt, &toml_edit::Table, usize)> = Vec::new();
+    let mut entries: Vec<(EntryAt, &toml_edit::Table, usize)> = Vec::new();
     if let Some(a) = doc.get("joint").and_then(Item::as_array_of_tables) {
         for (index, t) in a.iter().enumerate() {
-            let at = CrossAt {
+            let at = EntryAt {
                 pattern: None,
                 index,
             };
@@ -79,7 +55,7 @@ pub(super) fn cross_unknowns(
                 continue;
             };
             for (index, t) in a.iter().enumerate() {
-                let at = CrossAt {
+                let at = EntryAt {
                     pattern: Some(pattern),
                     index,
                 };
@@ -138,10 +114,10 @@ pub(super) fn cross_unknowns(
 /// the `cross` key where absent.
 pub(super) fn set_crosses(
     d: &mut DocumentMut,
-    at: CrossAt,
+    at: EntryAt,
     copies: &[[f64; 10]],
 ) -> Result<(), String> {
-    let Some(t) = entry_mut(d, at) else {
+    let Some(t) = at.table_mut(d, "joint") else {
         return Ok(());
     };
     let template = t

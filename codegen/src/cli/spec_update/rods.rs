@@ -18,15 +18,7 @@ use toml_edit::{DocumentMut, Item, Value};
 
 use runtime::model::{Mat3, Vec3};
 
-use super::{Unknown, involved, number, set, value};
-
-/// Where a parallelogram entry is: a top-level `[[parallelogram]]` (`pattern` `None`) or a
-/// `[[pattern.parallelogram]]` of `[[pattern]]` element `pattern`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub(super) struct RodsAt {
-    pub pattern: Option<usize>,
-    pub index: usize,
-}
+use super::{EntryAt, Unknown, involved, number, set, value};
 
 /// The unknowns' reference values for the update's columns: a valid rod (`m = 1/2`, `c = 0`,
 /// `i = 1`; one unit on `H` gives `c = 1`, `i = 1/2`).
@@ -74,11 +66,11 @@ pub(super) fn rod_unknowns(
     names: &mut Vec<String>,
     skipped: &mut Vec<String>,
 ) {
-    let mut entries: Vec<(RodsAt, String, usize)> = Vec::new();
+    let mut entries: Vec<(EntryAt, String, usize)> = Vec::new();
     if let Some(a) = doc.get("parallelogram").and_then(Item::as_array_of_tables) {
         for (index, t) in a.iter().enumerate() {
             let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
-            let at = RodsAt {
+            let at = EntryAt {
                 pattern: None,
                 index,
             };
@@ -93,7 +85,7 @@ pub(super) fn rod_unknowns(
             };
             for (index, t) in a.iter().enumerate() {
                 let name = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
-                let at = RodsAt {
+                let at = EntryAt {
                     pattern: Some(pattern),
                     index,
                 };
@@ -137,20 +129,12 @@ pub(super) fn rod_unknowns(
 /// Write an entry's rods: plain numbers for a top-level entry, per-copy arrays in
 /// `[parameters]` indexed by the entry's keys for a pattern's. `rod_inertia`'s `ixx` (the
 /// dropped spin) keeps its text.
-pub(super) fn set_rods(d: &mut DocumentMut, at: RodsAt, copies: &[[f64; 3]]) -> Result<(), String> {
-    let table = match at.pattern {
-        None => d
-            .get_mut("parallelogram")
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(at.index)),
-        Some(p) => d
-            .get_mut("pattern")
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(p))
-            .and_then(|p| p.get_mut("parallelogram"))
-            .and_then(Item::as_array_of_tables_mut)
-            .and_then(|a| a.get_mut(at.index)),
-    };
+pub(super) fn set_rods(
+    d: &mut DocumentMut,
+    at: EntryAt,
+    copies: &[[f64; 3]],
+) -> Result<(), String> {
+    let table = at.table_mut(d, "parallelogram");
     let Some(t) = table else {
         return Ok(());
     };
