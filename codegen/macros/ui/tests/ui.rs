@@ -3,13 +3,15 @@
 //! compiler output beside it (`.stderr`; regenerate with `TRYBUILD=overwrite`, then read them).
 //!
 //! trybuild compiles the cases in a crate of its own, at
-//! `<target dir>/tests/trybuild/nocdyn-macros`, and that crate's `CARGO_MANIFEST_DIR` is what
+//! `<target dir>/tests/trybuild/nocdyn-macros-ui`, and that crate's `CARGO_MANIFEST_DIR` is what
 //! `mechanism!` resolves paths against. The bad specs are therefore copied to `tests/ui/` there
 //! first, so that a case's path (`"tests/ui/negative_mass.toml"`) names the same file from this
 //! crate and from trybuild's.
 //!
 //! Cost: trybuild builds the macro and its dependencies (codegen, nalgebra, syn, …) once more in
-//! that directory, about 70 CPU-seconds from cold; the cases themselves take a second.
+//! that directory, for the host only: this crate depends on the macro alone, so the cases' side
+//! builds nothing but them (from `codegen/macros` itself, trybuild also built the macro's
+//! dependencies a second time, for the cases). The cases themselves take a second.
 
 use std::path::{Path, PathBuf};
 
@@ -20,7 +22,7 @@ fn bad_specs_are_compile_errors() {
     let target = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .parent()
         .expect("CARGO_TARGET_TMPDIR is inside the target dir");
-    let there = target.join("tests/trybuild/nocdyn-macros/tests/ui");
+    let there = target.join("tests/trybuild/nocdyn-macros-ui/tests/ui");
     std::fs::create_dir_all(&there).expect("trybuild's project dir");
     let specs: Vec<PathBuf> = std::fs::read_dir(&here)
         .expect("tests/ui")
