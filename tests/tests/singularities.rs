@@ -958,8 +958,9 @@ fn delta4_shaft_gimbal_lock() {
 /// proximal and distal links in one line (stretched, `|B₀ − A₀| = l₁ + l₂`): the leg Jacobian's
 /// determinant vanishes, a leg (type-I) singularity. The platform keeps its home rotation
 /// (`φ = 0`) and moves so that `B₀` runs along the line from `A₀` through `B₀`'s home position,
-/// `|B₀ − A₀| = 0.55 m − δ` (1e-1 … 1e-12 m, then 0). Measured (`--nocapture`): both `f64`
-/// routes `Ok` to ≤ 7.2e-9 against double-double down to δ = 1e-8 m, then `Err(Leg(0))` from
+/// `|B₀ − A₀| = l₁ + l₂ − δ = 0.8 m − δ` (1e-1 … 1e-12 m, then 0; the links of
+/// `mechanisms/specs/planar_3rrr.toml`, 0.4 m each). Measured (`--nocapture`): both `f64`
+/// routes `Ok` to ≤ 2.3e-9 against double-double down to δ = 1e-8 m, then `Err(Leg(0))` from
 /// 1e-9 m (double-double too) to δ = 0 (where double-double reports `Reach(0)`); 1 mm beyond,
 /// `Err(Reach(0))` from both.
 #[test]
@@ -973,7 +974,7 @@ fn planar_3rrr_stretched_leg_singularity() {
     let walk: Vec<Point> = deltas()
         .into_iter()
         .map(|d| {
-            let r = 0.55 - d;
+            let r = 0.8 - d;
             // The platform origin that puts B₀ at A₀ + r·dir (B₀ − origin is fixed at φ = 0).
             let p = [
                 a0[0] + r * dir[0] / n - (b0[0] - home[0]),
@@ -986,7 +987,7 @@ fn planar_3rrr_stretched_leg_singularity() {
         })
         .collect();
     let bad = walk_report(
-        "Planar 3-RRR, |B₀ − A₀| = 0.55 m − δ (leg 0 stretched)",
+        "Planar 3-RRR, |B₀ − A₀| = 0.8 m − δ (leg 0 stretched)",
         &plan,
         &walk,
         &states(3, 0x3e),
@@ -1000,7 +1001,7 @@ fn planar_3rrr_stretched_leg_singularity() {
     finish(&bad);
     // Beyond the boundary (1 mm further): out of reach, generated and runtime alike.
     let x = {
-        let r = 0.551;
+        let r = 0.801;
         [
             a0[0] + r * dir[0] / n - (b0[0] - home[0]),
             a0[1] + r * dir[1] / n - (b0[1] - home[1]),
@@ -1027,8 +1028,9 @@ fn planar_3rrr_leg0(m: &ParallelModel) -> ([f64; 2], [f64; 2]) {
 /// one point (the rows of `A` dependent) while every leg stays regular. Found by turning the
 /// platform about its origin at home position: `φ*` is where the runtime's `det A` changes sign
 /// (bisection to rounding, legs regular); the walk is `φ = φ* − δ` (1e-1 … 1e-12 rad, then `φ*`).
-/// Measured: `φ* = 0.7120251828…` rad; both `f64` routes `Ok` to ≤ 1.3e-7 against
-/// double-double (pivot ratio 2.1e7) down to δ = 1e-9 rad, then `Err(Actuation(2))` from 1e-10 rad.
+/// Measured: `φ* = 0.7406672962…` rad; both `f64` routes `Ok` to ≤ 1.3e-8 against
+/// double-double (pivot ratio 1.6e7 at 1e-9 rad) down to δ = 1e-9 rad, then `Err(Actuation(2))`
+/// from 1e-10 rad.
 #[test]
 fn planar_3rrr_parallel_singularity() {
     let m = model("planar_3rrr");
