@@ -448,7 +448,7 @@ fn write_update(
     );
     if !up.unreachable.is_empty() {
         eprintln!(
-            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a body the loader adds that has no number in the spec (a parallelogram's elbow cross; a U joint's `cross` written with expressions, left unchanged), what a parallelogram's symmetric rods cannot have (a first moment across them, products of inertia), or a drive",
+            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a U joint's `cross` written with expressions (left unchanged), what a parallelogram's equal rods cannot have (a first moment along the motor axis, products of inertia with it: unequal rods), or a drive",
             if up.unreachable.len() == 1 { "" } else { "s" },
             up.unreachable
                 .iter()
