@@ -544,3 +544,7 @@ mod positions;
 // The 3-sigma claim over many noise seeds.
 #[path = "cli_identify/coverage.rs"]
 mod coverage;
+
+// A Delta's elbow crosses: the `cross` of a parallelogram.
+#[path = "cli_identify/elbow.rs"]
+mod elbow;

@@ -278,3 +278,148 @@ fn a_closed_loop_tree_joint_takes_a_cross() {
     assert_eq!(cross_mass(&src), Some(0.0));
     assert_eq!(cross_mass(&with), Some(0.25));
 }
+
+/// A parallel model of `src`.
+fn platform(name: &str, src: &str) -> runtime::parallel::ParallelModel {
+    match load_mechanism(name, src) {
+        Ok((Mechanism::Parallel(p), _)) => p,
+        Ok(_) => panic!("a platform"),
+        Err(d) => panic!("{}", d.render()),
+    }
+}
+
+/// Relative 2-norm of the difference of two Deltas' inverse dynamics over random states near
+/// home (the platform within 5 cm of it).
+fn delta_difference(a: &str, b: &str) -> f64 {
+    use runtime::parallel::noc;
+    let (ma, mb) = (platform("a.toml", a), platform("b.toml", b));
+    let (pa, pb) = (noc::Plan::new(&ma).unwrap(), noc::Plan::new(&mb).unwrap());
+    let mut s = 0x0e1b_0e1b_u64;
+    let (mut diff, mut norm) = (0.0f64, 0.0f64);
+    for _ in 0..20 {
+        let mut r = || 2.0 * uniform(&mut s) - 1.0;
+        let x = [0.05 * r(), 0.05 * r(), -1.0 + 0.05 * r()];
+        let u = [r(), r(), r()];
+        let ud = [5.0 * r(), 5.0 * r(), 5.0 * r()];
+        let ta = noc::inverse_dynamics(&pa, &x, &u, &ud).unwrap();
+        let tb = noc::inverse_dynamics(&pb, &x, &u, &ud).unwrap();
+        for (a, b) in ta.iter().zip(&tb) {
+            diff += (a - b) * (a - b);
+            norm += b * b;
+        }
+    }
+    (diff / norm).sqrt()
+}
+
+/// A parallelogram's `cross` is the elbow U's cross, whose first axis is the motor axis's
+/// direction through `E` (docs/spec.md, "Parallelograms"). A point mass on that axis does not
+/// turn with the cross, so it moves with the upper arm: the Delta with
+/// `cross = { mass = m, com = [0, c, 0] }` on a parallelogram is, by hand, the Delta whose elbow
+/// pin (a point mass 0.226 kg at `E`, in the upper arm's axes) also carries `m` at `(0, c, 0)`:
+/// mass `M = 0.226 + m`, mass centre `(0, mc/M, 0)`, inertia about it `μ c²` about `x` and `z`
+/// (`μ = 0.226 m / M`, two point masses `c` apart). Top-level entries (the expanded Delta, leg
+/// 1) and a `[[pattern.parallelogram]]` (the bundled Delta, every leg).
+#[test]
+fn a_parallelogram_cross_on_the_motor_axis_is_a_heavier_elbow_pin() {
+    let (m, c, pin) = (0.15, 0.03, 0.226);
+    let big_m = pin + m;
+    let mu = pin * m / big_m;
+    let merged = format!(
+        "mass = {big_m}\ncom = [0.0, {}, 0.0]\ninertia = {{ ixx = {}, iyy = 0.0, izz = {} }}\n",
+        m * c / big_m,
+        mu * c * c,
+        mu * c * c
+    );
+    let cross = format!("cross = {{ mass = {m}, com = [0.0, {c}, 0.0] }}\n");
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let expanded =
+        std::fs::read_to_string(format!("{dir}/tests/data/expanded/delta_rl5.toml")).unwrap();
+    let bundled =
+        std::fs::read_to_string(format!("{dir}/../mechanisms/specs/delta_rl5.toml")).unwrap();
+    for (src, name, pin_entry) in [
+        (
+            &expanded,
+            "name = \"forearm1\"\n",
+            "name = \"elbow_pin1\"\nmass = 0.226\n",
+        ),
+        (
+            &bundled,
+            "name = \"forearm{i}\"\n",
+            "name = \"elbow_pin{i}\"\nmass = 0.226\n",
+        ),
+    ] {
+        let with_key = src.replacen(name, &format!("{name}{cross}"), 1);
+        let by_hand = src.replacen(pin_entry, &pin_entry.replace("mass = 0.226\n", &merged), 1);
+        assert!(with_key != *src && by_hand != *src);
+        let d = delta_difference(&with_key, &by_hand);
+        let effect = delta_difference(src, &by_hand);
+        eprintln!(
+            "parallelogram cross vs a heavier elbow pin: {d:.2e} (relative 2-norm; the cross's effect {effect:.2e})"
+        );
+        assert!(d <= 1e-13, "{d:e}");
+        assert!(effect > 1e-3, "the cross changes nothing: {effect:e}");
+    }
+    // Off the axis it turns with the cross, not with the arm: not the pin's.
+    let off = bundled.replacen(
+        "name = \"forearm{i}\"\n",
+        &format!("name = \"forearm{{i}}\"\ncross = {{ mass = {m}, com = [{c}, 0.0, 0.0] }}\n"),
+        1,
+    );
+    let pin_off = bundled.replacen(
+        "name = \"elbow_pin{i}\"\nmass = 0.226\n",
+        &format!(
+            "name = \"elbow_pin{{i}}\"\nmass = {big_m}\ncom = [{}, 0.0, 0.0]\ninertia = {{ ixx = 0.0, iyy = {}, izz = {} }}\n",
+            m * c / big_m,
+            mu * c * c,
+            mu * c * c
+        ),
+        1,
+    );
+    let d = delta_difference(&off, &pin_off);
+    assert!(
+        d > 1e-6,
+        "a point off the first axis turns with the cross: {d:e}"
+    );
+}
+
+/// A parallelogram's `cross` is checked as a U joint's is, at its key.
+#[test]
+fn a_bad_parallelogram_cross_is_reported_at_its_key() {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let src = std::fs::read_to_string(format!("{dir}/../mechanisms/specs/delta_rl5.toml")).unwrap();
+    let with = |cross: &str| {
+        src.replacen(
+            "name = \"forearm{i}\"\n",
+            &format!("name = \"forearm{{i}}\"\ncross = {cross}\n"),
+            1,
+        )
+    };
+    let neg = with("{ mass = -0.1 }");
+    let e = errors(&neg);
+    assert!(e.contains("negative mass -0.1"), "{e}");
+    assert!(
+        e.contains(&format!("bad.toml:{}:", line_of(&neg, "cross = {"))),
+        "{e}"
+    );
+    assert!(
+        e.contains("\"forearm{i}\".cross.mass") || e.contains("\"forearm1\".cross.mass"),
+        "{e}"
+    );
+    let e = errors(&with("{ mas = 1.0, mass = 0.1 }"));
+    assert!(e.contains("unknown key \"mas\""), "{e}");
+    assert!(e.contains(".cross.mas"), "{e}");
+    let e = errors(&with("0.1"));
+    assert!(e.contains(".cross"), "{e}");
+    let e = errors(&with("{ com = [0.0, 0.0, 0.01] }"));
+    assert!(e.contains(".cross") && e.contains("mass"), "{e}");
+    let (_, w) = load_mechanism(
+        "w.toml",
+        &with("{ mass = 0.1, inertia = { ixx = 0.02, iyy = 1e-3, izz = 1e-3 } }"),
+    )
+    .unwrap_or_else(|d| panic!("{d}"));
+    let w = w.render();
+    assert!(
+        w.contains("triangle") && w.contains(".cross.inertia"),
+        "{w}"
+    );
+}

@@ -226,6 +226,9 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
             tau[s * n + i] = data.tau[s][i];
         }
     }
+    if let Some((cutoff, fs)) = data.parallel {
+        parallel_filter(&mut w, &mut tau, n, cutoff, fs);
+    }
     let stacked = Stacked { w, tau, n };
     let fit = wls::fit(&stacked, args.weights == Weights::Auto);
     if !fit
@@ -402,6 +405,35 @@ pub fn relative_mismatch(a: &[f64], b: &[f64], keep: &[bool]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Gautier's parallel filtering of positions-only data: each joint's efforts and every column
+/// of its regressor rows (`w`, `tau` stacked `n` rows per sample) through the same zero-phase
+/// low-pass over the samples. The filter is linear, so `τ = Y π` holds after it as before: the
+/// band the filter cuts from the efforts (their harmonics above the motion's, made by the
+/// dynamics' products of rates) is cut from the model too, and only the in-band error of the
+/// differentiated positions is left (docs/identification.md, "The CSV format").
+fn parallel_filter(w: &mut DMatrix<f64>, tau: &mut DVector<f64>, n: usize, cutoff: f64, fs: f64) {
+    let rows = tau.len() / n.max(1);
+    let mut series = vec![0.0; rows];
+    for i in 0..n {
+        for s in 0..rows {
+            series[s] = tau[s * n + i];
+        }
+        super::filter::filtfilt(&mut series, cutoff, fs);
+        for s in 0..rows {
+            tau[s * n + i] = series[s];
+        }
+        for k in 0..w.ncols() {
+            for s in 0..rows {
+                series[s] = w[(s * n + i, k)];
+            }
+            super::filter::filtfilt(&mut series, cutoff, fs);
+            for s in 0..rows {
+                w[(s * n + i, k)] = series[s];
+            }
+        }
+    }
+}
+
 /// Write the updated spec and report its physical consistency.
 fn write_update(
     reg: &Regressor,
@@ -448,7 +480,7 @@ fn write_update(
     );
     if !up.unreachable.is_empty() {
         eprintln!(
-            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a body the loader adds that has no number in the spec (a parallelogram's elbow cross; a U joint's `cross` written with expressions, left unchanged), what a parallelogram's symmetric rods cannot have (a first moment across them, products of inertia), or a drive",
+            "note: no number the update writes moves base parameter{} {} (kept at the spec's value{}): a U joint's `cross` written with expressions (left unchanged), what a parallelogram's equal rods cannot have (a first moment along the motor axis, products of inertia with it: unequal rods), or a drive",
             if up.unreachable.len() == 1 { "" } else { "s" },
             up.unreachable
                 .iter()

@@ -8,6 +8,9 @@
 
 use super::filter::{differentiate, filtfilt};
 
+/// Cutoff periods of samples dropped at each end of positions-only data (the filter's
+/// transient; see [`read`]).
+const EDGE_PERIODS: f64 = 3.0;
 /// Measured samples, one entry per kept row.
 #[derive(Clone, Debug, Default)]
 pub struct Samples {
@@ -25,6 +28,11 @@ pub struct Samples {
     pub lines: Vec<usize>,
     /// The `t` column of each kept row, s (empty without one).
     pub t: Vec<f64>,
+    /// Positions-only data: `(cutoff, sample rate)` (Hz) of the low-pass that the efforts
+    /// (here raw) and the regressor's columns go through together (parallel filtering: the
+    /// caller filters both over the kept rows, so that the same linear filter meets `τ = Y π`
+    /// on both sides).
+    pub parallel: Option<(f64, f64)>,
 }
 
 /// How positions-only data are filtered.
@@ -264,13 +272,16 @@ pub fn read(
                 0.5 * fs
             ));
         }
-        // Dropped at each end: the filter's transient (about one cutoff period) and the ends of
-        // the differences. Compared as a float first: a cutoff far below the sample rate makes
-        // it larger than any file.
-        let edge = (fs / filtering.cutoff).ceil().max(2.0);
+        // Dropped at each end: the filter's transient and the ends of the differences. The
+        // odd extension continues value and slope but flips the curvature, a step of `2 q̈₀`
+        // in `q̈` at the seam, whose response decays as `exp(−ζ ω_c t)` (`ζ = 1/√2`):
+        // `exp(−2π/√2) = 1.2e-2` of it after one cutoff period, `1.6e-6` after three, the
+        // in-band error's level (docs/identification.md, "The CSV format"). Compared as a
+        // float first: a cutoff far below the sample rate makes it larger than any file.
+        let edge = (EDGE_PERIODS * fs / filtering.cutoff).ceil().max(2.0);
         if 2.0 * edge + min_rows as f64 > rows.len() as f64 {
             return Err(format!(
-                "error: {file}: {}: too few to filter and differentiate at --cutoff {:?} Hz (need {min_rows} samples after dropping {} at each end: a cutoff period of samples)",
+                "error: {file}: {}: too few to filter and differentiate at --cutoff {:?} Hz (need {min_rows} samples after dropping {} at each end: three cutoff periods of samples)",
                 count(rows.len(), "row"),
                 filtering.cutoff,
                 if edge < 1e12 {
@@ -296,11 +307,11 @@ pub fn read(
             qd_cols[i] = d;
             qdd_cols[i] = dd;
         }
+        // The efforts stay raw here: the caller filters them with the regressor's columns.
         for (i, col) in tau_cols.iter_mut().enumerate() {
-            let mut tau: Vec<f64> = rows.iter().map(|r| pick(3, r)[i]).collect();
-            filtfilt(&mut tau, filtering.cutoff, fs);
-            *col = tau;
+            *col = rows.iter().map(|r| pick(3, r)[i]).collect();
         }
+        s.parallel = Some((filtering.cutoff, fs));
         for k in edge..rows.len() - edge {
             s.q.push((0..nq).map(|i| q_cols[i][k]).collect());
             s.qd.push((0..nq).map(|i| qd_cols[i][k]).collect());
@@ -310,7 +321,7 @@ pub fn read(
             s.t.push(t[k]);
         }
         s.note = Some(format!(
-            "positions only: {} and {} low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling), {} and {} by central differences; {edge} samples dropped at each end",
+            "positions only: {} and {} low-passed (2nd-order Butterworth forward and backward, cutoff {} Hz at {:.6} Hz sampling; tau with the regressor's columns, parallel filtering), {} and {} by central differences; {edge} samples dropped at each end",
             kinds[0],
             kinds[3],
             filtering.cutoff,

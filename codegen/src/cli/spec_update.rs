@@ -17,10 +17,10 @@
 //! changed pattern body is written as expressions indexing per-copy arrays that the update adds
 //! to `[parameters]` (`mass = "identified_cylinder_mass[i]"`). A parallelogram's rods are
 //! three numbers per entry (or copy), linear in their body's standard parameters
-//! ([`rods`]). A universal joint's `cross` is ten more unknowns per joint (or copy), solved
-//! for with the payload on what the bodies leave ([`crosses`]). Base parameters that no written
-//! number moves (a rod's asymmetric parameters, a parallelogram's elbow cross) keep the spec's
-//! values and are reported.
+//! ([`rods`]). A universal joint's `cross` (and a parallelogram's, its elbow U's) is ten more
+//! unknowns per entry (or copy), solved for with the payload on what the bodies cannot reach
+//! ([`crosses`]). Base parameters that no written number moves (what unequal rods would have,
+//! a drive the spec lacks) keep the spec's values and are reported.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use toml_edit::{DocumentMut, InlineTable, Item, Value};
@@ -38,6 +38,8 @@ use payload::{payload_unknowns, set_payload};
 mod rods;
 use rods::{rod_unknowns, rods_consistency, set_rods};
 mod armature;
+mod change;
+use change::{Change, minimum_norm_change};
 mod urdf;
 mod xml_scan;
 
@@ -101,8 +103,14 @@ enum Unknown {
     /// Standard parameter `k` of the `[scene] payload`.
     Payload { k: usize },
     /// Standard parameter `k` of the cross of copy `copy` (from 1; 1 for a top-level entry)
-    /// of the universal joint entry `at` ([`crosses`]).
-    Cross { at: EntryAt, copy: usize, k: usize },
+    /// of the universal joint entry `at` of array `array` (`joint`, or `parallelogram` for
+    /// its elbow's U) ([`crosses`]).
+    Cross {
+        array: &'static str,
+        at: EntryAt,
+        copy: usize,
+        k: usize,
+    },
 }
 
 /// The outcome of an update.
@@ -297,12 +305,12 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
     type Rods = std::collections::BTreeMap<usize, [f64; 3]>;
     let mut rods: std::collections::BTreeMap<EntryAt, Rods> = Default::default();
     let mut payload: Option<[f64; 10]> = None;
-    let mut crosses: std::collections::BTreeMap<EntryAt, Copies> = Default::default();
+    let mut crosses: std::collections::BTreeMap<(&str, EntryAt), Copies> = Default::default();
     for (u, &v) in unknowns.iter().zip(values) {
         match u {
-            Unknown::Cross { at, copy, k } => {
+            Unknown::Cross { array, at, copy, k } => {
                 crosses
-                    .entry(*at)
+                    .entry((*array, *at))
                     .or_default()
                     .entry(*copy)
                     .or_insert([0.0; 10])[*k] = v
@@ -381,9 +389,9 @@ fn apply(doc: &DocumentMut, unknowns: &[Unknown], values: &[f64]) -> Result<Docu
         let c: Vec<[f64; 3]> = c.into_values().collect();
         set_rods(&mut d, at, &c)?;
     }
-    for (at, c) in crosses {
+    for ((array, at), c) in crosses {
         let c: Vec<[f64; 10]> = c.into_values().collect();
-        set_crosses(&mut d, at, &c)?;
+        set_crosses(&mut d, array, at, &c)?;
     }
     if let Some(p) = payload {
         set_payload(&mut d, &p)?;
@@ -574,108 +582,6 @@ pub fn update(
 /// A body's standard parameters at the reference point of the update's columns: unit mass and
 /// unit principal moments about the origin (a valid body; one unit more on any is one too).
 const REFERENCE: [f64; 10] = [1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-
-/// The minimum-norm change of the unknowns and the map it was found on.
-struct Change {
-    /// `P`: base parameters per unit of each unknown.
-    p: DMatrix<f64>,
-    /// The unknowns changed.
-    z: Vec<f64>,
-    /// The change.
-    dz: DVector<f64>,
-    /// The base parameters that no unknown moves.
-    unreachable: Vec<usize>,
-}
-
-/// The base parameters of the spec with its unknowns set to the values given.
-type BaseOf<'a> = dyn FnMut(&[f64]) -> Result<Vec<f64>, String> + 'a;
-
-/// `Δ = P⁺ (π̂ − π0)` over the `fit` base parameters, `P` by moving each unknown by one from
-/// `reference` (`base` gives the base parameters of the spec with the unknowns set). The `late`
-/// unknowns (a payload) take only what the others leave: the others' minimum-norm change
-/// first, then theirs on the rest.
-#[allow(clippy::too_many_arguments)]
-fn minimum_norm_change(
-    nbp: usize,
-    z0: &[f64],
-    reference: &[f64],
-    pi0: &[f64],
-    target: &[f64],
-    fit: &[bool],
-    late: &[bool],
-    base: &mut BaseOf<'_>,
-) -> Result<Change, String> {
-    let mut p = DMatrix::zeros(nbp, z0.len());
-    let pi_ref = base(reference)?;
-    for c in 0..z0.len() {
-        let mut z = reference.to_vec();
-        z[c] += 1.0;
-        let pi = base(&z)?;
-        for r in 0..nbp {
-            p[(r, c)] = pi[r] - pi_ref[r];
-        }
-    }
-    // Rounding noise of the differences (the exact entries are sums of grouping coefficients).
-    let pmax = p.amax();
-    p.apply(|x| {
-        if x.abs() <= 1e-12 * pmax {
-            *x = 0.0
-        }
-    });
-    let unreachable: Vec<usize> = (0..nbp)
-        .filter(|&r| p.row(r).iter().all(|x| *x == 0.0))
-        .collect();
-    let d = DVector::from_fn(nbp, |k, _| {
-        if fit[k] && !unreachable.contains(&k) {
-            target[k] - pi0[k]
-        } else {
-            0.0
-        }
-    });
-    let mut dz = DVector::zeros(z0.len());
-    // What the first stage leaves to rounding is nothing for the second to take up.
-    let tiny = 1e-10 * d.amax();
-    let mut rest = d;
-    for stage in [false, true] {
-        let mut ps = p.clone();
-        for (c, &l) in late.iter().enumerate() {
-            if l != stage {
-                ps.column_mut(c).fill(0.0);
-            }
-        }
-        if ps.amax() == 0.0 {
-            continue;
-        }
-        let step = ps
-            .clone()
-            .pseudo_inverse(1e-12 * p.norm().max(f64::MIN_POSITIVE))
-            .map_err(|e| format!("error: the update's least squares failed: {e}"))?
-            * &rest;
-        rest -= &ps * &step;
-        // Only where this stage reached: a row it cannot move keeps its target whole, however
-        // small (a cross's first moment identified near zero).
-        for r in 0..nbp {
-            if rest[r].abs() <= tiny && ps.row(r).iter().any(|x| *x != 0.0) {
-                rest[r] = 0.0;
-            }
-        }
-        dz += step;
-    }
-    // An unknown that moves no base parameter stays as written (the SVD leaves rounding
-    // noise there).
-    for c in 0..z0.len() {
-        if p.column(c).iter().all(|x| *x == 0.0) {
-            dz[c] = 0.0;
-        }
-    }
-    let z: Vec<f64> = z0.iter().zip(dz.iter()).map(|(a, b)| a + b).collect();
-    Ok(Change {
-        p,
-        z,
-        dz,
-        unreachable,
-    })
-}
 
 /// The names (bodies, joints, entries) whose unknowns change.
 fn changed_names(names: &[String], dz: &DVector<f64>) -> Vec<String> {

@@ -12,6 +12,7 @@ use super::{
 
 pub(super) const GS: &str = "../mechanisms/specs/gough_stewart.toml";
 pub(super) const DELTA: &str = "../mechanisms/specs/delta_rl5.toml";
+pub(super) const TSAI: &str = "../mechanisms/specs/tsai_3upu.toml";
 
 pub(super) fn platform(name: &str, source: &str) -> runtime::parallel::ParallelModel {
     match codegen::spec::load(name, source, &Default::default()) {
@@ -75,7 +76,10 @@ pub(super) fn perturbed_platform(source: &str, rel: f64, seed: u64) -> String {
     for t in doc["body"].as_array_of_tables_mut().unwrap().iter_mut() {
         body(t, "", &mut f);
     }
-    for p in doc["pattern"].as_array_of_tables_mut().unwrap().iter_mut() {
+    let patterns = doc
+        .get_mut("pattern")
+        .and_then(|p| p.as_array_of_tables_mut());
+    for p in patterns.into_iter().flat_map(|a| a.iter_mut()) {
         if let Some(a) = p.get_mut("joint").and_then(|i| i.as_array_of_tables_mut()) {
             for t in a.iter_mut() {
                 for key in ["damping", "friction", "armature"] {

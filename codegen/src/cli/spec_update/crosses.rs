@@ -1,7 +1,9 @@
 //! The universal joints' crosses in the spec update (docs/identification.md, "The updated
 //! spec of a platform"): a U joint's `cross` (docs/spec.md, "Joint kinds") is a body's ten
 //! standard parameters in the cross's frame, so they are unknowns like a body's, per
-//! `[[joint]]` entry and per copy of a `[[pattern.joint]]` entry, at the values the loader
+//! `[[joint]]` entry and per copy of a `[[pattern.joint]]` entry (and so a parallelogram's
+//! `cross`, that of its elbow's U `<name>_elbow`, per `[[parallelogram]]` entry and per copy
+//! of a `[[pattern.parallelogram]]` entry: docs/spec.md, "Parallelograms"), at the values the loader
 //! gives them (`codegen::spec::written_crosses`; zero where the spec writes no `cross`). They
 //! are solved for with the payload, on what the bodies' and drives' numbers leave (the
 //! base parameters that only a cross moves, such as a Gough–Stewart's `MZ_u<i>_cross`), so
@@ -38,38 +40,44 @@ pub(super) fn cross_unknowns(
     names: &mut Vec<String>,
     skipped: &mut Vec<String>,
 ) {
-    let mut entries: Vec<(EntryAt, &toml_edit::Table, usize)> = Vec::new();
-    if let Some(a) = doc.get("joint").and_then(Item::as_array_of_tables) {
-        for (index, t) in a.iter().enumerate() {
-            let at = EntryAt {
-                pattern: None,
-                index,
-            };
-            entries.push((at, t, 0));
+    let mut entries: Vec<(&'static str, EntryAt, &toml_edit::Table, usize)> = Vec::new();
+    for array in ARRAYS {
+        if let Some(a) = doc.get(array).and_then(Item::as_array_of_tables) {
+            for (index, t) in a.iter().enumerate() {
+                let at = EntryAt {
+                    pattern: None,
+                    index,
+                };
+                entries.push((array, at, t, 0));
+            }
         }
     }
     if let Some(patterns) = doc.get("pattern").and_then(Item::as_array_of_tables) {
         for (pattern, p) in patterns.iter().enumerate() {
             let copies = p.get("copies").and_then(|c| c.as_integer()).unwrap_or(0) as usize;
-            let Some(a) = p.get("joint").and_then(Item::as_array_of_tables) else {
-                continue;
-            };
-            for (index, t) in a.iter().enumerate() {
-                let at = EntryAt {
-                    pattern: Some(pattern),
-                    index,
+            for array in ARRAYS {
+                let Some(a) = p.get(array).and_then(Item::as_array_of_tables) else {
+                    continue;
                 };
-                entries.push((at, t, copies));
+                for (index, t) in a.iter().enumerate() {
+                    let at = EntryAt {
+                        pattern: Some(pattern),
+                        index,
+                    };
+                    entries.push((array, at, t, copies));
+                }
             }
         }
     }
-    for (at, t, copies) in entries {
+    for (array, at, t, copies) in entries {
         let template = t.get("name").and_then(|n| n.as_str()).unwrap_or("?");
+        // The U joint the cross belongs to: the entry's, or a parallelogram's elbow.
+        let joint = u_joint(array, template);
         let copy_names: Vec<(usize, String)> = if at.pattern.is_none() {
-            vec![(1, template.to_string())]
+            vec![(1, joint.clone())]
         } else {
             (1..=copies)
-                .map(|i| (i, template.replace("{i}", &i.to_string())))
+                .map(|i| (i, joint.replace("{i}", &i.to_string())))
                 .collect()
         };
         let found: Vec<Option<[f64; 10]>> = copy_names
@@ -85,7 +93,7 @@ pub(super) fn cross_unknowns(
             // Not a universal joint with a cross body (another kind, or one into the platform).
             continue;
         }
-        let name = format!("joint `{template}` cross");
+        let name = format!("{array} `{template}` cross");
         let plain = t
             .get("cross")
             .and_then(Item::as_table_like)
@@ -102,7 +110,12 @@ pub(super) fn cross_unknowns(
         };
         for ((copy, _), v) in copy_names.iter().zip(values) {
             for (k, x) in v.into_iter().enumerate() {
-                unknowns.push(Unknown::Cross { at, copy: *copy, k });
+                unknowns.push(Unknown::Cross {
+                    array,
+                    at,
+                    copy: *copy,
+                    k,
+                });
                 z0.push(x);
                 names.push(name.clone());
             }
@@ -110,20 +123,34 @@ pub(super) fn cross_unknowns(
     }
 }
 
+/// The arrays whose entries carry a `cross`: a universal joint's, a parallelogram's elbow's.
+const ARRAYS: [&str; 2] = ["joint", "parallelogram"];
+
+/// The universal joint of entry `template` of `array`: the joint, or a parallelogram's elbow
+/// U `<name>_elbow`.
+fn u_joint(array: &str, template: &str) -> String {
+    if array == "parallelogram" {
+        format!("{template}_elbow")
+    } else {
+        template.to_string()
+    }
+}
+
 /// Write an entry's crosses (standard parameters per copy; one for a top-level entry), adding
 /// the `cross` key where absent.
 pub(super) fn set_crosses(
     d: &mut DocumentMut,
+    array: &str,
     at: EntryAt,
     copies: &[[f64; 10]],
 ) -> Result<(), String> {
-    let Some(t) = at.table_mut(d, "joint") else {
+    let Some(t) = at.table_mut(d, array) else {
         return Ok(());
     };
     let template = t
         .get("name")
         .and_then(|n| n.as_str())
-        .unwrap_or("joint")
+        .unwrap_or(array)
         .to_string();
     if t.get("cross").and_then(Item::as_table_like).is_none() {
         t.insert(
@@ -135,11 +162,11 @@ pub(super) fn set_crosses(
         .get_mut("cross")
         .and_then(Item::as_table_like_mut)
         .ok_or("a cross entry vanished")?;
-    let what = format!("joint `{template}` cross");
+    let what = format!("{array} `{template}` cross");
     match at.pattern {
         None => set_body(c, &copies[0]).map_err(|e| format!("{what}: {e}")),
         Some(_) => {
-            let stem = format!("{}_cross", stem(&template));
+            let stem = format!("{}_cross", stem(&u_joint(array, &template)));
             let arrays = per_copy_keys(c, &stem, &what, copies)?;
             put_arrays(d, arrays)
         }
@@ -239,7 +266,13 @@ pub(super) fn cross_consistency(
 ) -> Vec<(String, String, Vec<usize>)> {
     let mut out = Vec::new();
     for (c, u) in unknowns.iter().enumerate() {
-        let Unknown::Cross { at, copy, k: 0 } = u else {
+        let Unknown::Cross {
+            array,
+            at,
+            copy,
+            k: 0,
+        } = u
+        else {
             continue;
         };
         if c + 10 > z.len() || !changed.contains(&names[c]) {
@@ -249,13 +282,14 @@ pub(super) fn cross_consistency(
         let Some(what) = broken(&sp) else {
             continue;
         };
-        let joint = names[c]
-            .trim_start_matches("joint `")
+        let entry = names[c]
+            .trim_start_matches(&format!("{array} `"))
             .trim_end_matches("` cross");
+        let joint = u_joint(array, entry);
         let joint = if at.pattern.is_some() {
             joint.replace("{i}", &copy.to_string())
         } else {
-            joint.to_string()
+            joint
         };
         out.push((format!("{joint}_cross"), what, involved(p, c..c + 10)));
     }

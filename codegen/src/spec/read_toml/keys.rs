@@ -40,6 +40,7 @@ pub(super) const PARALLELOGRAM_KEYS: &[&str] = &[
     "rod_mass",
     "rod_com",
     "rod_inertia",
+    "cross",
 ];
 pub(super) const SPRING_KEYS: &[&str] = &[
     "name",

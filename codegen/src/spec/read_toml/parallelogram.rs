@@ -53,6 +53,10 @@ pub(super) struct ParallelogramSpec {
     /// Each rod's inertia about its mass centre, `x` along the rod.
     rod_inertia: [[f64; 3]; 3],
     rod_inertia_span: Range<usize>,
+    /// `cross`: the elbow U's cross body `<name>_elbow_cross` (an elbow axle turning about the
+    /// motor axis's direction), in the U's frame after its first turn (the parent's axes at
+    /// `E`); `None` when not written (massless).
+    cross: Option<BodySpec>,
 }
 
 fn unit(v: &Vec3) -> Vec3 {
@@ -76,6 +80,12 @@ impl ParallelogramSpec {
     pub(super) fn turn(&mut self, r: &runtime::model::Mat3, parent: bool, child: bool) {
         if parent {
             self.elbow = mat_vec(r, &self.elbow);
+            // The elbow U's frame has the parent's axes: the cross turns with the elbow.
+            if let Some(c) = &mut self.cross {
+                c.com = mat_vec(r, &c.com);
+                c.inertia =
+                    runtime::model::mat_mul(&runtime::model::mat_mul(r, &c.inertia), &transpose(r));
+            }
         }
         if child {
             self.platform_point = mat_vec(r, &self.platform_point);
@@ -175,6 +185,14 @@ impl Reader<'_> {
             "each rod's inertia about its mass centre, x along the rod: { ixx, iyy, izz }",
         )
         .and_then(|v| Some((self.inertia(v, &format!("{path}.rod_inertia"))?, v.span())));
+        // The elbow's cross, read as a universal joint's `cross` is (docs/spec.md,
+        // "Parallelograms").
+        let cross = get(t, "cross").and_then(|v| {
+            let key = format!("{path}.cross");
+            let c = self.table(v, &key)?;
+            let joint = format!("{}_elbow", name.as_deref().unwrap_or("parallelogram"));
+            Some(self.cross(&joint, c, key, v.span()))
+        });
         let (parent, parent_span) = parent?;
         let (child, child_span) = child?;
         let (length, length_span) = length?;
@@ -202,6 +220,7 @@ impl Reader<'_> {
             rod_com: rod_com?,
             rod_inertia,
             rod_inertia_span,
+            cross,
         })
     }
 
@@ -426,6 +445,7 @@ impl Reader<'_> {
         );
         u.placement = Placement::Origin(at(pg.elbow));
         u.axes = vec![axis(a), axis(n)];
+        u.cross = pg.cross.clone();
         let mut s = joint(pg.name.clone(), Kind::Spherical, rods, pg.child.clone());
         s.placement = Placement::Origin(at([l * d[0], l * d[1], l * d[2]]));
         s.child_origin = Some(at(pg.platform_point));
