@@ -150,12 +150,11 @@ macro_rules! platforms {
 fn reach(name: &str) -> f64 {
     match name {
         "planar_five_bar" | "delta_rl5" | "delta4_rl5" | "planar_3rrr" => 0.1,
-        "gough_stewart" | "tsai_3upu" | "prs_head" => 0.02,
+        "gough_stewart" | "tsai_3upu" | "prs_head" | "rus_hexapod" | "sliding_hexapod" => 0.02,
         _ => 0.5,
     }
 }
 
-// (The 6-PUS and 6-RUS hexapods' scenes leave the regressor out.)
 platforms!(
     gough_stewart,
     agile_eye,
@@ -165,6 +164,8 @@ platforms!(
     tsai_3upu,
     prs_head,
     delta4_rl5,
+    rus_hexapod,
+    sliding_hexapod,
 );
 
 /// The Delta's platform only translates, so its inertia tensor moves nothing: two models that
