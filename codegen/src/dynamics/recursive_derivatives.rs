@@ -239,8 +239,8 @@ pub fn recursive_inverse_dynamics_derivatives(g: &mut Graph, tree: &Tree) -> Vec
 
 /// The rate of every composite inertia's components in its joint's frame `F` (the joint frame
 /// for a revolute joint, the body frame for a prismatic one), from the tips: with `İ_i` the rate
-/// in body `i`'s frame (zero for a single body), a revolute joint's turn adds `q̇ [S ×*, I^C]`
-/// (`ḣ += q̇ e_z × h`, `J̇ += q̇ ([e_z]× J − J [e_z]×)`) before the turn to `F`; the rate in `F`
+/// in body `i`'s frame (zero for a single body) turned to `F`, a revolute joint's turn adds
+/// `q̇ [S ×*, I^C]` in `F` (`ḣ += q̇ e_z × h`, `J̇ += q̇ ([e_z]× J − J [e_z]×)`); the rate in `F`
 /// moves to the parent as an inertia of zero mass, plus, for a prismatic joint, the rate of the
 /// parallel-axis terms along its slide.
 fn composite_rates(
@@ -269,39 +269,44 @@ fn composite_rates(
         let (c, r, v) = (comp[i], body[i], qd[i]);
         let rf = match l.kind {
             JointKind::Revolute => {
+                // `Rz (İ + q̇ [e_z×, I^C]) Rzᵀ = Rz İ Rzᵀ + q̇ [e_z×, I^C_F]`: the turn's term from
+                // the composite already in `F` (the composite's own move to the parent), so that
+                // a body alone (`İ = 0`) needs no turn of its rate.
+                let hf = s.rz(i, c.h);
+                let jf = s.congruence_rz(i, &c.j);
+                let hr = s.rz(i, r.h);
+                let jr = s.congruence_rz(i, &r.j);
                 let h = [
                     {
-                        let t = s.g.mul(v, c.h[1]);
-                        s.g.sub(r.h[0], t)
+                        let t = s.g.mul(v, hf[1]);
+                        s.g.sub(hr[0], t)
                     },
                     {
-                        let t = s.g.mul(v, c.h[0]);
-                        s.g.add(r.h[1], t)
+                        let t = s.g.mul(v, hf[0]);
+                        s.g.add(hr[1], t)
                     },
-                    r.h[2],
+                    hr[2],
                 ];
-                let j = c.j;
+                let j = jf;
                 let d01 = s.g.sub(j[0][0], j[1][1]);
                 let t01 = s.g.mul(v, j[0][1]);
                 let t01 = s.g.scale(2.0, t01);
                 let t02 = s.g.mul(v, j[1][2]);
                 let t12 = s.g.mul(v, j[0][2]);
                 let t00 = s.g.mul(v, d01);
-                let rj = r.j;
                 let m = [
                     [
-                        s.g.sub(rj[0][0], t01),
-                        s.g.add(rj[0][1], t00),
-                        s.g.sub(rj[0][2], t02),
+                        s.g.sub(jr[0][0], t01),
+                        s.g.add(jr[0][1], t00),
+                        s.g.sub(jr[0][2], t02),
                     ],
-                    [zero, s.g.add(rj[1][1], t01), s.g.add(rj[1][2], t12)],
-                    [zero, zero, rj[2][2]],
+                    [zero, s.g.add(jr[1][1], t01), s.g.add(jr[1][2], t12)],
+                    [zero, zero, jr[2][2]],
                 ];
-                let m = s.symmetrize(m);
                 Composite {
                     m: zero,
-                    h: s.rz(i, h),
-                    j: s.congruence_rz(i, &m),
+                    h,
+                    j: s.symmetrize(m),
                 }
             }
             JointKind::Prismatic => r,
