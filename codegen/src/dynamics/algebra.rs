@@ -217,7 +217,36 @@ impl<'a> Sym<'a> {
     /// Symmetric `R S Rᵀ` for body `i`'s rotation `R = R0 Rz(q_i)` (upper triangle computed,
     /// mirrored).
     pub(super) fn congruence_to_parent(&mut self, i: usize, s: &M3) -> M3 {
-        // A = Rz S Rzᵀ, then B = R0 A R0ᵀ.
+        let a = self.congruence_rz(i, s);
+        self.congruence_r0(i, &a)
+    }
+    /// Symmetric `R0 A R0ᵀ` for body `i`'s fixed rotation `R0` (the second step of
+    /// [`Sym::congruence_to_parent`]).
+    pub(super) fn congruence_r0(&mut self, i: usize, a: &M3) -> M3 {
+        let r0 = self.cm(&self.tree.links[i].rot);
+        // T = R0 A (rows), B_rc = T_r · R0_c for r ≤ c.
+        let t: Vec<V3> = (0..3)
+            .map(|r| {
+                let col = |c: usize| [a[0][c], a[1][c], a[2][c]];
+                let (c0, c1, c2) = (col(0), col(1), col(2));
+                [
+                    self.dot(r0[r], c0),
+                    self.dot(r0[r], c1),
+                    self.dot(r0[r], c2),
+                ]
+            })
+            .collect();
+        let mut b = *a;
+        for r in 0..3 {
+            for c in r..3 {
+                b[r][c] = self.dot(t[r], r0[c]);
+            }
+        }
+        self.symmetrize(b)
+    }
+    /// Symmetric `Rz(q_i) S Rz(q_i)ᵀ` (the first step of [`Sym::congruence_to_parent`]; `S`
+    /// itself for prismatic joints).
+    pub(super) fn congruence_rz(&mut self, i: usize, s: &M3) -> M3 {
         let cols = [
             [s[0][0], s[1][0], s[2][0]],
             [s[0][1], s[1][1], s[2][1]],
@@ -234,27 +263,7 @@ impl<'a> Sym<'a> {
             [a_rows[0][1], a_rows[1][1], a_rows[2][1]],
             [a_rows[0][2], a_rows[1][2], a_rows[2][2]],
         ];
-        let a = self.symmetrize(a);
-        let r0 = self.cm(&self.tree.links[i].rot);
-        // T = R0 A (rows), B_rc = T_r · R0_c for r ≤ c.
-        let t: Vec<V3> = (0..3)
-            .map(|r| {
-                let col = |c: usize| [a[0][c], a[1][c], a[2][c]];
-                let (c0, c1, c2) = (col(0), col(1), col(2));
-                [
-                    self.dot(r0[r], c0),
-                    self.dot(r0[r], c1),
-                    self.dot(r0[r], c2),
-                ]
-            })
-            .collect();
-        let mut b = a;
-        for r in 0..3 {
-            for c in r..3 {
-                b[r][c] = self.dot(t[r], r0[c]);
-            }
-        }
-        self.symmetrize(b)
+        self.symmetrize(a)
     }
     pub(super) fn symmetrize(&mut self, mut m: M3) -> M3 {
         for r in 0..3 {

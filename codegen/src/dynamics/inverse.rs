@@ -48,6 +48,46 @@ pub fn inverse_dynamics(g: &mut Graph, tree: &Tree, terms: Terms) -> Vec<ExprId>
     inverse_dynamics_sunk(g, tree, terms, &[])
 }
 
+/// Each non-root body's subtree wrench (force, moment about its origin) in its joint frame, as
+/// inverse dynamics' backward sweep forms it on the way to the parent (the same nodes: the same
+/// moment forms, chosen from nothing paid); `None` for the roots.
+pub(super) fn joint_frame_wrenches(s: &mut Sym<'_>, motion: &Motion) -> Vec<Option<(V3, V3)>> {
+    let tree = s.tree;
+    let n = tree.dof();
+    let mut paid = Paid::default();
+    let mut wrenches = body_wrenches(s, motion, &mut paid);
+    add_runtime_wrenches(s, motion, &mut wrenches, &mut paid, &[]);
+    let Wrenches {
+        mut force,
+        mut moment,
+        extra_moment,
+    } = wrenches;
+    let mut out = vec![None; n];
+    for i in (0..n).rev() {
+        if let Some(p) = tree.links[i].parent {
+            let fz = s.rz(i, force[i]);
+            let nn = s.rz(i, moment[i]);
+            let nn = s.add3(nn, extra_moment[i]);
+            out[i] = Some((fz, nn));
+            let (f, nn) = to_parent(s, i, fz, nn);
+            force[p] = s.add3(force[p], f);
+            moment[p] = s.add3(moment[p], nn);
+        }
+    }
+    out
+}
+
+/// A wrench of body `i`'s joint frame (force `fz`, moment `nn` about the origin) in its
+/// parent's frame.
+fn to_parent(s: &mut Sym<'_>, i: usize, fz: V3, nn: V3) -> (V3, V3) {
+    let r0 = s.cm(&s.tree.links[i].rot);
+    let f = s.mat_vec(&r0, fz);
+    let nn = s.mat_vec(&r0, nn);
+    let off = s.offset(i);
+    let pf = s.cross(off, f);
+    (f, s.add3(nn, pf))
+}
+
 /// Twists and their rates per body, from the forward sweep.
 pub(super) struct Motion {
     /// `ω_i`, body frame.
