@@ -529,15 +529,15 @@ fn joint(
 }
 
 /// Entry `i`'s `<limit lower upper velocity>`, read from the tag as written: a range when
-/// `lower` and `upper` are both written, finite and `lower < upper` (URDF's defaults of 0 make
-/// none), with `velocity` when it is positive and finite. Anything else is no limit: the
+/// `lower` and `upper` are both written, within ±1e9 and `lower < upper` (URDF's defaults of 0 make
+/// none), with `velocity` when it is positive and within ±1e9. Anything else is no limit: the
 /// tools then use their own bounds (`codegen excite` says which on standard error).
 fn limit(spans: &Spans<'_, '_>, i: usize) -> Option<LimitSpec> {
     let t = &spans.doc.tags[spans.doc.descend(*spans.list.get(i)?, &["limit"])?];
     let num = |a: &str| {
         t.attr(a)
             .and_then(|a| a.value.trim().parse::<f64>().ok())
-            .filter(|x| x.is_finite())
+            .filter(|x| super::in_range(*x))
     };
     let (lower, upper) = (num("lower")?, num("upper")?);
     (lower < upper).then(|| LimitSpec {

@@ -182,7 +182,7 @@ fn a_bad_limit_is_an_error_at_the_key() {
         (
             "limit = { lower = 0.2, upper = 1.4, velocity = 0 }",
             "joint \"j1\".limit.velocity",
-            "positive, finite",
+            "must be positive",
         ),
         (
             "limit = { lower = 0.2, upper = nan }",
@@ -210,4 +210,34 @@ fn a_bad_limit_is_an_error_at_the_key() {
         assert!(err.contains(&format!("arm.toml:{line}:")), "{limit}: {err}");
         assert!(o.stdout.is_empty());
     }
+}
+
+/// `identify --out` changes the bodies and keeps a joint's `limit` as written.
+#[test]
+fn identify_out_keeps_the_limit_key() {
+    let dir = scratch("limits_out");
+    let two_r = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(TWO_R)).unwrap();
+    let line = "limit = { lower = \"10 deg\", upper = 1.4, velocity = 0.8 }";
+    let spec = two_r.replacen(
+        "axis = [0.0, 0.0, 1.0]",
+        &format!("axis = [0.0, 0.0, 1.0]\n{line}"),
+        1,
+    );
+    let p = dir.join("arm.toml");
+    std::fs::write(&p, &spec).unwrap();
+    let (t, e) = (dir.join("t.csv"), dir.join("arm2.toml"));
+    ok(&run(&[
+        "excite",
+        s(&p),
+        "--restarts",
+        "1",
+        "--evaluations",
+        "30",
+        "--with-tau",
+        "-o",
+        s(&t),
+    ]));
+    ok(&run(&["identify", s(&p), s(&t), "--out", s(&e)]));
+    let out = std::fs::read_to_string(&e).unwrap();
+    assert_eq!(out.lines().filter(|l| *l == line).count(), 1, "{out}");
 }

@@ -5,6 +5,7 @@
 
 use super::keys::LIMIT_KEYS;
 use super::{Reader, get};
+use crate::spec::RANGE_HINT;
 use crate::spec::ir::{Kind, LimitSpec};
 
 impl Reader<'_> {
@@ -53,8 +54,9 @@ impl Reader<'_> {
             } else {
                 r.number(x, &full)
             }?;
-            if !y.is_finite() {
-                r.err(format!("`{k}` must be finite"), &full, x.span());
+            if !crate::spec::in_range(y) {
+                r.err(format!("`{k}` ({y:e}) is out of range"), &full, x.span())
+                    .hint = Some(RANGE_HINT.into());
                 return None;
             }
             Some(y)
@@ -66,10 +68,10 @@ impl Reader<'_> {
             Some(x) => {
                 let full = format!("{key}.velocity");
                 match self.number(x, &full) {
-                    Some(s) if s > 0.0 && s.is_finite() => Some(Some(s)),
+                    Some(s) if s > 0.0 && crate::spec::in_range(s) => Some(Some(s)),
                     Some(s) => {
                         self.err(
-                            format!("`velocity` must be a positive, finite speed, not {s}"),
+                            format!("`velocity` must be positive and within ±1e9, not {s}"),
                             &full,
                             x.span(),
                         )
