@@ -171,17 +171,16 @@ pub fn load_mechanism(
     load(file_name, source, &SceneOverrides::default()).map(|l| (l.mechanism, l.warnings))
 }
 
+/// What [`load_any`] reads: the mechanism, its scene and the tree joints' limits.
+type Read = (Mechanism, Scene, Vec<JointLimit>);
+
 /// Reads, checks and lowers once; also returns the span of the `[platform]` header for a
 /// parallel spec.
 fn load_any(
     file_name: &str,
     source: &str,
     overrides: &SceneOverrides,
-) -> (
-    Option<(Mechanism, Scene, Vec<JointLimit>)>,
-    Diagnostics,
-    Option<std::ops::Range<usize>>,
-) {
+) -> (Option<Read>, Diagnostics, Option<std::ops::Range<usize>>) {
     let mut diags = Diagnostics::new(file_name, source);
     if source.len() > MAX_SOURCE_BYTES {
         diags.push(too_large(source.len(), true));
