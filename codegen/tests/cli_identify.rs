@@ -548,3 +548,7 @@ mod coverage;
 // A Delta's elbow crosses: the `cross` of a parallelogram.
 #[path = "cli_identify/elbow.rs"]
 mod elbow;
+
+// `excite` within the joint limits of URDF and TOML specs.
+#[path = "cli_identify/limits.rs"]
+mod limits;

@@ -2,10 +2,12 @@
 //! "Exciting trajectories"). Each joint follows a finite Fourier series of period `T`
 //! (Swevers et al. 1997),
 //! `q_i(t) = Σ_{l=1..L} a_il/(l ω_f) sin(l ω_f t) − b_il/(l ω_f) cos(l ω_f t)`, `ω_f = 2π/T`,
-//! periodic and analytic in `q̇` and `q̈`. The coefficients minimize the condition number of
-//! the base regressor stacked over the period, subject to `|q_i| ≤ q_max` and `|q̇_i| ≤
-//! q̇_max`: a candidate's joints are scaled down until they hold (on a grid of 400 points per
-//! period, with a 0.1 % margin), so every candidate is feasible. The search is a coordinate
+//! periodic and analytic in `q̇` and `q̈`, plus an offset `c_i`: the middle of the joint's range
+//! when the spec gives it limits, else 0 ([`super::excite_bounds`]). The coefficients minimize
+//! the condition number of the base regressor stacked over the period, subject to
+//! `|q_i − c_i| ≤ q_max_i` and `|q̇_i| ≤ q̇_max_i`: a candidate's joints are scaled down until
+//! they hold (on a grid of 400 points per period, with a 0.1 % margin), so every candidate is
+//! feasible. The search is a coordinate
 //! (pattern) search from random starts: each coefficient moved by `± h`, kept when the
 //! condition number drops; `h` halves after a sweep without gain. Deterministic for a seed.
 //!
@@ -23,6 +25,7 @@ use clap::Args;
 use nalgebra::DMatrix;
 
 use super::Rng;
+use super::excite_bounds::{self, Bounds};
 use super::regressor::Regressor;
 use super::wls::condition;
 
@@ -44,9 +47,15 @@ pub struct ExciteArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Position bound per joint (rad or m): one value, or one per joint separated by commas
-    /// (trees).
-    #[arg(long, value_delimiter = ',', default_value = "1.0")]
+    /// (trees). A joint without limits keeps `|q| <= Q_MAX` (default 1.0). A joint with limits
+    /// (TOML `limit`, URDF `<limit>`) moves about the middle `c` of its range with
+    /// `|q - c| <= min(half range × (1 - --limit-margin), Q_MAX)`: given here, it bounds
+    /// further; not given, the range alone bounds.
+    #[arg(long, value_delimiter = ',', value_name = "Q_MAX")]
     pub q_max: Vec<f64>,
+    /// The fraction of each limited joint's half range kept free at both ends, in [0, 1).
+    #[arg(long, default_value_t = 0.05, value_name = "FRACTION")]
+    pub limit_margin: f64,
     /// A platform's bound on each move from home, m.
     #[arg(long, default_value_t = 0.05, value_name = "M")]
     pub reach: f64,
@@ -54,8 +63,9 @@ pub struct ExciteArgs {
     #[arg(long, default_value_t = 0.1, value_name = "RAD")]
     pub turn: f64,
     /// Velocity bound per joint (rad/s or m/s): one value, or one per joint (a platform's
-    /// speeds `u`).
-    #[arg(long, value_delimiter = ',', default_value = "2.0")]
+    /// speeds `u`). Default 2.0 for joints without a velocity limit; a joint with one keeps
+    /// `|qd| <= min(velocity, QD_MAX)` (the limit alone when not given).
+    #[arg(long, value_delimiter = ',', value_name = "QD_MAX")]
     pub qd_max: Vec<f64>,
     /// Random starts of the search.
     #[arg(long, default_value_t = 3)]
@@ -93,6 +103,8 @@ pub struct Fourier {
     pub l: usize,
     /// Fundamental `ω_f`, rad/s.
     pub w: f64,
+    /// Offsets `c_i` per joint (rad or m), empty for none.
+    pub offset: Vec<f64>,
 }
 
 /// `sin` and `cos` of each harmonic's phase `l ω_f t` at given times: the series' only
@@ -166,16 +178,22 @@ impl Fourier {
         self.state_at(Phases::new(self.w, self.l, vec![t]).at(0))
     }
 
-    /// All joints at the time of the phases `sc`.
+    /// All joints at the time of the phases `sc`, offsets included (a zero offset is not
+    /// added: the sum keeps its sign).
     fn state_at(&self, sc: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut s = (vec![0.0; self.n], vec![0.0; self.n], vec![0.0; self.n]);
         for i in 0..self.n {
             (s.0[i], s.1[i], s.2[i]) = self.joint_at(i, sc);
+            if let Some(&c) = self.offset.get(i)
+                && c != 0.0
+            {
+                s.0[i] += c;
+            }
         }
         s
     }
 
-    /// Scale each joint's coefficients so that `|q_i| ≤ q_max_i` and `|q̇_i| ≤ q̇_max_i` on
+    /// Scale each joint's coefficients so that `|q_i − c_i| ≤ q_max_i` and `|q̇_i| ≤ q̇_max_i` on
     /// `grid` points per period, with a 0.1 % margin.
     #[cfg(test)]
     fn feasible(&self, q_max: &[f64], qd_max: &[f64], grid: usize) -> Fourier {
@@ -286,8 +304,13 @@ const MIN_PERIOD: f64 = 1e-3;
 /// The longest `--period`, s.
 const MAX_PERIOD: f64 = 1e5;
 
-/// Check the arguments; `Err` is the message (exit code 2).
-fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), String> {
+/// Check the arguments: the bounds per joint (offsets, `|q − c|`, `|q̇|`), given the tree
+/// joints' `limits`; `Err` is the message (exit code 2).
+fn check(
+    args: &ExciteArgs,
+    reg: &Regressor,
+    limits: &[Option<codegen::spec::JointLimit>],
+) -> Result<Bounds, String> {
     let n = reg.dof();
     if args.harmonics == 0 || args.harmonics > 50 {
         return Err("error: --harmonics must be in 1..=50".into());
@@ -323,8 +346,31 @@ fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), Str
     if args.noise.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
         return Err("error: --noise: standard deviations must be finite and >= 0".into());
     }
+    let given = |v: &[f64], what: &str| -> Result<Option<Vec<f64>>, String> {
+        if v.is_empty() {
+            Ok(None)
+        } else {
+            per_joint(v, n, what).map(Some)
+        }
+    };
+    let q_given = given(&args.q_max, "--q-max")?;
+    let qd_given = given(&args.qd_max, "--qd-max")?;
+    if !(0.0..1.0).contains(&args.limit_margin) {
+        return Err(format!(
+            "error: --limit-margin {:?}: must be in [0, 1) (a fraction of the half range)",
+            args.limit_margin
+        ));
+    }
+    if reg.turns(0).is_none() && limits.iter().any(Option::is_some) {
+        return Ok(excite_bounds::tree(
+            limits,
+            q_given.as_deref(),
+            qd_given.as_deref(),
+            args.limit_margin,
+        ));
+    }
     let q_max = match reg.turns(0) {
-        None => per_joint(&args.q_max, n, "--q-max")?,
+        None => q_given.unwrap_or(vec![excite_bounds::Q_MAX; n]),
         Some(_) => {
             let reach = per_joint(&[args.reach], 1, "--reach")?[0];
             let turn = per_joint(&[args.turn], 1, "--turn")?[0];
@@ -339,7 +385,12 @@ fn check(args: &ExciteArgs, reg: &Regressor) -> Result<(Vec<f64>, Vec<f64>), Str
                 .collect()
         }
     };
-    Ok((q_max, per_joint(&args.qd_max, n, "--qd-max")?))
+    Ok(Bounds {
+        centre: Vec::new(),
+        q: q_max,
+        qd: qd_given.unwrap_or(vec![excite_bounds::QD_MAX; n]),
+        line: String::new(),
+    })
 }
 
 /// Run `excite`.
@@ -354,7 +405,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         Ok(s) => s,
         Err(c) => return c,
     };
-    let (reg, warnings) = match Regressor::compile(&name, &source, sidecar) {
+    let (reg, warnings, limits) = match Regressor::compile_with_limits(&name, &source, sidecar) {
         Ok(r) => r,
         Err(e) => {
             eprint!("{e}");
@@ -370,13 +421,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     ) {
         return c;
     }
-    if name.ends_with(".urdf") && source.contains("<limit") {
-        eprintln!(
-            "note: {name}: the URDF's <limit> elements are not read (joint limits are not part of the model): the trajectory keeps within --q-max {:?} and --qd-max {:?}",
-            args.q_max, args.qd_max
-        );
-    }
-    let (q_max, qd_max) = match check(args, &reg) {
+    let bounds = match check(args, &reg, &limits) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("{e}");
@@ -393,7 +438,10 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
         reg.effort_kind(),
         if reg.dof() == 1 { "" } else { "s" }
     );
-    let best = search(&reg, args, &q_max, &qd_max);
+    if !bounds.line.is_empty() {
+        eprintln!("{}", bounds.line);
+    }
+    let best = search(&reg, args, &bounds);
     let n = reg.dof();
     let columns = reg.columns();
     let mut csv = String::from("t");
@@ -510,7 +558,8 @@ fn fmt_list(v: &[f64]) -> String {
 }
 
 /// The random starts and coordinate search; progress on standard error.
-fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> Fourier {
+fn search(reg: &Regressor, args: &ExciteArgs, bounds: &Bounds) -> Fourier {
+    let (q_max, qd_max, offset) = (&bounds.q, &bounds.qd, &bounds.centre);
     const GRID: usize = 400;
     let n = reg.dof();
     let l = args.harmonics;
@@ -533,7 +582,14 @@ fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> 
         let c: Vec<f64> = (0..n * 2 * l)
             .map(|k| unit[k / (2 * l)] * rng.uniform(-1.0, 1.0))
             .collect();
-        let mut cur = Fourier { c, n, l, w }.feasible_on(q_max, qd_max, &grid);
+        let mut cur = Fourier {
+            c,
+            n,
+            l,
+            w,
+            offset: offset.clone(),
+        }
+        .feasible_on(q_max, qd_max, &grid);
         let mut fc = cost(&cur);
         let mut evals = 1;
         let mut h = 0.5;
@@ -582,6 +638,7 @@ fn search(reg: &Regressor, args: &ExciteArgs, q_max: &[f64], qd_max: &[f64]) -> 
             n,
             l,
             w,
+            offset: offset.clone(),
         },
     }
 }
@@ -597,6 +654,7 @@ mod tests {
             n: 2,
             l: 2,
             w: 0.7,
+            offset: Vec::new(),
         };
         let (t, h) = (1.3, 1e-5);
         for i in 0..2 {

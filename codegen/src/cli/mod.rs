@@ -18,6 +18,7 @@ pub mod design;
 pub mod draw;
 pub mod effort_plot;
 pub mod excite;
+pub mod excite_bounds;
 pub mod filter;
 pub mod fix_home;
 pub mod grouping;

@@ -32,6 +32,17 @@ impl Regressor {
         source: &str,
         sidecar: Option<codegen::spec::SceneFile>,
     ) -> Result<(Regressor, String), String> {
+        Self::compile_with_limits(name, source, sidecar).map(|(r, w, _)| (r, w))
+    }
+
+    /// [`Self::compile`], with the tree joints' limits as the spec writes them
+    /// ([`codegen::spec::Loaded::limits`]) in the order of [`Self::dof`] (`None`: no limit;
+    /// all `None` for platforms and closed loops).
+    pub fn compile_with_limits(
+        name: &str,
+        source: &str,
+        sidecar: Option<codegen::spec::SceneFile>,
+    ) -> Result<(Regressor, String, Vec<Option<codegen::spec::JointLimit>>), String> {
         let overrides = codegen::spec::SceneOverrides {
             sidecar,
             ..Default::default()
@@ -42,12 +53,22 @@ impl Regressor {
         } else {
             loaded.warnings.render()
         };
+        let limits: Vec<Option<codegen::spec::JointLimit>> = match &loaded.mechanism {
+            Mechanism::Tree(m) => m
+                .joints
+                .iter()
+                .map(|j| loaded.limits.iter().find(|l| l.joint == j.name).cloned())
+                .collect(),
+            _ => Vec::new(),
+        };
         let r = match loaded.mechanism {
             Mechanism::Tree(m) => Regressor::Tree(Box::new(TreeRegressor::new(m))),
             Mechanism::Parallel(m) => Regressor::Platform(Box::new(PlatformRegressor::new(m)?)),
             Mechanism::Closed(m) => Regressor::Closed(Box::new(ClosedRegressor::new(m)?)),
         };
-        Ok((r, warnings))
+        let mut limits = limits;
+        limits.resize(r.dof(), None);
+        Ok((r, warnings, limits))
     }
 
     /// The mechanism's name.

@@ -383,6 +383,22 @@ pub(crate) struct JointSpec {
     /// frame (the joint frame carried by the first rotation); `None`: massless
     /// (docs/spec.md, "Joint kinds").
     pub cross: Option<BodySpec>,
+    /// `limit` (TOML) or `<limit>` (URDF): the joint's range and speed bound, carried beside
+    /// the model for the CLI tools (`excite`), never part of the dynamics.
+    pub limit: Option<LimitSpec>,
+}
+
+/// A joint's limits as written (rad or m, rad/s or m/s), with where.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct LimitSpec {
+    /// Lower bound of the coordinate, `< upper`.
+    pub lower: f64,
+    /// Upper bound of the coordinate.
+    pub upper: f64,
+    /// Bound on the speed `|q̇|`, `> 0`, when given.
+    pub velocity: Option<f64>,
+    /// Span of the limit (the TOML value or the URDF `<limit>` element).
+    pub span: Span,
 }
 
 /// The name of the fixed world in `parent`.

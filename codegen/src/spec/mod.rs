@@ -23,6 +23,7 @@ mod home;
 mod input;
 mod ir;
 mod joint_home;
+mod limits;
 mod lower;
 mod names;
 mod parallel;
@@ -52,6 +53,7 @@ pub use input::{
 };
 pub(crate) use input::{SNAP_HINT, in_range, name_too_long};
 use input::{check_size, too_large};
+pub use limits::JointLimit;
 pub(crate) use names::{is_module_name, sanitize_name, suggest_hint};
 pub use scene::{RuntimeBody, RuntimeParams, Scene, SceneFile, SceneOverrides, body_names};
 use scene::{check_scene_functions, no_drive, prepare, runtime_params};
@@ -102,6 +104,9 @@ pub struct Loaded {
     pub scene: Scene,
     /// The spec's warnings (e.g. an axis normalized).
     pub warnings: Diagnostics,
+    /// The tree joints' limits (TOML `limit`, URDF `<limit>`), for the tools; not part of
+    /// the dynamics. Empty for other mechanisms.
+    pub limits: Vec<JointLimit>,
 }
 
 /// Read, check and lower a spec of any kind in one pass: the mechanism, its scene (the
@@ -116,15 +121,16 @@ pub fn load(
     overrides: &SceneOverrides,
 ) -> Result<Loaded, Diagnostics> {
     let (read, diags, _) = load_any(file_name, source, overrides);
-    let (mechanism, scene) = match read {
-        Some((m, s)) => (Some(m), Some(s)),
-        None => (None, None),
+    let (mechanism, scene, limits) = match read {
+        Some((m, s, l)) => (Some(m), Some(s), l),
+        None => (None, None, Vec::new()),
     };
     let (mechanism, warnings) = finish(mechanism, diags)?;
     Ok(Loaded {
         mechanism,
         scene: scene.unwrap_or_default(),
         warnings,
+        limits,
     })
 }
 
@@ -133,7 +139,7 @@ pub fn load(
 /// them with [`load`] or [`load_mechanism`].
 pub fn load_tree(file_name: &str, source: &str) -> Result<(Model, Diagnostics), Diagnostics> {
     let (read, mut diags, platform) = load_any(file_name, source, &SceneOverrides::default());
-    let mechanism = read.map(|(m, _)| m);
+    let mechanism = read.map(|(m, _, _)| m);
     if let Some(span) = platform {
         diags.push(
             Diagnostic::error("this spec describes a parallel mechanism (it has a [platform] table), which cannot be loaded as a tree")
@@ -165,17 +171,16 @@ pub fn load_mechanism(
     load(file_name, source, &SceneOverrides::default()).map(|l| (l.mechanism, l.warnings))
 }
 
+/// What [`load_any`] reads: the mechanism, its scene and the tree joints' limits.
+type Read = (Mechanism, Scene, Vec<JointLimit>);
+
 /// Reads, checks and lowers once; also returns the span of the `[platform]` header for a
 /// parallel spec.
 fn load_any(
     file_name: &str,
     source: &str,
     overrides: &SceneOverrides,
-) -> (
-    Option<(Mechanism, Scene)>,
-    Diagnostics,
-    Option<std::ops::Range<usize>>,
-) {
+) -> (Option<Read>, Diagnostics, Option<std::ops::Range<usize>>) {
     let mut diags = Diagnostics::new(file_name, source);
     if source.len() > MAX_SOURCE_BYTES {
         diags.push(too_large(source.len(), true));
@@ -263,6 +268,9 @@ fn load_any(
             .and_then(|s| s.platform.as_ref())
             .map(|p| p.span.clone().unwrap_or(0..0));
         let functions = spec.as_ref().and_then(|s| s.scene.functions.clone());
+        let limits = spec
+            .as_ref()
+            .map_or(Vec::new(), |s| limits::collect(s, &mut d));
         let mechanism = spec.and_then(|s| {
             if let Some(sp) = s.springs.first()
                 && (s.platform.is_some() || !closed::is_closed(&s))
@@ -328,6 +336,7 @@ fn load_any(
                     params,
                     frames,
                 },
+                limits,
             )
         });
         (read, d, platform, side)

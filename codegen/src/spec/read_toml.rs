@@ -19,6 +19,7 @@ use crate::diag::Diagnostics;
 mod bodies;
 mod joints;
 mod keys;
+mod limit;
 mod mechanism;
 mod parallelogram;
 mod parameters;

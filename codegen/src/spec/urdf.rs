@@ -16,7 +16,9 @@
 use runtime::model::{Transform, rpy_to_matrix};
 
 use super::geom::rotate_inertia;
-use super::ir::{AxisSpec, BASE, BodySpec, DriveSpec, JointSpec, Kind, Placement, Span, Spec};
+use super::ir::{
+    AxisSpec, BASE, BodySpec, DriveSpec, JointSpec, Kind, LimitSpec, Placement, Span, Spec,
+};
 use super::sanitize_name;
 use crate::diag::{Diagnostic, Diagnostics};
 
@@ -34,8 +36,9 @@ pub(crate) fn read(source: &str, diags: &mut Diagnostics) -> Option<Spec> {
 /// A URDF document as a TOML spec that generates the same module (`codegen convert`): the
 /// links and joints in the order the reader takes them, every number as the URDF writes it
 /// (origins as `xyz` and `rpy`, the inertia in its `<inertial>` frame with `inertia_rpy`), so
-/// that the TOML reader builds the same model, bit for bit. Limits are not part of either
-/// model; a `<mimic>` is kept as a comment.
+/// that the TOML reader builds the same model, bit for bit. A `<limit>` that gives a range
+/// becomes the joint's `limit` (carried beside the model for the tools, as the URDF's is); a
+/// `<mimic>` is kept as a comment.
 pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
     use std::fmt::Write;
     let (r, names, spec) = read_robot(source, diags)?;
@@ -79,7 +82,7 @@ pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "# Converted from the URDF robot \"{}\" by `codegen convert`: the same model, number for\n# number. Joint limits are not part of nocdyn's model. Add a [scene] table for payloads,\n# locked joints, point masses or run-time parameters (docs/spec.md, docs/scene.md).\n",
+        "# Converted from the URDF robot \"{}\" by `codegen convert`: the same model, number for\n# number; joint limits as `limit` (carried for the tools, not part of the dynamics). Add a\n# [scene] table for payloads, locked joints, point masses or run-time parameters (docs/spec.md,\n# docs/scene.md).\n",
         r.name
     );
     let _ = writeln!(out, "[mechanism]");
@@ -148,6 +151,17 @@ pub(crate) fn to_toml(source: &str, diags: &mut Diagnostics) -> Option<String> {
             if d.friction > 0.0 {
                 let _ = writeln!(out, "friction = {}", n(d.friction));
             }
+        }
+        if let Some(l) = &js.limit {
+            let v = l
+                .velocity
+                .map_or(String::new(), |v| format!(", velocity = {}", n(v)));
+            let _ = writeln!(
+                out,
+                "limit = {{ lower = {}, upper = {}{v} }}",
+                n(l.lower),
+                n(l.upper)
+            );
         }
         if let Some(m) = &j.mimic {
             let _ = writeln!(
@@ -507,7 +521,31 @@ fn joint(
             armature: 0.0,
         },
         cross: None,
+        limit: match j.joint_type {
+            urdf_rs::JointType::Revolute | urdf_rs::JointType::Prismatic => limit(spans, i),
+            _ => None,
+        },
     }
+}
+
+/// Entry `i`'s `<limit lower upper velocity>`, read from the tag as written: a range when
+/// `lower` and `upper` are both written, within ±1e9 and `lower < upper` (URDF's defaults of 0 make
+/// none), with `velocity` when it is positive and within ±1e9. Anything else is no limit: the
+/// tools then use their own bounds (`codegen excite` says which on standard error).
+fn limit(spans: &Spans<'_, '_>, i: usize) -> Option<LimitSpec> {
+    let t = &spans.doc.tags[spans.doc.descend(*spans.list.get(i)?, &["limit"])?];
+    let num = |a: &str| {
+        t.attr(a)
+            .and_then(|a| a.value.trim().parse::<f64>().ok())
+            .filter(|x| super::in_range(*x))
+    };
+    let (lower, upper) = (num("lower")?, num("upper")?);
+    (lower < upper).then(|| LimitSpec {
+        lower,
+        upper,
+        velocity: num("velocity").filter(|v| *v > 0.0),
+        span: Some(t.span.clone()),
+    })
 }
 
 /// `joints` in depth-first order from the root, children in document order; unreachable joints

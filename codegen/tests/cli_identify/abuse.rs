@@ -334,39 +334,6 @@ fn lanes_errors_name_the_flag() {
     assert!(text(&o.stdout).contains("_lanes"));
 }
 
-/// A URDF's joint limits are not part of the model: `excite` on a URDF with `<limit>`s says
-/// that the bounds are its flags (a stranger's trajectory otherwise left the limits silently).
-#[test]
-fn excite_on_a_urdf_with_limits_says_they_are_not_read() {
-    let dir = scratch("abuse_urdf_limits");
-    let urdf = dir.join("arm.urdf");
-    std::fs::write(
-        &urdf,
-        r#"<robot name="arm"><link name="world"/>
-<link name="a"><inertial><origin xyz="0.2 0 0"/><mass value="2"/><inertia ixx="0.01" iyy="0.03" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial></link>
-<joint name="j1" type="revolute"><parent link="world"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-0.2" upper="0.2" effort="10" velocity="1"/></joint>
-</robot>"#,
-    )
-    .unwrap();
-    let out = dir.join("t.csv");
-    let o = run(&[
-        "excite",
-        s(&urdf),
-        "--restarts",
-        "1",
-        "--evaluations",
-        "5",
-        "-o",
-        s(&out),
-    ]);
-    ok(&o);
-    assert!(
-        text(&o.stderr).contains("<limit> elements are not read"),
-        "{}",
-        text(&o.stderr)
-    );
-}
-
 /// A header of 200,000 columns (none of them needed) took minutes: the check for a column
 /// named twice compared each with all before it. Now an error at once.
 #[test]

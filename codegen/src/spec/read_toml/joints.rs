@@ -1,7 +1,7 @@
 //! `[[joint]]` entries: `name`, `kind`, `parent`, `child` (required), one placement (`origin`,
 //! `dh` or `mdh`), the axes the kind takes (`axis` or `axes`), `actuated`, the drive
-//! (`damping`, `friction`, `armature`), `child_origin`, `home` and a universal joint's `cross`,
-//! read in that order.
+//! (`damping`, `friction`, `armature`), `child_origin`, `home`, a universal joint's `cross` and
+//! `limit` (`super::limit`), read in that order.
 
 use std::ops::Range;
 
@@ -72,6 +72,9 @@ impl Reader<'_> {
         let home_span = e.get("home").map(|v| v.span());
         let home = self.joint_home(e, kind);
         let cross = self.joint_cross(e, kind, name.as_deref());
+        let limit = e
+            .get("limit")
+            .and_then(|v| self.limit(v, &e.key("limit"), kind));
         let (Some((parent, parent_span)), Some((child, child_span))) = (parent, child) else {
             self.joints_incomplete = true;
             return None;
@@ -96,6 +99,7 @@ impl Reader<'_> {
             home_span,
             drive,
             cross,
+            limit,
         })
     }
 

@@ -94,7 +94,10 @@ pub(super) const JOINT_KEYS: &[&str] = &[
     "friction",
     "armature",
     "cross",
+    "limit",
 ];
+/// A joint's `limit` table.
+pub(super) const LIMIT_KEYS: &[&str] = &["lower", "upper", "velocity"];
 pub(super) const ORIGIN_KEYS: &[&str] = &["xyz", "rpy", "quat", "matrix", "axis_angle"];
 /// The ways an origin gives its rotation (at most one).
 pub(super) const ROTATION_KEYS: &[&str] = &["rpy", "quat", "matrix", "axis_angle"];

@@ -436,6 +436,7 @@ impl Reader<'_> {
             home_span: None,
             drive: DriveSpec::default(),
             cross: None,
+            limit: None,
         };
         let mut u = joint(
             format!("{}_elbow", pg.name),
