@@ -4,20 +4,11 @@
 //! never by the code under test.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-use super::{ok, s, scratch, text};
+use super::{ok, run, s, scratch, text};
 
 const IIWA: &str = "../mechanisms/specs/iiwa14.urdf";
 const TWO_R: &str = "../mechanisms/specs/planar_2r.toml";
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_codegen"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("the codegen binary runs")
-}
 
 /// The value of attribute `name` in the tag text `tag`.
 fn attr(tag: &str, name: &str) -> Option<f64> {
