@@ -228,7 +228,12 @@ fn tree_cross_out(test: &str, cross: &str) {
     );
     let truth = super::tree("truth.toml", &truth_src);
     let true_base = generated_base_parameters("truth.toml", &truth_src);
-    let (o, est, out) = identify_exact(&dir, &spec, &truth, "3");
+    let (o, est, out) = identify_exact(
+        &dir,
+        &spec,
+        &truth,
+        &["--seed", "3", "--evaluations", "40", "--samples", "300"],
+    );
     let stderr = text(&o.stderr);
     assert!(!stderr.contains("note: no number"), "{stderr}");
     let (e, _) = estimates(&est);
@@ -479,30 +484,20 @@ fn urdf_model(name: &str, source: &str, scene: Option<&str>) -> runtime::model::
     }
 }
 
-/// `excite` on the tree `spec` (seed `seed`, 40 evaluations, 300 samples), the efforts of
-/// `truth` at its states (noise-free), then `identify --estimates --out`, which must succeed:
-/// its output and the paths of the estimates and of the written spec.
+/// `excite` on the tree `spec` with options `excite` (one restart), the efforts of `truth` at
+/// its states (noise-free), then `identify --estimates --out` (to `updated.<spec's extension>`),
+/// which must succeed: its output and the paths of the estimates and of the written spec.
 fn identify_exact(
     dir: &std::path::Path,
     spec: &std::path::Path,
     truth: &runtime::model::Model,
-    seed: &str,
+    excite: &[&str],
 ) -> (std::process::Output, std::path::PathBuf, std::path::PathBuf) {
     let traj = dir.join("traj.csv");
-    let o = run(&[
-        "excite",
-        s(spec),
-        "--seed",
-        seed,
-        "--restarts",
-        "1",
-        "--evaluations",
-        "40",
-        "--samples",
-        "300",
-        "-o",
-        s(&traj),
-    ]);
+    let mut args = vec!["excite", s(spec), "--restarts", "1"];
+    args.extend_from_slice(excite);
+    args.extend(["-o", s(&traj)]);
+    let o = run(&args);
     ok(&o);
     let (_, rows) = super::csv_rows(&traj);
     let n = truth.dof();
@@ -524,7 +519,8 @@ fn identify_exact(
     }
     let data = dir.join("data.csv");
     std::fs::write(&data, csv).unwrap();
-    let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
+    let ext = spec.extension().and_then(|e| e.to_str()).unwrap_or("toml");
+    let (est, out) = (dir.join("est.csv"), dir.join(format!("updated.{ext}")));
     let o = run(&[
         "identify",
         s(spec),
@@ -584,48 +580,13 @@ fn urdf_out(test: &str, scene: Option<&str>, truth_scene: Option<&str>) {
     let truth_scene = truth_scene.or(scene);
     let truth = urdf_model("truth.urdf", &truth_src, truth_scene);
     let true_base = urdf_base_parameters("truth.urdf", &truth_src, truth_scene);
-    let traj = dir.join("traj.csv");
-    let o = run(&[
-        "excite",
-        s(&spec),
-        "--restarts",
-        "1",
-        "--evaluations",
-        "30",
-        "--samples",
-        "500",
-        "--seed",
-        "3",
-        "-o",
-        s(&traj),
-    ]);
-    ok(&o);
-    let (header, rows) = super::csv_rows(&traj);
+    let (o, est, out) = identify_exact(
+        &dir,
+        &spec,
+        &truth,
+        &["--evaluations", "30", "--samples", "500", "--seed", "3"],
+    );
     let n = truth.dof();
-    assert_eq!(header.len(), 1 + 3 * n);
-    let mut csv = header.join(",");
-    csv.push_str(&(1..=n).map(|i| format!(",tau{i}")).collect::<String>());
-    csv.push('\n');
-    for row in &rows {
-        let (q, qd, qdd) = (&row[1..1 + n], &row[1 + n..1 + 2 * n], &row[1 + 2 * n..]);
-        let tau = effort(&truth, q, qd, qdd);
-        let cells: Vec<String> = row.iter().chain(&tau).map(|v| format!("{v}")).collect();
-        csv.push_str(&cells.join(","));
-        csv.push('\n');
-    }
-    let data = dir.join("exact.csv");
-    std::fs::write(&data, csv).unwrap();
-    let (est, out) = (dir.join("est.csv"), dir.join("updated.urdf"));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
-    ok(&o);
     let stderr = text(&o.stderr);
     assert!(!stderr.contains("cannot reproduce"), "{stderr}");
     // A URDF has no number for a rotor's inertia: without `rotor_inertia` in its scene file, only
@@ -751,7 +712,12 @@ fn a_payload_takes_what_its_body_cannot() {
     let truth_src = payload_spec(1.1, 0.62, 0.74);
     let truth = super::tree("truth.toml", &truth_src);
     let true_base = generated_base_parameters("truth.toml", &truth_src);
-    let (o, est, out) = identify_exact(&dir, &spec, &truth, "2");
+    let (o, est, out) = identify_exact(
+        &dir,
+        &spec,
+        &truth,
+        &["--seed", "2", "--evaluations", "40", "--samples", "300"],
+    );
     let (stdout, stderr) = (text(&o.stdout), text(&o.stderr));
     assert!(stdout.contains("[scene] payload"), "{stdout}");
     assert!(stderr.contains("note: body `link2`"), "{stderr}");
