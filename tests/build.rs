@@ -191,6 +191,11 @@ fn main() {
             b.fma(true).implement("runtime");
         });
     }
+    // The PUMA 560 fused with the default `libm` backend (`libm::fma`, chosen at run time on
+    // x86): the `fma/puma560/…/fused_libm` benches, the CLI's note on `--fma`.
+    generate(&out, "fma_libm", Path::new(puma), |b| {
+        b.fma(true).math(codegen::MathBackend::Libm);
+    });
 
     // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
     // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.

@@ -789,3 +789,27 @@ fn a_urdf_joint_naming_no_link_is_an_error_at_the_name() {
     assert!(err.contains("did you mean \"l3\"?"), "{err}");
     assert!(!err.contains("not connected"), "{err}");
 }
+
+/// `--fma` with the default `libm` backend generates the fused module and says on stderr that
+/// on x86 its `libm::fma` is a call chosen at run time (slower than unfused: the `speed`
+/// bench's `fma/puma560/*/fused_libm`); with `--math std` there is no such note.
+#[test]
+fn fma_with_libm_gets_a_note() {
+    let o = run(&[PUMA, "--fma"]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    assert!(stdout(&o).contains("libm::fma("), "not fused with libm");
+    let note = stderr(&o);
+    assert!(
+        note.contains("libm::fma") && note.contains("--math std"),
+        "{note}"
+    );
+    for args in [&[PUMA, "--fma", "--math", "std"][..], &[PUMA]] {
+        let o = run(args);
+        assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+        assert!(
+            !stderr(&o).contains("libm::fma"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+    }
+}

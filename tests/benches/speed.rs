@@ -1,8 +1,10 @@
 //! Fused multiply–add and many states per call (issue 24), in one run:
 //!
-//! - `fma/{mechanism}/{function}/{plain,fused}`: the bundled module against the same spec
-//!   generated with `Config::fma` (`tests::variants::fma`), PUMA 560 and the 7-joint chain
-//!   (inverse dynamics, mass matrix), Gough–Stewart (inverse dynamics);
+//! - `fma/{mechanism}/{function}/{plain,fused}`: the bundled module (the `libm` backend)
+//!   against the same spec generated with `Config::fma` (`tests::variants::fma`, the `runtime`
+//!   backend with std: `f64::mul_add`, std's `sin_cos`), PUMA 560 and the 7-joint chain
+//!   (inverse dynamics, mass matrix), Gough–Stewart (inverse dynamics); for the PUMA 560 also
+//!   `fused_libm`, fused with the `libm` backend (`libm::fma`: `tests::variants::fma_libm_puma560`);
 //! - `lanes/{mechanism}/{function}/{scalar,lanes}`: `LANES` (4) states through the scalar
 //!   function one after the other against one call of its `_lanes` version (the same states,
 //!   lane last), in the same module (`tests::variants::lanes`); criterion's throughput is per
@@ -79,8 +81,25 @@ macro_rules! fma_tree {
         }
     };
 }
-fma_tree!(fma_puma560, puma560);
+fma_tree!(fma_puma560_runtime, puma560);
 fma_tree!(fma_chain7, chain7);
+
+/// The PUMA 560's `fma` groups with `fused_libm` beside `plain` and `fused`.
+fn fma_puma560(c: &mut Criterion) {
+    fma_puma560_runtime(c);
+    use tests::variants::fma_libm_puma560 as fused_libm;
+    let [q, qd, qdd] = states::<6, 1>(11).map(|s| s[0]);
+    let mut g = c.benchmark_group("fma/puma560/inverse_dynamics");
+    g.bench_function("fused_libm", |b| {
+        b.iter(|| fused_libm::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd)))
+    });
+    g.finish();
+    let mut g = c.benchmark_group("fma/puma560/mass_matrix");
+    g.bench_function("fused_libm", |b| {
+        b.iter(|| fused_libm::mass_matrix(black_box(&q)))
+    });
+    g.finish();
+}
 
 fn fma_gough_stewart(c: &mut Criterion) {
     use mechanisms::gough_stewart as plain;
