@@ -102,3 +102,53 @@ fn dh_on_a_child_side_frame_is_refused() {
         .to_string();
     assert!(e.contains("placed by DH parameters on \"link2\""), "{e}");
 }
+
+/// `[scene] frames` offers a body's own frame, the one the spec writes it in: for link2, F,
+/// whose pose in j2's joint frame is `child_origin⁻¹` (the rotation −90° about z, the origin
+/// at −Rz(−90°)·(−0.1, 0.2, 0) = (−0.2, −0.1, 0)). It was the joint frame, so a child-side
+/// body's `link2_pose` was off by `child_origin` (found by QA against Pinocchio with the frame
+/// placed by hand). link3, written in its joint frame in both arms, is the same frame.
+#[test]
+fn a_child_side_body_s_frame_is_its_own_frame() {
+    use codegen::spec::{SceneOverrides, load};
+    let scene = "\n[scene]\nframes = [\"link2\", \"link3\"]\n";
+    let a = load(
+        "a.toml",
+        &format!("{JOINT_FRAMES}{scene}"),
+        &SceneOverrides::default(),
+    )
+    .unwrap_or_else(|d| panic!("{d}"));
+    let b = load(
+        "b.toml",
+        &format!("{}{scene}", child_side()),
+        &SceneOverrides::default(),
+    )
+    .unwrap_or_else(|d| panic!("{d}"));
+    let (fa, fb) = (&a.scene.frames, &b.scene.frames);
+    assert_eq!(fa.len(), 2);
+    assert_eq!(fb.len(), 2);
+    let close = |x: &[f64], y: &[f64]| x.iter().zip(y).all(|(p, q)| (p - q).abs() < 1e-15);
+    // link2 in arm a: its joint frame.
+    assert!(
+        close(&fa[0].placement.translation, &[0.0; 3]),
+        "{:?}",
+        fa[0]
+    );
+    // link2 in arm b: F.
+    assert_eq!(fb[0].body, fa[0].body);
+    assert!(
+        close(&fb[0].placement.translation, &[-0.2, -0.1, 0.0]),
+        "{:?}",
+        fb[0]
+    );
+    let r = fb[0].placement.rotation;
+    let rz = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+    assert!((0..3).all(|i| close(&r[i], &rz[i])), "{r:?}");
+    // link3: the same frame in both.
+    assert_eq!(fb[1].body, fa[1].body);
+    assert!(close(
+        &fb[1].placement.translation,
+        &fa[1].placement.translation
+    ));
+    assert!((0..3).all(|i| close(&fb[1].placement.rotation[i], &fa[1].placement.rotation[i])));
+}

@@ -200,6 +200,15 @@ fn map_rejects_bad_arguments() {
         vec!["map", EYE, "--axes", "rx,rx", "-o", p],
         vec!["map", FIVE, "--steps", "1", "-o", p],
         vec!["map", FIVE, "--range", "0.1:-0.1", "-o", p],
+        // Spans infinity: the heat map's axis panicked in the plotting library (exit 101).
+        vec!["map", FIVE, "--range", "-1e308:1e308", "-o", p],
+        vec![
+            "map",
+            "../mechanisms/specs/puma560.toml",
+            "--range=-1e308:1e308",
+            "-o",
+            p,
+        ],
         vec!["map", FIVE, "--index", "nope", "-o", p],
         vec!["map", "tests/data/bad/negative_mass.toml", "-o", p],
     ] {
@@ -209,6 +218,50 @@ fn map_rejects_bad_arguments() {
     }
     let o = run(&["map", "no/such/spec.toml", "-o", p]);
     assert_eq!(o.status.code(), Some(1));
+}
+
+/// Counts no run can meet are refused at once, before any work: `isotropy --samples
+/// 18446744073709551615` panicked (capacity overflow, exit 101) and 4,294,967,296 aborted
+/// out of memory (134); `reduce --samples 4294967296` and `map --threads 100000` never ended.
+#[test]
+fn huge_counts_are_refused() {
+    let dir = scratch("huge");
+    let p = dir.join("x");
+    let p = p.to_str().unwrap();
+    for args in [
+        vec!["isotropy", FIVE, "--samples", "18446744073709551615"],
+        vec!["isotropy", FIVE, "--samples", "4294967296"],
+        vec!["isotropy", FIVE, "--samples", "100001"],
+        vec![
+            "reduce",
+            "../mechanisms/specs/planar_2r.toml",
+            "--samples",
+            "4294967296",
+        ],
+        vec![
+            "reduce",
+            "../mechanisms/specs/planar_2r.toml",
+            "--samples",
+            "100001",
+        ],
+        vec!["map", FIVE, "--threads", "100000", "-o", p],
+        vec!["map", FIVE, "--threads", "18446744073709551615", "-o", p],
+    ] {
+        let t0 = std::time::Instant::now();
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
+        assert!(
+            text(&o.stderr).contains("at most"),
+            "{args:?}: {}",
+            text(&o.stderr)
+        );
+        assert!(
+            t0.elapsed().as_secs() < 10,
+            "{args:?} took {:?}",
+            t0.elapsed()
+        );
+        assert!(!dir.join("x.csv").exists(), "{args:?} wrote a CSV");
+    }
 }
 
 #[test]

@@ -47,7 +47,7 @@ pub enum NormArg {
 pub struct IsotropyArgs {
     /// Mechanism spec (`.toml` or `.urdf`).
     pub spec: PathBuf,
-    /// Random starts.
+    /// Random starts (1 to 100,000).
     #[arg(long, default_value_t = 64)]
     pub samples: usize,
     /// Seed of the random starts (runs repeat exactly).
@@ -277,8 +277,17 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// The most random starts `--samples` takes: each is a Levenberg–Marquardt search (about
+/// 25 ms on the Gough–Stewart platform), and the starts are drawn before the search, so
+/// billions of them ran out of memory (or overflowed the allocation: a panic).
+const MAX_SAMPLES: usize = 100_000;
+
 /// The numeric arguments' bounds.
 fn check_args(args: &IsotropyArgs) -> Result<(), ExitCode> {
+    if args.samples > MAX_SAMPLES {
+        eprintln!("error: --samples {}: at most {MAX_SAMPLES}", args.samples);
+        return Err(ExitCode::from(2));
+    }
     let valid = args.range > 0.0
         && args.range.is_finite()
         && args.angle_range > 0.0

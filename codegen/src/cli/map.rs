@@ -63,7 +63,7 @@ pub struct MapArgs {
     /// Colour scale of the SVG.
     #[arg(long, value_enum, default_value = "auto")]
     pub scale: Scale,
-    /// Worker threads (default: one per core).
+    /// Worker threads (default: one per core; at most 1024).
     #[arg(long)]
     pub threads: Option<usize>,
 }
@@ -274,8 +274,17 @@ pub fn evaluate(
     MapResult { us, vs, values }
 }
 
+/// The most worker threads `--threads` takes: more only spawn idle threads (100,000 of them
+/// never finished starting).
+const MAX_THREADS: usize = 1024;
+
 /// Run `map`.
 pub fn run(args: &MapArgs) -> ExitCode {
+    if let Some(t) = args.threads
+        && t > MAX_THREADS
+    {
+        return usage(format!("--threads {t}: at most {MAX_THREADS}"));
+    }
     let target = match Target::load(&args.spec, args.space) {
         Ok(t) => t,
         Err(code) => return code,

@@ -348,8 +348,10 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{b}` is not a number"))?;
-    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-        return Err(format!("`{s}`: need finite LO < HI"));
+    // The width too: `-1e308:1e308` spans infinity, and the grid and the heat map's axis
+    // became NaN (a panic in the plotting library).
+    if !(lo.is_finite() && hi.is_finite() && lo < hi && (hi - lo).is_finite()) {
+        return Err(format!("`{s}`: need finite LO < HI, HI - LO finite"));
     }
     Ok((lo, hi))
 }
@@ -443,6 +445,7 @@ mod tests {
         assert!(parse_range("0.1").is_err());
         assert!(parse_range("a:1").is_err());
         assert!(parse_range("nan:1").is_err());
+        assert!(parse_range("-1e308:1e308").is_err());
     }
 
     #[test]

@@ -6,7 +6,8 @@
 //! the body's mass centre and inertia, the `origin` of the joints it carries, the
 //! `child_origin` of loop-closing joints into it, the points of springs on it and the elbow of
 //! parallelograms it carries, and a `[scene]` payload on it. The dynamics do not change: the
-//! same body is described in another frame.
+//! same body is described in another frame. The body's own frame is kept as its
+//! `own_frame` (its pose in the joint frame), which `[scene] frames` offers.
 //!
 //! A `child_origin` whose child another joint also reaches keeps its meaning, a loop-closing
 //! joint (`closed.rs`), and parallel mechanisms keep theirs (joints into the platform).
@@ -65,6 +66,9 @@ pub(crate) fn apply(mut spec: Spec, diags: &mut Diagnostics) -> Spec {
         for b in spec.bodies.iter_mut().filter(|b| b.name == child) {
             b.com = point(&to_joint, &b.com);
             b.inertia = rotate_inertia(&r, &b.inertia);
+            // The body's own frame, the one `[scene] frames` names, sits at `c⁻¹` in the
+            // joint frame.
+            b.own_frame = compose(&to_joint, &b.own_frame);
         }
         for m in 0..spec.joints.len() {
             if spec.joints[m].parent == child {

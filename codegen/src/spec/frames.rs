@@ -12,6 +12,7 @@
 
 use runtime::model::Transform;
 
+use super::geom::compose;
 use super::ir::{self, Named};
 use super::lower::Attach;
 use super::suggest_hint;
@@ -142,11 +143,17 @@ pub(super) fn resolve(
             });
             continue;
         }
+        // The body's own frame: where a child-side joint frame moved its data, `own_frame`
+        // places it back (the base has none).
+        let placement = match names.iter().position(|b| *b == n.name) {
+            Some(b) => compose(&at.pose, &spec.bodies[b].own_frame),
+            None => at.pose,
+        };
         frames.push(Frame {
             name: n.name.clone(),
             ident,
             body: at.target,
-            placement: at.pose,
+            placement,
         });
     }
     frames

@@ -295,6 +295,11 @@ pub(crate) struct BodySpec {
     /// Inertia about the mass centre in `F`'s axes (kg·m²), symmetric.
     pub inertia: Mat3,
     pub inertia_span: Span,
+    /// The pose of the body's own frame (the one the spec writes it in, the frame
+    /// `[scene] frames` names) in `F`: the identity, except after a child-side joint frame
+    /// (`child_origin` on a tree joint) has re-expressed the body in its joint frame
+    /// (`child_frame.rs`).
+    pub own_frame: Transform,
 }
 
 /// Joint kinds of the spec.

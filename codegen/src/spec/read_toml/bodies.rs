@@ -8,6 +8,8 @@ use toml::de::DeTable;
 
 use super::keys::{BODY_KEYS, CROSS_KEYS};
 use super::{Reader, get};
+use runtime::model::Transform;
+
 use crate::spec::ir::BodySpec;
 
 impl Reader<'_> {
@@ -91,6 +93,7 @@ impl Reader<'_> {
             com: com.unwrap_or([0.0; 3]),
             inertia: inertia.unwrap_or([[0.0; 3]; 3]),
             inertia_span: Some(inertia_span),
+            own_frame: Transform::IDENTITY,
         }
     }
 }

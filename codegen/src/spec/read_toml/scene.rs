@@ -10,6 +10,10 @@ use super::{Reader, Val, get};
 use crate::diag::Diagnostic;
 use crate::spec::ir::{Named, Payload, RuntimeInertia, SceneSpec};
 
+/// The smallest `[scene] coulomb_velocity`: the law `c·q̇/√(q̇² + v_s²)` needs `v_s²` above
+/// zero in the generated code's scalar type (`f32` too), or it is `0/0 = NaN` at rest
+/// (`1e-200` gave `inverse_dynamics(q, 0, 0)` NaN).
+const MIN_COULOMB_VELOCITY: f64 = 1e-12;
 impl Reader<'_> {
     /// The keys of `[scene]` (table `t`) in their fixed order; `gravity` overrides the
     /// mechanism's.
@@ -103,16 +107,16 @@ impl Reader<'_> {
         }
     }
 
-    /// `scene.coulomb_velocity`: a positive number.
+    /// `scene.coulomb_velocity`: a positive number, at least [`MIN_COULOMB_VELOCITY`].
     fn coulomb_velocity(&mut self, v: &Val<'_>, scene: &mut SceneSpec) {
         let Some(x) = self.number(v, "scene.coulomb_velocity") else {
             return;
         };
-        if x > 0.0 && x.is_finite() {
+        if x >= MIN_COULOMB_VELOCITY && x.is_finite() {
             scene.coulomb_velocity = x;
         } else {
             self.diags.push(
-                Diagnostic::error("`coulomb_velocity` must be a positive number")
+                Diagnostic::error("`coulomb_velocity` must be a positive number, at least 1e-12")
                     .with_key("scene.coulomb_velocity")
                     .with_span(Some(v.span()))
                     .with_hint("the speed scale v_s of the Coulomb law c·q̇/√(q̇² + v_s²), in rad/s or m/s; the default is 1e-4"),

@@ -134,7 +134,8 @@ fn check_inertia(doc: &Doc<'_>, inl: usize, lk: &str, diags: &mut Diagnostics) {
     }
 }
 
-/// A `<joint>`: its name, type, `<mimic>`, the numbers of its origin and axis, and its ends.
+/// A `<joint>`: its name, type, `<mimic>`, the numbers of its origin, axis and `<dynamics>`,
+/// and its ends.
 fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
     let t = &doc.tags[j];
     let name = t.attr("name").map_or("", |a| a.value);
@@ -164,6 +165,16 @@ fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
                 if let Some(at) = doc.tags[o].attr(a) {
                     check_triple(at, &format!("{jk}.{tag}.{a}"), diags);
                 }
+            }
+        }
+    }
+    // `<dynamics damping friction>`: one number each, finite and within range like every
+    // other number (non-finite values were read as 0 or reached the generator, which panicked
+    // on an infinite constant; a word was reported at the `<robot>` tag).
+    if let Some(d) = doc.child(j, "dynamics") {
+        for a in ["damping", "friction"] {
+            if let Some(at) = doc.tags[d].attr(a) {
+                check_number(at, &format!("{jk}.dynamics.{a}"), diags);
             }
         }
     }
