@@ -289,11 +289,14 @@ fn prs_head_generated_pose_fk_and_round_trip() {
     assert!(parasitic[2] > 1e-4, "{parasitic:?}");
 }
 
-/// Singular walks of the head, generated and runtime alike: tilted about x and about y to
-/// ±170° from home (the legs fold until a rod is perpendicular to its rail: the leg
-/// Jacobian's `Site::Leg`, then out of reach, `Site::Reach`; the parasitic solve's and the
-/// actuation matrix's limits on the way), every site of the generated module equal to the
-/// runtime's, and the efforts equal where both are regular.
+/// Singular walks of the head, generated and runtime alike, every site of the generated module
+/// equal to the runtime's and the efforts equal where both are regular. Tilted about x and about
+/// y to ±170° from home: a tilt raises the S centres on one side until a link stands vertical,
+/// perpendicular to its horizontal rail (the leg Jacobian's `Site::Leg`, then out of reach,
+/// `Site::Reach`); tilted about −x the two S centres that rise sit 0.1 m off the x axis and climb
+/// at most 0.1 m, short of the 0.143 m to the links' reach, and that walk stays regular. Lowered
+/// to the base plane: the links turn horizontal, so no actuator force has a vertical component
+/// (type II): the efforts grow as 1/pz, and in the plane both answer `Site::Actuation`.
 #[test]
 fn prs_head_tilt_walks_meet_the_same_sites() {
     use mechanisms::prs_head as g;
@@ -301,36 +304,78 @@ fn prs_head_tilt_walks_meet_the_same_sites() {
     let plan = Plan::new(&m).unwrap();
     let home = m.home_x();
     let mut seen: Vec<String> = Vec::new();
+    // Regular efforts agree to 1e-9, relative, times the growth of `A`'s condition number:
+    // on the way down it grows as 1/pz.
+    let tol = |x: &[f64; 3]| 1e-9 * (home[0] / x[0]).max(1.0);
+    let walk_through = |what: String, xs: &mut dyn Iterator<Item = [f64; 3]>| {
+        let mut walk: Vec<String> = Vec::new();
+        for x in xs {
+            let u = [0.1, -0.2, 0.3];
+            let r = noc::inverse_dynamics(&plan, &x, &u, &u);
+            let gr = g::inverse_dynamics(&x, &u, &u);
+            match (&r, &gr) {
+                (Ok(a), Ok(b)) => assert!(rel(b, a) <= tol(&x), "{x:?}: {a:?} vs {b:?}"),
+                (Err(a), Err(b)) => {
+                    let site = format!("{:?}", a.site);
+                    assert_eq!(site, format!("{:?}", b.site), "{x:?}: {a:?} vs {b:?}");
+                    if walk.last() != Some(&site) {
+                        walk.push(site);
+                    }
+                }
+                _ => panic!("{x:?}: runtime {r:?}, generated {gr:?}"),
+            }
+        }
+        println!("prs_head {what}: sites in order {walk:?}");
+        walk
+    };
     for axis in 0..2 {
         for sign in [1.0, -1.0] {
-            let mut walk: Vec<String> = Vec::new();
-            for s in 0..=3400 {
-                let t = sign * (170.0 * s as f64 / 3400.0).to_radians();
-                let mut x = [home[0], 0.0, 0.0];
-                x[1 + axis] = t;
-                let u = [0.1, -0.2, 0.3];
-                let r = noc::inverse_dynamics(&plan, &x, &u, &u);
-                let gr = g::inverse_dynamics(&x, &u, &u);
-                match (&r, &gr) {
-                    (Ok(a), Ok(b)) => assert!(rel(b, a) <= 1e-9, "{x:?}: {a:?} vs {b:?}"),
-                    (Err(a), Err(b)) => {
-                        let site = format!("{:?}", a.site);
-                        assert_eq!(site, format!("{:?}", b.site), "{x:?}: {a:?} vs {b:?}");
-                        if walk.last() != Some(&site) {
-                            walk.push(site);
-                        }
-                    }
-                    _ => panic!("{x:?}: runtime {r:?}, generated {gr:?}"),
-                }
-            }
-            println!(
-                "prs_head tilted about {} ({sign:+}) to 170°: sites in order {walk:?}",
-                ["x", "y"][axis]
+            let walk = walk_through(
+                format!("tilted about {} ({sign:+}) to 170°", ["x", "y"][axis]),
+                &mut (0..=3400).map(|s| {
+                    let t = sign * (170.0 * s as f64 / 3400.0).to_radians();
+                    let mut x = [home[0], 0.0, 0.0];
+                    x[1 + axis] = t;
+                    x
+                }),
             );
+            if axis == 0 && sign < 0.0 {
+                assert!(walk.is_empty(), "{walk:?}");
+            } else {
+                assert!(walk.iter().any(|s| s.starts_with("Reach(")), "{walk:?}");
+            }
             seen.extend(walk);
         }
     }
-    assert!(seen.iter().any(|s| s.starts_with("Actuation(")), "{seen:?}");
+    // Geometrically, to 1e-12 of the home height: the links' vertical components, and with
+    // them `A`'s heave column, shrink as pz, and the efforts that hold the platform up grow as
+    // 1/pz (type II). The pivot test, which scales the heave column by its own norm (its unit
+    // group), does not see a column that vanishes as a whole; the walk compares what both
+    // answer.
+    let down: Vec<[f64; 3]> = (0..=240)
+        .map(|k| [home[0] * 10f64.powf(-(k as f64) / 20.0), 0.0, 0.0])
+        .collect();
+    seen.extend(walk_through(
+        "lowered to the base plane".into(),
+        &mut down.iter().copied(),
+    ));
+    let effort = |x: &[f64; 3]| {
+        let t = g::inverse_dynamics(x, &[0.0; 3], &[0.0; 3]).unwrap();
+        t.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let growth = effort(&down[240]) / effort(&down[0]);
+    println!(
+        "prs_head lowered to 1e-12 of its home height: largest effort {growth:.1e} times home's"
+    );
+    assert!(growth > 1e9, "{growth:e}");
+    // In the plane every link is horizontal and `A`'s heave column is zero: both evaluators
+    // answer `Actuation` (which leg they name is a tie between zero pivots).
+    let plane = [0.0; 3];
+    let a = noc::inverse_dynamics(&plan, &plane, &[0.0; 3], &[0.0; 3]).unwrap_err();
+    let b = g::inverse_dynamics(&plane, &[0.0; 3], &[0.0; 3]).unwrap_err();
+    for e in [format!("{:?}", a.site), format!("{:?}", b.site)] {
+        assert!(e.starts_with("Actuation("), "{e}");
+    }
     assert!(seen.iter().any(|s| s.starts_with("Reach(")), "{seen:?}");
 }
 
