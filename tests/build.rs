@@ -191,10 +191,23 @@ fn main() {
             b.fma(true).implement("runtime");
         });
     }
+    // The functions a variant timed or compared for its dynamics alone keeps.
+    let dynamics_only = {
+        use codegen::spec::Function::*;
+        [
+            InverseDynamicsDerivatives,
+            ForwardDynamicsDerivatives,
+            Regressor,
+            Frames,
+        ]
+    };
     // The PUMA 560 fused with the default `libm` backend (`libm::fma`, chosen at run time on
-    // x86): the `fma/puma560/…/fused_libm` benches, the CLI's note on `--fma`.
+    // x86): the `fma/puma560/…/fused_libm` benches (inverse dynamics, mass matrix), the CLI's
+    // note on `--fma`; dynamics only.
     generate(&out, "fma_libm", Path::new(puma), |b| {
-        b.fma(true).math(codegen::MathBackend::Libm);
+        b.fma(true)
+            .math(codegen::MathBackend::Libm)
+            .omit(&dynamics_only);
     });
 
     // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
@@ -229,15 +242,6 @@ fn main() {
     });
     // `sin` and `cos` over all lanes at once (`Config::vector_sin_cos`): three arms in `f64`,
     // the PUMA 560 also with 8 lanes in `f32`; dynamics only.
-    let dynamics_only = {
-        use codegen::spec::Function::*;
-        [
-            InverseDynamicsDerivatives,
-            ForwardDynamicsDerivatives,
-            Regressor,
-            Frames,
-        ]
-    };
     generate(&out, "lanes_vector", Path::new(puma), |b| {
         b.spec(trees[2])
             .spec(trees[4])

@@ -148,12 +148,12 @@ pub mod tripod_task {
     ));
 }
 
-/// The PUMA 560, the 7-joint chain, the Gough–Stewart platform and the spherical five-bar with
-/// fused multiply–adds (`Config::fma`; `tests/tests/fma.rs`).
-/// The PUMA 560 with `mul_add` and the `libm` backend (`libm::fma`).
+/// The PUMA 560 with `mul_add` and the `libm` backend (`libm::fma`), dynamics only.
 pub mod fma_libm_puma560 {
     include!(concat!(env!("OUT_DIR"), "/variants/fma_libm/puma560.rs"));
 }
+/// The PUMA 560, the 7-joint chain, the Gough–Stewart platform and the spherical five-bar with
+/// fused multiply–adds (`Config::fma`; `tests/tests/fma.rs`).
 pub mod fma {
     /// The PUMA 560 with `mul_add`.
     pub mod puma560 {

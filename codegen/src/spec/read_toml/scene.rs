@@ -14,6 +14,7 @@ use crate::spec::ir::{Named, Payload, RuntimeInertia, SceneSpec};
 /// zero in the generated code's scalar type (`f32` too), or it is `0/0 = NaN` at rest
 /// (`1e-200` gave `inverse_dynamics(q, 0, 0)` NaN).
 const MIN_COULOMB_VELOCITY: f64 = 1e-12;
+
 impl Reader<'_> {
     /// The keys of `[scene]` (table `t`) in their fixed order; `gravity` overrides the
     /// mechanism's.
@@ -116,7 +117,9 @@ impl Reader<'_> {
             scene.coulomb_velocity = x;
         } else {
             self.diags.push(
-                Diagnostic::error("`coulomb_velocity` must be a positive number, at least 1e-12")
+                Diagnostic::error(format!(
+                    "`coulomb_velocity` must be a positive number, at least {MIN_COULOMB_VELOCITY:e}"
+                ))
                     .with_key("scene.coulomb_velocity")
                     .with_span(Some(v.span()))
                     .with_hint("the speed scale v_s of the Coulomb law c·q̇/√(q̇² + v_s²), in rad/s or m/s; the default is 1e-4"),
