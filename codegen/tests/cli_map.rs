@@ -220,6 +220,47 @@ fn map_rejects_bad_arguments() {
     assert_eq!(o.status.code(), Some(1));
 }
 
+/// `map`'s two files go where `write_output` puts every other output: never over the spec
+/// (exit code 2), never onto a directory or into a missing one (exit code 1), and neither is
+/// written when the other cannot be (both checked before any work).
+#[test]
+fn map_outputs_never_replace_the_spec_or_half_write() {
+    let dir = scratch("outputs");
+    // A spec whose name is the CSV `-o x` would write.
+    let spec = dir.join("x.csv");
+    std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join(FIVE), &spec).unwrap();
+    let before = std::fs::read(&spec).unwrap();
+    let p = dir.join("x");
+    let o = run(&[
+        "map",
+        spec.to_str().unwrap(),
+        "--steps",
+        "3",
+        "-o",
+        p.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("the spec"), "{}", text(&o.stderr));
+    assert_eq!(
+        std::fs::read(&spec).unwrap(),
+        before,
+        "the spec was overwritten"
+    );
+    assert!(!dir.join("x.svg").exists(), "an SVG was written");
+
+    // The SVG's path is a directory: nothing is written, the CSV neither.
+    std::fs::create_dir_all(dir.join("y.svg")).unwrap();
+    let y = dir.join("y");
+    let o = run(&["map", FIVE, "--steps", "3", "-o", y.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(!dir.join("y.csv").exists(), "a CSV was written");
+
+    // Into a missing directory.
+    let z = dir.join("missing").join("z");
+    let o = run(&["map", FIVE, "--steps", "3", "-o", z.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+}
+
 /// Counts no run can meet are refused at once, before any work: `isotropy --samples
 /// 18446744073709551615` panicked (capacity overflow, exit 101) and 4,294,967,296 aborted
 /// out of memory (134); `reduce --samples 4294967296` and `map --threads 100000` never ended.

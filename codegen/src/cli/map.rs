@@ -9,7 +9,6 @@
 //! * Trees: two joints by name (or `q0`, `q1`, …), values in rad or m; the other joints at
 //!   `--at` (default 0).
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -299,6 +298,16 @@ pub fn run(args: &MapArgs) -> ExitCode {
         .unwrap_or_else(|| PathBuf::from(format!("{}_{}", target.name(), args.index.word())));
     let csv_path = prefix.with_extension("csv");
     let svg_path = prefix.with_extension("svg");
+    // Neither file may replace the spec, and both go where they can (before any work).
+    if let Err(code) = super::distinct_outputs(
+        &[("the spec", args.spec.as_path())],
+        &[
+            ("the CSV", Some(csv_path.as_path())),
+            ("the SVG", Some(svg_path.as_path())),
+        ],
+    ) {
+        return code;
+    }
     let (us, vs) = slice.grids();
 
     let t0 = Instant::now();
@@ -310,7 +319,7 @@ pub fn run(args: &MapArgs) -> ExitCode {
 
     // CSV: one row per grid point.
     let csv = csv_text(args.index, &slice.axes, &result);
-    if let Err(e) = std::fs::File::create(&csv_path).and_then(|mut f| f.write_all(csv.as_bytes())) {
+    if let Err(e) = super::write_output(&csv_path, &csv) {
         eprintln!("error: cannot write {}: {e}", csv_path.display());
         return ExitCode::from(1);
     }
@@ -335,7 +344,10 @@ pub fn run(args: &MapArgs) -> ExitCode {
         values: &result.values,
         log,
     };
-    if let Err(e) = plot.write(&svg_path) {
+    if let Err(e) = plot
+        .render()
+        .and_then(|svg| super::write_output(&svg_path, &svg))
+    {
         eprintln!("error: cannot write {}: {e}", svg_path.display());
         return ExitCode::from(1);
     }

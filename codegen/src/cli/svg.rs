@@ -5,8 +5,6 @@
 //! `Err(Singular)` at a leg or parallel singularity) black, unreachable (`Site::Reach`) light
 //! grey, invalid (the matrix failed the index checks) red.
 
-use std::path::Path;
-
 use plotters::prelude::*;
 
 use super::Failure;
@@ -81,12 +79,15 @@ fn cell_edges(v: &[f64]) -> Vec<f64> {
 }
 
 impl HeatMap<'_> {
-    /// Write the SVG file.
-    pub fn write(&self, path: &Path) -> Result<(), String> {
-        self.draw(path).map_err(|e| e.to_string())
+    /// The SVG text (written by the caller through `write_output`, so that a failed write never
+    /// leaves half a drawing in place).
+    pub fn render(&self) -> Result<String, String> {
+        let mut svg = String::new();
+        self.draw(&mut svg).map_err(|e| e.to_string())?;
+        Ok(svg)
     }
 
-    fn draw(&self, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    fn draw(&self, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
         let tf = |v: f64| if self.log { v.log10() } else { v };
         let shown: Vec<f64> = self
             .values
@@ -107,7 +108,7 @@ impl HeatMap<'_> {
             (0.0, 1.0)
         };
 
-        let root = SVGBackend::new(path, (860, 680)).into_drawing_area();
+        let root = SVGBackend::with_string(out, (860, 680)).into_drawing_area();
         root.fill(&WHITE)?;
         let (head, body) = root.split_vertically(70);
         head.draw(&Text::new(
