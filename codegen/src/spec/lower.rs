@@ -24,7 +24,8 @@ pub(super) fn lower_built(spec: &Spec, diags: &mut Diagnostics) -> Option<Built>
     let topo = topo?;
     let built = build(spec, &topo, &axes, diags);
     check_runtime_bodies(spec, &built.attach, diags);
-    check_massless_subtrees(spec, &built, diags);
+    let massive = check_massless_subtrees(spec, &built, diags);
+    check_inertia_about_axes(spec, &built, &massive, diags);
     if diags.has_errors() {
         None
     } else {
@@ -35,8 +36,9 @@ pub(super) fn lower_built(spec: &Spec, diags: &mut Diagnostics) -> Option<Built>
 /// A movable joint that moves only massless bodies (no mass and no inertia anywhere beyond it)
 /// has a zero row and column in the mass matrix at every configuration: `forward_dynamics`
 /// always returns `Err(Singular)`. A warning, not an error: inverse dynamics and gravity are
-/// still right, and URDFs often have such links (no `<inertial>`). Once per spec joint.
-fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) {
+/// still right, and URDFs often have such links (no `<inertial>`). Once per spec joint. Returns
+/// per model joint whether it moves a mass or an inertia.
+fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) -> Vec<bool> {
     let m = &built.model;
     let mut massive: Vec<bool> = m
         .bodies
@@ -70,6 +72,62 @@ fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) 
             .with_key(j.key.clone())
             .with_span(j.span.clone())
             .with_hint("its row of the mass matrix is zero at every configuration, so forward_dynamics will always return Err(Singular); give a body beyond it a mass or an inertia, or make the joint fixed"),
+        );
+    }
+    massive
+}
+
+/// A revolute joint that moves mass, but none of it off its axis and no inertia about it (a
+/// point mass on the axis, a rod along it without its axial moment) has a zero diagonal entry
+/// in the mass matrix, `sᵀ I_c s = 0` with `I_c` the composite inertia beyond it: at every
+/// configuration when nothing beyond it moves the mass off the axis. Tested on the inertia
+/// matrix (the runtime's CRBA, rotor inertia on the diagonal) at the home pose and four fixed
+/// configurations spread over the joint ranges; a warning when the entry is zero at all five
+/// (to 1e-13 of the largest diagonal entry), as for a massless joint. Once per spec joint, not
+/// with run-time parameters (their constants stand in for values given at run time).
+fn check_inertia_about_axes(spec: &Spec, built: &Built, massive: &[bool], diags: &mut Diagnostics) {
+    let m = &built.model;
+    let n = m.dof();
+    if spec.scene.runtime_params || n == 0 {
+        return;
+    }
+    let mut zero = vec![true; n];
+    for k in 0..5 {
+        // Home (k = 0), then fixed, incommensurate angles (rad) and offsets (m).
+        let q: Vec<f64> = (0..n)
+            .map(|j| {
+                let x = (1.7 * j as f64 + 2.3 * k as f64).sin();
+                let scale = match m.joints[j].kind {
+                    JointKind::Revolute => 2.5,
+                    JointKind::Prismatic => 0.3,
+                };
+                if k == 0 { 0.0 } else { scale * x }
+            })
+            .collect();
+        let h = runtime::rnea::mass_matrix(m, &q);
+        let diag: Vec<f64> = (0..n)
+            .map(|i| h[(i, i)] + m.joints[i].drive.armature)
+            .collect();
+        let largest = diag.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+        for i in 0..n {
+            if diag[i].abs() > 1e-13 * largest {
+                zero[i] = false;
+            }
+        }
+    }
+    let mut reported = Vec::new();
+    for i in 0..n {
+        let sj = built.spec_joint[i];
+        if !zero[i] || !massive[i] || reported.contains(&sj) {
+            continue;
+        }
+        reported.push(sj);
+        let j = &spec.joints[sj];
+        diags.push(
+            Diagnostic::warning(format!("joint \"{}\" moves no inertia about its axis", j.name))
+            .with_key(j.key.clone())
+            .with_span(j.span.clone())
+            .with_hint("the mass beyond it lies on its axis and has no moment about it (a point mass on the axis, or a body without its axial moment), so its row of the mass matrix is zero and forward_dynamics will always return Err(Singular); give a body beyond it an inertia about the axis or move its mass centre off the axis, or make the joint fixed"),
         );
     }
 }

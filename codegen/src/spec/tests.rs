@@ -7,10 +7,16 @@ use super::geom::{MassProps, dh_matrix, mdh_matrix};
 use super::ir::{Dh, Kind};
 use super::load_tree;
 
+/// Loads a tree that must have no warnings but the one for point masses on their joints' axes
+/// (most specs here are kinematic: point masses at the joint origins).
 fn ok(name: &str, src: &str) -> Model {
     match load_tree(name, src) {
         Ok((m, w)) => {
-            assert!(w.is_empty(), "unexpected warnings:\n{}", w.render());
+            let unexpected = w
+                .iter()
+                .filter(|d| !d.message.ends_with("moves no inertia about its axis"))
+                .count();
+            assert_eq!(unexpected, 0, "unexpected warnings:\n{}", w.render());
             m
         }
         Err(e) => panic!("{}", e.render()),
@@ -405,6 +411,7 @@ name = "w"
 [[body]]
 name = "a"
 mass = 1
+com = [0.1, 0, 0]
 [[joint]]
 name = "j"
 kind = "R"
@@ -1189,4 +1196,66 @@ fn suggestions_are_bounded() {
     let longer = "a".repeat(n + 1);
     let near = format!("{}b", &longer[1..]);
     assert_eq!(closest(&near, &[&longer]), None);
+}
+
+/// A point mass on the axis of the joint that turns it (and nothing beyond it off that axis)
+/// gives a zero diagonal entry of the mass matrix at every configuration: a warning at the
+/// joint, not for the joint that swings it about another axis, and none once the mass leaves
+/// the axis or has a moment about it.
+#[test]
+fn point_mass_on_its_own_axis_is_warned() {
+    let spec = |tool: &str| {
+        format!(
+            r#"
+[mechanism]
+name = "p"
+[[body]]
+name = "arm"
+mass = 1
+com = [0.2, 0, 0]
+inertia = {{ ixx = 0.001, iyy = 0.01, izz = 0.01 }}
+[[body]]
+name = "tool"
+mass = 0.5
+{tool}
+[[joint]]
+name = "swing"
+kind = "R"
+parent = "base"
+child = "arm"
+[[joint]]
+name = "spin"
+kind = "R"
+parent = "arm"
+child = "tool"
+axis = [1, 0, 0]
+origin = {{ xyz = [0.4, 0, 0] }}
+"#
+        )
+    };
+    let warned = |tool: &str| -> Vec<String> {
+        let (_, w) = load_tree("p.toml", &spec(tool)).unwrap();
+        w.iter().map(|d| d.message.clone()).collect()
+    };
+    assert_eq!(
+        warned("com = [0.05, 0, 0]"),
+        ["joint \"spin\" moves no inertia about its axis"]
+    );
+    assert!(warned("com = [0.05, 0.01, 0]").is_empty());
+    assert!(warned("inertia = { ixx = 2e-4, iyy = 1e-4, izz = 1e-4 }").is_empty());
+    // A rod along the axis: moments about the other two only, still none about this one.
+    assert_eq!(
+        warned("inertia = { ixx = 0, iyy = 1e-4, izz = 1e-4 }"),
+        ["joint \"spin\" moves no inertia about its axis"]
+    );
+    // The rotor's inertia fills the diagonal.
+    let (_, w) = load_tree(
+        "p.toml",
+        &format!(
+            "[scene]\nrotor_inertia = true\narmature = {{ spin = 1e-5 }}\n{}",
+            spec("com = [0.05, 0, 0]")
+        ),
+    )
+    .unwrap();
+    assert!(w.is_empty(), "{}", w.render());
 }

@@ -338,13 +338,45 @@ pub(super) fn check_declared_motion(
         ));
     }
     let msg = parts.join("; and ");
+    // Too few motions with legs of the right type: a leg whose own joint screws are dependent
+    // at home (two axes in line, a leg of zero length) has lost a freedom there. Not for a
+    // parallelogram leg, whose rods' twists are not joint screws.
+    let singular_leg = (!missing.is_empty())
+        .then(|| {
+            (0..pm.legs.len().min(tree.closing.len())).find_map(|li| {
+                let c = tree.closing[li];
+                let name = &tree.spec.joints[c].name;
+                if tree.spec.parallelograms.contains(name) {
+                    return None;
+                }
+                let t = leg_twists(tree, axes, pm, li, size);
+                let r = span(&t).len();
+                (r < t.len()).then(|| (name.clone(), t.len(), r))
+            })
+        })
+        .flatten();
+    let hint = match singular_leg {
+        Some((name, n, r)) => format!(
+            "leg \"{name}\" is at a singularity of its own at home: its {n} joint screws span only {r} motions (two of its axes in line, or a leg of zero length); choose a platform.home away from it, or change the leg"
+        ),
+        None => {
+            let examples = match word {
+                "translation" => {
+                    " (a Delta's [[parallelogram]]s, or Tsai's 3-UPU with the base U's first axis parallel to the platform U's second and the inner axes parallel)"
+                }
+                "orientation" => " (every joint axis through the centre)",
+                _ => "",
+            };
+            format!(
+                "the platform's motion is what the legs' constraint wrenches leave it: coordinates = \"{word}\" needs legs that allow exactly that{examples}; choose the coordinates of the motion the legs allow, or change the legs (docs/spec.md, \"The declared motion\")"
+            )
+        }
+    };
     diags.push(
         Diagnostic::error(format!("{msg} (at home, by reciprocal screws)"))
             .with_key("platform.coordinates")
             .with_span(ps.coordinates_span.clone())
-            .with_hint(format!(
-                "the platform's motion is what the legs' constraint wrenches leave it: coordinates = \"{word}\" needs legs that allow exactly that (a Delta's [[parallelogram]]s or Tsai's 3-UPU with the base U's first axis parallel to the platform U's second and the inner axes parallel, for \"translation\"; every axis through the centre, for \"orientation\"); choose the coordinates of the motion the legs allow, or change the legs (docs/spec.md, \"The declared motion\")"
-            )),
+            .with_hint(hint),
     );
 }
 

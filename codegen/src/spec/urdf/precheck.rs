@@ -174,7 +174,17 @@ fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
     if let Some(d) = doc.child(j, "dynamics") {
         for a in ["damping", "friction"] {
             if let Some(at) = doc.tags[d].attr(a) {
-                check_number(at, &format!("{jk}.dynamics.{a}"), diags);
+                let key = format!("{jk}.dynamics.{a}");
+                check_number(at, &key, diags);
+                // A negative coefficient would feed energy in: it is read as 0, and said so.
+                if at.value.trim().parse::<f64>().is_ok_and(|x| x < 0.0) {
+                    diags.push(
+                        Diagnostic::warning(format!("negative {a}=\"{}\" is read as 0", at.value))
+                            .with_key(key)
+                            .with_span(at.span.clone())
+                            .with_hint("friction only dissipates: write 0 or a positive value"),
+                    );
+                }
             }
         }
     }
