@@ -2,11 +2,13 @@
 //! spec at other fidelity levels (`[scene]` point-mass and massless bodies), with another math
 //! backend (the `libm` crate instead of std), and a URDF with its angles rounded as published
 //! files write them, generated as written and snapped. Each lands in
-//! `$OUT_DIR/variants/<variant>/<module>.rs` and is declared in `src/variants.rs`.
+//! `$OUT_DIR/variants/<variant>/<module>.rs` and is declared in `src/variants.rs`. Those only the
+//! benchmarks and the chart use are generated with the `figures` feature alone.
 
 use std::path::{Path, PathBuf};
 
 use codegen::build_script::Builder;
+use codegen::spec::Function;
 
 fn generate(out: &Path, variant: &str, spec: &Path, setup: impl FnOnce(&mut Builder)) {
     let dir = out.join("variants").join(variant);
@@ -68,70 +70,38 @@ fn with_runtime_inertia(scene: &str) -> String {
     scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
 }
 
+/// What a variant used for its dynamics alone leaves out.
+const DYNAMICS_ONLY: [Function; 4] = [
+    Function::InverseDynamicsDerivatives,
+    Function::ForwardDynamicsDerivatives,
+    Function::Regressor,
+    Function::Frames,
+];
+
+/// What a variant that no test differentiates leaves out: the derivatives, a platform's or a
+/// closed loop's largest functions (tested on the bundled modules).
+const NO_DERIVATIVES: [Function; 2] = [
+    Function::InverseDynamicsDerivatives,
+    Function::ForwardDynamicsDerivatives,
+];
+
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
     let puma = "../mechanisms/specs/puma560.toml";
     let gs = "../mechanisms/specs/gough_stewart.toml";
-    let iiwa = "../mechanisms/specs/iiwa14.urdf";
     println!("cargo:rerun-if-changed=build.rs");
+    if std::env::var_os("CARGO_FEATURE_FIGURES").is_some() {
+        figures(&out);
+    }
 
-    generate(&out, "libm", Path::new(puma), |b| {
-        b.math(codegen::MathBackend::Libm);
-    });
-    let wrist = r#""link4", "link5", "link6""#;
-    let p = with_scene(
-        &out,
-        puma,
-        "puma_point_wrist",
-        &format!("point_mass = [{wrist}]"),
-    );
-    generate(&out, "puma_point_wrist", &p, |_| {});
-    let p = with_scene(
-        &out,
-        puma,
-        "puma_massless_wrist",
-        &format!("massless = [{wrist}]"),
-    );
-    generate(&out, "puma_massless_wrist", &p, |_| {});
-    let legs: Vec<String> = (1..=6)
-        .flat_map(|k| [format!("\"cylinder{k}\""), format!("\"piston{k}\"")])
-        .collect();
-    let p = with_scene(
-        &out,
-        gs,
-        "gs_point_legs",
-        &format!("point_mass = [{}]", legs.join(", ")),
-    );
-    generate(&out, "gs_point_legs", &p, |_| {});
     let p = with_scene(&out, gs, "gs_id_only", "functions = [\"inverse_dynamics\"]");
     generate(&out, "gs_id_only", &p, |_| {});
-    // Codourey's simplified Delta, for the speed/accuracy chart beside the exact model.
-    let delta = "../mechanisms/specs/delta_rl5.toml";
-    let p = with_scene(&out, delta, "delta_codourey", "delta_model = \"codourey\"");
-    generate(&out, "delta_codourey", &p, |_| {});
-    // The Delta in joint coordinates (the closed-loop route), for the bench against its
-    // platform form.
-    let joints = "data/delta_rl5_joints.toml";
-    println!("cargo:rerun-if-changed={joints}");
-    generate(&out, "delta_joints", Path::new(joints), |_| {});
     // The planar 3-RRR in joint coordinates, for the bench against its task form.
     let joints = "data/planar_3rrr_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
-    generate(&out, "planar3_joints", Path::new(joints), |_| {});
-    // Tsai's 3-UPU in joint coordinates, likewise.
-    let joints = "data/tsai_3upu_joints.toml";
-    println!("cargo:rerun-if-changed={joints}");
-    generate(&out, "upu_joints", Path::new(joints), |_| {});
-    // The 4-axis Delta in joint coordinates, likewise.
-    let joints = "data/delta4_rl5_joints.toml";
-    println!("cargo:rerun-if-changed={joints}");
-    generate(&out, "delta4_joints", Path::new(joints), |_| {});
-    // The 3-PRS tripod of mechanisms/specs/tripod_3prs.toml in task coordinates (heave_tilt),
-    // for the bench against its joint-coordinate form.
-    let task = "data/tripod_3prs_task.toml";
-    println!("cargo:rerun-if-changed={task}");
-    generate(&out, "tripod_task", Path::new(task), |_| {});
-
+    generate(&out, "planar3_joints", Path::new(joints), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
     // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
     let p = with_scene(
         &out,
@@ -155,28 +125,34 @@ fn main() {
     let p = write(&out, "gs_params", &src);
     // With the `Dynamics` impl: `tests/tests/implement.rs` reads its frames through the trait.
     generate(&out, "gs_params", &p, |b| {
-        b.implement("runtime");
+        b.implement("runtime").omit(&NO_DERIVATIVES);
     });
     let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
     let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_GS));
     let p = write(&out, "gs_inertia", &src);
-    generate(&out, "gs_inertia", &p, |_| {});
+    generate(&out, "gs_inertia", &p, |b| {
+        b.omit(&NO_DERIVATIVES);
+    });
     // A generic leg (Newton inverse kinematics): `tests/tests/parallel.rs`.
     let generic = Path::new("../codegen/tests/data/good_parallel/generic_leg.toml");
     println!("cargo:rerun-if-changed={}", generic.display());
-    generate(&out, "generic_leg", generic, |_| {});
+    generate(&out, "generic_leg", generic, |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
     let sfb = "../mechanisms/specs/spherical_five_bar.toml";
     println!("cargo:rerun-if-changed={sfb}");
     let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_CLOSED}");
     let p = write(&out, "closed_params", &src);
     generate(&out, "closed_params", &p, |b| {
-        b.implement("runtime");
+        b.implement("runtime").omit(&NO_DERIVATIVES);
     });
     let src = std::fs::read_to_string(sfb).unwrap_or_else(|e| panic!("{sfb}: {e}"));
     let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_CLOSED));
     let p = write(&out, "closed_inertia", &src);
-    generate(&out, "closed_inertia", &p, |_| {});
+    generate(&out, "closed_inertia", &p, |b| {
+        b.omit(&NO_DERIVATIVES);
+    });
 
     // Fused multiply–add (`tests/tests/fma.rs`, the `fma` bench group): a tree of 6 and of 7
     // joints, a platform and a closed loop, each with `Config::fma`.
@@ -191,25 +167,6 @@ fn main() {
             b.fma(true).implement("runtime");
         });
     }
-    // The functions a variant timed or compared for its dynamics alone keeps.
-    let dynamics_only = {
-        use codegen::spec::Function::*;
-        [
-            InverseDynamicsDerivatives,
-            ForwardDynamicsDerivatives,
-            Regressor,
-            Frames,
-        ]
-    };
-    // The PUMA 560 fused with the default `libm` backend (`libm::fma`, chosen at run time on
-    // x86): the `fma/puma560/…/fused_libm` benches (inverse dynamics, mass matrix), the CLI's
-    // note on `--fma`; dynamics only.
-    generate(&out, "fma_libm", Path::new(puma), |b| {
-        b.fma(true)
-            .math(codegen::MathBackend::Libm)
-            .omit(&dynamics_only);
-    });
-
     // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
     // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.
     let trees = [
@@ -230,13 +187,6 @@ fn main() {
         }
         b.lanes(Some(4));
     });
-    // The same with trigonometry from the `libm` crate (half the cost of std's `sin_cos` here,
-    // and inlined): the `lanes_libm` bench groups.
-    generate(&out, "lanes_libm", Path::new(puma), |b| {
-        b.spec(trees[2])
-            .lanes(Some(4))
-            .math(codegen::MathBackend::Libm);
-    });
     generate(&out, "lanes_f32", Path::new(puma), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });
@@ -247,24 +197,105 @@ fn main() {
             .spec(trees[4])
             .lanes(Some(4))
             .vector_sin_cos(true)
-            .omit(&dynamics_only);
+            .omit(&DYNAMICS_ONLY);
     });
     generate(&out, "lanes_vector_f32", Path::new(puma), |b| {
         b.lanes(Some(8))
             .float(codegen::Float::F32)
             .vector_sin_cos(true)
-            .omit(&dynamics_only);
+            .omit(&DYNAMICS_ONLY);
+    });
+}
+
+/// The variants only the benchmarks (`benches/`) and the chart (`src/bin/chart.rs`) use.
+fn figures(out: &Path) {
+    let puma = "../mechanisms/specs/puma560.toml";
+    let gs = "../mechanisms/specs/gough_stewart.toml";
+    let iiwa = "../mechanisms/specs/iiwa14.urdf";
+    generate(out, "libm", Path::new(puma), |b| {
+        b.math(codegen::MathBackend::Libm);
+    });
+    let wrist = r#""link4", "link5", "link6""#;
+    let p = with_scene(
+        out,
+        puma,
+        "puma_point_wrist",
+        &format!("point_mass = [{wrist}]"),
+    );
+    generate(out, "puma_point_wrist", &p, |_| {});
+    let p = with_scene(
+        out,
+        puma,
+        "puma_massless_wrist",
+        &format!("massless = [{wrist}]"),
+    );
+    generate(out, "puma_massless_wrist", &p, |_| {});
+    let legs: Vec<String> = (1..=6)
+        .flat_map(|k| [format!("\"cylinder{k}\""), format!("\"piston{k}\"")])
+        .collect();
+    let p = with_scene(
+        out,
+        gs,
+        "gs_point_legs",
+        &format!("point_mass = [{}]", legs.join(", ")),
+    );
+    generate(out, "gs_point_legs", &p, |_| {});
+    // Codourey's simplified Delta, for the speed/accuracy chart beside the exact model.
+    let delta = "../mechanisms/specs/delta_rl5.toml";
+    let p = with_scene(out, delta, "delta_codourey", "delta_model = \"codourey\"");
+    generate(out, "delta_codourey", &p, |_| {});
+    // The Delta in joint coordinates (the closed-loop route), for the bench against its
+    // platform form (inverse dynamics: these four keep their dynamics only).
+    let joints = "data/delta_rl5_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(out, "delta_joints", Path::new(joints), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
+    // Tsai's 3-UPU in joint coordinates, likewise.
+    let joints = "data/tsai_3upu_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(out, "upu_joints", Path::new(joints), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
+    // The 4-axis Delta in joint coordinates, likewise.
+    let joints = "data/delta4_rl5_joints.toml";
+    println!("cargo:rerun-if-changed={joints}");
+    generate(out, "delta4_joints", Path::new(joints), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
+    // The 3-PRS tripod of mechanisms/specs/tripod_3prs.toml in task coordinates (heave_tilt),
+    // for the bench against its joint-coordinate form.
+    let task = "data/tripod_3prs_task.toml";
+    println!("cargo:rerun-if-changed={task}");
+    generate(out, "tripod_task", Path::new(task), |b| {
+        b.omit(&DYNAMICS_ONLY);
     });
 
+    // The PUMA 560 fused with the default `libm` backend (`libm::fma`, chosen at run time on
+    // x86): the `fma/puma560/…/fused_libm` benches (inverse dynamics, mass matrix), the CLI's
+    // note on `--fma`; dynamics only.
+    generate(out, "fma_libm", Path::new(puma), |b| {
+        b.fma(true)
+            .math(codegen::MathBackend::Libm)
+            .omit(&DYNAMICS_ONLY);
+    });
+
+    // The same with trigonometry from the `libm` crate (half the cost of std's `sin_cos` here,
+    // and inlined): the `lanes_libm` bench groups.
+    generate(out, "lanes_libm", Path::new(puma), |b| {
+        b.spec("../mechanisms/specs/chain7.toml")
+            .lanes(Some(4))
+            .math(codegen::MathBackend::Libm);
+    });
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
     println!("cargo:rerun-if-changed={iiwa}");
     let rounded = src
         .replace("1.5707963267948966", "1.5708")
         .replace("3.141592653589793", "3.1416");
-    let p = write(&out, "iiwa_rounded", &rounded);
-    generate(&out, "iiwa_rounded", &p, |_| {});
-    generate(&out, "iiwa_snapped", &p, |b| {
+    let p = write(out, "iiwa_rounded", &rounded);
+    generate(out, "iiwa_rounded", &p, |_| {});
+    generate(out, "iiwa_snapped", &p, |b| {
         b.snap(1e-4);
     });
 }

@@ -10,7 +10,7 @@
 //! generated vs the runtime evaluator `runtime::parallel::noc`.
 //!
 //! ```text
-//! cargo bench -p tests --bench dynamics
+//! cargo bench -p tests --features figures --bench dynamics
 //! ```
 
 use std::hint::black_box;

@@ -19,7 +19,7 @@
 //!
 //! ```text
 //! RUSTFLAGS="-C target-cpu=native" CARGO_TARGET_DIR=$PWD/target/native \
-//!     cargo bench -p tests --bench speed
+//!     cargo bench -p tests --features figures --bench speed
 //! ```
 //!
 //! `sin_cos/four_angles` times what one angle costs a `_lanes` function (a call per lane).

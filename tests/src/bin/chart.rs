@@ -9,7 +9,7 @@
 //! ∞-norm over the states). Writes `PREFIX.csv`, `PREFIX.md` and `PREFIX.svg` (log–log).
 //!
 //! ```text
-//! cargo run --profile bench -p tests --bin chart [-- PREFIX]   (default: docs/figures/chart)
+//! cargo run --profile bench -p tests --features figures --bin chart [-- PREFIX]   (default: docs/figures/chart)
 //! ```
 
 use std::fmt::Write as _;
