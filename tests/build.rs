@@ -287,6 +287,14 @@ fn figures(out: &Path) {
             .lanes(Some(4))
             .math(codegen::MathBackend::Libm);
     });
+    // The three arms of `lanes_vector` with 8 lanes: the `lanes_vector8` benches.
+    generate(out, "lanes_vector8", Path::new(puma), |b| {
+        b.spec("../mechanisms/specs/chain7.toml")
+            .spec(iiwa)
+            .lanes(Some(8))
+            .vector_sin_cos(true)
+            .omit(&DYNAMICS_ONLY);
+    });
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
     println!("cargo:rerun-if-changed={iiwa}");

@@ -11,7 +11,8 @@
 //!   state; `lanes_libm/…` the same with the `libm` crate's trigonometry
 //!   (`tests::variants::lanes_libm`); `lanes_vector/…` with `sin` and `cos` of all lanes at
 //!   once (`Config::vector_sin_cos`, `tests::variants::lanes_vector`; its `scalar` is the
-//!   same module's scalar function, std's `sin_cos`).
+//!   same module's scalar function, std's `sin_cos`); `lanes_vector8/…` the same with 8 lanes
+//!   (`tests::variants::lanes_vector8`).
 //!
 //! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
 //! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
@@ -182,6 +183,9 @@ lanes_tree!(lanes_libm_chain7, lanes_libm, chain7);
 lanes_tree!(lanes_vector_puma560, lanes_vector, puma560);
 lanes_tree!(lanes_vector_chain7, lanes_vector, chain7);
 lanes_tree!(lanes_vector_iiwa14, lanes_vector, iiwa14);
+lanes_tree!(lanes_vector8_puma560, lanes_vector8, puma560);
+lanes_tree!(lanes_vector8_chain7, lanes_vector8, chain7);
+lanes_tree!(lanes_vector8_iiwa14, lanes_vector8, iiwa14);
 
 /// What a `_lanes` function pays per angle: four `sin_cos` calls of the math backend, std
 /// (the modules here: `runtime::math`) and the `libm` crate.
@@ -228,6 +232,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, sin_cos, wrappers
 }
 criterion_main!(benches);

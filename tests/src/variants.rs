@@ -239,6 +239,33 @@ pub mod lanes_libm {
     }
 }
 
+/// The same three arms with 8 lanes (two 256-bit vectors per operation on AVX2, one 512-bit
+/// on AVX-512), for the `lanes_vector8` benches.
+#[cfg(feature = "figures")]
+pub mod lanes_vector8 {
+    /// `mechanisms/specs/puma560.toml`.
+    pub mod puma560 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector8/puma560.rs"
+        ));
+    }
+    /// `mechanisms/specs/chain7.toml`.
+    pub mod chain7 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector8/chain7.rs"
+        ));
+    }
+    /// `mechanisms/specs/iiwa14.urdf`.
+    pub mod iiwa14 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector8/iiwa14.rs"
+        ));
+    }
+}
+
 /// Three arms with 4 lanes whose `sin_cos` is one polynomial over all lanes
 /// (`Config::vector_sin_cos`), dynamics only.
 pub mod lanes_vector {
