@@ -59,22 +59,43 @@ fn check_massless_subtrees(spec: &Spec, built: &Built, diags: &mut Diagnostics) 
             massive[p] = true;
         }
     }
+    let flagged: Vec<bool> = massive.iter().map(|m| !m).collect();
+    warn_joints(
+        spec,
+        built,
+        &flagged,
+        "moves only massless bodies",
+        "its row of the mass matrix is zero at every configuration, so forward_dynamics will always return Err(Singular); give a body beyond it a mass or an inertia, or make the joint fixed",
+        diags,
+    );
+    massive
+}
+
+/// A warning `joint "<name>" <what>` with `hint` at each spec joint one of whose model joints
+/// is `flagged` (once per spec joint: a U or S expands into several).
+fn warn_joints(
+    spec: &Spec,
+    built: &Built,
+    flagged: &[bool],
+    what: &str,
+    hint: &str,
+    diags: &mut Diagnostics,
+) {
     let mut reported = Vec::new();
-    for (i, moves_mass) in massive.iter().enumerate() {
+    for (i, _) in flagged.iter().enumerate().filter(|(_, f)| **f) {
         let sj = built.spec_joint[i];
-        if *moves_mass || reported.contains(&sj) {
+        if reported.contains(&sj) {
             continue;
         }
         reported.push(sj);
         let j = &spec.joints[sj];
         diags.push(
-            Diagnostic::warning(format!("joint \"{}\" moves only massless bodies", j.name))
-            .with_key(j.key.clone())
-            .with_span(j.span.clone())
-            .with_hint("its row of the mass matrix is zero at every configuration, so forward_dynamics will always return Err(Singular); give a body beyond it a mass or an inertia, or make the joint fixed"),
+            Diagnostic::warning(format!("joint \"{}\" {what}", j.name))
+                .with_key(j.key.clone())
+                .with_span(j.span.clone())
+                .with_hint(hint),
         );
     }
-    massive
 }
 
 /// A revolute joint that moves mass, but none of it off its axis and no inertia about it (a
@@ -115,21 +136,15 @@ fn check_inertia_about_axes(spec: &Spec, built: &Built, massive: &[bool], diags:
             }
         }
     }
-    let mut reported = Vec::new();
-    for i in 0..n {
-        let sj = built.spec_joint[i];
-        if !zero[i] || !massive[i] || reported.contains(&sj) {
-            continue;
-        }
-        reported.push(sj);
-        let j = &spec.joints[sj];
-        diags.push(
-            Diagnostic::warning(format!("joint \"{}\" moves no inertia about its axis", j.name))
-            .with_key(j.key.clone())
-            .with_span(j.span.clone())
-            .with_hint("the mass beyond it lies on its axis and has no moment about it (a point mass on the axis, or a body without its axial moment), so its row of the mass matrix is zero and forward_dynamics will always return Err(Singular); give a body beyond it an inertia about the axis or move its mass centre off the axis, or make the joint fixed"),
-        );
-    }
+    let flagged: Vec<bool> = (0..n).map(|i| zero[i] && massive[i]).collect();
+    warn_joints(
+        spec,
+        built,
+        &flagged,
+        "moves no inertia about its axis",
+        "the mass beyond it lies on its axis and has no moment about it (a point mass on the axis, or a body without its axial moment), so its row of the mass matrix is zero and forward_dynamics will always return Err(Singular); give a body beyond it an inertia about the axis or move its mass centre off the axis, or make the joint fixed",
+        diags,
+    );
 }
 
 /// A body named in `[scene] runtime_inertia` must move: one fixed to the base (directly or
