@@ -70,6 +70,12 @@ fn with_runtime_inertia(scene: &str) -> String {
     scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
 }
 
+/// The bundled specs the variants start from.
+const PUMA: &str = "../mechanisms/specs/puma560.toml";
+const CHAIN7: &str = "../mechanisms/specs/chain7.toml";
+const GS: &str = "../mechanisms/specs/gough_stewart.toml";
+const IIWA: &str = "../mechanisms/specs/iiwa14.urdf";
+
 /// What a variant used for its dynamics alone leaves out.
 const DYNAMICS_ONLY: [Function; 4] = [
     Function::InverseDynamicsDerivatives,
@@ -87,16 +93,15 @@ const NO_DERIVATIVES: [Function; 2] = [
 
 fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR is set by cargo"));
-    let puma = "../mechanisms/specs/puma560.toml";
-    let gs = "../mechanisms/specs/gough_stewart.toml";
     println!("cargo:rerun-if-changed=build.rs");
     if std::env::var_os("CARGO_FEATURE_FIGURES").is_some() {
         figures(&out);
     }
 
-    let p = with_scene(&out, gs, "gs_id_only", "functions = [\"inverse_dynamics\"]");
+    let p = with_scene(&out, GS, "gs_id_only", "functions = [\"inverse_dynamics\"]");
     generate(&out, "gs_id_only", &p, |_| {});
-    // The planar 3-RRR in joint coordinates, for the bench against its task form.
+    // The planar 3-RRR in joint coordinates (`tests/tests/planar3.rs`, and the bench against its
+    // task form).
     let joints = "data/planar_3rrr_joints.toml";
     println!("cargo:rerun-if-changed={joints}");
     generate(&out, "planar3_joints", Path::new(joints), |b| {
@@ -105,29 +110,29 @@ fn main() {
     // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
     let p = with_scene(
         &out,
-        puma,
+        PUMA,
         "puma_drives",
         "friction = true\nrotor_inertia = true",
     );
     generate(&out, "puma_drives", &p, |_| {});
 
     // Run-time parameters (`tests/tests/params.rs`): a payload on a tool on a turned flange.
-    let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
+    let src = std::fs::read_to_string(PUMA).unwrap_or_else(|e| panic!("{PUMA}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE}");
     let p = write(&out, "puma_params", &src);
     generate(&out, "puma_params", &p, |_| {});
-    let src = std::fs::read_to_string(puma).unwrap_or_else(|e| panic!("{puma}: {e}"));
+    let src = std::fs::read_to_string(PUMA).unwrap_or_else(|e| panic!("{PUMA}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_INERTIA}");
     let p = write(&out, "puma_inertia", &src);
     generate(&out, "puma_inertia", &p, |_| {});
-    let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
+    let src = std::fs::read_to_string(GS).unwrap_or_else(|e| panic!("{GS}: {e}"));
     let src = format!("{src}\n{PARAMS_SCENE_GS}");
     let p = write(&out, "gs_params", &src);
     // With the `Dynamics` impl: `tests/tests/implement.rs` reads its frames through the trait.
     generate(&out, "gs_params", &p, |b| {
         b.implement("runtime").omit(&NO_DERIVATIVES);
     });
-    let src = std::fs::read_to_string(gs).unwrap_or_else(|e| panic!("{gs}: {e}"));
+    let src = std::fs::read_to_string(GS).unwrap_or_else(|e| panic!("{GS}: {e}"));
     let src = format!("{src}\n{}", with_runtime_inertia(PARAMS_SCENE_GS));
     let p = write(&out, "gs_inertia", &src);
     generate(&out, "gs_inertia", &p, |b| {
@@ -157,9 +162,9 @@ fn main() {
     // Fused multiply–add (`tests/tests/fma.rs`, the `fma` bench group): a tree of 6 and of 7
     // joints, a platform and a closed loop, each with `Config::fma`.
     for spec in [
-        puma,
-        "../mechanisms/specs/chain7.toml",
-        gs,
+        PUMA,
+        CHAIN7,
+        GS,
         "../mechanisms/specs/spherical_five_bar.toml",
     ] {
         println!("cargo:rerun-if-changed={spec}");
@@ -170,11 +175,11 @@ fn main() {
     // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
     // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.
     let trees = [
-        "../mechanisms/specs/puma560.toml",
+        PUMA,
         "../mechanisms/specs/puma560.urdf",
-        "../mechanisms/specs/chain7.toml",
+        CHAIN7,
         "../mechanisms/specs/gripper_tree.toml",
-        "../mechanisms/specs/iiwa14.urdf",
+        IIWA,
         "../mechanisms/specs/planar_2r.toml",
         "../mechanisms/specs/stanford_arm.toml",
     ];
@@ -187,19 +192,19 @@ fn main() {
         }
         b.lanes(Some(4));
     });
-    generate(&out, "lanes_f32", Path::new(puma), |b| {
+    generate(&out, "lanes_f32", Path::new(PUMA), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });
     // `sin` and `cos` over all lanes at once (`Config::vector_sin_cos`): three arms in `f64`,
     // the PUMA 560 also with 8 lanes in `f32`; dynamics only.
-    generate(&out, "lanes_vector", Path::new(puma), |b| {
+    generate(&out, "lanes_vector", Path::new(PUMA), |b| {
         b.spec(trees[2])
             .spec(trees[4])
             .lanes(Some(4))
             .vector_sin_cos(true)
             .omit(&DYNAMICS_ONLY);
     });
-    generate(&out, "lanes_vector_f32", Path::new(puma), |b| {
+    generate(&out, "lanes_vector_f32", Path::new(PUMA), |b| {
         b.lanes(Some(8))
             .float(codegen::Float::F32)
             .vector_sin_cos(true)
@@ -209,23 +214,20 @@ fn main() {
 
 /// The variants only the benchmarks (`benches/`) and the chart (`src/bin/chart.rs`) use.
 fn figures(out: &Path) {
-    let puma = "../mechanisms/specs/puma560.toml";
-    let gs = "../mechanisms/specs/gough_stewart.toml";
-    let iiwa = "../mechanisms/specs/iiwa14.urdf";
-    generate(out, "libm", Path::new(puma), |b| {
+    generate(out, "libm", Path::new(PUMA), |b| {
         b.math(codegen::MathBackend::Libm);
     });
     let wrist = r#""link4", "link5", "link6""#;
     let p = with_scene(
         out,
-        puma,
+        PUMA,
         "puma_point_wrist",
         &format!("point_mass = [{wrist}]"),
     );
     generate(out, "puma_point_wrist", &p, |_| {});
     let p = with_scene(
         out,
-        puma,
+        PUMA,
         "puma_massless_wrist",
         &format!("massless = [{wrist}]"),
     );
@@ -235,7 +237,7 @@ fn figures(out: &Path) {
         .collect();
     let p = with_scene(
         out,
-        gs,
+        GS,
         "gs_point_legs",
         &format!("point_mass = [{}]", legs.join(", ")),
     );
@@ -274,7 +276,7 @@ fn figures(out: &Path) {
     // The PUMA 560 fused with the default `libm` backend (`libm::fma`, chosen at run time on
     // x86): the `fma/puma560/…/fused_libm` benches (inverse dynamics, mass matrix), the CLI's
     // note on `--fma`; dynamics only.
-    generate(out, "fma_libm", Path::new(puma), |b| {
+    generate(out, "fma_libm", Path::new(PUMA), |b| {
         b.fma(true)
             .math(codegen::MathBackend::Libm)
             .omit(&DYNAMICS_ONLY);
@@ -282,22 +284,22 @@ fn figures(out: &Path) {
 
     // The same with trigonometry from the `libm` crate (half the cost of std's `sin_cos` here,
     // and inlined): the `lanes_libm` bench groups.
-    generate(out, "lanes_libm", Path::new(puma), |b| {
-        b.spec("../mechanisms/specs/chain7.toml")
+    generate(out, "lanes_libm", Path::new(PUMA), |b| {
+        b.spec(CHAIN7)
             .lanes(Some(4))
             .math(codegen::MathBackend::Libm);
     });
     // The three arms of `lanes_vector` with 8 lanes: the `lanes_vector8` benches.
-    generate(out, "lanes_vector8", Path::new(puma), |b| {
-        b.spec("../mechanisms/specs/chain7.toml")
-            .spec(iiwa)
+    generate(out, "lanes_vector8", Path::new(PUMA), |b| {
+        b.spec(CHAIN7)
+            .spec(IIWA)
             .lanes(Some(8))
             .vector_sin_cos(true)
             .omit(&DYNAMICS_ONLY);
     });
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
-    let src = std::fs::read_to_string(iiwa).unwrap_or_else(|e| panic!("{iiwa}: {e}"));
-    println!("cargo:rerun-if-changed={iiwa}");
+    let src = std::fs::read_to_string(IIWA).unwrap_or_else(|e| panic!("{IIWA}: {e}"));
+    println!("cargo:rerun-if-changed={IIWA}");
     let rounded = src
         .replace("1.5707963267948966", "1.5708")
         .replace("3.141592653589793", "3.1416");
