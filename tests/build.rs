@@ -107,6 +107,13 @@ fn main() {
     generate(&out, "planar3_joints", Path::new(joints), |b| {
         b.omit(&DYNAMICS_ONLY);
     });
+    // A planar 3-RPR whose leg lines can all pass through the platform's origin
+    // (`tests/tests/singularities.rs`, `rpr_legs_through_the_platform_origin`).
+    let rpr = "data/rpr_turning.toml";
+    println!("cargo:rerun-if-changed={rpr}");
+    generate(&out, "rpr_turning", Path::new(rpr), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
     // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
     let p = with_scene(
         &out,

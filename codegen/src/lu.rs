@@ -11,12 +11,14 @@
 //! - at step `k` each lower row `i` is swapped into row `k` by selects when `|m_ik| > |m_kk|`,
 //!   so row `k` ends with the largest entry of the column (the pivot a search would choose, the
 //!   first one on ties) without a data-dependent branch;
-//! - the tolerance test is that of the matrix with each column scaled by the largest 2-norm of
-//!   its unit group (`PlatformMotion::unit_groups`: the speeds in rad/s, those in m/s), so the
-//!   test does not depend on the units, yet a column that shrinks against the others of its
-//!   unit (the platform moving along that speed with the actuators still) is a small pivot
-//!   (scaling changes neither the pivots chosen nor, in exact arithmetic, the solution): the
-//!   scaled pivot `|p_k|/g_k` (`g_k` the group's largest column norm) must exceed `tol` times
+//! - the tolerance test is that of the matrix with each column scaled by its unit group's
+//!   reference ([`runtime::parallel::noc::ColumnUnits`]: the group's largest 2-norm, or
+//!   another group's times the platform's radius `L` between rotation speeds (rad/s) and
+//!   translation speeds (m/s), whichever is larger), so the test does not depend on the
+//!   units, yet a column that shrinks against the others of its unit, or a whole group that
+//!   vanishes (the platform moving along those speeds with the actuators still), is a small
+//!   pivot (scaling changes neither the pivots chosen nor, in exact arithmetic, the solution):
+//!   the scaled pivot `|p_k|/g_k` (`g_k` the reference) must exceed `tol` times
 //!   the larger of 1 and the largest scaled pivot so far. It is compared squared and
 //!   cross-multiplied, `p_k² · d > tol² · n · g_k²` with the largest so far kept as the
 //!   fraction `n / d` (starting at 1), so the test needs neither a square root nor a division;
@@ -33,6 +35,7 @@
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
+use runtime::parallel::noc::ColumnUnits;
 
 /// What the emitted function solves for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,9 +59,9 @@ pub(crate) struct LuSolve<'a> {
     pub rhs: Rhs,
     /// The squared pivot tolerance, `tol²`.
     pub tol2: f64,
-    /// The unit group of each column (`PlatformMotion::unit_groups`): a column's pivot is
-    /// scaled by the largest column norm of its group.
-    pub groups: &'a [usize],
+    /// The unit group of each column and the groups' conversion: a column's pivot is scaled
+    /// by its group's reference.
+    pub units: ColumnUnits<'a>,
     /// The square-root call of the chosen math backend, applied to the tokens given.
     pub sqrt: &'a dyn Fn(TokenStream) -> TokenStream,
 }
@@ -186,27 +189,47 @@ fn column_norms(n: usize, st: &mut Vec<TokenStream>) {
     }
 }
 
-/// The column norm a pivot is scaled by: `g{j}`, the largest `n{i}` of column `j`'s unit group
-/// (by selects, NaN left out), the same for every column of a group.
+/// The squared reference a pivot is scaled by: `g{j}`, the same for every column of a group.
+/// With one unit group, the largest `n{i}` (by selects, NaN left out); with more, each group's
+/// largest as `h{j}` (at its first column `j`), then the largest of it and every other group's
+/// times [`ColumnUnits::factor2`] (`L²` or `1/L²`).
 fn group_norms(s: &LuSolve<'_>, st: &mut Vec<TokenStream>) {
-    let group = |j: usize| s.groups.get(j).copied().unwrap_or(0);
-    for j in 0..s.n {
-        let gj = g(j);
-        let first = (0..s.n).find(|&i| group(i) == group(j)).unwrap_or(j);
-        if first < j {
-            let g_first = g(first);
-            st.push(quote!(let #gj = #g_first;));
-            continue;
-        }
-        let n0 = format_ident!("n{}", j);
-        st.push(quote!(let #gj = #n0;));
+    let u = s.units;
+    let first = |j: usize| (0..s.n).find(|&i| u.group(i) == u.group(j)).unwrap_or(j);
+    let leaders: Vec<usize> = (0..s.n).filter(|&j| first(j) == j).collect();
+    let own = |j: usize| if leaders.len() > 1 { h(j) } else { g(j) };
+    for &j in &leaders {
+        let (oj, n0) = (own(j), format_ident!("n{}", j));
+        st.push(quote!(let #oj = #n0;));
         for i in j + 1..s.n {
-            if group(i) == group(j) {
+            if u.group(i) == u.group(j) {
                 let ni = format_ident!("n{}", i);
-                st.push(quote!(let #gj = if #ni > #gj { #ni } else { #gj };));
+                st.push(quote!(let #oj = if #ni > #oj { #ni } else { #oj };));
             }
         }
     }
+    if leaders.len() > 1 {
+        for &j in &leaders {
+            let (gj, hj) = (g(j), h(j));
+            st.push(quote!(let #gj = #hj;));
+            for &k in leaders.iter().filter(|&&k| k != j) {
+                let (hk, c) = (
+                    h(k),
+                    crate::emit::float_lit(u.factor2(u.group(k), u.group(j))),
+                );
+                st.push(quote!(let c = #c * #hk;));
+                st.push(quote!(let #gj = if c > #gj { c } else { #gj };));
+            }
+        }
+    }
+    for j in (0..s.n).filter(|&j| first(j) != j) {
+        let (gj, gf) = (g(j), g(first(j)));
+        st.push(quote!(let #gj = #gf;));
+    }
+}
+
+fn h(j: usize) -> Ident {
+    format_ident!("h{}", j)
 }
 
 fn g(j: usize) -> Ident {

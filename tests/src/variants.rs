@@ -132,6 +132,15 @@ pub mod planar3_joints {
     ));
 }
 
+/// A planar 3-RPR whose leg lines all pass through the platform's origin when it turns back
+/// by 40° (`tests/data/rpr_turning.toml`; `tests/tests/singularities.rs`).
+pub mod rpr_turning {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/rpr_turning/rpr_turning.rs"
+    ));
+}
+
 /// Tsai's 3-UPU of `mechanisms/specs/tsai_3upu.toml` in joint coordinates (`tests/data/
 /// tsai_3upu_joints.toml`, the closed-loop route), for the bench against its platform form.
 #[cfg(feature = "figures")]

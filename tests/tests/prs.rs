@@ -349,9 +349,10 @@ fn prs_head_tilt_walks_meet_the_same_sites() {
     }
     // Geometrically, to 1e-12 of the home height: the links' vertical components, and with
     // them `A`'s heave column, shrink as pz, and the efforts that hold the platform up grow as
-    // 1/pz (type II). The pivot test, which scales the heave column by its own norm (its unit
-    // group), does not see a column that vanishes as a whole; the walk compares what both
-    // answer.
+    // 1/pz (type II). The tilt columns shrink with it, so `A` is a regular matrix times pz:
+    // the pivot test, which compares the heave column with the tilt columns times the
+    // platform's radius, sees no singularity short of the plane, and the efforts are large but
+    // accurate; the walk compares what both answer.
     let down: Vec<[f64; 3]> = (0..=240)
         .map(|k| [home[0] * 10f64.powf(-(k as f64) / 20.0), 0.0, 0.0])
         .collect();

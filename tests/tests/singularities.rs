@@ -1517,3 +1517,123 @@ fn out_of_reach() {
     let b = dd::inverse_dynamics_dd(&plan, &x, &z, &z).unwrap();
     assert!(rel(&a, &b) < 1e-12);
 }
+
+/// A planar 3-RPR whose leg lines all pass through the platform's origin when it is turned by
+/// `-beta` (`tests/data/rpr_turning.toml`): the platform turns about its origin with the
+/// actuators held, so `A`'s rotation column vanishes there (each leg's moment arm about the
+/// origin is zero: plane geometry, independent of the code). That column is alone in its unit
+/// group (rad/s), and scaled by its own norm it looked regular: the generated inverse dynamics
+/// and actuator mass matrix returned `Ok` with entries of 1e16 and more. Its reference is now
+/// at least the translation group's times the platform's radius (`noc::ColumnUnits`).
+/// Checked: every route says `Err(Actuation)` there and `1e-12` rad from it, with a condition
+/// estimate of at least `1/ACTUATION_TOLERANCE`; the generated module (inverse dynamics and
+/// actuator mass matrix), the runtime and the literal route agree on `Ok` or `Err` and its site
+/// along a walk toward it; where `Ok`, the results agree with the literal route to the
+/// accuracy the condition allows; forward dynamics, which needs no `A⁻¹`, answers throughout.
+#[test]
+fn rpr_legs_through_the_platform_origin() {
+    use tests::variants::rpr_turning as g;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/rpr_turning.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let m = match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
+        _ => panic!("rpr_turning does not load as a platform"),
+    };
+    let plan = plan(&m);
+    let beta = 40f64.to_radians();
+    // The moment arm of each leg line about the platform's origin at turn `phi` (plane
+    // geometry): base points at radius 0.6, platform points at 0.15 turned by `beta + phi`.
+    let arm = |phi: f64| {
+        (0..3)
+            .map(|i| {
+                let a = i as f64 * 2.0 * std::f64::consts::PI / 3.0;
+                let (bx, by) = (0.6 * a.cos(), 0.6 * a.sin());
+                let (px, py) = (0.15 * (a + beta + phi).cos(), 0.15 * (a + beta + phi).sin());
+                let (dx, dy) = (px - bx, py - by);
+                (px * dy - py * dx).abs() / dx.hypot(dy)
+            })
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        arm(-beta) < 1e-15 && arm(0.0) > 0.05,
+        "the geometry is not the one described"
+    );
+    let (u, ud) = ([0.1, -0.2, 0.3], [0.5, 0.4, -0.3]);
+    // Each module has its own `Singular`: compared by site (as printed) and estimate.
+    type Verdict = Result<Vec<f64>, (String, f64)>;
+    fn verdict<T: AsRef<[f64]>, E: std::fmt::Debug>(
+        r: Result<T, E>,
+        err: impl Fn(&E) -> (String, f64),
+    ) -> Verdict {
+        r.map(|v| v.as_ref().to_vec()).map_err(|e| err(&e))
+    }
+    let site = |r: &Verdict| r.as_ref().err().map(|e| e.0.clone());
+    let mut seen_err = false;
+    for k in 0..=14 {
+        let delta = if k == 14 { 0.0 } else { 10f64.powi(-k) };
+        let x = [0.0, 0.0, -beta + delta];
+        let of_module = |e: &g::Singular| (format!("{:?}", e.site), e.condition_estimate);
+        let of_runtime = |e: &Singular| (format!("{:?}", e.site), e.condition_estimate);
+        let gen_id = verdict(g::inverse_dynamics(&x, &u, &ud), of_module);
+        let gen_m = verdict(g::actuator_mass_matrix(&x).map(|m| m.concat()), of_module);
+        let gen_fd = verdict(g::forward_dynamics(&x, &u, &ud), of_module);
+        let rt = verdict(noc::inverse_dynamics(&plan, &x, &u, &ud), of_runtime);
+        let lit = verdict(
+            runtime::parallel::literal::inverse_dynamics(&plan, &x, &u, &ud)
+                .map(|t| t.as_slice().to_vec()),
+            of_runtime,
+        );
+        assert_eq!(
+            site(&gen_id),
+            site(&rt),
+            "δ = {delta:e}: generated vs runtime"
+        );
+        assert_eq!(
+            site(&gen_id),
+            site(&gen_m),
+            "δ = {delta:e}: ID vs actuator mass matrix"
+        );
+        // Forward dynamics needs no `A⁻¹` (docs/method.md): it answers here too.
+        assert!(gen_fd.is_ok(), "δ = {delta:e}: forward dynamics {gen_fd:?}");
+        assert_eq!(
+            site(&gen_id),
+            site(&lit),
+            "δ = {delta:e}: generated vs literal"
+        );
+        match (&gen_id, &lit) {
+            (Ok(a), Ok(b)) => {
+                assert!(!seen_err, "δ = {delta:e}: Ok again after an Err closer out");
+                // The error grows like the condition, about 1/δ here.
+                let e = tests::pkm::rel(a, b);
+                assert!(
+                    e < 1e-13 / delta.min(1.0),
+                    "δ = {delta:e}: {e:e} against the literal route"
+                );
+            }
+            (Err((site, cond)), _) => {
+                seen_err = true;
+                assert!(
+                    site.starts_with("Actuation("),
+                    "δ = {delta:e}: {site} {cond:e}"
+                );
+                assert!(
+                    *cond >= min_condition(Site::Actuation(0)),
+                    "δ = {delta:e}: {site} {cond:e}"
+                );
+            }
+            _ => unreachable!(),
+        }
+        if delta <= 1e-12 {
+            assert!(
+                gen_id.is_err(),
+                "δ = {delta:e}: Ok at the singularity: {gen_id:?}"
+            );
+        }
+        if delta >= 1e-4 {
+            assert!(
+                gen_id.is_ok(),
+                "δ = {delta:e}: Err away from it: {gen_id:?}"
+            );
+        }
+    }
+}

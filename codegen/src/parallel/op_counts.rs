@@ -15,6 +15,9 @@ pub fn lu_many_ops(n: usize, k: usize, groups: &[usize]) -> OpCount {
         .filter(|&j| (0..j).all(|i| groups.get(i) != groups.get(j)))
         .count();
     c.cmp += n - distinct;
+    // With several groups, each group's reference against every other group's, converted.
+    c.mul += distinct * (distinct - 1);
+    c.cmp += distinct * (distinct - 1);
     for p in 0..n {
         let rows = n - p - 1;
         // The pivot's conditional swaps (one comparison per lower row); its square and the

@@ -42,7 +42,7 @@ pub(super) fn templates(
         cfg,
         plan,
         "lu_solve",
-        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with each column scaled by the largest 2-norm of its unit group (the speeds\n in rad/s, those in m/s) must exceed the tolerance times the larger of 1 and the largest\n pivot so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of that reference to\n this pivot as the condition estimate.",
+        " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with each column scaled by its unit group's reference (the group's largest\n 2-norm, or another group's times the platform's radius between the speeds in rad/s and\n those in m/s, whichever is larger) must exceed the tolerance times the larger of 1 and the largest\n pivot so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of that reference to\n this pivot as the condition estimate.",
         false,
         lu::Rhs::Vector,
     );
@@ -205,7 +205,7 @@ fn lu_fn(
         transpose,
         rhs,
         tol2: act_tol2,
-        groups: plan.motion.unit_groups(),
+        units: plan.column_units(),
         sqrt: &sqrt_call,
     })
 }

@@ -358,25 +358,21 @@ pub fn generalized_force(plan: &Plan, terms: &Terms, u: &[f64], ud: &[f64]) -> D
 }
 
 /// The LU factorization with partial pivoting (`nalgebra`) of the column-scaled actuation
-/// matrix `Â = A D⁻¹` (`D` the largest magnitude of each column's unit group,
-/// `PlatformMotion::unit_groups`), or of `Âᵀ`; `Err(Actuation(i))` when the smallest pivot
-/// falls below [`ACTUATION_TOLERANCE`] times the largest or 1 (the threshold of
+/// matrix `Â = A D⁻¹` (`D` each column's unit-group reference, as [`super::noc::ColumnUnits`]
+/// takes it but from the columns' largest magnitudes), or of `Âᵀ`; `Err(Actuation(i))` when the
+/// smallest pivot falls below [`ACTUATION_TOLERANCE`] times the largest or 1 (the threshold of
 /// [`super::noc::lu_solve`]). Returns the factorization and `D`.
 type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 
 fn actuation_lu(
     a: &DMatrix<f64>,
     transpose: bool,
-    groups: &[usize],
+    units: super::noc::ColumnUnits<'_>,
 ) -> Result<(Lu, DVector<f64>), Singular> {
-    // Each column scaled by the largest magnitude in its unit group.
+    // Each column scaled by its unit group's reference.
     let amax: alloc::vec::Vec<f64> = a.column_iter().map(|c| c.amax()).collect();
-    let group = |j: usize| groups.get(j).copied().unwrap_or(0);
     let scale = DVector::from_fn(a.ncols(), |j, _| {
-        (0..a.ncols())
-            .filter(|&i| group(i) == group(j))
-            .map(|i| amax[i])
-            .fold(f64::MIN_POSITIVE, f64::max)
+        units.reference(&amax, j).max(f64::MIN_POSITIVE)
     });
     let scaled = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / scale[j]);
     let lu = if transpose {
@@ -412,9 +408,9 @@ const SINGULAR_A: Singular = Singular {
 fn solve_transposed(
     a: &DMatrix<f64>,
     f: &DVector<f64>,
-    groups: &[usize],
+    units: super::noc::ColumnUnits<'_>,
 ) -> Result<DVector<f64>, Singular> {
-    let (lu, scale) = actuation_lu(a, true, groups)?;
+    let (lu, scale) = actuation_lu(a, true, units)?;
     lu.solve(&f.component_div(&scale)).ok_or(SINGULAR_A)
 }
 
@@ -434,7 +430,7 @@ pub fn inverse_dynamics(
     check_finite(&[ud])?;
     let terms = terms(plan, x, u)?;
     let f = generalized_force(plan, &terms, u, ud);
-    finite(solve_transposed(&terms.a, &f, plan.motion.unit_groups())?)
+    finite(solve_transposed(&terms.a, &f, plan.column_units())?)
 }
 
 /// The generalized inertia `I = TᵀMT + Lᵀ I_a L` of the speeds `u` at `x`.
@@ -482,7 +478,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<DMatrix<f64>, Sing
     let n = plan.dof();
     let terms = terms(plan, x, &vec![0.0; n])?;
     let i = generalized_inertia(plan, &terms);
-    let (lu, scale) = actuation_lu(&terms.a, false, plan.motion.unit_groups())?;
+    let (lu, scale) = actuation_lu(&terms.a, false, plan.column_units())?;
     // A⁻¹ = D⁻¹ Â⁻¹ (A = Â D).
     let ainv = lu.try_inverse().ok_or(SINGULAR_A)?;
     let ainv = DMatrix::from_fn(n, n, |r, c| ainv[(r, c)] / scale[r]);

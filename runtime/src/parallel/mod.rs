@@ -133,7 +133,9 @@ impl PlatformMotion {
     /// physical unit (rad/s, m/s) share a group. The pivot test of `A`'s LU scales the columns
     /// of a group by the group's largest column norm, not each column by its own: a column
     /// that shrinks against the others of its unit is a singularity (the platform moves along
-    /// that speed with the actuators still), which scaling it alone to unit norm would hide.
+    /// that speed with the actuators still), which scaling it alone to unit norm would hide;
+    /// and a group's scale is at least another group's converted by the platform's radius
+    /// (`noc::ColumnUnits`), so that a whole group that vanishes is one too.
     pub fn unit_groups(&self) -> &'static [usize] {
         match self {
             PlatformMotion::Pose => &[0, 0, 0, 1, 1, 1],
@@ -142,6 +144,18 @@ impl PlatformMotion {
             PlatformMotion::PlanarPose { .. } => &[0, 0, 1],
             PlatformMotion::HeaveTilt { .. } => &[0, 1, 1],
             PlatformMotion::Schoenflies { .. } => &[0, 0, 0, 1],
+        }
+    }
+    /// Whether each unit group of [`Self::unit_groups`] holds rotation speeds (rad/s; the
+    /// other groups hold speeds in m/s), indexed by group.
+    pub fn rotational_groups(&self) -> &'static [bool] {
+        match self {
+            PlatformMotion::Pose => &[true, false],
+            PlatformMotion::Orientation { .. } => &[true],
+            PlatformMotion::Translation { .. } | PlatformMotion::PlanarPoint { .. } => &[false],
+            PlatformMotion::PlanarPose { .. }
+            | PlatformMotion::HeaveTilt { .. }
+            | PlatformMotion::Schoenflies { .. } => &[false, true],
         }
     }
     /// Whether the platform is a Schönflies carrier with a turning tool (`Schoenflies`).
@@ -336,6 +350,20 @@ impl ParallelModel {
             }
         }
         s
+    }
+
+    /// The platform's radius (m): the largest distance of a leg's joint centre from the
+    /// platform frame's origin, at least 1 mm. A rotation speed's column of the actuation
+    /// matrix is a translation speed's times about this length (the legs' moment arms), which
+    /// its pivot test uses (`noc::ColumnUnits`).
+    pub fn platform_radius(&self) -> f64 {
+        let mut r: f64 = 1e-3;
+        for leg in &self.legs {
+            if let LegEnd::Spherical { on_platform: p, .. } = &leg.end {
+                r = r.max(libm::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]));
+            }
+        }
+        r
     }
 
     /// Check the structure the evaluators rely on: one leg per DOF, one actuator per leg, leg

@@ -110,7 +110,7 @@ pub use inertia::{
 pub use legs::{
     JointPos, LegKin, actuated_positions, actuation_matrix, kinematics, leg_kinematics, positions,
 };
-pub use lu::lu_solve;
+pub use lu::{ColumnUnits, lu_solve};
 pub(crate) use motion::leg_motion;
 pub use parasitic::{
     FullPose, PARASITIC_ITERATIONS, PARASITIC_TOLERANCE, Parasitic, parasitic, parasitic_pose,
@@ -129,8 +129,8 @@ use crate::scalar::Real;
 /// singularity grows like `ε/h²` (measured on the five-bar's stretched leg): `1e-4` keeps it
 /// below about `1e-8`.
 pub const LEG_TOLERANCE: f64 = 1e-4;
-/// Actuation-matrix threshold: `A` (each column scaled by the largest norm of its unit group,
-/// `PlatformMotion::unit_groups`) is singular when a pivot of its partially pivoted LU is
+/// Actuation-matrix threshold: `A` (each column scaled by its unit group's reference,
+/// [`ColumnUnits`]) is singular when a pivot of its partially pivoted LU is
 /// `≤ ACTUATION_TOLERANCE` times the larger of 1 and the largest pivot; the condition estimate
 /// is the ratio of that reference to the pivot.
 pub const ACTUATION_TOLERANCE: f64 = 1e-8;

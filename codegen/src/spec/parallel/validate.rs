@@ -320,6 +320,8 @@ fn validate_diagnostic(
     });
     let hint = if msg.contains("does not close") {
         "at home every leg joint is at zero: place the leg's joint frames (`origin`) so that the joint on the leg meets `child_origin` on the platform at platform.home"
+    } else if msg.contains("of the actuation matrix") {
+        "the platform can move at home with every actuator held (a parallel singularity): the legs' lines of action are dependent there, as when they all meet in one point or are all parallel; move the legs' points on the platform or on the base, or the home pose, so that they are not"
     } else if ps.coordinates == Some(Coordinates::PlanarPose) {
         SUPPORTED_PLANAR_POSE_HINT
     } else if ps.coordinates == Some(Coordinates::HeaveTilt) {

@@ -123,7 +123,7 @@ pub fn inverse_dynamics(
     let (pl, legs) = kinematics(plan, x)?;
     let f = generalized_force(plan, &pl, &legs, u, ud, true);
     let a = actuation_matrix(plan, &pl, &legs);
-    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+    solve_dyn(&a, &f, true, plan.column_units())
 }
 
 /// Actuator efforts that hold the mechanism still against gravity at `x`: `A⁻ᵀ (−γ)`, equal
@@ -134,7 +134,7 @@ pub fn gravity(plan: &Plan, x: &[f64]) -> Result<Vec<f64>, Singular> {
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(plan, &pl, &legs, &z, &z, true);
     let a = actuation_matrix(plan, &pl, &legs);
-    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+    solve_dyn(&a, &f, true, plan.column_units())
 }
 
 /// Velocity-dependent actuator efforts `A⁻ᵀ C u` (Coriolis and centrifugal terms, the rotor
@@ -145,7 +145,7 @@ pub fn coriolis(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular>
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(&plan.without_friction(), &pl, &legs, u, &z, false);
     let a = actuation_matrix(plan, &pl, &legs);
-    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+    solve_dyn(&a, &f, true, plan.column_units())
 }
 
 /// Actuator efforts of the leg joints' friction (viscous and regularized Coulomb, actuated
@@ -156,7 +156,7 @@ pub fn friction(plan: &Plan, x: &[f64], u: &[f64]) -> Result<Vec<f64>, Singular>
     let z = vec![0.0; plan.dof()];
     let f = generalized_force(&plan.friction_only(), &pl, &legs, u, &z, false);
     let a = actuation_matrix(plan, &pl, &legs);
-    solve_dyn(&a, &f, true, plan.motion.unit_groups())
+    solve_dyn(&a, &f, true, plan.column_units())
 }
 
 /// The generalized force `I u̇ + C u − γ` of the speeds `u` (before the actuation map).
@@ -192,7 +192,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
     for j in 0..n {
         let mut e = vec![0.0; n];
         e[j] = 1.0;
-        let c = solve_dyn(&a, &e, false, plan.motion.unit_groups())?;
+        let c = solve_dyn(&a, &e, false, plan.column_units())?;
         for r in 0..n {
             b[r][j] = (0..n).map(|k| i[r][k] * c[k]).sum();
         }
@@ -200,7 +200,7 @@ pub fn actuator_mass_matrix(plan: &Plan, x: &[f64]) -> Result<Vec<Vec<f64>>, Sin
     let mut out = vec![vec![0.0; n]; n];
     for j in 0..n {
         let col: Vec<f64> = (0..n).map(|r| b[r][j]).collect();
-        let c = solve_dyn(&a, &col, true, plan.motion.unit_groups())?;
+        let c = solve_dyn(&a, &col, true, plan.column_units())?;
         for r in 0..n {
             out[r][j] = c[r];
         }

@@ -175,7 +175,7 @@ pub fn forward_kinematics(
         if cur.1 <= tol {
             return Ok(x);
         }
-        let Ok(du) = solve_dyn(&cur.2, &cur.0, false, plan.motion.unit_groups()) else {
+        let Ok(du) = solve_dyn(&cur.2, &cur.0, false, plan.column_units()) else {
             return Err(NoConvergence {
                 iterations: it,
                 residual: cur.1,

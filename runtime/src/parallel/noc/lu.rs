@@ -1,6 +1,6 @@
 //! The solves with the actuation matrix `A` of step 6 (`τ = A⁻ᵀ f`, `A⁻¹` in forward
 //! kinematics): [`lu_solve`], LU with partial pivoting of `A` with its columns scaled by unit
-//! group, checked against
+//! group ([`ColumnUnits`]), checked against
 //! [`ACTUATION_TOLERANCE`], for fixed sizes and on row vectors.
 
 use alloc::vec::Vec;
@@ -9,18 +9,88 @@ use super::ACTUATION_TOLERANCE;
 use crate::scalar::{Singular, Site};
 use crate::solve::check_finite;
 
+/// How the pivot test of `A` ([`lu_solve`]) scales its columns (docs/method.md, "The pivot
+/// test of `A`"): each column by the reference of its unit group
+/// (`PlatformMotion::unit_groups`), the larger of the group's largest column 2-norm and every
+/// other group's largest, converted by the platform's radius `L`: a column of a rotation speed
+/// (rad/s) is compared with `L` times one of a translation speed (m/s), as the legs' moment
+/// arms make it. So a whole group that vanishes is a small pivot, as a single column that
+/// shrinks within its group is: a planar 3-RPR whose three leg lines pass through the
+/// platform's origin has an `ω` column of zeros (rounding noise at a computed pose), which
+/// its own norm would scale back to unit length.
+#[derive(Clone, Copy, Debug)]
+pub struct ColumnUnits<'a> {
+    /// The unit group of each column (`PlatformMotion::unit_groups`).
+    pub groups: &'a [usize],
+    /// Per group, whether its speeds are rotations (`PlatformMotion::rotational_groups`).
+    pub rotational: &'a [bool],
+    /// The platform's radius `L` (m, `ParallelModel::platform_radius`).
+    pub length: f64,
+}
+
+impl ColumnUnits<'_> {
+    /// The group of column `j` (all one group when `groups` is short).
+    pub fn group(&self, j: usize) -> usize {
+        self.groups.get(j).copied().unwrap_or(0)
+    }
+
+    /// The factor that turns a column norm of group `h` into one comparable with group `g`'s:
+    /// `L` from translations to rotations, `1/L` back, 1 between groups of one kind.
+    pub fn factor(&self, h: usize, g: usize) -> f64 {
+        let rot = |k: usize| self.rotational.get(k).copied().unwrap_or(false);
+        match (rot(h), rot(g)) {
+            (false, true) => self.length,
+            (true, false) => 1.0 / self.length,
+            _ => 1.0,
+        }
+    }
+
+    /// [`Self::factor`] for squared norms: `L²`, `1/L²` or 1.
+    pub fn factor2(&self, h: usize, g: usize) -> f64 {
+        let rot = |k: usize| self.rotational.get(k).copied().unwrap_or(false);
+        match (rot(h), rot(g)) {
+            (false, true) => self.length * self.length,
+            (true, false) => 1.0 / (self.length * self.length),
+            _ => 1.0,
+        }
+    }
+
+    /// Column `j`'s squared reference from the squared column norms `norm2`: the largest
+    /// `norm2[i] · factor2(group(i), group(j))` (NaN left out).
+    pub fn reference2(&self, norm2: &[f64], j: usize) -> f64 {
+        self.largest(norm2, j, |h, g| self.factor2(h, g))
+    }
+
+    /// Column `j`'s reference from column norms `norm` of any one kind (2-norms, largest
+    /// magnitudes): the largest `norm[i] · factor(group(i), group(j))` (NaN left out).
+    pub fn reference(&self, norm: &[f64], j: usize) -> f64 {
+        self.largest(norm, j, |h, g| self.factor(h, g))
+    }
+
+    fn largest(&self, norm: &[f64], j: usize, factor: impl Fn(usize, usize) -> f64) -> f64 {
+        let mut s: f64 = 0.0;
+        for (i, &n) in norm.iter().enumerate() {
+            let (gi, gj) = (self.group(i), self.group(j));
+            let v = if gi == gj { n } else { n * factor(gi, gj) };
+            if v > s {
+                s = v;
+            }
+        }
+        s
+    }
+}
+
 /// Solve `a x = b` (`transpose`: `aᵀ x = b`) by LU with partial pivoting of `a` with each column
-/// scaled by the largest 2-norm of its unit group (`groups[j]`, `PlatformMotion::unit_groups`);
-/// a pivot `≤ ACTUATION_TOLERANCE` times the larger of 1 and the largest pivot (or a
-/// non-finite one) is reported as `Site::Actuation(pivot)` with the ratio of that reference to
-/// the pivot as the condition estimate. Both solves factorize the same matrix, so they
-/// give the same verdict at every `a` (LAPACK's `dgetrf` and `dgetrs`). Fixed-size, no
-/// allocation.
+/// scaled by its unit group's reference ([`ColumnUnits`]); a pivot `≤ ACTUATION_TOLERANCE`
+/// times the larger of 1 and the largest pivot (or a non-finite one) is reported as
+/// `Site::Actuation(pivot)` with the ratio of that reference to the pivot as the condition
+/// estimate. Both solves factorize the same matrix, so they give the same verdict at every `a`
+/// (LAPACK's `dgetrf` and `dgetrs`). Fixed-size, no allocation.
 pub fn lu_solve<const N: usize>(
     a: &[[f64; N]; N],
     b: &[f64; N],
     transpose: bool,
-    groups: &[usize],
+    units: ColumnUnits<'_>,
 ) -> Result<[f64; N], Singular> {
     // m = a·S (column scaling S), factorized in place as P m = L U: the multipliers below the
     // diagonal, swapped with their rows.
@@ -31,18 +101,10 @@ pub fn lu_solve<const N: usize>(
             norm[j] += row[j] * row[j];
         }
     }
-    // Each column scaled by the largest norm of its unit group (`groups[j]`; all one group
-    // when `groups` is short).
-    let group = |j: usize| groups.get(j).copied().unwrap_or(0);
+    // Each column scaled by its unit group's reference.
     let mut sc = [1.0; N];
     for j in 0..N {
-        let mut s: f64 = 0.0;
-        for i in 0..N {
-            if group(i) == group(j) && norm[i] > s {
-                s = norm[i];
-            }
-        }
-        let s = crate::math::sqrt(s);
+        let s = crate::math::sqrt(units.reference2(&norm, j));
         if s > 0.0 {
             sc[j] = 1.0 / s;
             for row in m.iter_mut() {
@@ -148,7 +210,7 @@ pub(super) fn solve_dyn(
     a: &[Vec<f64>],
     b: &[f64],
     transpose: bool,
-    groups: &[usize],
+    units: ColumnUnits<'_>,
 ) -> Result<Vec<f64>, Singular> {
     macro_rules! fixed {
         ($n:literal) => {{
@@ -160,7 +222,7 @@ pub(super) fn solve_dyn(
                     m[i][j] = a[i][j];
                 }
             }
-            lu_solve(&m, &v, transpose, groups).map(|x| x.to_vec())
+            lu_solve(&m, &v, transpose, units).map(|x| x.to_vec())
         }};
     }
     match b.len() {

@@ -8,6 +8,7 @@ use alloc::vec::Vec;
 
 use super::api::inverse_dynamics;
 use super::delta::{DeltaPlan, delta_plan};
+use super::lu::ColumnUnits;
 use super::shaft::{ShaftPlan, shaft_plan};
 use super::subproblems::rus_crank;
 use super::ups::{UpsPlan, ups_plan};
@@ -74,6 +75,10 @@ pub struct Plan {
     pub platform: (f64, Vec3, Mat3),
     /// Legs.
     pub legs: Vec<LegPlan>,
+    /// The platform's radius (m, `ParallelModel::platform_radius`): the length that converts
+    /// a rotation speed's column of `A` to a translation speed's in its pivot test
+    /// ([`ColumnUnits`]).
+    pub radius: f64,
 }
 
 pub(super) fn sub3(a: &Vec3, b: &Vec3) -> Vec3 {
@@ -286,6 +291,7 @@ impl Plan {
                 model.platform.inertia,
             ),
             legs,
+            radius: model.platform_radius(),
         };
         // The constraint Jacobian must have full rank at home: every leg Jacobian and the
         // actuation matrix regular there.
@@ -297,6 +303,15 @@ impl Plan {
             )
         })?;
         Ok(plan)
+    }
+
+    /// The units of `A`'s columns for its pivot test.
+    pub fn column_units(&self) -> ColumnUnits<'static> {
+        ColumnUnits {
+            groups: self.motion.unit_groups(),
+            rotational: self.motion.rotational_groups(),
+            length: self.radius,
+        }
     }
 
     /// This plan without the drives' friction (viscous and Coulomb; the rotor inertias
