@@ -9,8 +9,9 @@ use super::ACTUATION_TOLERANCE;
 use crate::scalar::{Singular, Site};
 use crate::solve::check_finite;
 
-/// How the pivot test of `A` ([`lu_solve`]) scales its columns (docs/method.md, "The pivot
-/// test of `A`"): each column by the reference of its unit group
+/// How the pivot test of `A` ([`lu_solve`]) scales its columns (docs/method.md, "Parallel
+/// manipulators: actuation matrix", the actuator efforts): each column by the reference of its
+/// unit group
 /// (`PlatformMotion::unit_groups`), the larger of the group's largest column 2-norm and every
 /// other group's largest, converted by the platform's radius `L`: a column of a rotation speed
 /// (rad/s) is compared with `L` times one of a translation speed (m/s), as the legs' moment
