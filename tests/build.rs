@@ -114,6 +114,13 @@ fn main() {
     generate(&out, "rpr_turning", Path::new(rpr), |b| {
         b.omit(&DYNAMICS_ONLY);
     });
+    // A planar 3-RRR whose first leg can fold onto its base joint (`tests/tests/
+    // singularities.rs`, `rrr_leg_folded_onto_its_base_joint`).
+    let fold = "data/planar_3rrr_fold.toml";
+    println!("cargo:rerun-if-changed={fold}");
+    generate(&out, "rrr_fold", Path::new(fold), |b| {
+        b.omit(&DYNAMICS_ONLY);
+    });
     // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
     let p = with_scene(
         &out,

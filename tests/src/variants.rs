@@ -141,6 +141,15 @@ pub mod rpr_turning {
     ));
 }
 
+/// A planar 3-RRR whose first leg folds onto its base joint at `(0, 0.2)` m
+/// (`tests/data/planar_3rrr_fold.toml`; `tests/tests/singularities.rs`).
+pub mod rrr_fold {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/variants/rrr_fold/planar_3rrr_fold.rs"
+    ));
+}
+
 /// Tsai's 3-UPU of `mechanisms/specs/tsai_3upu.toml` in joint coordinates (`tests/data/
 /// tsai_3upu_joints.toml`, the closed-loop route), for the bench against its platform form.
 #[cfg(feature = "figures")]

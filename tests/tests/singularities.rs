@@ -1637,3 +1637,92 @@ fn rpr_legs_through_the_platform_origin() {
         }
     }
 }
+
+/// A planar 3-RRR with equal links whose first leg folds onto its base joint
+/// (`tests/data/planar_3rrr_fold.toml`, the platform at `(ε, 0.2)` m: the platform point
+/// `ε` from the base joint). There the leg Jacobian's first column, `e_z × (P − A)`, vanishes
+/// (a leg singularity; the crank's rate grows as 1/ε). The determinant test divided by each
+/// column's own norm, so a column of length ε was scaled back to unit length: `actuator_rates`
+/// answered `Ok` down to ε = 1e-16, 1.8e-5 off at 1e-12 and 1.4e-2 at 1e-16 (relative, against
+/// double-double). Each column's norm is now floored by its norm at home
+/// (`LegPlan::column_home`), so the leg is `Err(Leg(0))` once `|P − A|` is below
+/// `LEG_TOLERANCE` times its home value (0.2 m). Checked on the generated module against the
+/// double-double route: every answer is `Ok` within `ACCURACY` or `Err` with a condition
+/// estimate past its site's threshold, `Err(Leg(0))` from 1e-6 m, `Ok` at 1e-4 m.
+#[test]
+fn rrr_leg_folded_onto_its_base_joint() {
+    use tests::variants::rrr_fold as g;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/planar_3rrr_fold.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let m = match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
+        _ => panic!("planar_3rrr_fold does not load as a platform"),
+    };
+    // The double-double reference without the floors (its own 32 digits hold to ε = 1e-16).
+    let mut reference = plan(&m);
+    for leg in &mut reference.legs {
+        leg.column_home = [0.0; 3];
+    }
+    let (u, ud) = ([0.01, 0.02, 0.03], [0.1, 0.2, 0.3]);
+    let rel = |a: &[f64], b: &[f64]| {
+        let n = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / n
+    };
+    let site_ok = |site: String, cond: f64, eps: f64| {
+        let min = if site.starts_with("Leg(") {
+            min_condition(Site::Leg(0))
+        } else if site.starts_with("Actuation(") {
+            min_condition(Site::Actuation(0))
+        } else {
+            0.0
+        };
+        assert!(
+            cond >= min,
+            "ε = {eps:e}: {site} with condition estimate {cond:e}"
+        );
+    };
+    for k in 1..=16 {
+        let eps = 10f64.powi(-k);
+        let x = [eps, 0.2, 0.0];
+        let a = references::dd::actuation_dd(&reference, &x).expect("double-double A");
+        let rates_dd: Vec<f64> = a
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .zip(&u)
+                    .fold(dd::DD::from(0.0), |s, (aij, uj)| s + aij.mul_f64(*uj))
+                    .to_f64()
+            })
+            .collect();
+        match g::actuator_rates(&x, &u) {
+            Ok(r) => {
+                let e = rel(&r, &rates_dd);
+                assert!(e <= ACCURACY, "ε = {eps:e}: actuator_rates Ok, {e:e} off");
+            }
+            Err(e) => site_ok(format!("{:?}", e.site), e.condition_estimate, eps),
+        }
+        match (
+            g::inverse_dynamics(&x, &u, &ud),
+            dd::inverse_dynamics_dd(&reference, &x, &u, &ud),
+        ) {
+            (Ok(t), Ok(t_dd)) => {
+                let e = rel(&t, &t_dd);
+                assert!(e <= ACCURACY, "ε = {eps:e}: inverse_dynamics Ok, {e:e} off");
+            }
+            (Ok(t), Err(d)) => panic!("ε = {eps:e}: Ok({t:?}) where double-double fails: {d:?}"),
+            (Err(e), _) => site_ok(format!("{:?}", e.site), e.condition_estimate, eps),
+        }
+        let leg = g::actuator_rates(&x, &u)
+            .err()
+            .map(|e| format!("{:?}", e.site));
+        if eps <= 1e-6 {
+            assert_eq!(leg.as_deref(), Some("Leg(0)"), "ε = {eps:e}");
+        }
+        if eps >= 1e-4 {
+            assert_eq!(leg, None, "ε = {eps:e}");
+        }
+    }
+}

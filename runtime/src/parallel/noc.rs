@@ -125,7 +125,9 @@ use crate::scalar::Real;
 
 /// Leg-Jacobian threshold: a leg is singular when `|det J_J| ≤ LEG_TOLERANCE · ∏‖columns‖`
 /// (the Hadamard ratio `h`; its inverse, reported as the condition estimate, grows like the
-/// condition number of `J_J`). The velocity terms carry `J⁻¹` twice, so rounding near a leg
+/// condition number of `J_J`), a moment-arm column's norm taken at least its norm at home
+/// (`LegPlan::column_home`: a column that vanishes, the end point reaching a revolute axis, is
+/// then a small ratio). The velocity terms carry `J⁻¹` twice, so rounding near a leg
 /// singularity grows like `ε/h²` (measured on the five-bar's stretched leg): `1e-4` keeps it
 /// below about `1e-8`.
 pub const LEG_TOLERANCE: f64 = 1e-4;

@@ -417,17 +417,11 @@ fn chain_pose<R: Real>(lp: &LegPlan, q: &[JointPos<R>]) -> Chain<R> {
 
 /// The rows of `J_J⁻¹` from the Jacobian columns' adjugate, the determinant tested (with
 /// `jacobian`, and not for a closed-form UPS leg).
-fn jacobian_inverse<R: Real>(
-    lp: &LegPlan,
-    k: usize,
-    e: &[V<R>],
-    o: &[V<R>],
-    end: V<R>,
-    jacobian: bool,
-) -> Result<[V<R>; 3], Singular> {
+/// The leg Jacobian's columns (`J_J`, 3 × 3) from the joints' axes `e` and points `o` and
+/// the end point `end`, all in one frame.
+fn jacobian_columns<R: Real>(lp: &LegPlan, e: &[V<R>], o: &[V<R>], end: V<R>) -> Vec<V<R>> {
     let n = lp.joints.len();
-    // Jacobian columns and their adjugate.
-    let cols: Vec<V<R>> = match lp.kind {
+    match lp.kind {
         LegKind::SphericalRr => vec![e[0], e[1], end],
         // A virtual third column along the plane normal keeps J_J 3 × 3; its rate is zero
         // because the end point moves in the plane.
@@ -452,12 +446,65 @@ fn jacobian_inverse<R: Real>(
                 JointKind::Prismatic => e[j],
             })
             .collect(),
-    };
+    }
+}
+
+/// Which of the leg Jacobian's columns ([`jacobian_columns`]) are moment arms, a revolute
+/// axis crossed with the way to the end point (the others are unit axes, of constant norm).
+fn moment_arms(lp: &LegPlan) -> [bool; 3] {
+    match lp.kind {
+        LegKind::SphericalRr => [false; 3],
+        LegKind::PlanarRr | LegKind::Shaft => [true, true, false],
+        LegKind::PlanarPr => [false, true, false],
+        LegKind::PlanarRp => [true, false, false],
+        _ => {
+            let r = |j: usize| lp.joints.get(j) == Some(&JointKind::Revolute);
+            [r(0), r(1), r(2)]
+        }
+    }
+}
+
+/// [`LegPlan::column_home`]: the squared norms at home of the leg Jacobian's moment-arm
+/// columns (0 for its unit-axis columns, which need no floor).
+pub(super) fn home_column_norms(lp: &LegPlan) -> [f64; 3] {
+    let v = |p: &[f64; 3]| -> V<f64> { *p };
+    let e: Vec<V<f64>> = lp.axes.iter().map(v).collect();
+    let o: Vec<V<f64>> = lp.points.iter().map(v).collect();
+    let cols = jacobian_columns(lp, &e, &o, v(&lp.end_home));
+    let arms = moment_arms(lp);
+    let mut out = [0.0; 3];
+    for (k, c) in cols.iter().take(3).enumerate() {
+        if arms[k] {
+            out[k] = dot(*c, *c);
+        }
+    }
+    out
+}
+
+fn jacobian_inverse<R: Real>(
+    lp: &LegPlan,
+    k: usize,
+    e: &[V<R>],
+    o: &[V<R>],
+    end: V<R>,
+    jacobian: bool,
+) -> Result<[V<R>; 3], Singular> {
+    // Jacobian columns and their adjugate.
+    let cols = jacobian_columns(lp, e, o, end);
     let r0 = cross(cols[1], cols[2]);
     let r1 = cross(cols[2], cols[0]);
     let r2 = cross(cols[0], cols[1]);
     let det = dot(cols[0], r0);
-    let hn = (dot(cols[0], cols[0]) * dot(cols[1], cols[1]) * dot(cols[2], cols[2])).sqrt();
+    // Each column's squared norm, a moment arm's at least its norm at home
+    // (`LegPlan::column_home`).
+    let norm2 = |k: usize| {
+        let n = dot(cols[k], cols[k]);
+        match lp.column_home[k] {
+            0.0 => n,
+            f => R::select_abs_gt(n, R::c(f), n, R::c(f)),
+        }
+    };
+    let hn = (norm2(0) * norm2(1) * norm2(2)).sqrt();
     // (A shaft's columns are orthogonal: its own test is the U's gimbal lock, in `shaft_ik`.)
     let det = if jacobian && lp.ups.is_none() && lp.delta.is_none() && lp.shaft.is_none() {
         R::check(

@@ -62,6 +62,11 @@ pub struct LegPlan {
     /// The shaft of a Schönflies platform (see [`ShaftPlan`]): `Some` for a
     /// [`LegKind::Shaft`] leg, `None` otherwise.
     pub shaft: Option<ShaftPlan>,
+    /// The squared norms of the leg Jacobian's columns at home: the floor of each column's
+    /// norm in its determinant test, so that a column that vanishes (the end point reaching
+    /// a revolute axis: a folded R-R leg's end on its base joint) is a small ratio, not a
+    /// column scaled back to unit norm by its own rounding noise. Zero for a unit-axis column.
+    pub column_home: [f64; 3],
 }
 
 /// The constant data of a whole mechanism: what the evaluators need, prepared once.
@@ -205,6 +210,7 @@ impl Plan {
                 ups: None,
                 delta: None,
                 shaft: None,
+                column_home: [0.0; 3],
             };
             match kind {
                 LegKind::Ups => {
@@ -280,6 +286,9 @@ impl Plan {
                     plan.length = libm::sqrt(dot3(&d, &d));
                 }
             }
+            // (Also for a leg with a closed form: the plans without one, the regressor's and
+            // the friction's, test its Jacobian.)
+            plan.column_home = super::legs::home_column_norms(&plan);
             legs.push(plan);
         }
         let plan = Plan {
