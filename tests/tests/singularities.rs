@@ -50,6 +50,19 @@ fn model(name: &str) -> ParallelModel {
     tests::pkm::model(name)
 }
 
+/// The model of a platform spec in `tests/data/`.
+fn data_model(file: &str) -> ParallelModel {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(file);
+    let src = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
+    match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
+        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
+        Ok(_) => panic!("{file} is not a parallel mechanism"),
+        Err(d) => panic!("{d}"),
+    }
+}
+
 fn plan(m: &ParallelModel) -> Plan {
     Plan::new(m).unwrap_or_else(|e| panic!("{}: {e}", m.name))
 }
@@ -1523,7 +1536,7 @@ fn out_of_reach() {
 /// actuators held, so `A`'s rotation column vanishes there (each leg's moment arm about the
 /// origin is zero: plane geometry, independent of the code). That column is alone in its unit
 /// group (rad/s), and scaled by its own norm it looked regular: the generated inverse dynamics
-/// and actuator mass matrix returned `Ok` with entries of 1e16 and more. Its reference is now
+/// returned `Ok` with 1.9e11 N 1e-12 rad from it. Its reference is now
 /// at least the translation group's times the platform's radius (`noc::ColumnUnits`).
 /// Checked: every route says `Err(Actuation)` there and `1e-12` rad from it, with a condition
 /// estimate of at least `1/ACTUATION_TOLERANCE`; the generated module (inverse dynamics and
@@ -1533,12 +1546,7 @@ fn out_of_reach() {
 #[test]
 fn rpr_legs_through_the_platform_origin() {
     use tests::variants::rpr_turning as g;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/rpr_turning.toml");
-    let src = std::fs::read_to_string(&path).unwrap();
-    let m = match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
-        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
-        _ => panic!("rpr_turning does not load as a platform"),
-    };
+    let m = data_model("rpr_turning.toml");
     let plan = plan(&m);
     let beta = 40f64.to_radians();
     // The moment arm of each leg line about the platform's origin at turn `phi` (plane
@@ -1652,12 +1660,7 @@ fn rpr_legs_through_the_platform_origin() {
 #[test]
 fn rrr_leg_folded_onto_its_base_joint() {
     use tests::variants::rrr_fold as g;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/planar_3rrr_fold.toml");
-    let src = std::fs::read_to_string(&path).unwrap();
-    let m = match codegen::spec::load_mechanism(&path.to_string_lossy(), &src) {
-        Ok((codegen::spec::Mechanism::Parallel(m), _)) => m,
-        _ => panic!("planar_3rrr_fold does not load as a platform"),
-    };
+    let m = data_model("planar_3rrr_fold.toml");
     // The double-double reference without the floors (its own 32 digits hold to ε = 1e-16).
     let mut reference = plan(&m);
     for leg in &mut reference.legs {
