@@ -415,8 +415,6 @@ fn chain_pose<R: Real>(lp: &LegPlan, q: &[JointPos<R>]) -> Chain<R> {
     }
 }
 
-/// The rows of `J_J⁻¹` from the Jacobian columns' adjugate, the determinant tested (with
-/// `jacobian`, and not for a closed-form UPS leg).
 /// The leg Jacobian's columns (`J_J`, 3 × 3) from the joints' axes `e` and points `o` and
 /// the end point `end`, all in one frame.
 fn jacobian_columns<R: Real>(lp: &LegPlan, e: &[V<R>], o: &[V<R>], end: V<R>) -> Vec<V<R>> {
@@ -481,6 +479,8 @@ pub(super) fn home_column_norms(lp: &LegPlan) -> [f64; 3] {
     out
 }
 
+/// The rows of `J_J⁻¹` from the Jacobian columns' adjugate, the determinant tested (with
+/// `jacobian`, and not for a closed-form UPS leg).
 fn jacobian_inverse<R: Real>(
     lp: &LegPlan,
     k: usize,
