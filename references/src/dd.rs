@@ -400,19 +400,19 @@ pub fn solve_pivots(a: &[Vec<DD>], b: &[DD], transpose: bool) -> (Vec<DD>, Vec<D
     (x, pivots)
 }
 
-/// Condition data of the actuation matrix, computed in double-double on the matrix the runtime
-/// factorizes (`A` with its columns scaled to unit 2-norm).
+/// Condition data of the actuation matrix, computed in double-double on `A` with each column
+/// scaled to unit 2-norm (the textbook scaling, not the runtime's unit-group references of
+/// `noc::ColumnUnits`: a reference of the matrix, not of the runtime's estimate).
 #[derive(Clone, Copy, Debug)]
 pub struct Conditioning {
-    /// Largest over smallest pivot of the partially pivoted LU (the runtime's estimate,
-    /// `noc::lu_solve`, here without rounding error).
+    /// Largest over smallest pivot of the partially pivoted LU (the kind of estimate
+    /// `noc::lu_solve` reports, here on unit columns and without rounding error).
     pub pivot_ratio: f64,
     /// The 1-norm condition number `‖M‖₁ ‖M⁻¹‖₁` of the scaled matrix `M`.
     pub kappa1: f64,
 }
 
-/// [`Conditioning`] of `A` (columns scaled to unit norm), as `noc::lu_solve(A, ·, _)` sees it
-/// for either solve.
+/// [`Conditioning`] of `A` with its columns scaled to unit norm.
 pub fn conditioning(a: &[Vec<DD>]) -> Conditioning {
     let n = a.len();
     // mᵢⱼ = a_ij, columns scaled.
