@@ -107,20 +107,19 @@ fn main() {
     generate(&out, "planar3_joints", Path::new(joints), |b| {
         b.omit(&DYNAMICS_ONLY);
     });
-    // A planar 3-RPR whose leg lines can all pass through the platform's origin
-    // (`tests/tests/singularities.rs`, `rpr_legs_through_the_platform_origin`).
-    let rpr = "data/rpr_turning.toml";
-    println!("cargo:rerun-if-changed={rpr}");
-    generate(&out, "rpr_turning", Path::new(rpr), |b| {
-        b.omit(&DYNAMICS_ONLY);
-    });
-    // A planar 3-RRR whose first leg can fold onto its base joint (`tests/tests/
-    // singularities.rs`, `rrr_leg_folded_onto_its_base_joint`).
-    let fold = "data/planar_3rrr_fold.toml";
-    println!("cargo:rerun-if-changed={fold}");
-    generate(&out, "rrr_fold", Path::new(fold), |b| {
-        b.omit(&DYNAMICS_ONLY);
-    });
+    // Walks into singularities (`tests/tests/singularities.rs`): a planar 3-RPR whose leg
+    // lines can all pass through the platform's origin (`rpr_legs_through_the_platform_origin`)
+    // and a planar 3-RRR whose first leg can fold onto its base joint
+    // (`rrr_leg_folded_onto_its_base_joint`).
+    for (variant, spec) in [
+        ("rpr_turning", "data/rpr_turning.toml"),
+        ("rrr_fold", "data/planar_3rrr_fold.toml"),
+    ] {
+        println!("cargo:rerun-if-changed={spec}");
+        generate(&out, variant, Path::new(spec), |b| {
+            b.omit(&DYNAMICS_ONLY);
+        });
+    }
     // Friction and rotor inertia (`tests/tests/regressor.rs`: their base parameters).
     let p = with_scene(
         &out,

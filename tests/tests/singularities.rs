@@ -1700,9 +1700,10 @@ fn rrr_leg_folded_onto_its_base_joint() {
                     .to_f64()
             })
             .collect();
-        match g::actuator_rates(&x, &u) {
+        let rates = g::actuator_rates(&x, &u);
+        match &rates {
             Ok(r) => {
-                let e = rel(&r, &rates_dd);
+                let e = rel(r, &rates_dd);
                 assert!(e <= ACCURACY, "ε = {eps:e}: actuator_rates Ok, {e:e} off");
             }
             Err(e) => site_ok(format!("{:?}", e.site), e.condition_estimate, eps),
@@ -1718,9 +1719,7 @@ fn rrr_leg_folded_onto_its_base_joint() {
             (Ok(t), Err(d)) => panic!("ε = {eps:e}: Ok({t:?}) where double-double fails: {d:?}"),
             (Err(e), _) => site_ok(format!("{:?}", e.site), e.condition_estimate, eps),
         }
-        let leg = g::actuator_rates(&x, &u)
-            .err()
-            .map(|e| format!("{:?}", e.site));
+        let leg = rates.err().map(|e| format!("{:?}", e.site));
         if eps <= 1e-6 {
             assert_eq!(leg.as_deref(), Some("Leg(0)"), "ε = {eps:e}");
         }

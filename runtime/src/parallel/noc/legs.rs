@@ -416,48 +416,33 @@ fn chain_pose<R: Real>(lp: &LegPlan, q: &[JointPos<R>]) -> Chain<R> {
 }
 
 /// The leg Jacobian's columns (`J_J`, 3 × 3) from the joints' axes `e` and points `o` and
-/// the end point `end`, all in one frame.
-fn jacobian_columns<R: Real>(lp: &LegPlan, e: &[V<R>], o: &[V<R>], end: V<R>) -> Vec<V<R>> {
+/// the end point `end`, all in one frame, and which of them are moment arms (a revolute axis
+/// crossed with the way to the end point; the others are unit axes, of constant norm).
+fn jacobian_columns<R: Real>(
+    lp: &LegPlan,
+    e: &[V<R>],
+    o: &[V<R>],
+    end: V<R>,
+) -> (Vec<V<R>>, [bool; 3]) {
     let n = lp.joints.len();
+    let arm = |j: usize, p: V<R>| cross(e[j], sub(p, o[j]));
     match lp.kind {
-        LegKind::SphericalRr => vec![e[0], e[1], end],
+        LegKind::SphericalRr => (vec![e[0], e[1], end], [false; 3]),
         // A virtual third column along the plane normal keeps J_J 3 × 3; its rate is zero
         // because the end point moves in the plane.
-        LegKind::PlanarRr => vec![
-            cross(e[0], sub(end, o[0])),
-            cross(e[1], sub(end, o[1])),
-            e[0],
-        ],
+        LegKind::PlanarRr => (vec![arm(0, end), arm(1, end), e[0]], [true, true, false]),
         // The same virtual column (the revolute's axis is the plane normal).
-        LegKind::PlanarPr => vec![e[0], cross(e[1], sub(end, o[1])), e[1]],
-        LegKind::PlanarRp => vec![cross(e[0], sub(end, o[0])), e[1], e[0]],
+        LegKind::PlanarPr => (vec![e[0], arm(1, end), e[1]], [false, true, false]),
+        LegKind::PlanarRp => (vec![arm(0, end), e[1], e[0]], [true, false, false]),
         // A shaft: the tube's U and prismatic joint at the second U's centre T = o₄ (the
         // motor's column is known from ω; shaft.rs).
-        LegKind::Shaft => vec![
-            cross(e[1], sub(o[4], o[1])),
-            cross(e[2], sub(o[4], o[2])),
-            e[3],
-        ],
-        _ => (0..n)
-            .map(|j| match lp.joints[j] {
-                JointKind::Revolute => cross(e[j], sub(end, o[j])),
-                JointKind::Prismatic => e[j],
-            })
-            .collect(),
-    }
-}
-
-/// Which of the leg Jacobian's columns ([`jacobian_columns`]) are moment arms, a revolute
-/// axis crossed with the way to the end point (the others are unit axes, of constant norm).
-fn moment_arms(lp: &LegPlan) -> [bool; 3] {
-    match lp.kind {
-        LegKind::SphericalRr => [false; 3],
-        LegKind::PlanarRr | LegKind::Shaft => [true, true, false],
-        LegKind::PlanarPr => [false, true, false],
-        LegKind::PlanarRp => [true, false, false],
+        LegKind::Shaft => (vec![arm(1, o[4]), arm(2, o[4]), e[3]], [true, true, false]),
         _ => {
-            let r = |j: usize| lp.joints.get(j) == Some(&JointKind::Revolute);
-            [r(0), r(1), r(2)]
+            let revolute = |j: usize| lp.joints.get(j) == Some(&JointKind::Revolute);
+            let cols = (0..n)
+                .map(|j| if revolute(j) { arm(j, end) } else { e[j] })
+                .collect();
+            (cols, [revolute(0), revolute(1), revolute(2)])
         }
     }
 }
@@ -465,18 +450,8 @@ fn moment_arms(lp: &LegPlan) -> [bool; 3] {
 /// [`LegPlan::column_home`]: the squared norms at home of the leg Jacobian's moment-arm
 /// columns (0 for its unit-axis columns, which need no floor).
 pub(super) fn home_column_norms(lp: &LegPlan) -> [f64; 3] {
-    let v = |p: &[f64; 3]| -> V<f64> { *p };
-    let e: Vec<V<f64>> = lp.axes.iter().map(v).collect();
-    let o: Vec<V<f64>> = lp.points.iter().map(v).collect();
-    let cols = jacobian_columns(lp, &e, &o, v(&lp.end_home));
-    let arms = moment_arms(lp);
-    let mut out = [0.0; 3];
-    for (k, c) in cols.iter().take(3).enumerate() {
-        if arms[k] {
-            out[k] = dot(*c, *c);
-        }
-    }
-    out
+    let (cols, arms) = jacobian_columns(lp, &lp.axes, &lp.points, lp.end_home);
+    core::array::from_fn(|k| if arms[k] { dot(cols[k], cols[k]) } else { 0.0 })
 }
 
 /// The rows of `J_J⁻¹` from the Jacobian columns' adjugate, the determinant tested (with
@@ -490,7 +465,7 @@ fn jacobian_inverse<R: Real>(
     jacobian: bool,
 ) -> Result<[V<R>; 3], Singular> {
     // Jacobian columns and their adjugate.
-    let cols = jacobian_columns(lp, e, o, end);
+    let (cols, _) = jacobian_columns(lp, e, o, end);
     let r0 = cross(cols[1], cols[2]);
     let r1 = cross(cols[2], cols[0]);
     let r2 = cross(cols[0], cols[1]);

@@ -11,9 +11,8 @@ use crate::solve::check_finite;
 
 /// How the pivot test of `A` ([`lu_solve`]) scales its columns (docs/method.md, "Parallel
 /// manipulators: actuation matrix", the actuator efforts): each column by the reference of its
-/// unit group
-/// (`PlatformMotion::unit_groups`), the larger of the group's largest column 2-norm and every
-/// other group's largest, converted by the platform's radius `L`: a column of a rotation speed
+/// unit group (`PlatformMotion::unit_groups`), the larger of the group's largest column 2-norm
+/// and every other group's largest, converted by the platform's radius `L`: a column of a rotation speed
 /// (rad/s) is compared with `L` times one of a translation speed (m/s), as the legs' moment
 /// arms make it. So a whole group that vanishes is a small pivot, as a single column that
 /// shrinks within its group is: a planar 3-RPR whose three leg lines pass through the
@@ -35,24 +34,29 @@ impl ColumnUnits<'_> {
         self.groups.get(j).copied().unwrap_or(0)
     }
 
+    /// Whether groups `h` and `g` are of one kind (`None`), or `h` holds translations and `g`
+    /// rotations (`Some(true)`), or the other way round (`Some(false)`).
+    fn conversion(&self, h: usize, g: usize) -> Option<bool> {
+        let rot = |k: usize| self.rotational.get(k).copied().unwrap_or(false);
+        (rot(h) != rot(g)).then(|| rot(g))
+    }
+
     /// The factor that turns a column norm of group `h` into one comparable with group `g`'s:
     /// `L` from translations to rotations, `1/L` back, 1 between groups of one kind.
     pub fn factor(&self, h: usize, g: usize) -> f64 {
-        let rot = |k: usize| self.rotational.get(k).copied().unwrap_or(false);
-        match (rot(h), rot(g)) {
-            (false, true) => self.length,
-            (true, false) => 1.0 / self.length,
-            _ => 1.0,
+        match self.conversion(h, g) {
+            Some(true) => self.length,
+            Some(false) => 1.0 / self.length,
+            None => 1.0,
         }
     }
 
     /// [`Self::factor`] for squared norms: `L²`, `1/L²` or 1.
     pub fn factor2(&self, h: usize, g: usize) -> f64 {
-        let rot = |k: usize| self.rotational.get(k).copied().unwrap_or(false);
-        match (rot(h), rot(g)) {
-            (false, true) => self.length * self.length,
-            (true, false) => 1.0 / (self.length * self.length),
-            _ => 1.0,
+        match self.conversion(h, g) {
+            Some(true) => self.length * self.length,
+            Some(false) => 1.0 / (self.length * self.length),
+            None => 1.0,
         }
     }
 
@@ -69,9 +73,10 @@ impl ColumnUnits<'_> {
     }
 
     fn largest(&self, norm: &[f64], j: usize, factor: impl Fn(usize, usize) -> f64) -> f64 {
+        let gj = self.group(j);
         let mut s: f64 = 0.0;
         for (i, &n) in norm.iter().enumerate() {
-            let (gi, gj) = (self.group(i), self.group(j));
+            let gi = self.group(i);
             let v = if gi == gj { n } else { n * factor(gi, gj) };
             if v > s {
                 s = v;
