@@ -70,7 +70,9 @@ fn with_runtime_inertia(scene: &str) -> String {
     scene.replacen("[scene]\n", "[scene]\nruntime_inertia = \"all\"\n", 1)
 }
 
-/// The bundled specs the variants start from.
+// The bundled platforms and closed loops (`PARALLEL`, `CLOSED`).
+include!("src/bundled.rs");
+
 const PUMA: &str = "../mechanisms/specs/puma560.toml";
 const CHAIN7: &str = "../mechanisms/specs/chain7.toml";
 const GS: &str = "../mechanisms/specs/gough_stewart.toml";
@@ -205,6 +207,26 @@ fn main() {
         }
         b.lanes(Some(4));
     });
+    // The bundled platforms and closed loops with 4 lanes (dynamics only): their `_lanes`
+    // functions against the scalar ones in `tests/tests/lanes.rs`.
+    for (variant, names) in [
+        ("lanes_parallel", &PARALLEL[..]),
+        ("lanes_closed", &CLOSED[..]),
+    ] {
+        let specs: Vec<String> = names
+            .iter()
+            .map(|n| format!("../mechanisms/specs/{n}.toml"))
+            .collect();
+        for spec in &specs {
+            println!("cargo:rerun-if-changed={spec}");
+        }
+        generate(&out, variant, Path::new(&specs[0]), |b| {
+            for spec in &specs[1..] {
+                b.spec(spec);
+            }
+            b.lanes(Some(4)).omit(&DYNAMICS_ONLY);
+        });
+    }
     generate(&out, "lanes_f32", Path::new(PUMA), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });

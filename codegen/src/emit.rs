@@ -409,7 +409,7 @@ pub(crate) fn return_tokens(f: &Function<'_>, outs: &[TokenStream]) -> TokenStre
 }
 
 /// One part or a tuple of parts, in output order ([`Part::Hidden`] ones left out).
-fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
+pub(crate) fn parts_tokens(parts: &[Part], n: usize, outs: &[TokenStream]) -> TokenStream {
     let mut rest = outs;
     let mut items = Vec::new();
     for p in parts {
@@ -519,38 +519,31 @@ pub(crate) fn chunked(
 
 /// `site: Site::…` of a guard in a parallel module.
 fn site_tokens(site: runtime::scalar::Site) -> TokenStream {
+    let e = site_expr(site);
+    quote!(site: #e)
+}
+
+/// The generated module's `Site::…` value of `site`.
+pub(crate) fn site_expr(site: runtime::scalar::Site) -> TokenStream {
     use runtime::scalar::Site as S;
-    match site {
-        S::MassMatrix(i) => {
+    let (variant, i) = match site {
+        S::MassMatrix(i) => ("MassMatrix", Some(i)),
+        S::Leg(i) => ("Leg", Some(i)),
+        S::Reach(i) => ("Reach", Some(i)),
+        S::Actuation(i) => ("Actuation", Some(i)),
+        S::Closure(i) => ("Closure", Some(i)),
+        S::Constraint(i) => ("Constraint", Some(i)),
+        S::Spring(i) => ("Spring", Some(i)),
+        S::Platform => ("Platform", None),
+        S::Input => ("Input", None),
+    };
+    let variant = Ident::new(variant, Span::call_site());
+    match i {
+        Some(i) => {
             let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::MassMatrix(#i))
+            quote!(Site::#variant(#i))
         }
-        S::Leg(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Leg(#i))
-        }
-        S::Reach(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Reach(#i))
-        }
-        S::Actuation(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Actuation(#i))
-        }
-        S::Closure(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Closure(#i))
-        }
-        S::Constraint(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Constraint(#i))
-        }
-        S::Spring(i) => {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(site: Site::Spring(#i))
-        }
-        S::Platform => quote!(site: Site::Platform),
-        S::Input => quote!(site: Site::Input),
+        None => quote!(Site::#variant),
     }
 }
 
@@ -620,7 +613,7 @@ pub(crate) fn return_type(shape: &Shape) -> TokenStream {
 }
 
 /// The type of one part or a tuple of parts ([`Part::Hidden`] ones left out).
-fn parts_type(parts: &[Part]) -> TokenStream {
+pub(crate) fn parts_type(parts: &[Part]) -> TokenStream {
     let tys: Vec<TokenStream> = parts
         .iter()
         .filter(|p| !matches!(p, Part::Hidden(_)))

@@ -1,5 +1,6 @@
-//! Many states per call ([`crate::Config::lanes`]): for each of a tree module's dynamics
-//! functions ([`FUNCTIONS`]), a `<name>_lanes` that evaluates `LANES` states at once.
+//! Many states per call ([`crate::Config::lanes`]): for each of a module's dynamics functions
+//! ([`FUNCTIONS`], and a platform's or closed loop's `actuator_mass_matrix`), a `<name>_lanes`
+//! that evaluates `LANES` states at once.
 //!
 //! The same scheduled statements as the scalar function, over `Lanes` (`[f64; LANES]` in a
 //! struct whose operators are written out lane by lane, which LLVM turns into vector
@@ -20,6 +21,17 @@
 //! guards record the first failure and skip it from there on; its values are not to be read).
 //! Every per-lane step is unrolled at generation time: constant indices only, no panicking
 //! operation, no heap.
+//!
+//! Platforms and closed loops: every function can fail, so every `_lanes` function returns
+//! each lane's status, its `Err` the scalar function's (a non-finite input first, then the
+//! guards in the scalar order, each lane's first failure recorded by the guard's site code,
+//! `lane_site` turning it back into the `Site`). A function that is one kernel (a closed
+//! loop's dynamics, a platform's `mass_matrix` and `forward_dynamics`) runs its schedule over
+//! the lanes whole. A platform's functions that solve with the actuation matrix `A`
+//! (`inverse_dynamics`, `gravity`, `coriolis`, `actuator_mass_matrix`) run their kernel
+//! (`id_parts`, …) over the lanes, which returns each lane's `Result` as the scalar kernel
+//! does, and the wrappers (`templates/platform_lanes.rs`) solve each lane with the scalar
+//! functions' own LU: the pivots are chosen per lane, and the kernel is most of the work.
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -27,7 +39,7 @@ use quote::{format_ident, quote};
 mod sin_cos;
 
 use crate::Config;
-use crate::emit::{self, Function, Shape};
+use crate::emit::{self, Function, Part, Shape};
 use crate::schedule::{Operand, Schedule, Step};
 use crate::sym::{Arg, ExprId, Graph, Node};
 
@@ -40,30 +52,173 @@ pub const FUNCTIONS: [&str; 5] = [
     "forward_dynamics",
 ];
 
+/// A platform module's kernels and the public functions built on them that get a `_lanes`
+/// version (`codegen/templates/platform_lanes.rs`): each lane's kernel result is solved by
+/// the scalar functions' LU of `A`.
+const KERNELS: [(&str, &str); 4] = [
+    ("id_parts", "inverse_dynamics"),
+    ("gravity_parts", "gravity"),
+    ("coriolis_parts", "coriolis"),
+    ("inertia_parts", "actuator_mass_matrix"),
+];
+
+/// The public `_lanes` wrappers around the kernels.
+const PLATFORM_LANES: &str = include_str!("../templates/platform_lanes.rs");
+
 /// The widest `lanes` accepted (16 `f32` lanes fill an AVX-512 register).
 pub const MAX: usize = 16;
 
-/// `LANES`, the `Lanes` type and the `_lanes` functions of `functions`' dynamics functions
-/// (nothing when none is a tree's).
-pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usize) -> TokenStream {
-    let chosen: Vec<&Function<'_>> = functions
-        .iter()
-        .filter(|f| f.public && !f.sites && FUNCTIONS.contains(&f.name))
-        .filter(|f| {
+/// The functions with a `_lanes` version in a module of `functions` (by their scalar names).
+pub(crate) fn names(functions: &[Function<'_>]) -> Vec<&'static str> {
+    let has = |n: &str| functions.iter().any(|f| f.name == n);
+    let mut names: Vec<&'static str> = FUNCTIONS
+        .into_iter()
+        .filter(|n| functions.iter().any(|f| f.name == *n && flat(f)))
+        .collect();
+    for (kernel, wrapper) in KERNELS {
+        if has(kernel) {
+            names.push(wrapper);
+        }
+    }
+    // A closed loop's `actuator_mass_matrix` is its `mass_matrix` (the actuated joints are its
+    // independent coordinates).
+    if functions.iter().any(|f| f.sites) && has("mass_matrix") && !has("inertia_parts") {
+        names.push("actuator_mass_matrix");
+    }
+    names.sort_by_key(|n| {
+        FUNCTIONS
+            .iter()
+            .chain(["actuator_mass_matrix"].iter())
+            .position(|m| m == n)
+    });
+    names
+}
+
+/// A public function whose `_lanes` version is its own schedule over the lanes: a tree's
+/// [`FUNCTIONS`], or a platform's or closed loop's that return one vector or one matrix.
+fn flat(f: &Function<'_>) -> bool {
+    f.public
+        && FUNCTIONS.contains(&f.name)
+        && if f.sites {
+            matches!(&f.shape, Shape::Fallible(p) if matches!(p[..], [Part::Vector] | [Part::Matrix]))
+        } else {
             matches!(
                 f.shape,
                 Shape::Vector | Shape::Matrix | Shape::FallibleVector
             )
-        })
+        }
+}
+
+/// `LANES`, the `Lanes` type and the `_lanes` functions of `functions`' dynamics functions
+/// (nothing when the module has none of them).
+pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usize) -> TokenStream {
+    let chosen: Vec<&Function<'_>> = functions.iter().filter(|f| flat(f)).collect();
+    let kernels: Vec<&Function<'_>> = functions
+        .iter()
+        .filter(|f| KERNELS.iter().any(|(k, _)| *k == f.name))
         .collect();
-    if chosen.is_empty() {
+    if chosen.is_empty() && kernels.is_empty() {
         return TokenStream::new();
     }
     let ty = lanes_type(cfg, l);
     let fns = chosen.iter().map(|f| function(g, f, l));
+    let sites = functions.iter().any(|f| f.sites);
+    if !sites {
+        return quote! {
+            #ty
+            #(#fns)*
+        };
+    }
+    let kernel_fns = kernels.iter().map(|f| kernel(g, f, l));
+    let lane_site = lane_site(g, chosen.iter().chain(&kernels).copied());
+    let params = kernels.iter().any(|f| f.args.contains(&Arg::P));
+    let wrappers: Vec<&str> = KERNELS
+        .iter()
+        .filter(|(k, _)| kernels.iter().any(|f| f.name == *k))
+        .map(|(_, w)| *w)
+        .collect();
+    let mut wrapper_items: Vec<String> = wrappers.iter().map(|w| format!("{w}_lanes")).collect();
+    if wrappers.iter().any(|w| *w != "actuator_mass_matrix") {
+        wrapper_items.push("solve_t_lanes".into());
+    }
+    let wrapper_items: Vec<&str> = wrapper_items.iter().map(String::as_str).collect();
+    let wrappers = crate::template::Specialize::new(cfg)
+        .params(params)
+        .items(PLATFORM_LANES, &wrapper_items);
+    let closed_amm = if names(functions).contains(&"actuator_mass_matrix")
+        && !functions.iter().any(|f| f.name == "inertia_parts")
+    {
+        closed_actuator_mass_matrix(functions)
+    } else {
+        TokenStream::new()
+    };
     quote! {
         #ty
+        #lane_site
         #(#fns)*
+        #(#kernel_fns)*
+        #wrappers
+        #closed_amm
+    }
+}
+
+/// A closed loop's `actuator_mass_matrix_lanes`: its `mass_matrix_lanes`.
+fn closed_actuator_mass_matrix(functions: &[Function<'_>]) -> TokenStream {
+    let real = emit::real();
+    let params = functions
+        .iter()
+        .any(|f| f.name == "mass_matrix" && f.args.contains(&Arg::P));
+    let (p_arg, p) = if params {
+        (quote!(, p: &Params), quote!(, p))
+    } else {
+        (quote!(), quote!())
+    };
+    quote! {
+        /// `actuator_mass_matrix` of `LANES` states at once: `mass_matrix_lanes` (the actuated
+        /// joints are the independent coordinates).
+        #[inline(always)]
+        pub fn actuator_mass_matrix_lanes(
+            x: &[[#real; LANES]; NX] #p_arg
+        ) -> ([[[#real; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
+            mass_matrix_lanes(x #p)
+        }
+    }
+}
+
+/// `lane_site`, the `Site` of a guard's code (`runtime::scalar::Site::code`) as the `_lanes`
+/// functions record a lane's first failure: one arm per guard of `functions`.
+fn lane_site<'a>(g: &Graph, functions: impl Iterator<Item = &'a Function<'a>>) -> TokenStream {
+    use runtime::scalar::Site;
+    let mut codes: Vec<u16> = Vec::new();
+    for f in functions {
+        for st in &f.schedule.steps {
+            if let Step::Check { node } = *st
+                && let Node::Guard { index, .. } = g.node(node)
+            {
+                codes.push(index & !crate::sym::TWO_SIDED);
+            }
+        }
+    }
+    codes.sort_unstable();
+    codes.dedup();
+    let arms = codes
+        .iter()
+        .filter(|&&c| Site::from_code(c) != Site::Input)
+        .map(|&c| {
+            let site = emit::site_expr(Site::from_code(c));
+            let c = Literal::u16_unsuffixed(c);
+            quote!(#c => #site,)
+        });
+    quote! {
+        /// The `Site` of a guard's code, as a `_lanes` function records each lane's first
+        /// failure (`Site::Input` for a non-finite input or result).
+        #[inline]
+        fn lane_site(code: u16) -> Site {
+            match code {
+                #(#arms)*
+                _ => Site::Input,
+            }
+        }
     }
 }
 
@@ -216,14 +371,14 @@ fn lane_scalar(g: &Graph, s: &Schedule, id: ExprId, k: usize) -> TokenStream {
 }
 
 /// One step over lanes.
-fn step(g: &Graph, s: &Schedule, st: &Step, l: usize) -> TokenStream {
+fn step(g: &Graph, s: &Schedule, st: &Step, l: usize, sites: bool) -> TokenStream {
     let op = |id| lane_operand(g, s, id);
     match *st {
         Step::SinCos { sin, cos, arg } => {
             let (a, b, x) = (emit::var(sin), emit::var(cos), op(arg));
             quote!(let (#a, #b) = Lanes::sin_cos(#x);)
         }
-        Step::Check { node } => (0..l).map(|k| check(g, s, node, k)).collect(),
+        Step::Check { node } => (0..l).map(|k| check(g, s, node, k, sites)).collect(),
         Step::MulAdd { name, node, mul } => {
             let x = emit::var(name);
             let [a, b, c] = crate::fma::args(g, node, mul, &op, &|v| {
@@ -266,10 +421,10 @@ fn binary(a: TokenStream, op: TokenStream, b: TokenStream) -> TokenStream {
     quote!(#a #op #b)
 }
 
-/// A tree's pivot test in lane `k`, without a branch: the lane's first failure is kept (its
+/// A guard's test in lane `k` (a tree's pivot, a platform's or closed loop's site), without a branch: the lane's first failure is kept (its
 /// pivot, value, magnitude and scale, so that the `Err` is built at the end as the scalar
 /// function builds it), later tests leave it.
-fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize) -> TokenStream {
+fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize, sites: bool) -> TokenStream {
     let Node::Guard {
         value,
         tol,
@@ -295,8 +450,13 @@ fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize) -> TokenStream {
         (quote!(#v > #t), quote!(#v))
     };
     let lane = Literal::usize_unsuffixed(k);
+    let none = if sites {
+        quote!(u16::MAX)
+    } else {
+        quote!(usize::MAX)
+    };
     quote! {
-        let bad = fail_at[#lane] == usize::MAX && !(#test);
+        let bad = fail_at[#lane] == #none && !(#test);
         fail_at[#lane] = if bad { #pivot } else { fail_at[#lane] };
         fail_value[#lane] = if bad { #v } else { fail_value[#lane] };
         fail_magnitude[#lane] = if bad { #magnitude } else { fail_magnitude[#lane] };
@@ -318,12 +478,16 @@ fn lane_array(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
     }
 }
 
-/// The `_lanes` version of `f` (a [`Shape::Vector`], [`Shape::Matrix`] or
-/// [`Shape::FallibleVector`] function).
-fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
+/// Arguments and entry statements of a `_lanes` function (each input transposed into
+/// `Lanes`; the record of each lane's first failure when the function can fail, with a
+/// platform's or closed loop's non-finite inputs recorded first, as its scalar function
+/// tests them first), and its schedule with the `sin_cos` of inputs first.
+fn prologue(
+    g: &Graph,
+    f: &Function<'_>,
+    l: usize,
+) -> (Vec<TokenStream>, Vec<TokenStream>, Schedule) {
     let real = emit::real();
-    let s = &f.schedule;
-    let name = format_ident!("{}_lanes", f.name);
     let mut args = Vec::new();
     let mut entry = Vec::new();
     for a in &f.args {
@@ -332,12 +496,39 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
             entry.push(quote!(let p = p.to_array().map(Lanes::splat);));
             continue;
         }
+        let len = if *a == Arg::X {
+            quote!(NX)
+        } else {
+            quote!(DOF)
+        };
         let id = Ident::new(a.name(), Span::call_site());
-        args.push(quote!(#id: &[[#real; LANES]; DOF]));
-        entry.push(quote!(let #id: [Lanes; DOF] = #id.map(Lanes);));
+        args.push(quote!(#id: &[[#real; LANES]; #len]));
+        entry.push(quote!(let #id: [Lanes; #len] = #id.map(Lanes);));
     }
-    let fallible = matches!(f.shape, Shape::FallibleVector);
-    if fallible {
+    if f.sites {
+        entry.push(quote! {
+            let mut fail_at = [u16::MAX; LANES];
+            let mut fail_value: [#real; LANES] = [0.0; LANES];
+            let mut fail_magnitude: [#real; LANES] = [0.0; LANES];
+            let mut fail_scale: [#real; LANES] = [0.0; LANES];
+        });
+        let input = Literal::u16_unsuffixed(runtime::scalar::Site::Input.code());
+        for a in f.args.iter().filter(|a| **a != Arg::P) {
+            let id = Ident::new(a.name(), Span::call_site());
+            let each = (0..l).map(Literal::usize_unsuffixed).map(|k| {
+                quote! {
+                    let bad = fail_at[#k] == u16::MAX && !v.0[#k].is_finite();
+                    fail_at[#k] = if bad { #input } else { fail_at[#k] };
+                    fail_value[#k] = if bad { v.0[#k] } else { fail_value[#k] };
+                }
+            });
+            entry.push(quote! {
+                for v in #id.iter() {
+                    #(#each)*
+                }
+            });
+        }
+    } else if matches!(f.shape, Shape::FallibleVector) {
         entry.push(quote! {
             let mut fail_at = [usize::MAX; LANES];
             let mut fail_value: [#real; LANES] = [0.0; LANES];
@@ -345,6 +536,7 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
             let mut fail_scale: [#real; LANES] = [0.0; LANES];
         });
     }
+    let s = &f.schedule;
     // The `sin_cos` of inputs first: each is a call per lane, and a call spills every vector
     // register, so they are made while nothing else is live (pure functions: the order is free).
     let mut hoisted = s.clone();
@@ -352,56 +544,115 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
         |st| matches!(st, Step::SinCos { arg, .. } if matches!(s.operand(g, *arg), Operand::Input(..))),
     );
     hoisted.steps = first.into_iter().chain(rest).collect();
-    let s = &hoisted;
-    let stmts: Vec<TokenStream> = s.steps.iter().map(|st| step(g, s, st, l)).collect();
-    let stmts = emit::chunked(g, s, &f.outputs, stmts);
-    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
-    let values = emit::return_tokens(f, &outs);
-    let lane = quote!([#real; LANES]);
-    let (ret_ty, ret) = match f.shape {
-        Shape::Vector => (quote!([#lane; DOF]), values),
-        Shape::Matrix => (quote!([[#lane; DOF]; DOF]), values),
-        Shape::FallibleVector => {
-            let all_const = f.outputs.iter().all(|&o| g.as_const(o).is_some());
-            let status = (0..l).map(|k| {
-                let outs: Vec<TokenStream> =
-                    f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
-                let k = Literal::usize_unsuffixed(k);
-                let finite = (!all_const).then(|| {
-                    quote! {
-                        for v in [#(#outs),*].iter() {
-                            if !v.is_finite() {
-                                break 'lane Err(Singular {
-                                    pivot: DOF,
-                                    value: *v,
-                                    condition_estimate: #real::INFINITY,
-                                });
-                            }
-                        }
-                    }
-                });
-                quote! {
-                    'lane: {
-                        if fail_at[#k] != usize::MAX {
-                            let a = fail_magnitude[#k];
-                            break 'lane Err(Singular {
-                                pivot: fail_at[#k],
-                                value: fail_value[#k],
-                                condition_estimate: if a > 0.0 {
-                                    fail_scale[#k] / a
-                                } else {
-                                    #real::INFINITY
-                                },
-                            });
-                        }
-                        #finite
-                        Ok(())
-                    }
+    (args, entry, hoisted)
+}
+
+/// The scheduled statements over the lanes.
+fn statements(g: &Graph, f: &Function<'_>, s: &Schedule, l: usize) -> Vec<TokenStream> {
+    let stmts: Vec<TokenStream> = s
+        .steps
+        .iter()
+        .map(|st| step(g, s, st, l, f.sites))
+        .collect();
+    emit::chunked(g, s, &f.outputs, stmts)
+}
+
+/// Lane `k`'s status, a labelled block: the `Err` of its first failed guard or input, else
+/// that of a non-finite output among `outs` (the lane's scalars), else `Ok(#ok)`.
+fn status(
+    g: &Graph,
+    f: &Function<'_>,
+    outs: &[TokenStream],
+    k: usize,
+    ok: TokenStream,
+) -> TokenStream {
+    let real = emit::real();
+    let all_const = f.outputs.iter().all(|&o| g.as_const(o).is_some());
+    let k = Literal::usize_unsuffixed(k);
+    let (at, out_at, none) = if f.sites {
+        (
+            quote!(site: lane_site(fail_at[#k])),
+            quote!(site: Site::Input),
+            quote!(u16::MAX),
+        )
+    } else {
+        (
+            quote!(pivot: fail_at[#k]),
+            quote!(pivot: DOF),
+            quote!(usize::MAX),
+        )
+    };
+    let finite = (!all_const).then(|| {
+        quote! {
+            for v in [#(#outs),*].iter() {
+                if !v.is_finite() {
+                    break 'lane Err(Singular {
+                        #out_at,
+                        value: *v,
+                        condition_estimate: #real::INFINITY,
+                    });
                 }
-            });
+            }
+        }
+    });
+    quote! {
+        'lane: {
+            if fail_at[#k] != #none {
+                let a = fail_magnitude[#k];
+                break 'lane Err(Singular {
+                    #at,
+                    value: fail_value[#k],
+                    condition_estimate: if a > 0.0 {
+                        fail_scale[#k] / a
+                    } else {
+                        #real::INFINITY
+                    },
+                });
+            }
+            #finite
+            Ok(#ok)
+        }
+    }
+}
+
+/// The `_lanes` version of `f` (see [`flat`]): the values lane last, and for a function that
+/// can fail each lane's status.
+fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
+    let real = emit::real();
+    let name = format_ident!("{}_lanes", f.name);
+    let (args, entry, s) = prologue(g, f, l);
+    let s = &s;
+    let stmts = statements(g, f, s, l);
+    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
+    let lane = quote!([#real; LANES]);
+    let statuses = || {
+        (0..l).map(|k| {
+            let outs: Vec<TokenStream> =
+                f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
+            status(g, f, &outs, k, quote!(()))
+        })
+    };
+    let (ret_ty, ret) = match &f.shape {
+        Shape::Vector => (quote!([#lane; DOF]), emit::return_tokens(f, &outs)),
+        Shape::Matrix => (quote!([[#lane; DOF]; DOF]), emit::return_tokens(f, &outs)),
+        Shape::FallibleVector => {
+            let status = statuses();
             (
                 quote!(([#lane; DOF], [Result<(), Singular>; LANES])),
                 quote!(([#(#outs),*], [#(#status),*])),
+            )
+        }
+        Shape::Fallible(parts) if f.sites => {
+            let values = emit::parts_tokens(parts, f.dof, &outs);
+            let ty = if parts[..] == [Part::Matrix] {
+                quote!([[#lane; DOF]; DOF])
+            } else {
+                quote!([#lane; DOF])
+            };
+            let status = statuses();
+            (
+                quote!((#ty, [Result<(), Singular>; LANES])),
+                quote!((#values, [#(#status),*])),
             )
         }
         _ => panic!("internal error: no lanes version of `{}`", f.name),
@@ -411,6 +662,7 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
          result is entry `i` of state `k`, bit for bit what `{}` gives for that state.",
         f.name, f.name
     );
+    let fallible = !matches!(f.shape, Shape::Vector | Shape::Matrix);
     let doc_err = fallible.then(|| {
         quote! {
             #[doc = ""]
@@ -428,6 +680,39 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
             #(#entry)*
             #(#stmts)*
             #ret
+        }
+    }
+}
+
+/// The `_lanes` version of a platform's kernel `f` (private): each lane's result as the
+/// scalar kernel returns it, for the wrappers (`templates/platform_lanes.rs`) to solve.
+fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
+    let name = format_ident!("{}_lanes", f.name);
+    let (args, entry, s) = prologue(g, f, l);
+    let s = &s;
+    let stmts = statements(g, f, s, l);
+    let Shape::Fallible(parts) = &f.shape else {
+        panic!("internal error: kernel `{}` cannot fail", f.name)
+    };
+    let ty = emit::return_type(&f.shape);
+    let status = (0..l).map(|k| {
+        let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
+        let value = emit::parts_tokens(parts, f.dof, &outs);
+        status(g, f, &outs, k, value)
+    });
+    let doc = format!(
+        " `{}` of `LANES` states at once: lane `k`'s result is bit for bit what `{}` returns \
+         for state `k` (entry `[i][k]` of an argument is entry `i` of state `k`).",
+        f.name, f.name
+    );
+    quote! {
+        #[doc = #doc]
+        #[inline]
+        #[allow(unused_variables, unused_mut, clippy::all)]
+        fn #name(#(#args),*) -> [#ty; LANES] {
+            #(#entry)*
+            #(#stmts)*
+            [#(#status),*]
         }
     }
 }

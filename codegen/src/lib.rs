@@ -121,13 +121,14 @@ pub struct Config {
     /// library call. Results differ from the unfused ones by rounding (tests: ≤ 1e-12
     /// relative).
     pub fma: bool,
-    /// `Some(L)`: a tree module also holds `<name>_lanes` of its dynamics functions
-    /// ([`lanes::FUNCTIONS`]), which evaluate `L` states per call (`LANES = L`, 2 to
-    /// [`lanes::MAX`]), lane last: `q: &[[f64; LANES]; DOF]` in (`q[i][k]`: coordinate `i` of
-    /// state `k`), `[[f64; LANES]; DOF]` out, and for `forward_dynamics` also each lane's
-    /// status `[Result<(), Singular>; LANES]`; every lane bit for bit the scalar function on its
-    /// state ([`lanes`]). 4 fills an AVX2 register in `f64`, 8 in `f32`. `None` (default): the
-    /// module as before, byte for byte. Trees only.
+    /// `Some(L)`: the module also holds `<name>_lanes` of its dynamics functions
+    /// ([`lanes::FUNCTIONS`], and a platform's or closed loop's `actuator_mass_matrix`), which
+    /// evaluate `L` states per call (`LANES = L`, 2 to [`lanes::MAX`]), lane last:
+    /// `q: &[[f64; LANES]; DOF]` in (`q[i][k]`: coordinate `i` of state `k`; a platform's or
+    /// closed loop's `x: &[[f64; LANES]; NX]`), `[[f64; LANES]; DOF]` out, and for every
+    /// function that can fail also each lane's status `[Result<(), Singular>; LANES]`; every
+    /// lane bit for bit the scalar function on its state ([`lanes`]). 4 fills an AVX2 register
+    /// in `f64`, 8 in `f32`. `None` (default): the module as before, byte for byte.
     pub lanes: Option<usize>,
     /// With `lanes`: the `_lanes` functions take `sin` and `cos` of all lanes at once, by a
     /// branch-free polynomial that vectorizes (Cody–Waite reduction by π/2 and fdlibm's
@@ -230,9 +231,6 @@ fn check_options(
                 "`lanes` takes 2 to {} states per call, not {l}",
                 lanes::MAX
             ));
-        }
-        if !matches!(mechanism, spec::Mechanism::Tree(_)) {
-            return Err("`lanes` (many states per call) is offered for trees only so far".into());
         }
         if cfg.emit == Emit::C {
             return Err("the C wrapper crate (`emit c`) takes no `lanes`".into());

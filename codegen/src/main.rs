@@ -93,8 +93,8 @@ struct Cli {
     /// where the target has FMA (`-C target-cpu=native`).
     #[arg(long)]
     fma: bool,
-    /// Also emit `<function>_lanes` of a tree's dynamics functions, evaluating N states per
-    /// call (`4` fills an AVX2 register in `f64`, `8` in `f32`).
+    /// Also emit `<function>_lanes` of the dynamics functions, evaluating N states per call
+    /// (`4` fills an AVX2 register in `f64`, `8` in `f32`).
     #[arg(long, value_name = "N", value_parser = lane_count)]
     lanes: Option<usize>,
     /// With `--lanes`: `sin` and `cos` of all lanes at once by a polynomial that vectorizes
@@ -259,29 +259,11 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    if let Some(lanes) = cli.lanes {
-        if cli.emit == EmitArg::C {
-            eprintln!("error: --lanes {lanes}: the C wrapper crate (--emit c) takes no lanes");
-            return ExitCode::from(2);
-        }
-        let overrides = codegen::spec::SceneOverrides {
-            sidecar: sidecar.clone(),
-            ..Default::default()
-        };
-        // A spec that does not load is reported by `compile` below, at its place.
-        if let Ok(loaded) = codegen::spec::load(&name, &source, &overrides) {
-            let kind = match loaded.mechanism {
-                codegen::spec::Mechanism::Tree(_) => None,
-                codegen::spec::Mechanism::Parallel(_) => Some("a parallel mechanism"),
-                codegen::spec::Mechanism::Closed(_) => Some("a closed loop"),
-            };
-            if let Some(kind) = kind {
-                eprintln!(
-                    "error: --lanes {lanes}: many states per call are offered for trees only so far, and {name} is {kind} (leave out --lanes)"
-                );
-                return ExitCode::from(2);
-            }
-        }
+    if let Some(lanes) = cli.lanes
+        && cli.emit == EmitArg::C
+    {
+        eprintln!("error: --lanes {lanes}: the C wrapper crate (--emit c) takes no lanes");
+        return ExitCode::from(2);
     }
     if cli.emit == EmitArg::C {
         if cli.output.is_none() {

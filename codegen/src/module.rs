@@ -62,7 +62,7 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
     if let Some(l) = cfg.lanes {
         after_math_backend(format!(
             "Lanes: {l} states per call in the `_lanes` functions ({}).",
-            crate::lanes::FUNCTIONS.join(", ")
+            crate::lanes::names(&plan.functions).join(", ")
         ));
     }
     if cfg.fma {

@@ -681,14 +681,32 @@ mod binary {
             .unwrap_or(1500)
     }
 
-    /// A run is killed after this long (`NOCDYN_FUZZ_TIMEOUT`, seconds; default 5).
+    /// A run is killed after this long (`NOCDYN_FUZZ_TIMEOUT`, seconds): by default 5 s, or
+    /// three times what the binary takes here on the bundled spec slowest to generate (the
+    /// RUS hexapod with `--stats`), whichever is longer. A hang still fails; a slow or loaded
+    /// machine, on which that spec alone takes most of 5 s, does not.
     fn cli_timeout() -> Duration {
-        Duration::from_secs_f64(
-            std::env::var("NOCDYN_FUZZ_TIMEOUT")
+        static LIMIT: std::sync::OnceLock<Duration> = std::sync::OnceLock::new();
+        *LIMIT.get_or_init(|| {
+            if let Some(s) = std::env::var("NOCDYN_FUZZ_TIMEOUT")
                 .ok()
                 .and_then(|s| s.parse().ok())
-                .unwrap_or(5.0),
-        )
+            {
+                return Duration::from_secs_f64(s);
+            }
+            let spec =
+                Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/rus_hexapod.toml");
+            let start = Instant::now();
+            let status = Command::new(binary())
+                .arg(&spec)
+                .arg("--stats")
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .expect("the binary runs");
+            assert!(status.success(), "{} --stats: {status}", spec.display());
+            (3 * start.elapsed()).max(Duration::from_secs(5))
+        })
     }
 
     /// The binary driven: the one cargo built for the tests, or `NOCDYN_FUZZ_BIN` (e.g. a release

@@ -12,7 +12,8 @@
 //!   (`tests::variants::lanes_libm`); `lanes_vector/…` with `sin` and `cos` of all lanes at
 //!   once (`Config::vector_sin_cos`, `tests::variants::lanes_vector`; its `scalar` is the
 //!   same module's scalar function, std's `sin_cos`); `lanes_vector8/…` the same with 8 lanes
-//!   (`tests::variants::lanes_vector8`).
+//!   (`tests::variants::lanes_vector8`); `lanes/{platform or closed loop}/…` the same for
+//!   three platforms and two closed loops (`tests::variants::lanes_parallel`, `lanes_closed`).
 //!
 //! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
 //! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
@@ -187,6 +188,104 @@ lanes_tree!(lanes_vector8_puma560, lanes_vector8, puma560);
 lanes_tree!(lanes_vector8_chain7, lanes_vector8, chain7);
 lanes_tree!(lanes_vector8_iiwa14, lanes_vector8, iiwa14);
 
+/// A platform's or closed loop's functions, `LANES` (4) regular states through the scalar
+/// function one after the other against one `_lanes` call (`tests::variants::lanes_parallel`,
+/// `lanes_closed`): inverse dynamics, the actuator-space mass matrix, forward dynamics.
+macro_rules! lanes_sites {
+    ($fn_name:ident, $variant:ident, $m:ident, $states:path) => {
+        fn $fn_name(c: &mut Criterion) {
+            use tests::variants::$variant::$m as g;
+            const N: usize = g::DOF;
+            const NX: usize = g::NX;
+            const L: usize = g::LANES;
+            let mut r = tests::rng(14);
+            let mut state = $states(stringify!($m));
+            let states: Vec<_> = (0..L).map(|_| state(&mut r)).collect();
+            let x: [[f64; NX]; L] =
+                core::array::from_fn(|k| states[k].0.clone().try_into().expect("NX coordinates"));
+            let u: [[f64; N]; L] =
+                core::array::from_fn(|k| states[k].1.clone().try_into().expect("DOF speeds"));
+            let ud: [[f64; N]; L] =
+                core::array::from_fn(|k| states[k].2.clone().try_into().expect("DOF rates"));
+            let (xl, ul, udl) = (transpose(x), transpose(u), transpose(ud));
+            let (taul, status) = g::inverse_dynamics_lanes(&xl, &ul, &udl);
+            assert!(status.iter().all(Result::is_ok));
+            let tau: [[f64; N]; L] = transpose(taul);
+            let name = concat!("lanes/", stringify!($m));
+            let mut grp = c.benchmark_group(format!("{name}/inverse_dynamics"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let (x, u, ud) = (black_box(&x), black_box(&u), black_box(&ud));
+                    core::array::from_fn::<_, L, _>(|k| g::inverse_dynamics(&x[k], &u[k], &ud[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| {
+                b.iter(|| {
+                    g::inverse_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&udl))
+                })
+            });
+            grp.finish();
+            let mut grp = c.benchmark_group(format!("{name}/actuator_mass_matrix"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let x = black_box(&x);
+                    core::array::from_fn::<_, L, _>(|k| g::actuator_mass_matrix(&x[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| {
+                b.iter(|| g::actuator_mass_matrix_lanes(black_box(&xl)))
+            });
+            grp.finish();
+            let mut grp = c.benchmark_group(format!("{name}/forward_dynamics"));
+            grp.throughput(Throughput::Elements(L as u64));
+            grp.bench_function("scalar", |b| {
+                b.iter(|| {
+                    let (x, u, tau) = (black_box(&x), black_box(&u), black_box(&tau));
+                    core::array::from_fn::<_, L, _>(|k| g::forward_dynamics(&x[k], &u[k], &tau[k]))
+                })
+            });
+            grp.bench_function("lanes", |b| {
+                b.iter(|| {
+                    g::forward_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&taul))
+                })
+            });
+            grp.finish();
+        }
+    };
+}
+lanes_sites!(
+    lanes_gough_stewart,
+    lanes_parallel,
+    gough_stewart,
+    tests::pkm::near_home
+);
+lanes_sites!(
+    lanes_delta_rl5,
+    lanes_parallel,
+    delta_rl5,
+    tests::pkm::near_home
+);
+lanes_sites!(
+    lanes_agile_eye,
+    lanes_parallel,
+    agile_eye,
+    tests::pkm::near_home
+);
+lanes_sites!(
+    lanes_four_bar,
+    lanes_closed,
+    four_bar,
+    tests::closed::assembled
+);
+lanes_sites!(
+    lanes_andrews_squeezer,
+    lanes_closed,
+    andrews_squeezer,
+    tests::closed::assembled
+);
+
 /// What a `_lanes` function pays per angle: four `sin_cos` calls of the math backend, std
 /// (the modules here: `runtime::math`) and the `libm` crate.
 fn sin_cos(c: &mut Criterion) {
@@ -232,6 +331,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
 }
 criterion_main!(benches);

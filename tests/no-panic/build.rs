@@ -4,6 +4,10 @@
 //! through a function pointer, an indirect call the proof cannot see through (it reports a
 //! possible panic); docs/performance.md, "Fused multiply–add".
 
+//!
+//! Also a platform (the planar 3-RRR) and a closed loop (the four-bar) with `_lanes` functions,
+//! dynamics only: their per-lane guards, and the platform's per-lane LU.
+
 fn main() {
     let spec = "../../mechanisms/specs/puma560.toml";
     println!("cargo:rerun-if-changed={spec}");
@@ -13,7 +17,28 @@ fn main() {
         .math(codegen::MathBackend::Runtime("runtime".into()))
         .lanes(Some(4))
         .vector_sin_cos(true)
-        .out_dir(out)
+        .out_dir(&out)
+        .compile()
+        .unwrap_or_else(|e| panic!("\n{e}"));
+    let (platform, closed) = (
+        "../../mechanisms/specs/planar_3rrr.toml",
+        "../../mechanisms/specs/four_bar.toml",
+    );
+    println!("cargo:rerun-if-changed={platform}");
+    println!("cargo:rerun-if-changed={closed}");
+    use codegen::spec::Function as F;
+    codegen::build_script::Builder::new()
+        .spec(platform)
+        .spec(closed)
+        .math(codegen::MathBackend::Runtime("runtime".into()))
+        .lanes(Some(4))
+        .omit(&[
+            F::InverseDynamicsDerivatives,
+            F::ForwardDynamicsDerivatives,
+            F::Regressor,
+            F::Frames,
+        ])
+        .out_dir(&out)
         .compile()
         .unwrap_or_else(|e| panic!("\n{e}"));
 }

@@ -6,16 +6,7 @@ use rand::rngs::StdRng;
 use runtime::closed::ClosedModel;
 use runtime::closed::noc::{self, Plan};
 
-/// The bundled closed-loop specs (module names).
-pub const CLOSED: [&str; 7] = [
-    "four_bar",
-    "five_bar_joints",
-    "spherical_five_bar",
-    "bricard",
-    "n_four_bar",
-    "tripod_3prs",
-    "andrews_squeezer",
-];
+pub use crate::bundled::CLOSED;
 
 /// The validated model of a bundled closed-loop spec.
 pub fn model(name: &str) -> ClosedModel {
@@ -61,4 +52,12 @@ pub fn reach(name: &str) -> f64 {
         "tripod_3prs" => 0.05,
         _ => 3.0,
     }
+}
+
+/// Random assembled states of the bundled closed loop `name` (`random_state` within
+/// `reach(name)`).
+pub fn assembled(name: &str) -> impl FnMut(&mut StdRng) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let plan = Plan::new(&model(name)).expect("a bundled closed loop has a plan");
+    let reach = reach(name);
+    move |r| random_state(&plan, r, reach)
 }

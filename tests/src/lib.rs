@@ -2,6 +2,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod base_parameters;
+mod bundled;
 pub mod closed;
 pub mod dual;
 

@@ -6,19 +6,7 @@ use rand::rngs::StdRng;
 use runtime::parallel::ParallelModel;
 use runtime::parallel::noc::{self, Plan};
 
-/// The bundled parallel specs: (module name, spec file name).
-pub const PARALLEL: [&str; 10] = [
-    "gough_stewart",
-    "sliding_hexapod",
-    "rus_hexapod",
-    "agile_eye",
-    "planar_five_bar",
-    "delta_rl5",
-    "planar_3rrr",
-    "tsai_3upu",
-    "prs_head",
-    "delta4_rl5",
-];
+pub use crate::bundled::PARALLEL;
 
 /// The spec file of a bundled mechanism.
 pub fn spec_path(name: &str) -> std::path::PathBuf {
@@ -98,4 +86,14 @@ pub fn rel(a: &[f64], b: &[f64]) -> f64 {
     } else {
         num / den
     }
+}
+
+/// Random regular states of the bundled platform `name` near home (`random_state`, rotations
+/// up to 0.1 rad, translations up to 2 % of its size).
+pub fn near_home(name: &str) -> impl FnMut(&mut StdRng) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let m = model(name);
+    let plan = Plan::new(&m).expect("a bundled platform has a plan");
+    let home = home_x(&m);
+    let reach = 0.02 * m.size();
+    move |r| random_state(&plan, &home, r, 0.1, reach)
 }

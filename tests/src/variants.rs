@@ -240,6 +240,133 @@ pub mod lanes {
         include!(concat!(env!("OUT_DIR"), "/variants/lanes/stanford_arm.rs"));
     }
 }
+/// Every bundled platform with `_lanes` functions of 4 states per call, dynamics only
+/// (`tests/tests/lanes.rs`).
+pub mod lanes_parallel {
+    /// `mechanisms/specs/gough_stewart.toml` with 4 lanes.
+    pub mod gough_stewart {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/gough_stewart.rs"
+        ));
+    }
+    /// `mechanisms/specs/sliding_hexapod.toml` with 4 lanes.
+    pub mod sliding_hexapod {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/sliding_hexapod.rs"
+        ));
+    }
+    /// `mechanisms/specs/rus_hexapod.toml` with 4 lanes.
+    pub mod rus_hexapod {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/rus_hexapod.rs"
+        ));
+    }
+    /// `mechanisms/specs/agile_eye.toml` with 4 lanes.
+    pub mod agile_eye {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/agile_eye.rs"
+        ));
+    }
+    /// `mechanisms/specs/planar_five_bar.toml` with 4 lanes.
+    pub mod planar_five_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/planar_five_bar.rs"
+        ));
+    }
+    /// `mechanisms/specs/delta_rl5.toml` with 4 lanes.
+    pub mod delta_rl5 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/delta_rl5.rs"
+        ));
+    }
+    /// `mechanisms/specs/planar_3rrr.toml` with 4 lanes.
+    pub mod planar_3rrr {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/planar_3rrr.rs"
+        ));
+    }
+    /// `mechanisms/specs/tsai_3upu.toml` with 4 lanes.
+    pub mod tsai_3upu {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/tsai_3upu.rs"
+        ));
+    }
+    /// `mechanisms/specs/prs_head.toml` with 4 lanes.
+    pub mod prs_head {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/prs_head.rs"
+        ));
+    }
+    /// `mechanisms/specs/delta4_rl5.toml` with 4 lanes.
+    pub mod delta4_rl5 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_parallel/delta4_rl5.rs"
+        ));
+    }
+}
+/// Every bundled closed loop with `_lanes` functions of 4 states per call, dynamics only
+/// (`tests/tests/lanes.rs`).
+pub mod lanes_closed {
+    /// `mechanisms/specs/four_bar.toml` with 4 lanes.
+    pub mod four_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/four_bar.rs"
+        ));
+    }
+    /// `mechanisms/specs/five_bar_joints.toml` with 4 lanes.
+    pub mod five_bar_joints {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/five_bar_joints.rs"
+        ));
+    }
+    /// `mechanisms/specs/spherical_five_bar.toml` with 4 lanes.
+    pub mod spherical_five_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/spherical_five_bar.rs"
+        ));
+    }
+    /// `mechanisms/specs/bricard.toml` with 4 lanes.
+    pub mod bricard {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/bricard.rs"
+        ));
+    }
+    /// `mechanisms/specs/n_four_bar.toml` with 4 lanes.
+    pub mod n_four_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/n_four_bar.rs"
+        ));
+    }
+    /// `mechanisms/specs/tripod_3prs.toml` with 4 lanes.
+    pub mod tripod_3prs {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/tripod_3prs.rs"
+        ));
+    }
+    /// `mechanisms/specs/andrews_squeezer.toml` with 4 lanes.
+    pub mod andrews_squeezer {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_closed/andrews_squeezer.rs"
+        ));
+    }
+}
 /// The PUMA 560 in `f32` with 8 lanes.
 pub mod lanes_f32_puma560 {
     include!(concat!(env!("OUT_DIR"), "/variants/lanes_f32/puma560.rs"));

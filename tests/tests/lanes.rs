@@ -86,6 +86,276 @@ check_lanes!(iiwa14, iiwa14, 5);
 check_lanes!(planar_2r, planar_2r, 6);
 check_lanes!(stanford_arm, stanford_arm, 7);
 
+/// Lane-last arrays of `L` states, one column each.
+fn columns<const N: usize, const L: usize>(states: &[Vec<f64>]) -> [[f64; L]; N] {
+    core::array::from_fn(|i| core::array::from_fn(|k| states[k][i]))
+}
+
+/// A platform's or closed loop's `_lanes` functions against its scalar ones, bit for bit, on
+/// 25 × 4 random regular states; every fifth round one lane has a NaN coordinate (its own
+/// `Err(Site::Input)`), and every fifth another lane is `far` (moved off the workspace or off
+/// the loops' closure: the scalar functions' `Err`, whatever it is, for that lane alone).
+macro_rules! check_site_lanes {
+    ($test:ident, $variant:ident, $m:ident, $seed:expr, $state:expr, $far:expr) => {
+        #[test]
+        fn $test() {
+            use tests::variants::$variant::$m as g;
+            const N: usize = g::DOF;
+            const NX: usize = g::NX;
+            const L: usize = g::LANES;
+            let name = stringify!($m);
+            let mut r = tests::rng($seed);
+            let mut state = $state(name);
+            let far: fn(&mut [f64]) = $far;
+            let mut far_errors = 0;
+            for round in 0..25 {
+                let mut xs = Vec::new();
+                let (mut us, mut uds) = (Vec::new(), Vec::new());
+                for _ in 0..L {
+                    let (x, u, ud) = state(&mut r);
+                    xs.push(x);
+                    us.push(u);
+                    uds.push(ud);
+                }
+                let nan = (round % 5 == 4).then(|| round % L);
+                let moved = (round % 5 == 2).then(|| (round + 1) % L);
+                if let Some(k) = nan {
+                    xs[k][0] = f64::NAN;
+                }
+                if let Some(k) = moved {
+                    far(&mut xs[k]);
+                }
+                let x: [[f64; L]; NX] = columns(&xs);
+                let (u, ud): ([[f64; L]; N], [[f64; L]; N]) = (columns(&us), columns(&uds));
+                let (tau, id) = g::inverse_dynamics_lanes(&x, &u, &ud);
+                let (gr, grs) = g::gravity_lanes(&x);
+                let (c, cs) = g::coriolis_lanes(&x, &u);
+                let (m, ms) = g::mass_matrix_lanes(&x);
+                let (am, ams) = g::actuator_mass_matrix_lanes(&x);
+                let (fd, fds) = g::forward_dynamics_lanes(&x, &u, &tau);
+                for k in 0..L {
+                    let (xk, uk, udk, tauk): ([f64; NX], [f64; N], [f64; N], [f64; N]) =
+                        (lane(&x, k), lane(&u, k), lane(&ud, k), lane(&tau, k));
+                    let pairs = [
+                        (
+                            "ID",
+                            format!("{:?}", id[k].map(|()| lane(&tau, k))),
+                            format!("{:?}", g::inverse_dynamics(&xk, &uk, &udk)),
+                        ),
+                        (
+                            "G",
+                            format!("{:?}", grs[k].map(|()| lane(&gr, k))),
+                            format!("{:?}", g::gravity(&xk)),
+                        ),
+                        (
+                            "C",
+                            format!("{:?}", cs[k].map(|()| lane(&c, k))),
+                            format!("{:?}", g::coriolis(&xk, &uk)),
+                        ),
+                        (
+                            "M",
+                            format!("{:?}", ms[k].map(|()| lane_matrix(&m, k))),
+                            format!("{:?}", g::mass_matrix(&xk)),
+                        ),
+                        (
+                            "actuator M",
+                            format!("{:?}", ams[k].map(|()| lane_matrix(&am, k))),
+                            format!("{:?}", g::actuator_mass_matrix(&xk)),
+                        ),
+                        (
+                            "FD",
+                            format!("{:?}", fds[k].map(|()| lane(&fd, k))),
+                            format!("{:?}", g::forward_dynamics(&xk, &uk, &tauk)),
+                        ),
+                    ];
+                    for (what, lanes, scalar) in pairs {
+                        assert_eq!(lanes, scalar, "{name} {what}, round {round}, lane {k}");
+                    }
+                    let scalar = g::inverse_dynamics(&xk, &uk, &udk);
+                    if nan == Some(k) {
+                        assert!(
+                            matches!(
+                                scalar,
+                                Err(g::Singular {
+                                    site: g::Site::Input,
+                                    ..
+                                })
+                            ),
+                            "{name}: {scalar:?}"
+                        );
+                    } else if moved == Some(k) {
+                        far_errors += usize::from(scalar.is_err());
+                    } else {
+                        assert!(
+                            scalar.is_ok(),
+                            "{name}, round {round}, lane {k}: {scalar:?}"
+                        );
+                    }
+                }
+            }
+            // The far lanes exercise the guards of one lane among regular ones.
+            assert!(far_errors > 0, "{name}: no far lane failed");
+        }
+    };
+}
+
+/// A platform pose a thousand times as far from the base (every coordinate scaled).
+fn platform_far(x: &mut [f64]) {
+    for v in x.iter_mut() {
+        *v *= 1e3;
+    }
+}
+
+/// A platform pose at the base's origin with a zero quaternion where it has one (for the
+/// platforms that reach every pose: prismatic legs, a spherical wrist).
+fn platform_zero(x: &mut [f64]) {
+    x.iter_mut().for_each(|v| *v = 0.0);
+}
+
+/// Joint coordinates that no longer close the loops.
+fn closed_open(x: &mut [f64]) {
+    for v in x.iter_mut() {
+        *v += 0.3;
+    }
+}
+
+check_site_lanes!(
+    gough_stewart,
+    lanes_parallel,
+    gough_stewart,
+    11,
+    tests::pkm::near_home,
+    platform_zero
+);
+check_site_lanes!(
+    sliding_hexapod,
+    lanes_parallel,
+    sliding_hexapod,
+    12,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    rus_hexapod,
+    lanes_parallel,
+    rus_hexapod,
+    13,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    agile_eye,
+    lanes_parallel,
+    agile_eye,
+    14,
+    tests::pkm::near_home,
+    platform_zero
+);
+check_site_lanes!(
+    planar_five_bar,
+    lanes_parallel,
+    planar_five_bar,
+    15,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    delta_rl5,
+    lanes_parallel,
+    delta_rl5,
+    16,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    planar_3rrr,
+    lanes_parallel,
+    planar_3rrr,
+    17,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    tsai_3upu,
+    lanes_parallel,
+    tsai_3upu,
+    18,
+    tests::pkm::near_home,
+    platform_zero
+);
+check_site_lanes!(
+    prs_head,
+    lanes_parallel,
+    prs_head,
+    19,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    delta4_rl5,
+    lanes_parallel,
+    delta4_rl5,
+    20,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    four_bar,
+    lanes_closed,
+    four_bar,
+    21,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    five_bar_joints,
+    lanes_closed,
+    five_bar_joints,
+    22,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    spherical_five_bar,
+    lanes_closed,
+    spherical_five_bar,
+    23,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    bricard,
+    lanes_closed,
+    bricard,
+    24,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    n_four_bar,
+    lanes_closed,
+    n_four_bar,
+    25,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    tripod_3prs,
+    lanes_closed,
+    tripod_3prs,
+    26,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    andrews_squeezer,
+    lanes_closed,
+    andrews_squeezer,
+    27,
+    tests::closed::assembled,
+    closed_open
+);
+
 /// The same in `f32` with 8 lanes.
 #[test]
 fn puma560_f32_eight_lanes() {
@@ -110,7 +380,7 @@ fn puma560_f32_eight_lanes() {
     }
 }
 
-/// The options are checked: lanes are refused outside 2..=16 and for a platform.
+/// The options are checked: lanes are refused outside 2..=16; a platform has them too.
 #[test]
 fn lanes_options_are_checked() {
     let compile = |spec: &str, lanes| {
@@ -136,11 +406,8 @@ fn lanes_options_are_checked() {
             .unwrap_err()
             .contains("2 to 16")
     );
-    assert!(
-        compile("gough_stewart.toml", 4)
-            .unwrap_err()
-            .contains("trees only")
-    );
+    let code = compile("gough_stewart.toml", 4).unwrap();
+    assert!(code.contains("pub fn actuator_mass_matrix_lanes"));
     let code = compile("planar_2r.toml", 4).unwrap();
     assert!(code.contains("pub fn forward_dynamics_lanes"));
     assert!(code.contains("// Lanes: 4 states per call"));

@@ -176,7 +176,7 @@ mod actuation {
     pub fn f_of(u: &[f64; DOF], ud: &[f64; DOF]) -> [f64; DOF] {
         [ud[0] + u[1], ud[1] - 2.0 * u[0], ud[2] + 0.5]
     }
-    fn id_parts(
+    pub(super) fn id_parts(
         x: &[f64; NX],
         u: &[f64; DOF],
         ud: &[f64; DOF],
@@ -184,13 +184,13 @@ mod actuation {
     ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
         Ok((a_of(x), f_of(u, ud)))
     }
-    fn gravity_parts(
+    pub(super) fn gravity_parts(
         x: &[f64; NX],
         _p: &Params,
     ) -> Result<([[f64; DOF]; DOF], [f64; DOF]), Singular> {
         Ok((a_of(x), f_of(&[0.0; DOF], &[0.0; DOF])))
     }
-    fn coriolis_parts(
+    pub(super) fn coriolis_parts(
         x: &[f64; NX],
         u: &[f64; DOF],
         _p: &Params,
@@ -234,7 +234,7 @@ mod actuation {
     ) -> Result<(Matrix, [[f64; NBP]; DOF]), Singular> {
         Ok((a_of(x), fb_of(u, ud)))
     }
-    fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
+    pub(super) fn inertia_parts(x: &[f64; NX], p: &Params) -> Result<(Matrix, Matrix), Singular> {
         Ok((a_of(x), i_of(x, p)))
     }
     fn fail() -> Singular {
@@ -244,7 +244,10 @@ mod actuation {
             condition_estimate: f64::INFINITY,
         }
     }
-    fn lu_solve_t(a: &[[f64; DOF]; DOF], b: &[f64; DOF]) -> Result<[f64; DOF], Singular> {
+    pub(super) fn lu_solve_t(
+        a: &[[f64; DOF]; DOF],
+        b: &[f64; DOF],
+    ) -> Result<[f64; DOF], Singular> {
         let mut t = [[0.0; DOF]; DOF];
         for i in 0..DOF {
             for j in 0..DOF {
@@ -253,7 +256,7 @@ mod actuation {
         }
         super::solve(&t, b).ok_or_else(fail)
     }
-    fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
+    pub(super) fn lu_inverse(a: &[[f64; DOF]; DOF]) -> Result<[[f64; DOF]; DOF], Singular> {
         let mut inv = [[0.0; DOF]; DOF];
         for c in 0..DOF {
             let mut e = [0.0; DOF];
@@ -266,6 +269,82 @@ mod actuation {
         Ok(inv)
     }
     include!("../../codegen/templates/platform_actuation.rs");
+}
+
+/// `platform_lanes.rs` over `actuation`'s kernels: two lanes, the kernels' `_lanes` versions
+/// as a generated module's would be (each lane the scalar kernel; a lane with a NaN `x` is
+/// its `Err(Site::Input)`), and a minimal `Lanes`.
+mod actuation_lanes {
+    pub use super::actuation::{DOF, NX, Params, Singular, Site};
+    use super::actuation::{
+        coriolis_parts, gravity_parts, id_parts, inertia_parts, lu_inverse, lu_solve_t,
+    };
+    pub const LANES: usize = 2;
+    #[derive(Clone, Copy)]
+    pub struct Lanes(pub [f64; LANES]);
+    impl Lanes {
+        fn splat(v: f64) -> Lanes {
+            Lanes([v; LANES])
+        }
+    }
+    impl core::ops::Add for Lanes {
+        type Output = Lanes;
+        fn add(self, o: Lanes) -> Lanes {
+            Lanes([self.0[0] + o.0[0], self.0[1] + o.0[1]])
+        }
+    }
+    impl core::ops::Mul for Lanes {
+        type Output = Lanes;
+        fn mul(self, o: Lanes) -> Lanes {
+            Lanes([self.0[0] * o.0[0], self.0[1] * o.0[1]])
+        }
+    }
+    fn lane<const N: usize>(a: &[[f64; LANES]; N], k: usize) -> [f64; N] {
+        core::array::from_fn(|i| a[i][k])
+    }
+    fn each<T>(
+        x: &[[f64; LANES]; NX],
+        f: impl Fn(usize, &[f64; NX]) -> Result<T, Singular>,
+    ) -> [Result<T, Singular>; LANES] {
+        core::array::from_fn(|k| {
+            let xk = lane(x, k);
+            if xk[0].is_nan() {
+                return Err(Singular {
+                    site: Site::Input,
+                    value: xk[0],
+                    condition_estimate: f64::INFINITY,
+                });
+            }
+            f(k, &xk)
+        })
+    }
+    type Parts = Result<([[f64; DOF]; DOF], [f64; DOF]), Singular>;
+    fn id_parts_lanes(
+        x: &[[f64; LANES]; NX],
+        u: &[[f64; LANES]; DOF],
+        ud: &[[f64; LANES]; DOF],
+        p: &Params,
+    ) -> [Parts; LANES] {
+        each(x, |k, xk| id_parts(xk, &lane(u, k), &lane(ud, k), p))
+    }
+    fn gravity_parts_lanes(x: &[[f64; LANES]; NX], p: &Params) -> [Parts; LANES] {
+        each(x, |_, xk| gravity_parts(xk, p))
+    }
+    fn coriolis_parts_lanes(
+        x: &[[f64; LANES]; NX],
+        u: &[[f64; LANES]; DOF],
+        p: &Params,
+    ) -> [Parts; LANES] {
+        each(x, |k, xk| coriolis_parts(xk, &lane(u, k), p))
+    }
+    #[allow(clippy::type_complexity)]
+    fn inertia_parts_lanes(
+        x: &[[f64; LANES]; NX],
+        p: &Params,
+    ) -> [Result<([[f64; DOF]; DOF], [[f64; DOF]; DOF]), Singular>; LANES] {
+        each(x, |_, xk| inertia_parts(xk, p))
+    }
+    include!("../../codegen/templates/platform_lanes.rs");
 }
 
 /// A one-loop mechanism in joint coordinates `x = (θ, φ)`: `θ` independent, `φ` dependent
@@ -483,4 +562,58 @@ fn closed_assembly_follows_the_branch() {
         forward_kinematics(&[f64::NAN], &[0.0, 0.0]).map_err(|e| e.iterations),
         Err(0)
     );
+}
+
+/// The `_lanes` wrappers give each lane the scalar wrapper's result, bit for bit, and a
+/// failing lane its own `Err` beside a regular one.
+#[test]
+fn platform_lanes_are_the_scalar_wrappers_lane_by_lane() {
+    use actuation::*;
+    use actuation_lanes::*;
+    let p = Params { scale: 1.3 };
+    let states = [
+        ([0.2, -0.4, 0.7], [0.5, -1.0, 0.3], [1.0, 2.0, -0.5]),
+        ([f64::NAN, 0.1, 0.0], [0.0; 3], [0.0; 3]),
+        ([-0.3, 0.9, -0.2], [-0.7, 0.4, 1.1], [0.0, -1.0, 2.5]),
+    ];
+    for pair in [[0, 1], [2, 0], [1, 2]] {
+        type State = ([f64; 3], [f64; 3], [f64; 3]);
+        let col = |f: fn(&State) -> [f64; 3]| -> [[f64; LANES]; 3] {
+            core::array::from_fn(|i| core::array::from_fn(|k| f(&states[pair[k]])[i]))
+        };
+        let (x, u, ud) = (col(|s| s.0), col(|s| s.1), col(|s| s.2));
+        let (tau, st) = inverse_dynamics_lanes(&x, &u, &ud, &p);
+        let (g, gs) = gravity_lanes(&x, &p);
+        let (c, cs) = coriolis_lanes(&x, &u, &p);
+        let (m, ms) = actuator_mass_matrix_lanes(&x, &p);
+        for (k, &s) in pair.iter().enumerate() {
+            let (xk, uk, udk) = &states[s];
+            let v = |a: &[[f64; LANES]; DOF]| -> [f64; DOF] { core::array::from_fn(|i| a[i][k]) };
+            let text = |r: &dyn std::fmt::Debug| format!("{r:?}");
+            let mk: [[f64; DOF]; DOF] = core::array::from_fn(|i| v(&m[i]));
+            if s == 1 {
+                // The kernels' `Err` of that lane (the scalar stand-ins do not test inputs).
+                for status in [st[k], gs[k], cs[k], ms[k]] {
+                    assert!(matches!(
+                        status,
+                        Err(Singular {
+                            site: Site::Input,
+                            ..
+                        })
+                    ));
+                }
+                continue;
+            }
+            assert_eq!(
+                text(&st[k].map(|()| v(&tau))),
+                text(&inverse_dynamics(xk, uk, udk, &p))
+            );
+            assert_eq!(text(&gs[k].map(|()| v(&g))), text(&gravity(xk, &p)));
+            assert_eq!(text(&cs[k].map(|()| v(&c))), text(&coriolis(xk, uk, &p)));
+            assert_eq!(
+                text(&ms[k].map(|()| mk)),
+                text(&actuator_mass_matrix(xk, &p))
+            );
+        }
+    }
 }

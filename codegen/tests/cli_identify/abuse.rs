@@ -314,17 +314,17 @@ fn excite_rejects_periods_and_noise_that_leave_the_numbers() {
     );
 }
 
-/// `--lanes` with a platform or a closed loop was reported as a spec error keyed `platform`
-/// (for a tree and a four-bar too); now the flag is named, and out-of-range counts are
+/// `--lanes` with a platform or a closed loop was reported as a spec error keyed `platform`;
+/// now a platform and a closed loop have `_lanes` functions too, and out-of-range counts are
 /// rejected by the argument parser.
 #[test]
 fn lanes_errors_name_the_flag() {
     for spec in [DELTA, FOUR_BAR] {
-        let err = rejected(
-            &[spec, "--lanes", "4"],
-            "--lanes 4: many states per call are offered for trees only",
-        );
-        assert!(!err.contains(": platform"), "{err}");
+        let o = run(&[spec, "--lanes", "4"]);
+        ok(&o);
+        let code = text(&o.stdout);
+        assert!(code.contains("pub fn inverse_dynamics_lanes"), "{spec}");
+        assert!(code.contains("pub fn actuator_mass_matrix_lanes"), "{spec}");
     }
     for bad in ["0", "1", "17", "99999", "abc"] {
         rejected(&[TWO_R, "--lanes", bad], "'--lanes <N>'");

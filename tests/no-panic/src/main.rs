@@ -313,6 +313,96 @@ pub const LANES: &[(&str, fn(&mut u64) -> F)] = &[("puma560_lanes", |seed| {
         + if status[0].is_ok() { a[0][0] } else { 0.0 }
 })];
 
+/// The planar 3-RRR and the four-bar generated with `lanes = 4` (`build.rs`).
+#[allow(dead_code)]
+mod planar_3rrr_lanes {
+    include!(concat!(env!("OUT_DIR"), "/planar_3rrr.rs"));
+}
+#[allow(dead_code)]
+mod four_bar_lanes {
+    include!(concat!(env!("OUT_DIR"), "/four_bar.rs"));
+}
+
+/// A platform's or closed loop's `_lanes` functions, each under its own `#[no_panic]`, in a
+/// module named after it (`x` has `NX` rows, the rest `DOF`).
+macro_rules! site_lanes {
+    ($proof:ident, $m:ident, $($name:ident($($arg:ident: $len:ident),*) -> $out:ident;)*) => {
+        mod $proof {
+            use super::$m as m;
+            use super::F;
+            pub type Status = [Result<(), m::Singular>; m::LANES];
+            pub type Vector = ([[F; m::LANES]; m::DOF], Status);
+            pub type Matrix = ([[[F; m::LANES]; m::DOF]; m::DOF], Status);
+            $(
+                #[cfg_attr(feature = "prove", no_panic::no_panic)]
+                #[inline(never)]
+                pub fn $name($($arg: &[[F; m::LANES]; m::$len]),*) -> $out {
+                    m::$name($($arg),*)
+                }
+            )*
+        }
+    };
+}
+
+site_lanes! {
+    planar_3rrr_proof, planar_3rrr_lanes,
+    inverse_dynamics_lanes(x: NX, u: DOF, ud: DOF) -> Vector;
+    gravity_lanes(x: NX) -> Vector;
+    coriolis_lanes(x: NX, u: DOF) -> Vector;
+    mass_matrix_lanes(x: NX) -> Matrix;
+    actuator_mass_matrix_lanes(x: NX) -> Matrix;
+    forward_dynamics_lanes(x: NX, u: DOF, tau: DOF) -> Vector;
+}
+
+site_lanes! {
+    four_bar_proof, four_bar_lanes,
+    inverse_dynamics_lanes(x: NX, u: DOF, ud: DOF) -> Vector;
+    gravity_lanes(x: NX) -> Vector;
+    coriolis_lanes(x: NX, u: DOF) -> Vector;
+    mass_matrix_lanes(x: NX) -> Matrix;
+    actuator_mass_matrix_lanes(x: NX) -> Matrix;
+    forward_dynamics_lanes(x: NX, u: DOF, tau: DOF) -> Vector;
+}
+
+/// The `_lanes` wrappers of a platform's or closed loop's proof module, called once on opaque
+/// inputs (coordinates in ±1: regular and singular lanes alike).
+macro_rules! site_lanes_run {
+    ($proof:ident, $m:ident) => {
+        (stringify!($m), |seed: &mut u64| -> F {
+            use $m as m;
+            use $proof as p;
+            let mut rows = |scale: F| -> [[F; m::LANES]; m::NX] {
+                core::array::from_fn(|_| inputs::<{ m::LANES }>(seed, scale))
+            };
+            let x = rows(1.0);
+            let mut rows = |scale: F| -> [[F; m::LANES]; m::DOF] {
+                core::array::from_fn(|_| inputs::<{ m::LANES }>(seed, scale))
+            };
+            let (u, ud) = (rows(1.0), rows(1.0));
+            // The checksum adds lane 0 of each result where its status is `Ok`.
+            let ok = |v: F, s: &p::Status| if s[0].is_ok() { v } else { 0.0 };
+            let (tau, ts) = p::inverse_dynamics_lanes(&x, &u, &ud);
+            let (a, fs) = p::forward_dynamics_lanes(&x, &u, &tau);
+            let (g, gs) = p::gravity_lanes(&x);
+            let (c, cs) = p::coriolis_lanes(&x, &u);
+            let (m, ms) = p::mass_matrix_lanes(&x);
+            let (am, ams) = p::actuator_mass_matrix_lanes(&x);
+            ok(tau[0][0], &ts)
+                + ok(g[0][0], &gs)
+                + ok(c[0][0], &cs)
+                + ok(m[0][0][0], &ms)
+                + ok(am[0][0][0], &ams)
+                + ok(a[0][0], &fs)
+        })
+    };
+}
+
+/// Every platform and closed-loop `_lanes` wrapper, called once.
+pub const SITE_LANES: &[(&str, fn(&mut u64) -> F)] = &[
+    site_lanes_run!(planar_3rrr_proof, planar_3rrr_lanes),
+    site_lanes_run!(four_bar_proof, four_bar_lanes),
+];
+
 /// A function that can panic (index out of bounds): `--features canary` must fail to link.
 #[cfg(feature = "canary")]
 #[no_panic::no_panic]
@@ -325,7 +415,12 @@ fn main() {
     let mut seed = black_box(0x9e37_79b9_7f4a_7c15_u64);
     #[cfg(feature = "canary")]
     println!("canary: {}", canary(&black_box([1.0; 4]), black_box(7)));
-    for (name, run) in MECHANISMS.iter().chain(FRAMES).chain(LANES) {
+    for (name, run) in MECHANISMS
+        .iter()
+        .chain(FRAMES)
+        .chain(LANES)
+        .chain(SITE_LANES)
+    {
         let s = run(&mut seed);
         println!("{name}: checksum {s:e}");
     }

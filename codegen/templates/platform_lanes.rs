@@ -1,0 +1,126 @@
+// Template: the `_lanes` functions of a platform module that solve with the actuation matrix
+// `A`, around the kernels' `_lanes` versions (`id_parts_lanes`, …, each lane's result as the
+// scalar kernel returns it). The kernels' arithmetic runs over the lanes; each lane's solve
+// is the scalar functions' own LU (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit
+// the scalar function. Specialized by `codegen/src/template.rs`; compiled and tested as a
+// module by `tests/tests/templates.rs`.
+
+/// `inverse_dynamics` of `LANES` states at once: entry `[i][k]` of an argument or of the
+/// result is entry `i` of state `k`, bit for bit what `inverse_dynamics` gives for that state.
+///
+/// The second part is each lane's status: `Err` where the scalar function returns that `Err`
+/// for the lane's state (that lane's values are then not to be read); the other lanes are not
+/// affected.
+#[inline]
+pub fn inverse_dynamics_lanes(
+    x: &[[f64; LANES]; NX],
+    u: &[[f64; LANES]; DOF],
+    ud: &[[f64; LANES]; DOF],
+    p: &Params,
+) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
+    solve_t_lanes(id_parts_lanes(x, u, ud, p))
+}
+
+/// `gravity` of `LANES` states at once, lane by lane as `inverse_dynamics_lanes`.
+#[inline]
+pub fn gravity_lanes(
+    x: &[[f64; LANES]; NX],
+    p: &Params,
+) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
+    solve_t_lanes(gravity_parts_lanes(x, p))
+}
+
+/// `coriolis` of `LANES` states at once, lane by lane as `inverse_dynamics_lanes`.
+#[inline]
+pub fn coriolis_lanes(
+    x: &[[f64; LANES]; NX],
+    u: &[[f64; LANES]; DOF],
+    p: &Params,
+) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
+    solve_t_lanes(coriolis_parts_lanes(x, u, p))
+}
+
+/// Each lane's `Aᵀ τ = f` by `lu_solve_t`, the results lane last.
+#[inline]
+#[allow(clippy::type_complexity)]
+fn solve_t_lanes(
+    parts: [Result<([[f64; DOF]; DOF], [f64; DOF]), Singular>; LANES],
+) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
+    let mut out = [[0.0; LANES]; DOF];
+    let mut status = [Ok(()); LANES];
+    for (k, (part, st)) in parts.iter().zip(status.iter_mut()).enumerate() {
+        match part.and_then(|(a, f)| lu_solve_t(&a, &f)) {
+            Ok(t) => {
+                for (o, v) in out.iter_mut().zip(t) {
+                    if let Some(o) = o.get_mut(k) {
+                        *o = v;
+                    }
+                }
+            }
+            Err(e) => *st = Err(e),
+        }
+    }
+    (out, status)
+}
+
+/// `actuator_mass_matrix` of `LANES` states at once, lane by lane as
+/// `inverse_dynamics_lanes`: each lane's `A⁻¹` by `lu_inverse`, then `A⁻ᵀ I A⁻¹` over the
+/// lanes in the scalar function's order of operations.
+#[inline]
+#[allow(clippy::type_complexity)]
+pub fn actuator_mass_matrix_lanes(
+    x: &[[f64; LANES]; NX],
+    p: &Params,
+) -> ([[[f64; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
+    let parts = inertia_parts_lanes(x, p);
+    let mut status = [Ok(()); LANES];
+    let mut ai = [[Lanes::splat(0.0); DOF]; DOF];
+    let mut im = [[Lanes::splat(0.0); DOF]; DOF];
+    for (k, (part, st)) in parts.iter().zip(status.iter_mut()).enumerate() {
+        match part.and_then(|(a, i)| Ok((lu_inverse(&a)?, i))) {
+            Ok((a, i)) => {
+                for (to, from) in ai.iter_mut().zip(a).chain(im.iter_mut().zip(i)) {
+                    for (t, f) in to.iter_mut().zip(from) {
+                        if let Some(t) = t.0.get_mut(k) {
+                            *t = f;
+                        }
+                    }
+                }
+            }
+            Err(e) => *st = Err(e),
+        }
+    }
+    // B = I A⁻¹, then A⁻ᵀ B (upper triangle, mirrored).
+    let mut b = [[Lanes::splat(0.0); DOF]; DOF];
+    for r in 0..DOF {
+        for c in 0..DOF {
+            let mut s = Lanes::splat(0.0);
+            for k in 0..DOF {
+                s = s + im[r][k] * ai[k][c];
+            }
+            b[r][c] = s;
+        }
+    }
+    let mut out = [[[0.0; LANES]; DOF]; DOF];
+    for r in 0..DOF {
+        for c in r..DOF {
+            let mut s = Lanes::splat(0.0);
+            for k in 0..DOF {
+                s = s + ai[k][r] * b[k][c];
+            }
+            // The scalar function's first non-finite entry, in this order, per lane.
+            for (v, st) in s.0.iter().zip(status.iter_mut()) {
+                if st.is_ok() && !v.is_finite() {
+                    *st = Err(Singular {
+                        site: Site::Input,
+                        value: *v,
+                        condition_estimate: f64::INFINITY,
+                    });
+                }
+            }
+            out[r][c] = s.0;
+            out[c][r] = s.0;
+        }
+    }
+    (out, status)
+}
