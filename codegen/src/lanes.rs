@@ -29,8 +29,8 @@
 //! loop's dynamics, a platform's `mass_matrix` and `forward_dynamics`) runs its schedule over
 //! the lanes whole. A platform's functions that solve with the actuation matrix `A`
 //! (`inverse_dynamics`, `gravity`, `coriolis`, `actuator_mass_matrix`) run their kernel
-//! (`id_parts`, …) over the lanes, which returns each lane's `Result` as the scalar kernel
-//! does, and the wrappers (`templates/platform_lanes.rs`) solve each lane with the scalar
+//! (`id_parts`, …) over the lanes, which returns its parts lane last and each lane's status,
+//! and the wrappers (`templates/platform_lanes.rs`) solve each lane with the scalar
 //! functions' own LU: the pivots are chosen per lane, and the kernel is most of the work.
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
@@ -141,6 +141,7 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     if wrappers.iter().any(|w| *w != "actuator_mass_matrix") {
         wrapper_items.push("solve_t_lanes".into());
     }
+    wrapper_items.push("lane_of".into());
     let wrapper_items: Vec<&str> = wrapper_items.iter().map(String::as_str).collect();
     let wrappers = crate::template::Specialize::new(cfg)
         .params(params)
@@ -684,9 +685,13 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     }
 }
 
-/// The `_lanes` version of a platform's kernel `f` (private): each lane's result as the
-/// scalar kernel returns it, for the wrappers (`templates/platform_lanes.rs`) to solve.
+/// The `_lanes` version of a platform's kernel `f` (private): its parts lane last and each
+/// lane's status, for the wrappers (`templates/platform_lanes.rs`) to solve lane by lane.
+/// Lane `k` is bit for bit what the scalar kernel returns for state `k`. (Results handed
+/// out per lane instead, as the scalar kernel's `Result`s, kept LLVM from vectorizing the
+/// kernel at all.)
 fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
+    let real = emit::real();
     let name = format_ident!("{}_lanes", f.name);
     let (args, entry, s) = prologue(g, f, l);
     let s = &s;
@@ -694,25 +699,38 @@ fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let Shape::Fallible(parts) = &f.shape else {
         panic!("internal error: kernel `{}` cannot fail", f.name)
     };
-    let ty = emit::return_type(&f.shape);
+    let lane = quote!([#real; LANES]);
+    let types: Vec<TokenStream> = parts
+        .iter()
+        .map(|p| match p {
+            Part::Matrix => quote!([[#lane; DOF]; DOF]),
+            Part::Vector => quote!([#lane; DOF]),
+            _ => panic!(
+                "internal error: kernel `{}` has a part without lanes",
+                f.name
+            ),
+        })
+        .collect();
+    let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
+    let values = emit::parts_tokens(parts, f.dof, &outs);
     let status = (0..l).map(|k| {
         let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
-        let value = emit::parts_tokens(parts, f.dof, &outs);
-        status(g, f, &outs, k, value)
+        status(g, f, &outs, k, quote!(()))
     });
     let doc = format!(
-        " `{}` of `LANES` states at once: lane `k`'s result is bit for bit what `{}` returns \
-         for state `k` (entry `[i][k]` of an argument is entry `i` of state `k`).",
+        " `{}` of `LANES` states at once: entry `[i][k]` of an argument or a part is entry `i` \
+         of state `k`, and lane `k` (with its status) is bit for bit what `{}` returns for \
+         state `k`.",
         f.name, f.name
     );
     quote! {
         #[doc = #doc]
         #[inline]
         #[allow(unused_variables, unused_mut, clippy::all)]
-        fn #name(#(#args),*) -> [#ty; LANES] {
+        fn #name(#(#args),*) -> ((#(#types),*), [Result<(), Singular>; LANES]) {
             #(#entry)*
             #(#stmts)*
-            [#(#status),*]
+            (#values, [#(#status),*])
         }
     }
 }

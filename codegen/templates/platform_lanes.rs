@@ -1,8 +1,8 @@
 // Template: the `_lanes` functions of a platform module that solve with the actuation matrix
-// `A`, around the kernels' `_lanes` versions (`id_parts_lanes`, …, each lane's result as the
-// scalar kernel returns it). The kernels' arithmetic runs over the lanes; each lane's solve
-// is the scalar functions' own LU (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit
-// the scalar function. Specialized by `codegen/src/template.rs`; compiled and tested as a
+// `A`, around the kernels' `_lanes` versions (`id_parts_lanes`, …: the parts lane last and
+// each lane's status, lane `k` what the scalar kernel returns for state `k`). The kernels'
+// arithmetic runs over the lanes; each lane's solve is the scalar functions' own LU
+// (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit the scalar function. Specialized by `codegen/src/template.rs`; compiled and tested as a
 // module by `tests/tests/templates.rs`.
 
 /// `inverse_dynamics` of `LANES` states at once: entry `[i][k]` of an argument or of the
@@ -40,16 +40,33 @@ pub fn coriolis_lanes(
     solve_t_lanes(coriolis_parts_lanes(x, u, p))
 }
 
-/// Each lane's `Aᵀ τ = f` by `lu_solve_t`, the results lane last.
+/// Lane `k` of a lane-last array.
+#[inline]
+fn lane_of<const N: usize>(v: &[[f64; LANES]; N], k: usize) -> [f64; N] {
+    let mut out = [0.0; N];
+    for (o, row) in out.iter_mut().zip(v) {
+        if let Some(x) = row.get(k) {
+            *o = *x;
+        }
+    }
+    out
+}
+
+/// Each regular lane's `Aᵀ τ = f` by `lu_solve_t`, the results lane last.
 #[inline]
 #[allow(clippy::type_complexity)]
 fn solve_t_lanes(
-    parts: [Result<([[f64; DOF]; DOF], [f64; DOF]), Singular>; LANES],
+    ((a, f), mut status): (
+        ([[[f64; LANES]; DOF]; DOF], [[f64; LANES]; DOF]),
+        [Result<(), Singular>; LANES],
+    ),
 ) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
     let mut out = [[0.0; LANES]; DOF];
-    let mut status = [Ok(()); LANES];
-    for (k, (part, st)) in parts.iter().zip(status.iter_mut()).enumerate() {
-        match part.and_then(|(a, f)| lu_solve_t(&a, &f)) {
+    for (k, st) in status.iter_mut().enumerate() {
+        if st.is_err() {
+            continue;
+        }
+        match lu_solve_t(&a.map(|row| lane_of(&row, k)), &lane_of(&f, k)) {
             Ok(t) => {
                 for (o, v) in out.iter_mut().zip(t) {
                     if let Some(o) = o.get_mut(k) {
@@ -72,14 +89,16 @@ pub fn actuator_mass_matrix_lanes(
     x: &[[f64; LANES]; NX],
     p: &Params,
 ) -> ([[[f64; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
-    let parts = inertia_parts_lanes(x, p);
-    let mut status = [Ok(()); LANES];
+    let ((a, i), mut status) = inertia_parts_lanes(x, p);
     let mut ai = [[Lanes::splat(0.0); DOF]; DOF];
-    let mut im = [[Lanes::splat(0.0); DOF]; DOF];
-    for (k, (part, st)) in parts.iter().zip(status.iter_mut()).enumerate() {
-        match part.and_then(|(a, i)| Ok((lu_inverse(&a)?, i))) {
-            Ok((a, i)) => {
-                for (to, from) in ai.iter_mut().zip(a).chain(im.iter_mut().zip(i)) {
+    let im = i.map(|row| row.map(Lanes));
+    for (k, st) in status.iter_mut().enumerate() {
+        if st.is_err() {
+            continue;
+        }
+        match lu_inverse(&a.map(|row| lane_of(&row, k))) {
+            Ok(inv) => {
+                for (to, from) in ai.iter_mut().zip(inv) {
                     for (t, f) in to.iter_mut().zip(from) {
                         if let Some(t) = t.0.get_mut(k) {
                             *t = f;

@@ -120,6 +120,22 @@ fn fma_gough_stewart(c: &mut Criterion) {
     g.finish();
 }
 
+/// A group `name` of `scalar` (`l` states through the scalar function, one after the other)
+/// against `lanes` (one `_lanes` call of the same states); criterion's throughput is per state.
+fn scalar_vs_lanes<A, B>(
+    c: &mut Criterion,
+    name: String,
+    l: usize,
+    mut scalar: impl FnMut() -> A,
+    mut lanes: impl FnMut() -> B,
+) {
+    let mut grp = c.benchmark_group(name);
+    grp.throughput(Throughput::Elements(l as u64));
+    grp.bench_function("scalar", |b| b.iter(&mut scalar));
+    grp.bench_function("lanes", |b| b.iter(&mut lanes));
+    grp.finish();
+}
+
 macro_rules! lanes_tree {
     ($fn_name:ident, $m:ident) => {
         lanes_tree!($fn_name, lanes, $m);
@@ -135,44 +151,36 @@ macro_rules! lanes_tree {
             let taul = g::inverse_dynamics_lanes(&ql, &qdl, &qddl);
             let tau: [[f64; N]; L] = transpose(taul);
             let name = concat!(stringify!($variant), "/", stringify!($m));
-            let mut grp = c.benchmark_group(format!("{name}/inverse_dynamics"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+            scalar_vs_lanes(
+                c,
+                format!("{name}/inverse_dynamics"),
+                L,
+                || {
                     let (q, qd, qdd) = (black_box(&q), black_box(&qd), black_box(&qdd));
                     core::array::from_fn::<_, L, _>(|k| g::inverse_dynamics(&q[k], &qd[k], &qdd[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| {
-                b.iter(|| {
-                    g::inverse_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&qddl))
-                })
-            });
-            grp.finish();
-            let mut grp = c.benchmark_group(format!("{name}/mass_matrix"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+                },
+                || g::inverse_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&qddl)),
+            );
+            scalar_vs_lanes(
+                c,
+                format!("{name}/mass_matrix"),
+                L,
+                || {
                     let q = black_box(&q);
                     core::array::from_fn::<_, L, _>(|k| g::mass_matrix(&q[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| b.iter(|| g::mass_matrix_lanes(black_box(&ql))));
-            grp.finish();
-            let mut grp = c.benchmark_group(format!("{name}/forward_dynamics"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+                },
+                || g::mass_matrix_lanes(black_box(&ql)),
+            );
+            scalar_vs_lanes(
+                c,
+                format!("{name}/forward_dynamics"),
+                L,
+                || {
                     let (q, qd, tau) = (black_box(&q), black_box(&qd), black_box(&tau));
                     core::array::from_fn::<_, L, _>(|k| g::forward_dynamics(&q[k], &qd[k], &tau[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| {
-                b.iter(|| {
-                    g::forward_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&taul))
-                })
-            });
-            grp.finish();
+                },
+                || g::forward_dynamics_lanes(black_box(&ql), black_box(&qdl), black_box(&taul)),
+            );
         }
     };
 }
@@ -212,46 +220,36 @@ macro_rules! lanes_sites {
             assert!(status.iter().all(Result::is_ok));
             let tau: [[f64; N]; L] = transpose(taul);
             let name = concat!("lanes/", stringify!($m));
-            let mut grp = c.benchmark_group(format!("{name}/inverse_dynamics"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+            scalar_vs_lanes(
+                c,
+                format!("{name}/inverse_dynamics"),
+                L,
+                || {
                     let (x, u, ud) = (black_box(&x), black_box(&u), black_box(&ud));
                     core::array::from_fn::<_, L, _>(|k| g::inverse_dynamics(&x[k], &u[k], &ud[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| {
-                b.iter(|| {
-                    g::inverse_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&udl))
-                })
-            });
-            grp.finish();
-            let mut grp = c.benchmark_group(format!("{name}/actuator_mass_matrix"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+                },
+                || g::inverse_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&udl)),
+            );
+            scalar_vs_lanes(
+                c,
+                format!("{name}/actuator_mass_matrix"),
+                L,
+                || {
                     let x = black_box(&x);
                     core::array::from_fn::<_, L, _>(|k| g::actuator_mass_matrix(&x[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| {
-                b.iter(|| g::actuator_mass_matrix_lanes(black_box(&xl)))
-            });
-            grp.finish();
-            let mut grp = c.benchmark_group(format!("{name}/forward_dynamics"));
-            grp.throughput(Throughput::Elements(L as u64));
-            grp.bench_function("scalar", |b| {
-                b.iter(|| {
+                },
+                || g::actuator_mass_matrix_lanes(black_box(&xl)),
+            );
+            scalar_vs_lanes(
+                c,
+                format!("{name}/forward_dynamics"),
+                L,
+                || {
                     let (x, u, tau) = (black_box(&x), black_box(&u), black_box(&tau));
                     core::array::from_fn::<_, L, _>(|k| g::forward_dynamics(&x[k], &u[k], &tau[k]))
-                })
-            });
-            grp.bench_function("lanes", |b| {
-                b.iter(|| {
-                    g::forward_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&taul))
-                })
-            });
-            grp.finish();
+                },
+                || g::forward_dynamics_lanes(black_box(&xl), black_box(&ul), black_box(&taul)),
+            );
         }
     };
 }

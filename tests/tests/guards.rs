@@ -294,18 +294,7 @@ type Use<'a> = dyn Fn(&runtime::parallel::noc::Platform<Tracked>, &[runtime::par
 fn parallel_guards_match_the_runtime_tests() {
     use runtime::parallel::noc::{self, Plan};
     let mut rows = Vec::new();
-    for name in [
-        "gough_stewart",
-        "agile_eye",
-        "sliding_hexapod",
-        "rus_hexapod",
-        "planar_five_bar",
-        "delta_rl5",
-        "planar_3rrr",
-        "tsai_3upu",
-        "prs_head",
-        "delta4_rl5",
-    ] {
+    for name in tests::pkm::PARALLEL {
         let model = tests::pkm::model(name);
         let plan = Plan::new(&model).unwrap();
         let mut rng = tests::rng(32);

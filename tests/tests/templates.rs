@@ -302,47 +302,88 @@ mod actuation_lanes {
     fn lane<const N: usize>(a: &[[f64; LANES]; N], k: usize) -> [f64; N] {
         core::array::from_fn(|i| a[i][k])
     }
-    fn each<T>(
+    type Lanes2<const N: usize> = [[f64; LANES]; N];
+    type Status = [Result<(), Singular>; LANES];
+    /// Each lane of `f` (a lane with a NaN `x` is `Err(Site::Input)`), its two parts lane last.
+    #[allow(clippy::type_complexity)]
+    fn each<const R: usize>(
         x: &[[f64; LANES]; NX],
-        f: impl Fn(usize, &[f64; NX]) -> Result<T, Singular>,
-    ) -> [Result<T, Singular>; LANES] {
-        core::array::from_fn(|k| {
+        f: impl Fn(usize, &[f64; NX]) -> Result<([[f64; DOF]; DOF], [[f64; R]; 1]), Singular>,
+    ) -> (([Lanes2<DOF>; DOF], Lanes2<R>), Status) {
+        let mut a = [[[0.0; LANES]; DOF]; DOF];
+        let mut b = [[0.0; LANES]; R];
+        let mut status = [Ok(()); LANES];
+        for k in 0..LANES {
             let xk = lane(x, k);
-            if xk[0].is_nan() {
-                return Err(Singular {
+            let r = if xk[0].is_nan() {
+                Err(Singular {
                     site: Site::Input,
                     value: xk[0],
                     condition_estimate: f64::INFINITY,
-                });
+                })
+            } else {
+                f(k, &xk)
+            };
+            match r {
+                Ok((ak, [bk])) => {
+                    for i in 0..DOF {
+                        for j in 0..DOF {
+                            a[i][j][k] = ak[i][j];
+                        }
+                    }
+                    for i in 0..R {
+                        b[i][k] = bk[i];
+                    }
+                }
+                Err(e) => status[k] = Err(e),
             }
-            f(k, &xk)
-        })
+        }
+        ((a, b), status)
     }
-    type Parts = Result<([[f64; DOF]; DOF], [f64; DOF]), Singular>;
     fn id_parts_lanes(
         x: &[[f64; LANES]; NX],
         u: &[[f64; LANES]; DOF],
         ud: &[[f64; LANES]; DOF],
         p: &Params,
-    ) -> [Parts; LANES] {
-        each(x, |k, xk| id_parts(xk, &lane(u, k), &lane(ud, k), p))
+    ) -> (([Lanes2<DOF>; DOF], Lanes2<DOF>), Status) {
+        each(x, |k, xk| {
+            id_parts(xk, &lane(u, k), &lane(ud, k), p).map(|(a, f)| (a, [f]))
+        })
     }
-    fn gravity_parts_lanes(x: &[[f64; LANES]; NX], p: &Params) -> [Parts; LANES] {
-        each(x, |_, xk| gravity_parts(xk, p))
+    fn gravity_parts_lanes(
+        x: &[[f64; LANES]; NX],
+        p: &Params,
+    ) -> (([Lanes2<DOF>; DOF], Lanes2<DOF>), Status) {
+        each(x, |_, xk| gravity_parts(xk, p).map(|(a, f)| (a, [f])))
     }
     fn coriolis_parts_lanes(
         x: &[[f64; LANES]; NX],
         u: &[[f64; LANES]; DOF],
         p: &Params,
-    ) -> [Parts; LANES] {
-        each(x, |k, xk| coriolis_parts(xk, &lane(u, k), p))
+    ) -> (([Lanes2<DOF>; DOF], Lanes2<DOF>), Status) {
+        each(x, |k, xk| {
+            coriolis_parts(xk, &lane(u, k), p).map(|(a, f)| (a, [f]))
+        })
     }
-    #[allow(clippy::type_complexity)]
+    /// `A` and `I` lane last (`I` row by row through `each`'s second part).
     fn inertia_parts_lanes(
         x: &[[f64; LANES]; NX],
         p: &Params,
-    ) -> [Result<([[f64; DOF]; DOF], [[f64; DOF]; DOF]), Singular>; LANES] {
-        each(x, |_, xk| inertia_parts(xk, p))
+    ) -> (([Lanes2<DOF>; DOF], [Lanes2<DOF>; DOF]), Status) {
+        let ((a, _), status) = each::<DOF>(x, |_, xk| {
+            inertia_parts(xk, p).map(|(a, _)| (a, [[0.0; DOF]]))
+        });
+        let mut i = [[[0.0; LANES]; DOF]; DOF];
+        for k in 0..LANES {
+            if let Ok((_, ik)) = inertia_parts(&lane(x, k), p) {
+                for r in 0..DOF {
+                    for c in 0..DOF {
+                        i[r][c][k] = ik[r][c];
+                    }
+                }
+            }
+        }
+        ((a, i), status)
     }
     include!("../../codegen/templates/platform_lanes.rs");
 }

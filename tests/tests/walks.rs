@@ -443,18 +443,7 @@ fn turned(m: &ParallelModel, axis: usize, deg: f64, dp: [f64; 3]) -> Vec<f64> {
 #[test]
 fn parallel_generated_and_runtime_agree_toward_singularities() {
     let mut bad = Vec::new();
-    for name in [
-        "gough_stewart",
-        "sliding_hexapod",
-        "rus_hexapod",
-        "agile_eye",
-        "planar_five_bar",
-        "delta_rl5",
-        "planar_3rrr",
-        "tsai_3upu",
-        "prs_head",
-        "delta4_rl5",
-    ] {
+    for name in tests::pkm::PARALLEL {
         let m = tests::pkm::model(name);
         let plan = ParallelPlan::new(&m).unwrap();
         let home = tests::pkm::home_x(&m);

@@ -323,9 +323,21 @@ mod four_bar_lanes {
     include!(concat!(env!("OUT_DIR"), "/four_bar.rs"));
 }
 
-/// A platform's or closed loop's `_lanes` functions, each under its own `#[no_panic]`, in a
-/// module named after it (`x` has `NX` rows, the rest `DOF`).
+/// A platform's or closed loop's `_lanes` functions (the six every such module has with
+/// lanes), each under its own `#[no_panic]`, in a module named after it (`x` has `NX` rows,
+/// the rest `DOF`).
 macro_rules! site_lanes {
+    ($proof:ident, $m:ident) => {
+        site_lanes! {
+            $proof, $m,
+            inverse_dynamics_lanes(x: NX, u: DOF, ud: DOF) -> Vector;
+            gravity_lanes(x: NX) -> Vector;
+            coriolis_lanes(x: NX, u: DOF) -> Vector;
+            mass_matrix_lanes(x: NX) -> Matrix;
+            actuator_mass_matrix_lanes(x: NX) -> Matrix;
+            forward_dynamics_lanes(x: NX, u: DOF, tau: DOF) -> Vector;
+        }
+    };
     ($proof:ident, $m:ident, $($name:ident($($arg:ident: $len:ident),*) -> $out:ident;)*) => {
         mod $proof {
             use super::$m as m;
@@ -344,25 +356,8 @@ macro_rules! site_lanes {
     };
 }
 
-site_lanes! {
-    planar_3rrr_proof, planar_3rrr_lanes,
-    inverse_dynamics_lanes(x: NX, u: DOF, ud: DOF) -> Vector;
-    gravity_lanes(x: NX) -> Vector;
-    coriolis_lanes(x: NX, u: DOF) -> Vector;
-    mass_matrix_lanes(x: NX) -> Matrix;
-    actuator_mass_matrix_lanes(x: NX) -> Matrix;
-    forward_dynamics_lanes(x: NX, u: DOF, tau: DOF) -> Vector;
-}
-
-site_lanes! {
-    four_bar_proof, four_bar_lanes,
-    inverse_dynamics_lanes(x: NX, u: DOF, ud: DOF) -> Vector;
-    gravity_lanes(x: NX) -> Vector;
-    coriolis_lanes(x: NX, u: DOF) -> Vector;
-    mass_matrix_lanes(x: NX) -> Matrix;
-    actuator_mass_matrix_lanes(x: NX) -> Matrix;
-    forward_dynamics_lanes(x: NX, u: DOF, tau: DOF) -> Vector;
-}
+site_lanes!(planar_3rrr_proof, planar_3rrr_lanes);
+site_lanes!(four_bar_proof, four_bar_lanes);
 
 /// The `_lanes` wrappers of a platform's or closed loop's proof module, called once on opaque
 /// inputs (coordinates in ±1: regular and singular lanes alike).
