@@ -141,7 +141,9 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     if wrappers.iter().any(|w| *w != "actuator_mass_matrix") {
         wrapper_items.push("solve_t_lanes".into());
     }
-    wrapper_items.push("lane_of".into());
+    if !wrappers.is_empty() {
+        wrapper_items.push("lane_of".into());
+    }
     let wrapper_items: Vec<&str> = wrapper_items.iter().map(String::as_str).collect();
     let wrappers = crate::template::Specialize::new(cfg)
         .params(params)
