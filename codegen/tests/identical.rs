@@ -106,19 +106,66 @@ fn check_float(file: &str, cli_args: &[&str], math: &MathBackend, float: Float) 
         from_macro == from_cli,
         "{spec} {cli_args:?}: macro expansion differs from the CLI's"
     );
-    // No path of this machine leaks into the module (the macro's tracking constant is separate).
+    // No path of this machine leaks into the module (the macro's tracking constant is separate),
+    // nor the spec's file name, nor anything shaped like a timestamp.
     let text = String::from_utf8(from_cli).expect("UTF-8");
     let root = manifest_dir().parent().expect("workspace root");
-    assert!(
-        !text.contains(root.to_str().expect("UTF-8 path")),
-        "{spec}: absolute path in output"
-    );
-    assert!(
-        !text.contains("mechanisms/specs"),
-        "{spec}: spec path in output"
-    );
+    let mut forbidden = vec![
+        root.to_str().expect("UTF-8 path").to_owned(),
+        env!("CARGO_TARGET_TMPDIR").to_owned(),
+        "mechanisms/specs".to_owned(),
+        file.to_owned(),
+    ];
+    if let Ok(home) = std::env::var("HOME")
+        && home.len() > 1
+    {
+        forbidden.push(home);
+    }
+    for f in &forbidden {
+        assert!(
+            !text.contains(f.as_str()),
+            "{spec}: the output contains {f}"
+        );
+    }
+    assert!(!has_timestamp(&text), "{spec}: the output has a timestamp");
 }
 
+/// `true` when `s` has something shaped like a date (`2024-05-27`) or a clock time (`12:34:56`).
+fn has_timestamp(s: &str) -> bool {
+    let b = s.as_bytes();
+    let digits = |at: usize, n: usize| {
+        b.get(at..at + n)
+            .is_some_and(|d| d.iter().all(u8::is_ascii_digit))
+    };
+    (0..b.len()).any(|i| {
+        let boundary = i == 0 || !b[i - 1].is_ascii_alphanumeric();
+        boundary
+            && ((digits(i, 4)
+                && b.get(i + 4) == Some(&b'-')
+                && digits(i + 5, 2)
+                && b.get(i + 7) == Some(&b'-')
+                && digits(i + 8, 2))
+                || (digits(i, 2)
+                    && b.get(i + 2) == Some(&b':')
+                    && digits(i + 3, 2)
+                    && b.get(i + 5) == Some(&b':')
+                    && digits(i + 6, 2)))
+    })
+}
+
+#[test]
+fn timestamp_detector_works() {
+    assert!(has_timestamp("// generated 2024-05-27"));
+    assert!(has_timestamp("at 12:34:56 UTC"));
+    assert!(!has_timestamp("x1234-56-78 = 1; [f64; 12]; a:b:c"));
+}
+
+/// Every bundled spec (trees and parallel mechanisms, TOML and URDF) gives one module in two
+/// processes: the CLI's, given the spec by a relative path, and this one's (`Builder`, by an
+/// absolute path; the macro, relative to the calling crate). Each process seeds std's
+/// `HashMap`s differently (`RandomState` draws fresh keys per process), so an iteration over a
+/// std hash map that reached the output would show up here; the generator itself uses
+/// `IndexMap`/`FxHash` (fixed order and seed).
 #[test]
 fn cli_builder_and_macro_agree_on_every_bundled_spec() {
     let specs = bundled_specs();
