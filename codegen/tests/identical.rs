@@ -110,8 +110,10 @@ fn check_float(file: &str, cli_args: &[&str], math: &MathBackend, float: Float) 
     // nor the spec's file name, nor anything shaped like a timestamp.
     let text = String::from_utf8(from_cli).expect("UTF-8");
     let root = manifest_dir().parent().expect("workspace root");
+    let canonical = root.canonicalize().expect("the workspace root");
     let mut forbidden = vec![
         root.to_str().expect("UTF-8 path").to_owned(),
+        canonical.to_str().expect("UTF-8 path").to_owned(),
         env!("CARGO_TARGET_TMPDIR").to_owned(),
         "mechanisms/specs".to_owned(),
         file.to_owned(),

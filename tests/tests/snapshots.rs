@@ -12,7 +12,7 @@ fn generate(path: &std::path::Path) -> codegen::Generated {
 
 /// Each bundled spec generated once, in this process, against the module and the op-count table
 /// committed by another: a generator whose output moved with hash order or addresses would fail
-/// here (and two runs of the CLI are compared in `codegen/tests/identical.rs`).
+/// here (and `codegen/tests/identical.rs` compares the CLI's process with its own).
 #[test]
 fn generated_modules() {
     insta::glob!("../../mechanisms/specs", "*.{toml,urdf}", |path| {
