@@ -66,3 +66,32 @@ fn implement_modules() {
         insta::assert_snapshot!(format!("implement_{spec}"), tail);
     }
 }
+
+/// Many states per call (`Config::lanes`, two lanes; dynamics only): a tree, a platform and a
+/// closed loop. The `_lanes` functions, their guards over the lanes and each lane's `Err` are
+/// generated code of their own, a contract as the scalar functions are; `lanes.rs` checks them
+/// against the scalar functions.
+#[test]
+fn lanes_modules() {
+    use codegen::spec::Function as F;
+    for spec in ["planar_2r.toml", "planar_3rrr.toml", "four_bar.toml"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../mechanisms/specs")
+            .join(spec);
+        let src = std::fs::read_to_string(&path).unwrap();
+        let mut cfg = Config {
+            lanes: Some(2),
+            ..Config::default()
+        };
+        cfg.scene.omit = vec![
+            F::InverseDynamicsDerivatives,
+            F::ForwardDynamicsDerivatives,
+            F::Regressor,
+            F::Frames,
+        ];
+        let code = compile(spec, &src, &cfg)
+            .unwrap_or_else(|d| panic!("{d}"))
+            .code;
+        insta::assert_snapshot!(format!("lanes_{spec}"), code);
+    }
+}
