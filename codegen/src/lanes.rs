@@ -17,15 +17,17 @@
 //! JAX's `vmap` would take), LLVM keeps every operation scalar and nothing is gained (measured:
 //! slower than the scalar function four times). `forward_dynamics_lanes` returns the values and
 //! each lane's status, `([[f64; LANES]; DOF], [Result<(), Singular>; LANES])`: a lane's `Err`
-//! is the one the scalar function reports for that state, and it does not stop the others (its
-//! guards record the first failure and skip it from there on; its values are not to be read).
-//! Every per-lane step is unrolled at generation time: constant indices only, no panicking
-//! operation, no heap.
+//! is the one the scalar function reports for that state, and it does not stop the others
+//! (its values are not to be read). Over the lanes a guard only marks its lane `bad` (one
+//! compare and one `or`, which vectorize); at the end each lane marked `bad` or with a
+//! non-finite result is evaluated once more by the scalar function, whose `Err` it takes:
+//! exact by construction, and free on average since failures are rare. Every per-lane step
+//! is unrolled at generation time: constant indices only, no panicking operation, no heap.
 //!
 //! Platforms and closed loops: every function can fail, so every `_lanes` function returns
-//! each lane's status, its `Err` the scalar function's (a non-finite input first, then the
-//! guards in the scalar order, each lane's first failure recorded by the guard's site code,
-//! `lane_site` turning it back into the `Site`). A function that is one kernel (a closed
+//! each lane's status, its `Err` the scalar function's (a lane with a non-finite input is
+//! marked `bad` on entry, and the scalar function's second look finds the same input, guard
+//! or result first). A function that is one kernel (a closed
 //! loop's dynamics, a platform's `mass_matrix` and `forward_dynamics`) runs its schedule over
 //! the lanes whole. A platform's functions that solve with the actuation matrix `A`
 //! (`inverse_dynamics`, `gravity`, `coriolis`, `actuator_mass_matrix`) run their kernel
@@ -122,32 +124,25 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     }
     let ty = lanes_type(cfg, l);
     let fns = chosen.iter().map(|f| function(g, f, l));
-    let sites = functions.iter().any(|f| f.sites);
-    if !sites {
-        return quote! {
-            #ty
-            #(#fns)*
-        };
-    }
     let kernel_fns = kernels.iter().map(|f| kernel(g, f, l));
-    let lane_site = lane_site(g, chosen.iter().chain(&kernels).copied());
-    let params = kernels.iter().any(|f| f.args.contains(&Arg::P));
     let wrappers: Vec<&str> = KERNELS
         .iter()
         .filter(|(k, _)| kernels.iter().any(|f| f.name == *k))
         .map(|(_, w)| *w)
         .collect();
-    let mut wrapper_items: Vec<String> = wrappers.iter().map(|w| format!("{w}_lanes")).collect();
+    let mut items: Vec<String> = wrappers.iter().map(|w| format!("{w}_lanes")).collect();
     if wrappers.iter().any(|w| *w != "actuator_mass_matrix") {
-        wrapper_items.push("solve_t_lanes".into());
+        items.push("solve_t_lanes".into());
     }
-    if !wrappers.is_empty() {
-        wrapper_items.push("lane_of".into());
+    // The per-lane helpers of the functions that can fail ([`settle`]).
+    if chosen.iter().any(|f| fallible(f)) || !kernels.is_empty() {
+        items.extend(["lane_of", "put_lane", "flag_non_finite"].map(String::from));
     }
-    let wrapper_items: Vec<&str> = wrapper_items.iter().map(String::as_str).collect();
-    let wrappers = crate::template::Specialize::new(cfg)
+    let items: Vec<&str> = items.iter().map(String::as_str).collect();
+    let params = kernels.iter().any(|f| f.args.contains(&Arg::P));
+    let templated = crate::template::Specialize::new(cfg)
         .params(params)
-        .items(PLATFORM_LANES, &wrapper_items);
+        .items(PLATFORM_LANES, &items);
     let closed_amm = if names(functions).contains(&"actuator_mass_matrix")
         && !functions.iter().any(|f| f.name == "inertia_parts")
     {
@@ -157,10 +152,9 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     };
     quote! {
         #ty
-        #lane_site
         #(#fns)*
         #(#kernel_fns)*
-        #wrappers
+        #templated
         #closed_amm
     }
 }
@@ -184,43 +178,6 @@ fn closed_actuator_mass_matrix(functions: &[Function<'_>]) -> TokenStream {
             x: &[[#real; LANES]; NX] #p_arg
         ) -> ([[[#real; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
             mass_matrix_lanes(x #p)
-        }
-    }
-}
-
-/// `lane_site`, the `Site` of a guard's code (`runtime::scalar::Site::code`) as the `_lanes`
-/// functions record a lane's first failure: one arm per guard of `functions`.
-fn lane_site<'a>(g: &Graph, functions: impl Iterator<Item = &'a Function<'a>>) -> TokenStream {
-    use runtime::scalar::Site;
-    let mut codes: Vec<u16> = Vec::new();
-    for f in functions {
-        for st in &f.schedule.steps {
-            if let Step::Check { node } = *st
-                && let Node::Guard { index, .. } = g.node(node)
-            {
-                codes.push(index & !crate::sym::TWO_SIDED);
-            }
-        }
-    }
-    codes.sort_unstable();
-    codes.dedup();
-    let arms = codes
-        .iter()
-        .filter(|&&c| Site::from_code(c) != Site::Input)
-        .map(|&c| {
-            let site = emit::site_expr(Site::from_code(c));
-            let c = Literal::u16_unsuffixed(c);
-            quote!(#c => #site,)
-        });
-    quote! {
-        /// The `Site` of a guard's code, as a `_lanes` function records each lane's first
-        /// failure (`Site::Input` for a non-finite input or result).
-        #[inline]
-        fn lane_site(code: u16) -> Site {
-            match code {
-                #(#arms)*
-                _ => Site::Input,
-            }
         }
     }
 }
@@ -374,14 +331,14 @@ fn lane_scalar(g: &Graph, s: &Schedule, id: ExprId, k: usize) -> TokenStream {
 }
 
 /// One step over lanes.
-fn step(g: &Graph, s: &Schedule, st: &Step, l: usize, sites: bool) -> TokenStream {
+fn step(g: &Graph, s: &Schedule, st: &Step, l: usize) -> TokenStream {
     let op = |id| lane_operand(g, s, id);
     match *st {
         Step::SinCos { sin, cos, arg } => {
             let (a, b, x) = (emit::var(sin), emit::var(cos), op(arg));
             quote!(let (#a, #b) = Lanes::sin_cos(#x);)
         }
-        Step::Check { node } => (0..l).map(|k| check(g, s, node, k, sites)).collect(),
+        Step::Check { node } => (0..l).map(|k| check(g, s, node, k)).collect(),
         Step::MulAdd { name, node, mul } => {
             let x = emit::var(name);
             let [a, b, c] = crate::fma::args(g, node, mul, &op, &|v| {
@@ -424,47 +381,24 @@ fn binary(a: TokenStream, op: TokenStream, b: TokenStream) -> TokenStream {
     quote!(#a #op #b)
 }
 
-/// A guard's test in lane `k` (a tree's pivot, a platform's or closed loop's site), without a branch: the lane's first failure is kept (its
-/// pivot, value, magnitude and scale, so that the `Err` is built at the end as the scalar
-/// function builds it), later tests leave it.
-fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize, sites: bool) -> TokenStream {
+/// A guard's test in lane `k` (a tree's pivot, a platform's or closed loop's site), without a
+/// branch: a failure marks the lane `bad`, and the lane's `Err` is the scalar function's (see
+/// [`settle`]).
+fn check(g: &Graph, s: &Schedule, node: ExprId, k: usize) -> TokenStream {
     let Node::Guard {
-        value,
-        tol,
-        scale,
-        index,
+        value, tol, index, ..
     } = g.node(node)
     else {
         return TokenStream::new();
     };
-    let (v, t, sc) = (
-        lane_scalar(g, s, value, k),
-        lane_scalar(g, s, tol, k),
-        lane_scalar(g, s, scale, k),
-    );
-    let two_sided = index & crate::sym::TWO_SIDED != 0;
-    let pivot = Literal::usize_unsuffixed((index & !crate::sym::TWO_SIDED) as usize);
-    let (test, magnitude) = if two_sided {
-        (
-            quote!(#v > #t || #v < -#t),
-            quote!(if #v < 0.0 { -#v } else { #v }),
-        )
+    let (v, t) = (lane_scalar(g, s, value, k), lane_scalar(g, s, tol, k));
+    let test = if index & crate::sym::TWO_SIDED != 0 {
+        quote!(#v > #t || #v < -#t)
     } else {
-        (quote!(#v > #t), quote!(#v))
+        quote!(#v > #t)
     };
     let lane = Literal::usize_unsuffixed(k);
-    let none = if sites {
-        quote!(u16::MAX)
-    } else {
-        quote!(usize::MAX)
-    };
-    quote! {
-        let bad = fail_at[#lane] == #none && !(#test);
-        fail_at[#lane] = if bad { #pivot } else { fail_at[#lane] };
-        fail_value[#lane] = if bad { #v } else { fail_value[#lane] };
-        fail_magnitude[#lane] = if bad { #magnitude } else { fail_magnitude[#lane] };
-        fail_scale[#lane] = if bad { #sc } else { fail_scale[#lane] };
-    }
+    quote!(bad[#lane] |= !(#test);)
 }
 
 /// An output over lanes, as the array the caller gets: `x7.0`, `q[3].0` or `[c; LANES]`.
@@ -482,20 +416,19 @@ fn lane_array(g: &Graph, s: &Schedule, id: ExprId) -> TokenStream {
 }
 
 /// Arguments and entry statements of a `_lanes` function (each input transposed into
-/// `Lanes`; the record of each lane's first failure when the function can fail, with a
-/// platform's or closed loop's non-finite inputs recorded first, as its scalar function
-/// tests them first), and its schedule with the `sin_cos` of inputs first.
-fn prologue(
-    g: &Graph,
-    f: &Function<'_>,
-    l: usize,
-) -> (Vec<TokenStream>, Vec<TokenStream>, Schedule) {
+/// `Lanes`; when the function can fail, the lanes marked `bad`, a platform's or closed loop's
+/// lanes with a non-finite input first), and its schedule with the `sin_cos` of inputs first.
+fn prologue(g: &Graph, f: &Function<'_>) -> (Vec<TokenStream>, Vec<TokenStream>, Schedule) {
     let real = emit::real();
     let mut args = Vec::new();
     let mut entry = Vec::new();
     for a in &f.args {
         if *a == Arg::P {
             args.push(quote!(p: &Params));
+            // `params` for the scalar function's second look at a failed lane ([`settle`]).
+            if fallible(f) {
+                entry.push(quote!(let params = p;));
+            }
             entry.push(quote!(let p = p.to_array().map(Lanes::splat);));
             continue;
         }
@@ -508,36 +441,14 @@ fn prologue(
         args.push(quote!(#id: &[[#real; LANES]; #len]));
         entry.push(quote!(let #id: [Lanes; #len] = #id.map(Lanes);));
     }
+    if fallible(f) {
+        entry.push(quote!(let mut bad = [false; LANES];));
+    }
     if f.sites {
-        entry.push(quote! {
-            let mut fail_at = [u16::MAX; LANES];
-            let mut fail_value: [#real; LANES] = [0.0; LANES];
-            let mut fail_magnitude: [#real; LANES] = [0.0; LANES];
-            let mut fail_scale: [#real; LANES] = [0.0; LANES];
-        });
-        let input = Literal::u16_unsuffixed(runtime::scalar::Site::Input.code());
         for a in f.args.iter().filter(|a| **a != Arg::P) {
             let id = Ident::new(a.name(), Span::call_site());
-            let each = (0..l).map(Literal::usize_unsuffixed).map(|k| {
-                quote! {
-                    let bad = fail_at[#k] == u16::MAX && !v.0[#k].is_finite();
-                    fail_at[#k] = if bad { #input } else { fail_at[#k] };
-                    fail_value[#k] = if bad { v.0[#k] } else { fail_value[#k] };
-                }
-            });
-            entry.push(quote! {
-                for v in #id.iter() {
-                    #(#each)*
-                }
-            });
+            entry.push(quote!(flag_non_finite(&mut bad, &#id.map(|v| v.0));));
         }
-    } else if matches!(f.shape, Shape::FallibleVector) {
-        entry.push(quote! {
-            let mut fail_at = [usize::MAX; LANES];
-            let mut fail_value: [#real; LANES] = [0.0; LANES];
-            let mut fail_magnitude: [#real; LANES] = [0.0; LANES];
-            let mut fail_scale: [#real; LANES] = [0.0; LANES];
-        });
     }
     let s = &f.schedule;
     // The `sin_cos` of inputs first: each is a call per lane, and a call spills every vector
@@ -552,69 +463,76 @@ fn prologue(
 
 /// The scheduled statements over the lanes.
 fn statements(g: &Graph, f: &Function<'_>, s: &Schedule, l: usize) -> Vec<TokenStream> {
-    let stmts: Vec<TokenStream> = s
-        .steps
-        .iter()
-        .map(|st| step(g, s, st, l, f.sites))
-        .collect();
+    let stmts: Vec<TokenStream> = s.steps.iter().map(|st| step(g, s, st, l)).collect();
     emit::chunked(g, s, &f.outputs, stmts)
 }
 
-/// Lane `k`'s status, a labelled block: the `Err` of its first failed guard or input, else
-/// that of a non-finite output among `outs` (the lane's scalars), else `Ok(#ok)`.
-fn status(
-    g: &Graph,
-    f: &Function<'_>,
-    outs: &[TokenStream],
-    k: usize,
-    ok: TokenStream,
-) -> TokenStream {
-    let real = emit::real();
-    let all_const = f.outputs.iter().all(|&o| g.as_const(o).is_some());
-    let k = Literal::usize_unsuffixed(k);
-    let (at, out_at, none) = if f.sites {
-        (
-            quote!(site: lane_site(fail_at[#k])),
-            quote!(site: Site::Input),
-            quote!(u16::MAX),
-        )
-    } else {
-        (
-            quote!(pivot: fail_at[#k]),
-            quote!(pivot: DOF),
-            quote!(usize::MAX),
-        )
+/// Whether `f`'s `_lanes` version returns each lane's status.
+fn fallible(f: &Function<'_>) -> bool {
+    f.sites || matches!(f.shape, Shape::FallibleVector)
+}
+
+/// The end of a `_lanes` function that can fail: its values `values` (of `parts`) and each
+/// lane's status. A lane marked `bad` (an input, a guard) or with a non-finite result is
+/// evaluated once more by the scalar function `scalar` (`f` itself, or the scalar kernel),
+/// whose `Err` (or values) it takes: the lane's `Err` is the scalar function's by
+/// construction, and over the lanes a guard costs one compare and one `or` per lane.
+/// Failures are rare, so the second evaluation costs nothing on average.
+fn settle(f: &Function<'_>, values: TokenStream, parts: &[Part]) -> TokenStream {
+    let scalar = Ident::new(f.name, Span::call_site());
+    let one = parts.len() == 1;
+    let part = |whole: TokenStream, i: usize| {
+        if one {
+            whole
+        } else {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(#whole.#i)
+        }
     };
-    let finite = (!all_const).then(|| {
-        quote! {
-            for v in [#(#outs),*].iter() {
-                if !v.is_finite() {
-                    break 'lane Err(Singular {
-                        #out_at,
-                        value: *v,
-                        condition_estimate: #real::INFINITY,
-                    });
+    let flags = parts.iter().enumerate().map(|(i, p)| {
+        let o = part(quote!(out), i);
+        match p {
+            Part::Matrix => quote! {
+                for row in #o.iter() {
+                    flag_non_finite(&mut bad, row);
+                }
+            },
+            _ => quote!(flag_non_finite(&mut bad, &#o);),
+        }
+    });
+    let puts = parts.iter().enumerate().map(|(i, p)| {
+        let (o, v) = (part(quote!(out), i), part(quote!(v), i));
+        match p {
+            Part::Matrix => quote! {
+                for (o, r) in #o.iter_mut().zip(#v) {
+                    put_lane(o, k, r);
+                }
+            },
+            _ => quote!(put_lane(&mut #o, k, #v);),
+        }
+    });
+    let args = f.args.iter().map(|a| {
+        if *a == Arg::P {
+            return quote!(params);
+        }
+        let id = Ident::new(a.name(), Span::call_site());
+        quote!(&lane_of(&#id.map(|v| v.0), k))
+    });
+    quote! {
+        let mut out = #values;
+        #(#flags)*
+        let mut status = [Ok(()); LANES];
+        for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
+            if bad {
+                match #scalar(#(#args),*) {
+                    Ok(v) => {
+                        #(#puts)*
+                    }
+                    Err(e) => *st = Err(e),
                 }
             }
         }
-    });
-    quote! {
-        'lane: {
-            if fail_at[#k] != #none {
-                let a = fail_magnitude[#k];
-                break 'lane Err(Singular {
-                    #at,
-                    value: fail_value[#k],
-                    condition_estimate: if a > 0.0 {
-                        fail_scale[#k] / a
-                    } else {
-                        #real::INFINITY
-                    },
-                });
-            }
-            #finite
-            Ok(#ok)
-        }
+        (out, status)
     }
 }
 
@@ -623,28 +541,18 @@ fn status(
 fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
     let name = format_ident!("{}_lanes", f.name);
-    let (args, entry, s) = prologue(g, f, l);
+    let (args, entry, s) = prologue(g, f);
     let s = &s;
     let stmts = statements(g, f, s, l);
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
     let lane = quote!([#real; LANES]);
-    let statuses = || {
-        (0..l).map(|k| {
-            let outs: Vec<TokenStream> =
-                f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
-            status(g, f, &outs, k, quote!(()))
-        })
-    };
     let (ret_ty, ret) = match &f.shape {
         Shape::Vector => (quote!([#lane; DOF]), emit::return_tokens(f, &outs)),
         Shape::Matrix => (quote!([[#lane; DOF]; DOF]), emit::return_tokens(f, &outs)),
-        Shape::FallibleVector => {
-            let status = statuses();
-            (
-                quote!(([#lane; DOF], [Result<(), Singular>; LANES])),
-                quote!(([#(#outs),*], [#(#status),*])),
-            )
-        }
+        Shape::FallibleVector => (
+            quote!(([#lane; DOF], [Result<(), Singular>; LANES])),
+            settle(f, quote!([#(#outs),*]), &[Part::Vector]),
+        ),
         Shape::Fallible(parts) if f.sites => {
             let values = emit::parts_tokens(parts, f.dof, &outs);
             let ty = if parts[..] == [Part::Matrix] {
@@ -652,10 +560,9 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
             } else {
                 quote!([#lane; DOF])
             };
-            let status = statuses();
             (
                 quote!((#ty, [Result<(), Singular>; LANES])),
-                quote!((#values, [#(#status),*])),
+                settle(f, values, parts),
             )
         }
         _ => panic!("internal error: no lanes version of `{}`", f.name),
@@ -695,7 +602,7 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
 fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
     let name = format_ident!("{}_lanes", f.name);
-    let (args, entry, s) = prologue(g, f, l);
+    let (args, entry, s) = prologue(g, f);
     let s = &s;
     let stmts = statements(g, f, s, l);
     let Shape::Fallible(parts) = &f.shape else {
@@ -715,10 +622,7 @@ fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
         .collect();
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
     let values = emit::parts_tokens(parts, f.dof, &outs);
-    let status = (0..l).map(|k| {
-        let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_scalar(g, s, o, k)).collect();
-        status(g, f, &outs, k, quote!(()))
-    });
+    let settle = settle(f, values, parts);
     let doc = format!(
         " `{}` of `LANES` states at once: entry `[i][k]` of an argument or a part is entry `i` \
          of state `k`, and lane `k` (with its status) is bit for bit what `{}` returns for \
@@ -732,7 +636,7 @@ fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
         fn #name(#(#args),*) -> ((#(#types),*), [Result<(), Singular>; LANES]) {
             #(#entry)*
             #(#stmts)*
-            (#values, [#(#status),*])
+            #settle
         }
     }
 }

@@ -2,8 +2,10 @@
 // `A`, around the kernels' `_lanes` versions (`id_parts_lanes`, …: the parts lane last and
 // each lane's status, lane `k` what the scalar kernel returns for state `k`). The kernels'
 // arithmetic runs over the lanes; each lane's solve is the scalar functions' own LU
-// (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit the scalar function. Specialized by `codegen/src/template.rs`; compiled and tested as a
-// module by `tests/tests/templates.rs`.
+// (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit the scalar function. With them
+// the per-lane helpers (`lane_of`, `put_lane`, `flag_non_finite`) of every module whose
+// `_lanes` functions can fail. Specialized by `codegen/src/template.rs`; compiled and tested
+// as a module by `tests/tests/templates.rs`.
 
 /// `inverse_dynamics` of `LANES` states at once: entry `[i][k]` of an argument or of the
 /// result is entry `i` of state `k`, bit for bit what `inverse_dynamics` gives for that state.
@@ -52,6 +54,26 @@ fn lane_of<const N: usize>(v: &[[f64; LANES]; N], k: usize) -> [f64; N] {
     out
 }
 
+/// Writes `v` into lane `k` of a lane-last array.
+#[inline]
+fn put_lane<const N: usize>(out: &mut [[f64; LANES]; N], k: usize, v: [f64; N]) {
+    for (o, x) in out.iter_mut().zip(v) {
+        if let Some(o) = o.get_mut(k) {
+            *o = x;
+        }
+    }
+}
+
+/// Marks each lane of `bad` where a lane-last array has a non-finite entry.
+#[inline]
+fn flag_non_finite<const N: usize>(bad: &mut [bool; LANES], v: &[[f64; LANES]; N]) {
+    for row in v {
+        for (b, x) in bad.iter_mut().zip(row) {
+            *b |= !x.is_finite();
+        }
+    }
+}
+
 /// Each regular lane's `Aᵀ τ = f` by `lu_solve_t`, the results lane last.
 #[inline]
 #[allow(clippy::type_complexity)]
@@ -67,13 +89,7 @@ fn solve_t_lanes(
             continue;
         }
         match lu_solve_t(&a.map(|row| lane_of(&row, k)), &lane_of(&f, k)) {
-            Ok(t) => {
-                for (o, v) in out.iter_mut().zip(t) {
-                    if let Some(o) = o.get_mut(k) {
-                        *o = v;
-                    }
-                }
-            }
+            Ok(t) => put_lane(&mut out, k, t),
             Err(e) => *st = Err(e),
         }
     }

@@ -299,12 +299,10 @@ mod actuation_lanes {
             Lanes([self.0[0] * o.0[0], self.0[1] * o.0[1]])
         }
     }
-    fn lane<const N: usize>(a: &[[f64; LANES]; N], k: usize) -> [f64; N] {
-        core::array::from_fn(|i| a[i][k])
-    }
     type Lanes2<const N: usize> = [[f64; LANES]; N];
     type Status = [Result<(), Singular>; LANES];
-    /// Each lane of `f` (a lane with a NaN `x` is `Err(Site::Input)`), its two parts lane last.
+    /// Each lane of `f` (a lane with a non-finite `x` is `Err(Site::Input)`), its two parts
+    /// lane last, through the template's per-lane helpers.
     #[allow(clippy::type_complexity)]
     fn each<const R: usize>(
         x: &[[f64; LANES]; NX],
@@ -313,12 +311,18 @@ mod actuation_lanes {
         let mut a = [[[0.0; LANES]; DOF]; DOF];
         let mut b = [[0.0; LANES]; R];
         let mut status = [Ok(()); LANES];
-        for k in 0..LANES {
-            let xk = lane(x, k);
-            let r = if xk[0].is_nan() {
+        let mut bad = [false; LANES];
+        flag_non_finite(&mut bad, x);
+        for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
+            let xk = lane_of(x, k);
+            let r = if bad {
                 Err(Singular {
                     site: Site::Input,
-                    value: xk[0],
+                    value: xk
+                        .iter()
+                        .copied()
+                        .find(|v| !v.is_finite())
+                        .unwrap_or(f64::NAN),
                     condition_estimate: f64::INFINITY,
                 })
             } else {
@@ -326,16 +330,12 @@ mod actuation_lanes {
             };
             match r {
                 Ok((ak, [bk])) => {
-                    for i in 0..DOF {
-                        for j in 0..DOF {
-                            a[i][j][k] = ak[i][j];
-                        }
+                    for (row, r) in a.iter_mut().zip(ak) {
+                        put_lane(row, k, r);
                     }
-                    for i in 0..R {
-                        b[i][k] = bk[i];
-                    }
+                    put_lane(&mut b, k, bk);
                 }
-                Err(e) => status[k] = Err(e),
+                Err(e) => *st = Err(e),
             }
         }
         ((a, b), status)
@@ -347,7 +347,7 @@ mod actuation_lanes {
         p: &Params,
     ) -> (([Lanes2<DOF>; DOF], Lanes2<DOF>), Status) {
         each(x, |k, xk| {
-            id_parts(xk, &lane(u, k), &lane(ud, k), p).map(|(a, f)| (a, [f]))
+            id_parts(xk, &lane_of(u, k), &lane_of(ud, k), p).map(|(a, f)| (a, [f]))
         })
     }
     fn gravity_parts_lanes(
@@ -362,7 +362,7 @@ mod actuation_lanes {
         p: &Params,
     ) -> (([Lanes2<DOF>; DOF], Lanes2<DOF>), Status) {
         each(x, |k, xk| {
-            coriolis_parts(xk, &lane(u, k), p).map(|(a, f)| (a, [f]))
+            coriolis_parts(xk, &lane_of(u, k), p).map(|(a, f)| (a, [f]))
         })
     }
     /// `A` and `I` lane last (`I` row by row through `each`'s second part).
@@ -375,7 +375,7 @@ mod actuation_lanes {
         });
         let mut i = [[[0.0; LANES]; DOF]; DOF];
         for k in 0..LANES {
-            if let Ok((_, ik)) = inertia_parts(&lane(x, k), p) {
+            if let Ok((_, ik)) = inertia_parts(&lane_of(x, k), p) {
                 for r in 0..DOF {
                     for c in 0..DOF {
                         i[r][c][k] = ik[r][c];
