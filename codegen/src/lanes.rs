@@ -32,8 +32,8 @@
 //! the lanes whole. A platform's functions that solve with the actuation matrix `A`
 //! (`inverse_dynamics`, `gravity`, `coriolis`, `actuator_mass_matrix`) run their kernel
 //! (`id_parts`, …) over the lanes, which returns its parts lane last and each lane's status,
-//! and the wrappers (`templates/platform_lanes.rs`) solve each lane with the scalar
-//! functions' own LU: the pivots are chosen per lane, and the kernel is most of the work.
+//! and the wrappers (`templates/platform_lanes.rs`) solve over the lanes too, with the scalar
+//! LU's statements over `Lanes` (`crate::lu`): each lane's pivots chosen by its own selects.
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};

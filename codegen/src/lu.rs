@@ -32,6 +32,12 @@
 //!   `Err(Actuation(i))`.
 //!
 //! The operation count is [`crate::parallel::lu_many_ops`]; the error paths are not counted.
+//!
+//! With [`LuSolve::lanes`], the same statements over `Lanes` (`crate::lanes`): each select a
+//! select per lane, so each lane makes the scalar function's operations on its own matrix (its
+//! pivots chosen by its own comparisons) and its result is the scalar one bit for bit. A
+//! failed test marks the lane in `bad` instead of returning; the caller takes that lane's
+//! `Err` from the scalar function.
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -64,6 +70,50 @@ pub(crate) struct LuSolve<'a> {
     pub units: ColumnUnits<'a>,
     /// The square-root call of the chosen math backend, applied to the tokens given.
     pub sqrt: &'a dyn Fn(TokenStream) -> TokenStream,
+    /// Over the lanes (`<name>_lanes`, see the module's doc).
+    pub lanes: bool,
+}
+
+/// A constant: `c`, or `Lanes::splat(c)` over the lanes.
+fn constant(lanes: bool, c: TokenStream) -> TokenStream {
+    if lanes { quote!(Lanes::splat(#c)) } else { c }
+}
+
+/// `if a > b { x } else { y }`, per lane over the lanes.
+fn select_gt(
+    lanes: bool,
+    a: TokenStream,
+    b: TokenStream,
+    x: TokenStream,
+    y: TokenStream,
+) -> TokenStream {
+    if lanes {
+        quote!(select_gt(#a, #b, #x, #y))
+    } else {
+        quote!(if #a > #b { #x } else { #y })
+    }
+}
+
+/// `let (u, v) = (v, u)` where the swap flag `c` holds. Over the lanes the flag is not a
+/// value but its comparison, `|c_a| > |c_b|` per lane (`Lanes::select_abs_gt`): selects by a
+/// mask array kept LLVM from vectorizing them.
+fn cond_swap(lanes: bool, c: &Ident, u: &Ident, v: &Ident) -> TokenStream {
+    if lanes {
+        let (ca, cb) = flag_operands(c);
+        quote! {
+            let (#u, #v) = (
+                Lanes::select_abs_gt(#ca, #cb, #v, #u),
+                Lanes::select_abs_gt(#ca, #cb, #u, #v),
+            );
+        }
+    } else {
+        quote!(let (#u, #v) = if #c { (#v, #u) } else { (#u, #v) };)
+    }
+}
+
+/// The two operands a swap flag compares over the lanes (`|c_a| > |c_b|`).
+fn flag_operands(c: &Ident) -> (Ident, Ident) {
+    (format_ident!("{}_a", c), format_ident!("{}_b", c))
 }
 
 fn m(i: usize, j: usize) -> Ident {
@@ -87,7 +137,7 @@ fn l(i: usize, k: usize) -> Ident {
 /// `aᵀ x = b` from the factorization `U = E_{n−2} P_{n−2} ⋯ E_0 P_0 a` (`P_k` the conditional
 /// swaps of step `k`, `E_k = I − l_k e_kᵀ` its elimination; LINPACK's `dgesl` with `job ≠ 0`):
 /// `Uᵀ z = b` forward, then `x = P_0ᵀ E_0ᵀ ⋯ P_{n−2}ᵀ E_{n−2}ᵀ z`, applied from the right.
-fn transposed_solve(n: usize, st: &mut Vec<TokenStream>) {
+fn transposed_solve(n: usize, lanes: bool, st: &mut Vec<TokenStream>) {
     for i in 0..n {
         let (xi, ri) = (x(i, 0), format_ident!("r{}", i));
         let terms = (0..i).map(|j| {
@@ -105,7 +155,7 @@ fn transposed_solve(n: usize, st: &mut Vec<TokenStream>) {
         st.push(quote!(let #xk = #xk #(#terms)*;));
         for i in (k + 1..n).rev() {
             let (u, v, sw) = (x(k, 0), x(i, 0), swap(k, i));
-            st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
+            st.push(cond_swap(lanes, &sw, &u, &v));
         }
     }
 }
@@ -116,13 +166,17 @@ fn abs(v: &Ident) -> TokenStream {
 
 /// The emitted function.
 pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
-    let real = crate::emit::real();
     let n = s.n;
     let k_rhs = match s.rhs {
         Rhs::Vector => 1,
         Rhs::Identity => n,
     };
-    let name = format_ident!("{}", s.name);
+    let name = if s.lanes {
+        format_ident!("{}_lanes", s.name)
+    } else {
+        format_ident!("{}", s.name)
+    };
+    let lanes = s.lanes;
     let doc = s.doc;
     let tol2 = Literal::f64_unsuffixed(s.tol2);
     let mut st: Vec<TokenStream> = Vec::new();
@@ -134,18 +188,26 @@ pub(crate) fn lu_solve_fn(s: &LuSolve<'_>) -> TokenStream {
     group_norms(s, &mut st);
     // The largest column of a group has unit norm once scaled: a pivot is compared with 1 as
     // well as with the largest before it.
-    st.push(quote!(let pn: #real = 1.0;));
-    st.push(quote!(let pd: #real = 1.0;));
+    if lanes {
+        st.push(quote!(let pn = Lanes::splat(1.0);));
+        st.push(quote!(let pd = Lanes::splat(1.0);));
+    } else {
+        let real = crate::emit::real();
+        st.push(quote!(let pn: #real = 1.0;));
+        st.push(quote!(let pd: #real = 1.0;));
+    }
     for k in 0..n {
         elimination_step(s, k, k_rhs, &tol2, &mut st);
     }
     if tr {
-        transposed_solve(n, &mut st);
+        transposed_solve(n, lanes, &mut st);
     }
     back_substitution(n, k_rhs, tr, &mut st);
-    match s.rhs {
-        Rhs::Vector => vector_fn(&name, doc, n, &st),
-        Rhs::Identity => identity_fn(&name, doc, n, &st),
+    match (s.rhs, lanes) {
+        (Rhs::Vector, false) => vector_fn(&name, doc, n, &st),
+        (Rhs::Identity, false) => identity_fn(&name, doc, n, &st),
+        (Rhs::Vector, true) => vector_lanes_fn(&name, n, &st),
+        (Rhs::Identity, true) => identity_lanes_fn(&name, n, &st),
     }
 }
 
@@ -159,20 +221,29 @@ fn load_locals(s: &LuSolve<'_>, k_rhs: usize, st: &mut Vec<TokenStream>) {
                 Literal::usize_unsuffixed(i),
                 Literal::usize_unsuffixed(j),
             );
-            st.push(quote!(let #mi = a[#r][#c];));
+            st.push(if s.lanes {
+                quote!(let #mi = Lanes(a[#r][#c]);)
+            } else {
+                quote!(let #mi = a[#r][#c];)
+            });
         }
     }
     for i in 0..n {
         for c in 0..k_rhs {
             let xi = x(i, c);
-            st.push(match s.rhs {
+            let v = match s.rhs {
                 Rhs::Vector => {
                     let i = Literal::usize_unsuffixed(i);
-                    quote!(let #xi = b[#i];)
+                    if s.lanes {
+                        quote!(Lanes(b[#i]))
+                    } else {
+                        quote!(b[#i])
+                    }
                 }
-                Rhs::Identity if i == c => quote!(let #xi = 1.0;),
-                Rhs::Identity => quote!(let #xi = 0.0;),
-            });
+                Rhs::Identity if i == c => constant(s.lanes, quote!(1.0)),
+                Rhs::Identity => constant(s.lanes, quote!(0.0)),
+            };
+            st.push(quote!(let #xi = #v;));
         }
     }
 }
@@ -204,7 +275,8 @@ fn group_norms(s: &LuSolve<'_>, st: &mut Vec<TokenStream>) {
         for i in j + 1..s.n {
             if u.group(i) == u.group(j) {
                 let ni = format_ident!("n{}", i);
-                st.push(quote!(let #oj = if #ni > #oj { #ni } else { #oj };));
+                let e = select_gt(s.lanes, quote!(#ni), quote!(#oj), quote!(#ni), quote!(#oj));
+                st.push(quote!(let #oj = #e;));
             }
         }
     }
@@ -215,10 +287,14 @@ fn group_norms(s: &LuSolve<'_>, st: &mut Vec<TokenStream>) {
             for &k in leaders.iter().filter(|&&k| k != j) {
                 let (hk, c) = (
                     h(k),
-                    crate::emit::float_lit(u.factor2(u.group(k), u.group(j))),
+                    constant(
+                        s.lanes,
+                        crate::emit::float_lit(u.factor2(u.group(k), u.group(j))),
+                    ),
                 );
                 st.push(quote!(let c = #c * #hk;));
-                st.push(quote!(let #gj = if c > #gj { c } else { #gj };));
+                let e = select_gt(s.lanes, quote!(c), quote!(#gj), quote!(c), quote!(#gj));
+                st.push(quote!(let #gj = #e;));
             }
         }
     }
@@ -245,37 +321,64 @@ fn elimination_step(
     tol2: &Literal,
     st: &mut Vec<TokenStream>,
 ) {
-    let (n, tr) = (s.n, s.transpose);
-    pivot_swaps(n, k, k_rhs, tr, st);
-    pivot_test(s, k, tol2, st);
+    let (n, tr, lanes) = (s.n, s.transpose, s.lanes);
+    pivot_swaps(n, k, k_rhs, tr, lanes, st);
+    if lanes {
+        pivot_flag(k, tol2, st);
+    } else {
+        pivot_test(s, k, tol2, st);
+    }
     if k + 1 < n {
         let gk = g(k);
-        st.push(quote!(let (pn, pd) = if lhs > rhs { (b2, #gk) } else { (pn, pd) };));
+        st.push(if lanes {
+            quote!(let (pn, pd) = (select_gt(lhs, rhs, b2, pn), select_gt(lhs, rhs, #gk, pd));)
+        } else {
+            quote!(let (pn, pd) = if lhs > rhs { (b2, #gk) } else { (pn, pd) };)
+        });
     }
     let (kk, rk) = (m(k, k), format_ident!("r{}", k));
-    st.push(quote!(let #rk = 1.0 / #kk;));
+    let one = constant(lanes, quote!(1.0));
+    st.push(quote!(let #rk = #one / #kk;));
     eliminate_below(n, k, k_rhs, tr, st);
 }
 
 /// Conditional swaps: row `k` ends with the largest |entry| of column `k`.
-fn pivot_swaps(n: usize, k: usize, k_rhs: usize, tr: bool, st: &mut Vec<TokenStream>) {
+fn pivot_swaps(n: usize, k: usize, k_rhs: usize, tr: bool, lanes: bool, st: &mut Vec<TokenStream>) {
     let kk = m(k, k);
     for i in k + 1..n {
-        let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
         let sw = if tr { swap(k, i) } else { format_ident!("s") };
-        st.push(quote!(let #sw = #a_ik > #a_kk;));
+        if lanes {
+            let ((sa, sb), ik) = (flag_operands(&sw), m(i, k));
+            st.push(quote!(let (#sa, #sb) = (#ik, #kk);));
+        } else {
+            let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
+            st.push(quote!(let #sw = #a_ik > #a_kk;));
+        }
         for j in k..n {
-            let (u, v) = (m(k, j), m(i, j));
-            st.push(quote!(let (#u, #v) = if #sw { (#v, #u) } else { (#u, #v) };));
+            st.push(cond_swap(lanes, &sw, &m(k, j), &m(i, j)));
         }
         for c in 0..k_rhs {
             if tr {
                 break;
             }
-            let (u, v) = (x(k, c), x(i, c));
-            st.push(quote!(let (#u, #v) = if s { (#v, #u) } else { (#u, #v) };));
+            st.push(cond_swap(lanes, &sw, &x(k, c), &x(i, c)));
         }
     }
+}
+
+/// [`pivot_test`] over the lanes: a lane whose pivot fails is marked in `bad`.
+fn pivot_flag(k: usize, tol2: &Literal, st: &mut Vec<TokenStream>) {
+    let real = crate::emit::real();
+    let (kk, nk) = (m(k, k), g(k));
+    st.push(quote! {
+        let b2 = #kk * #kk;
+        let lhs = b2 * pd;
+        let rhs = pn * #nk;
+        for (((bad, p), lhs), rhs) in bad.iter_mut().zip(#kk.0).zip(lhs.0).zip(rhs.0) {
+            let best = if p < 0.0 { -p } else { p };
+            *bad |= !((best > 0.0) & (best < #real::INFINITY)) | !(lhs > #tol2 * rhs);
+        }
+    });
 }
 
 /// The pivot's test against the column-scaled tolerance, `Err(Actuation(k))` when it fails.
@@ -361,6 +464,68 @@ fn vector_fn(name: &Ident, doc: &str, n: usize, st: &[TokenStream]) -> TokenStre
                 }
             }
             Ok(out)
+        }
+    }
+}
+
+/// [`vector_fn`] over the lanes: the lanes of a failed pivot or a non-finite result are
+/// marked in `bad` (their values are not to be read).
+fn vector_lanes_fn(name: &Ident, n: usize, st: &[TokenStream]) -> TokenStream {
+    let real = crate::emit::real();
+    let out = (0..n).map(|i| x(i, 0));
+    quote! {
+        /// The scalar solve's operations over the lanes, lane by lane; a lane whose pivot test
+        /// fails or whose result is not finite is marked in `bad`.
+        #[allow(clippy::all, unused_variables)]
+        fn #name(
+            a: &[[[#real; LANES]; DOF]; DOF],
+            b: &[[#real; LANES]; DOF],
+            bad: &mut [bool; LANES],
+        ) -> [[#real; LANES]; DOF] {
+            #(#st)*
+            let out = [#(#out.0),*];
+            flag_non_finite(bad, &out);
+            out
+        }
+    }
+}
+
+/// [`identity_fn`] over the lanes (the inverse as `Lanes`), marking lanes as
+/// [`vector_lanes_fn`].
+fn identity_lanes_fn(name: &Ident, n: usize, st: &[TokenStream]) -> TokenStream {
+    let real = crate::emit::real();
+    let rows = (0..n).map(|i| {
+        let row = (0..n).map(|c| x(i, c));
+        quote!([#(#row),*])
+    });
+    quote! {
+        /// The scalar inverse's operations over the lanes, lane by lane; a lane whose pivot
+        /// test fails or whose inverse is not finite is marked in `bad`.
+        #[allow(clippy::all, unused_variables)]
+        fn #name(a: &[[[#real; LANES]; DOF]; DOF], bad: &mut [bool; LANES]) -> [[Lanes; DOF]; DOF] {
+            #(#st)*
+            let out = [#(#rows),*];
+            for row in out.iter() {
+                flag_non_finite(bad, &row.map(|v| v.0));
+            }
+            out
+        }
+    }
+}
+
+/// The per-lane select the `_lanes` solves use besides `Lanes::select_abs_gt`.
+pub(crate) fn lanes_helpers() -> TokenStream {
+    quote! {
+        /// Per lane: `x` where `a > b`, else `y`.
+        #[inline(always)]
+        fn select_gt(a: Lanes, b: Lanes, x: Lanes, y: Lanes) -> Lanes {
+            let mut r = y;
+            for (((r, a), b), x) in r.0.iter_mut().zip(a.0).zip(b.0).zip(x.0) {
+                if a > b {
+                    *r = x;
+                }
+            }
+            r
         }
     }
 }

@@ -1,8 +1,9 @@
 // Template: the `_lanes` functions of a platform module that solve with the actuation matrix
 // `A`, around the kernels' `_lanes` versions (`id_parts_lanes`, …: the parts lane last and
 // each lane's status, lane `k` what the scalar kernel returns for state `k`). The kernels'
-// arithmetic runs over the lanes; each lane's solve is the scalar functions' own LU
-// (`lu_solve_t`, `lu_inverse`), so each lane is bit for bit the scalar function. With them
+// arithmetic runs over the lanes, and so do the solves (`lu_solve_t_lanes`,
+// `lu_inverse_lanes`: each lane the scalar LU's operations, its pivots its own), so each lane
+// is bit for bit the scalar function. With them
 // the per-lane helpers (`lane_of`, `put_lane`, `flag_non_finite`) of every module whose
 // `_lanes` functions can fail. Specialized by `codegen/src/template.rs`; compiled and tested
 // as a module by `tests/tests/templates.rs`.
@@ -74,7 +75,9 @@ fn flag_non_finite<const N: usize>(bad: &mut [bool; LANES], v: &[[f64; LANES]; N
     }
 }
 
-/// Each regular lane's `Aᵀ τ = f` by `lu_solve_t`, the results lane last.
+/// `Aᵀ τ = f` over the lanes by `lu_solve_t_lanes` (each lane the scalar `lu_solve_t`'s
+/// operations); a lane it marks (a failed pivot, a non-finite result) and that the kernel
+/// left `Ok` is solved again by `lu_solve_t`, whose `Err` it takes.
 #[inline]
 #[allow(clippy::type_complexity)]
 fn solve_t_lanes(
@@ -83,9 +86,10 @@ fn solve_t_lanes(
         [Result<(), Singular>; LANES],
     ),
 ) -> ([[f64; LANES]; DOF], [Result<(), Singular>; LANES]) {
-    let mut out = [[0.0; LANES]; DOF];
-    for (k, st) in status.iter_mut().enumerate() {
-        if st.is_err() {
+    let mut bad = [false; LANES];
+    let mut out = lu_solve_t_lanes(&a, &f, &mut bad);
+    for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
+        if !bad || st.is_err() {
             continue;
         }
         match lu_solve_t(&a.map(|row| lane_of(&row, k)), &lane_of(&f, k)) {
@@ -97,8 +101,9 @@ fn solve_t_lanes(
 }
 
 /// `actuator_mass_matrix` of `LANES` states at once, lane by lane as
-/// `inverse_dynamics_lanes`: each lane's `A⁻¹` by `lu_inverse`, then `A⁻ᵀ I A⁻¹` over the
-/// lanes in the scalar function's order of operations.
+/// `inverse_dynamics_lanes`: `A⁻¹` over the lanes by `lu_inverse_lanes` (a lane it marks
+/// again by `lu_inverse`, for its `Err`), then `A⁻ᵀ I A⁻¹` over the lanes in the scalar
+/// function's order of operations.
 #[inline]
 #[allow(clippy::type_complexity)]
 pub fn actuator_mass_matrix_lanes(
@@ -106,10 +111,11 @@ pub fn actuator_mass_matrix_lanes(
     p: &Params,
 ) -> ([[[f64; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
     let ((a, i), mut status) = inertia_parts_lanes(x, p);
-    let mut ai = [[Lanes::splat(0.0); DOF]; DOF];
+    let mut bad = [false; LANES];
+    let mut ai = lu_inverse_lanes(&a, &mut bad);
     let im = i.map(|row| row.map(Lanes));
-    for (k, st) in status.iter_mut().enumerate() {
-        if st.is_err() {
+    for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
+        if !bad || st.is_err() {
             continue;
         }
         match lu_inverse(&a.map(|row| lane_of(&row, k))) {

@@ -356,6 +356,82 @@ check_site_lanes!(
     closed_open
 );
 
+/// A lane at a singularity of the actuation matrix among regular ones: the Gough–Stewart
+/// platform at home turned 90° about the vertical (singular, `literal.rs` and
+/// `singularities.rs`). Its `A` is factorized over the lanes with the others' (the kernels are
+/// regular there); the lane's `Err(Actuation(_))` is the scalar functions', and the other
+/// lanes are their scalar results bit for bit.
+#[test]
+fn gough_stewart_actuation_singular_lane() {
+    use tests::variants::lanes_parallel::gough_stewart as g;
+    const L: usize = g::LANES;
+    let mut state = tests::pkm::near_home("gough_stewart");
+    let mut r = tests::rng(21);
+    let (mut xs, mut us, mut uds) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..L {
+        let (x, u, ud) = state(&mut r);
+        xs.push(x);
+        us.push(u);
+        uds.push(ud);
+    }
+    let x0 = g::HOME;
+    let (c, s) = (
+        std::f64::consts::FRAC_PI_4.cos(),
+        std::f64::consts::FRAC_PI_4.sin(),
+    );
+    let q0 = [x0[3], x0[4], x0[5], x0[6]];
+    // `R_z(90°) ⊗ q0`, scalar first.
+    let q = [
+        c * q0[0] - s * q0[3],
+        c * q0[1] - s * q0[2],
+        c * q0[2] + s * q0[1],
+        c * q0[3] + s * q0[0],
+    ];
+    let singular = 2;
+    xs[singular] = vec![x0[0], x0[1], x0[2], q[0], q[1], q[2], q[3]];
+    let x: [[f64; L]; g::NX] = columns(&xs);
+    let (u, ud): ([[f64; L]; g::DOF], [[f64; L]; g::DOF]) = (columns(&us), columns(&uds));
+    let (tau, id) = g::inverse_dynamics_lanes(&x, &u, &ud);
+    let (gr, grs) = g::gravity_lanes(&x);
+    let (am, ams) = g::actuator_mass_matrix_lanes(&x);
+    for k in 0..L {
+        let (xk, uk, udk) = (lane(&x, k), lane(&u, k), lane(&ud, k));
+        let scalar = g::inverse_dynamics(&xk, &uk, &udk);
+        if k == singular {
+            assert!(
+                matches!(
+                    scalar,
+                    Err(g::Singular {
+                        site: g::Site::Actuation(_),
+                        ..
+                    })
+                ),
+                "{scalar:?}"
+            );
+            assert!(g::actuator_mass_matrix(&xk).is_err());
+        } else {
+            assert!(scalar.is_ok(), "lane {k}: {scalar:?}");
+        }
+        let pairs = [
+            (
+                format!("{:?}", id[k].map(|()| lane(&tau, k))),
+                format!("{scalar:?}"),
+            ),
+            (
+                format!("{:?}", grs[k].map(|()| lane(&gr, k))),
+                format!("{:?}", g::gravity(&xk)),
+            ),
+            (
+                format!("{:?}", ams[k].map(|()| lane_matrix(&am, k))),
+                format!("{:?}", g::actuator_mass_matrix(&xk)),
+            ),
+        ];
+        for (lanes, scalar) in pairs {
+            assert_eq!(lanes, scalar, "lane {k}");
+        }
+    }
+}
+
 /// The same in `f32` with 8 lanes.
 #[test]
 fn puma560_f32_eight_lanes() {

@@ -385,6 +385,38 @@ mod actuation_lanes {
         }
         ((a, i), status)
     }
+    /// `lu_solve_t` lane by lane, a failing lane marked, as a generated module's.
+    fn lu_solve_t_lanes(
+        a: &[Lanes2<DOF>; DOF],
+        b: &Lanes2<DOF>,
+        bad: &mut [bool; LANES],
+    ) -> Lanes2<DOF> {
+        let mut out = [[0.0; LANES]; DOF];
+        for (k, bad) in bad.iter_mut().enumerate() {
+            match lu_solve_t(&a.map(|row| lane_of(&row, k)), &lane_of(b, k)) {
+                Ok(t) => put_lane(&mut out, k, t),
+                Err(_) => *bad = true,
+            }
+        }
+        out
+    }
+    /// `lu_inverse` lane by lane, a failing lane marked, as a generated module's.
+    fn lu_inverse_lanes(a: &[Lanes2<DOF>; DOF], bad: &mut [bool; LANES]) -> [[Lanes; DOF]; DOF] {
+        let mut out = [[Lanes::splat(0.0); DOF]; DOF];
+        for (k, bad) in bad.iter_mut().enumerate() {
+            match lu_inverse(&a.map(|row| lane_of(&row, k))) {
+                Ok(inv) => {
+                    for (to, from) in out.iter_mut().zip(inv) {
+                        for (t, f) in to.iter_mut().zip(from) {
+                            t.0[k] = f;
+                        }
+                    }
+                }
+                Err(_) => *bad = true,
+            }
+        }
+        out
+    }
     include!("../../codegen/templates/platform_lanes.rs");
 }
 

@@ -45,6 +45,7 @@ pub(super) fn templates(
         " Solve `a x = b`: LU with partial pivoting by conditional row swaps, straight-line code.\n\n A pivot of `a` with each column scaled by its unit group's reference (the group's largest\n 2-norm, or another group's times the platform's radius between the speeds in rad/s and\n those in m/s, whichever is larger) must exceed the tolerance times the larger of 1 and the largest\n pivot so far (compared squared and cross-multiplied: no square root or division outside\n the error path); otherwise `Err(Site::Actuation(k))` with the ratio of that reference to\n this pivot as the condition estimate.",
         false,
         lu::Rhs::Vector,
+        false,
     );
     // Wrappers of the kernels `[scene] functions` may leave out.
     let actuation = Specialize::new(cfg).params(params);
@@ -60,6 +61,7 @@ pub(super) fn templates(
             " Solve `aᵀ x = b` (as `lu_solve`, on the transpose).",
             true,
             lu::Rhs::Vector,
+            false,
         );
         let id = if want("id") {
             actuation.items(ACTUATION, &["inverse_dynamics"])
@@ -90,9 +92,23 @@ pub(super) fn templates(
             " `a⁻¹`: one factorization (as `lu_solve`) for the `DOF` columns of the identity.",
             false,
             lu::Rhs::Identity,
+            false,
         );
         let f = actuation.items(ACTUATION, &inverse);
         quote!(#lu_inverse #f)
+    };
+    // Over the lanes (`crate::lanes`): the solves of the kernels that have `_lanes` versions.
+    let solve_lanes = cfg.lanes.is_some() && (want("id") || want("gravity") || want("coriolis"));
+    let inverse_lanes = cfg.lanes.is_some() && want("inertia");
+    let lanes = if solve_lanes || inverse_lanes {
+        let solve =
+            solve_lanes.then(|| lu_fn(cfg, plan, "lu_solve_t", "", true, lu::Rhs::Vector, true));
+        let inverse = inverse_lanes
+            .then(|| lu_fn(cfg, plan, "lu_inverse", "", false, lu::Rhs::Identity, true));
+        let helpers = lu::lanes_helpers();
+        quote!(#solve #inverse #helpers)
+    } else {
+        quote!()
     };
     let kinematics = kinematics(cfg, plan);
     quote! {
@@ -106,6 +122,8 @@ pub(super) fn templates(
         #id_wrapper
 
         #amm_wrapper
+
+        #lanes
 
         #kinematics
     }
@@ -192,6 +210,7 @@ fn lu_fn(
     doc: &str,
     transpose: bool,
     rhs: lu::Rhs,
+    lanes: bool,
 ) -> TokenStream {
     let act_tol = crate::scalar::tolerance(noc::ACTUATION_TOLERANCE);
     // The squared tolerance, rounded to 13 significant digits so that `1e-8²` reads `1e-16`.
@@ -207,6 +226,7 @@ fn lu_fn(
         tol2: act_tol2,
         units: plan.column_units(),
         sqrt: &sqrt_call,
+        lanes,
     })
 }
 
