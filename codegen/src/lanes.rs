@@ -425,10 +425,6 @@ fn prologue(g: &Graph, f: &Function<'_>) -> (Vec<TokenStream>, Vec<TokenStream>,
     for a in &f.args {
         if *a == Arg::P {
             args.push(quote!(p: &Params));
-            // `params` for the scalar function's second look at a failed lane ([`settle`]).
-            if fallible(f) {
-                entry.push(quote!(let params = p;));
-            }
             entry.push(quote!(let p = p.to_array().map(Lanes::splat);));
             continue;
         }
@@ -472,14 +468,29 @@ fn fallible(f: &Function<'_>) -> bool {
     f.sites || matches!(f.shape, Shape::FallibleVector)
 }
 
-/// The end of a `_lanes` function that can fail: its values `values` (of `parts`) and each
-/// lane's status. A lane marked `bad` (an input, a guard) or with a non-finite result is
-/// evaluated once more by the scalar function `scalar` (`f` itself, or the scalar kernel),
-/// whose `Err` (or values) it takes: the lane's `Err` is the scalar function's by
-/// construction, and over the lanes a guard costs one compare and one `or` per lane.
-/// Failures are rare, so the second evaluation costs nothing on average.
-fn settle(f: &Function<'_>, values: TokenStream, parts: &[Part]) -> TokenStream {
+/// A `_lanes` function that can fail, as two: `<name>_marked` (private, inlined) runs the
+/// statements `body` over the lanes and returns the values `values` (of `parts`, type
+/// `values_ty`) with the lanes marked `bad` (an input, a guard, a non-finite result); `<name>`
+/// (`head`: its docs, visibility) returns the values and each lane's status, a marked lane
+/// evaluated once more by the scalar function (`f` itself, or the scalar kernel), whose `Err`
+/// (or values) it takes: the lane's `Err` is the scalar function's by construction, and over
+/// the lanes a guard costs one compare and one `or` per lane. Failures are rare, so the second
+/// evaluation costs nothing on average. (The per-lane loop stays out of the long function:
+/// in it, clippy took minutes over a platform's module.)
+#[allow(clippy::too_many_arguments)]
+fn settle(
+    f: &Function<'_>,
+    head: TokenStream,
+    args: &[TokenStream],
+    body: TokenStream,
+    values: TokenStream,
+    values_ty: TokenStream,
+    ret_ty: TokenStream,
+    parts: &[Part],
+) -> TokenStream {
     let scalar = Ident::new(f.name, Span::call_site());
+    let name = format_ident!("{}_lanes", f.name);
+    let marked = format_ident!("{}_lanes_marked", f.name);
     let one = parts.len() == 1;
     let part = |whole: TokenStream, i: usize| {
         if one {
@@ -511,28 +522,49 @@ fn settle(f: &Function<'_>, values: TokenStream, parts: &[Part]) -> TokenStream 
             _ => quote!(put_lane(&mut #o, k, #v);),
         }
     });
-    let args = f.args.iter().map(|a| {
+    let names: Vec<Ident> = f
+        .args
+        .iter()
+        .map(|a| Ident::new(if *a == Arg::P { "p" } else { a.name() }, Span::call_site()))
+        .collect();
+    let lane_args = f.args.iter().zip(&names).map(|(a, id)| {
         if *a == Arg::P {
-            return quote!(params);
+            quote!(#id)
+        } else {
+            quote!(&lane_of(#id, k))
         }
-        let id = Ident::new(a.name(), Span::call_site());
-        quote!(&lane_of(&#id.map(|v| v.0), k))
     });
+    let doc = format!(
+        " `{name}`'s values over the lanes, and the lanes it must evaluate again by `{}`.",
+        f.name
+    );
     quote! {
-        let mut out = #values;
-        #(#flags)*
-        let mut status = [Ok(()); LANES];
-        for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
-            if bad {
-                match #scalar(#(#args),*) {
-                    Ok(v) => {
-                        #(#puts)*
+        #[doc = #doc]
+        #[inline(always)]
+        #[allow(unused_variables, unused_mut, clippy::all)]
+        fn #marked(#(#args),*) -> (#values_ty, [bool; LANES]) {
+            #body
+            let mut out = #values;
+            #(#flags)*
+            (out, bad)
+        }
+        #[allow(clippy::type_complexity)]
+        #head
+        fn #name(#(#args),*) -> #ret_ty {
+            let (mut out, bad) = #marked(#(#names),*);
+            let mut status = [Ok(()); LANES];
+            for (k, (st, bad)) in status.iter_mut().zip(bad).enumerate() {
+                if bad {
+                    match #scalar(#(#lane_args),*) {
+                        Ok(v) => {
+                            #(#puts)*
+                        }
+                        Err(e) => *st = Err(e),
                     }
-                    Err(e) => *st = Err(e),
                 }
             }
+            (out, status)
         }
-        (out, status)
     }
 }
 
@@ -546,52 +578,64 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let stmts = statements(g, f, s, l);
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
     let lane = quote!([#real; LANES]);
-    let (ret_ty, ret) = match &f.shape {
-        Shape::Vector => (quote!([#lane; DOF]), emit::return_tokens(f, &outs)),
-        Shape::Matrix => (quote!([[#lane; DOF]; DOF]), emit::return_tokens(f, &outs)),
-        Shape::FallibleVector => (
-            quote!(([#lane; DOF], [Result<(), Singular>; LANES])),
-            settle(f, quote!([#(#outs),*]), &[Part::Vector]),
-        ),
-        Shape::Fallible(parts) if f.sites => {
-            let values = emit::parts_tokens(parts, f.dof, &outs);
-            let ty = if parts[..] == [Part::Matrix] {
-                quote!([[#lane; DOF]; DOF])
-            } else {
-                quote!([#lane; DOF])
-            };
-            (
-                quote!((#ty, [Result<(), Singular>; LANES])),
-                settle(f, values, parts),
-            )
-        }
-        _ => panic!("internal error: no lanes version of `{}`", f.name),
-    };
     let doc = format!(
         " `{}` of `LANES` states at once, lane by lane: entry `[i][k]` of an argument or of the \
          result is entry `i` of state `k`, bit for bit what `{}` gives for that state.",
         f.name, f.name
     );
-    let fallible = !matches!(f.shape, Shape::Vector | Shape::Matrix);
-    let doc_err = fallible.then(|| {
-        quote! {
-            #[doc = ""]
-            #[doc = " The second part is each lane's status: `Err` where the scalar function \
-                     returns that `Err` for the lane's state (that lane's values are then not \
-                     to be read); the other lanes are not affected."]
+    let (values_ty, values, parts) = match &f.shape {
+        Shape::Vector | Shape::Matrix => {
+            let ret_ty = if matches!(f.shape, Shape::Vector) {
+                quote!([#lane; DOF])
+            } else {
+                quote!([[#lane; DOF]; DOF])
+            };
+            let ret = emit::return_tokens(f, &outs);
+            return quote! {
+                #[doc = #doc]
+                #[inline]
+                #[allow(unused_variables, unused_mut, clippy::all)]
+                pub fn #name(#(#args),*) -> #ret_ty {
+                    #(#entry)*
+                    #(#stmts)*
+                    #ret
+                }
+            };
         }
-    });
-    quote! {
+        Shape::FallibleVector => (
+            quote!([#lane; DOF]),
+            quote!([#(#outs),*]),
+            &[Part::Vector][..],
+        ),
+        Shape::Fallible(parts) if f.sites => {
+            let ty = if parts[..] == [Part::Matrix] {
+                quote!([[#lane; DOF]; DOF])
+            } else {
+                quote!([#lane; DOF])
+            };
+            (ty, emit::parts_tokens(parts, f.dof, &outs), &parts[..])
+        }
+        _ => panic!("internal error: no lanes version of `{}`", f.name),
+    };
+    let head = quote! {
         #[doc = #doc]
-        #doc_err
+        #[doc = ""]
+        #[doc = " The second part is each lane's status: `Err` where the scalar function \
+                 returns that `Err` for the lane's state (that lane's values are then not \
+                 to be read); the other lanes are not affected."]
         #[inline]
-        #[allow(unused_variables, unused_mut, clippy::all)]
-        pub fn #name(#(#args),*) -> #ret_ty {
-            #(#entry)*
-            #(#stmts)*
-            #ret
-        }
-    }
+        pub
+    };
+    settle(
+        f,
+        head,
+        &args,
+        quote!(#(#entry)* #(#stmts)*),
+        values,
+        values_ty.clone(),
+        quote!((#values_ty, [Result<(), Singular>; LANES])),
+        parts,
+    )
 }
 
 /// The `_lanes` version of a platform's kernel `f` (private): its parts lane last and each
@@ -601,7 +645,6 @@ fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
 /// kernel at all.)
 fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
-    let name = format_ident!("{}_lanes", f.name);
     let (args, entry, s) = prologue(g, f);
     let s = &s;
     let stmts = statements(g, f, s, l);
@@ -622,21 +665,24 @@ fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
         .collect();
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
     let values = emit::parts_tokens(parts, f.dof, &outs);
-    let settle = settle(f, values, parts);
     let doc = format!(
         " `{}` of `LANES` states at once: entry `[i][k]` of an argument or a part is entry `i` \
          of state `k`, and lane `k` (with its status) is bit for bit what `{}` returns for \
          state `k`.",
         f.name, f.name
     );
-    quote! {
+    let head = quote! {
         #[doc = #doc]
         #[inline]
-        #[allow(unused_variables, unused_mut, clippy::all)]
-        fn #name(#(#args),*) -> ((#(#types),*), [Result<(), Singular>; LANES]) {
-            #(#entry)*
-            #(#stmts)*
-            #settle
-        }
-    }
+    };
+    settle(
+        f,
+        head,
+        &args,
+        quote!(#(#entry)* #(#stmts)*),
+        values,
+        quote!((#(#types),*)),
+        quote!(((#(#types),*), [Result<(), Singular>; LANES])),
+        parts,
+    )
 }
