@@ -422,6 +422,16 @@ fn prologue(g: &Graph, f: &Function<'_>) -> (Vec<TokenStream>, Vec<TokenStream>,
     let real = emit::real();
     let mut args = Vec::new();
     let mut entry = Vec::new();
+    if fallible(f) {
+        entry.push(quote!(let mut bad = [false; LANES];));
+    }
+    // A platform's or closed loop's non-finite inputs, read as given (before the transpose).
+    if f.sites {
+        for a in f.args.iter().filter(|a| **a != Arg::P) {
+            let id = Ident::new(a.name(), Span::call_site());
+            entry.push(quote!(flag_non_finite(&mut bad, #id);));
+        }
+    }
     for a in &f.args {
         if *a == Arg::P {
             args.push(quote!(p: &Params));
@@ -436,15 +446,6 @@ fn prologue(g: &Graph, f: &Function<'_>) -> (Vec<TokenStream>, Vec<TokenStream>,
         let id = Ident::new(a.name(), Span::call_site());
         args.push(quote!(#id: &[[#real; LANES]; #len]));
         entry.push(quote!(let #id: [Lanes; #len] = #id.map(Lanes);));
-    }
-    if fallible(f) {
-        entry.push(quote!(let mut bad = [false; LANES];));
-    }
-    if f.sites {
-        for a in f.args.iter().filter(|a| **a != Arg::P) {
-            let id = Ident::new(a.name(), Span::call_site());
-            entry.push(quote!(flag_non_finite(&mut bad, &#id.map(|v| v.0));));
-        }
     }
     let s = &f.schedule;
     // The `sin_cos` of inputs first: each is a call per lane, and a call spills every vector
@@ -468,15 +469,15 @@ fn fallible(f: &Function<'_>) -> bool {
     f.sites || matches!(f.shape, Shape::FallibleVector)
 }
 
-/// A `_lanes` function that can fail, as two: `<name>_marked` (private, inlined) runs the
-/// statements `body` over the lanes and returns the values `values` (of `parts`, type
-/// `values_ty`) with the lanes marked `bad` (an input, a guard, a non-finite result); `<name>`
-/// (`head`: its docs, visibility) returns the values and each lane's status, a marked lane
-/// evaluated once more by the scalar function (`f` itself, or the scalar kernel), whose `Err`
-/// (or values) it takes: the lane's `Err` is the scalar function's by construction, and over
-/// the lanes a guard costs one compare and one `or` per lane. Failures are rare, so the second
-/// evaluation costs nothing on average. (The per-lane loop stays out of the long function:
-/// in it, clippy took minutes over a platform's module.)
+/// A `_lanes` function that can fail, as two: `<name>_lanes_marked` (private, inlined) runs
+/// the statements `body` over the lanes and returns the values `values` (of `parts`, type
+/// `values_ty`) with the lanes marked `bad` (an input, a guard, a non-finite result);
+/// `<name>_lanes` (`head`: its docs, visibility) returns the values and each lane's status, a
+/// marked lane evaluated once more by the scalar function (`f` itself, or the scalar kernel),
+/// whose `Err` (or values) it takes: the lane's `Err` is the scalar function's by
+/// construction, and over the lanes a guard costs one compare and one `or` per lane. Failures
+/// are rare, so the second evaluation costs nothing on average. (The per-lane loop stays out
+/// of the long function: in it, clippy took minutes over a platform's module.)
 #[allow(clippy::too_many_arguments)]
 fn settle(
     f: &Function<'_>,

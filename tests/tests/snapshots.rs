@@ -22,15 +22,20 @@ fn generated_modules() {
     });
 }
 
+/// The text of the bundled spec `spec` (`mechanisms/specs/<spec>`).
+fn bundled(spec: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../mechanisms/specs")
+        .join(spec);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// Single precision: the `f32` modules of a tree, a parallel and a closed-loop mechanism (the
 /// same equations as their `f64` snapshots; the thresholds rescaled, the math calls `f32`).
 #[test]
 fn f32_modules() {
     for spec in ["puma560.toml", "agile_eye.toml", "four_bar.toml"] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../mechanisms/specs")
-            .join(spec);
-        let src = std::fs::read_to_string(&path).unwrap();
+        let src = bundled(spec);
         let cfg = Config {
             float: codegen::Float::F32,
             ..Config::default()
@@ -48,10 +53,7 @@ fn f32_modules() {
 #[test]
 fn implement_modules() {
     for spec in ["planar_2r.toml", "planar_five_bar.toml", "four_bar.toml"] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../mechanisms/specs")
-            .join(spec);
-        let src = std::fs::read_to_string(&path).unwrap();
+        let src = bundled(spec);
         let cfg = Config {
             implement: Some("runtime".into()),
             ..Config::default()
@@ -75,10 +77,7 @@ fn implement_modules() {
 fn lanes_modules() {
     use codegen::spec::Function as F;
     for spec in ["planar_2r.toml", "planar_3rrr.toml", "four_bar.toml"] {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../mechanisms/specs")
-            .join(spec);
-        let src = std::fs::read_to_string(&path).unwrap();
+        let src = bundled(spec);
         let mut cfg = Config {
             lanes: Some(2),
             ..Config::default()
