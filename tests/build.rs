@@ -230,6 +230,19 @@ fn main() {
     generate(&out, "lanes_f32", Path::new(PUMA), |b| {
         b.lanes(Some(8)).float(codegen::Float::F32);
     });
+    // A platform and a closed loop in `f32` with 8 lanes (dynamics only): their `_lanes`
+    // functions against the scalar `f32` ones in `tests/tests/lanes.rs`.
+    generate(
+        &out,
+        "lanes_f32_sites",
+        Path::new("../mechanisms/specs/planar_3rrr.toml"),
+        |b| {
+            b.spec("../mechanisms/specs/four_bar.toml")
+                .lanes(Some(8))
+                .float(codegen::Float::F32)
+                .omit(&DYNAMICS_ONLY);
+        },
+    );
     // `sin` and `cos` over all lanes at once (`Config::vector_sin_cos`): three arms in `f64`,
     // the PUMA 560 also with 8 lanes in `f32`; dynamics only.
     generate(&out, "lanes_vector", Path::new(PUMA), |b| {

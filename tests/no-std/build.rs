@@ -2,7 +2,7 @@
 //! multiply–adds and the vector `sin_cos`: the options whose code the bundled `mechanisms`
 //! crate does not hold, linked here without std as well; and a platform and a closed loop with
 //! frames (the bundled specs have none) and the `Dynamics` impl, whose frames `lib.rs` reads
-//! through the trait.
+//! through the trait; and the 3-RRR and the four-bar with the same lanes.
 
 fn main() {
     let spec = "../../mechanisms/specs/puma560.toml";
@@ -21,6 +21,25 @@ fn main() {
             .fma(true)
             .lanes(Some(lanes))
             .vector_sin_cos(true)
+            .out_dir(&dir)
+            .compile()
+            .unwrap_or_else(|e| panic!("\n{e}"));
+        // A platform and a closed loop with the same lanes (dynamics only): their `_lanes`
+        // functions keep a status per lane and fall back to the scalar function.
+        let mut b = codegen::build_script::Builder::new();
+        for spec in ["planar_3rrr", "four_bar"] {
+            let path = format!("../../mechanisms/specs/{spec}.toml");
+            println!("cargo:rerun-if-changed={path}");
+            b.spec(path);
+        }
+        b.math(codegen::MathBackend::Runtime("runtime".into()))
+            .float(float)
+            .lanes(Some(lanes))
+            .omit(&[
+                codegen::spec::Function::InverseDynamicsDerivatives,
+                codegen::spec::Function::ForwardDynamicsDerivatives,
+                codegen::spec::Function::Regressor,
+            ])
             .out_dir(&dir)
             .compile()
             .unwrap_or_else(|e| panic!("\n{e}"));

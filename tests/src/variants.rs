@@ -371,6 +371,23 @@ pub mod lanes_closed {
 pub mod lanes_f32_puma560 {
     include!(concat!(env!("OUT_DIR"), "/variants/lanes_f32/puma560.rs"));
 }
+/// A platform and a closed loop in `f32` with 8 lanes, dynamics only.
+pub mod lanes_f32_sites {
+    /// `mechanisms/specs/planar_3rrr.toml`.
+    pub mod planar_3rrr {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_f32_sites/planar_3rrr.rs"
+        ));
+    }
+    /// `mechanisms/specs/four_bar.toml`.
+    pub mod four_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_f32_sites/four_bar.rs"
+        ));
+    }
+}
 /// The PUMA 560 and the 7-joint chain with 4 lanes and the `libm` math backend.
 #[cfg(feature = "figures")]
 pub mod lanes_libm {

@@ -20,7 +20,10 @@ fn lane<T: Copy, const N: usize, const L: usize>(a: &[[T; L]; N], k: usize) -> [
 }
 
 /// Lane `k` of a lane-last matrix.
-fn lane_matrix<const N: usize, const L: usize>(a: &[[[f64; L]; N]; N], k: usize) -> [[f64; N]; N] {
+fn lane_matrix<T: Copy, const N: usize, const L: usize>(
+    a: &[[[T; L]; N]; N],
+    k: usize,
+) -> [[T; N]; N] {
     core::array::from_fn(|i| lane(&a[i], k))
 }
 
@@ -87,16 +90,20 @@ check_lanes!(planar_2r, planar_2r, 6);
 check_lanes!(stanford_arm, stanford_arm, 7);
 
 /// Lane-last arrays of `L` states, one column each.
-fn columns<const N: usize, const L: usize>(states: &[Vec<f64>]) -> [[f64; L]; N] {
+fn columns<T: Copy, const N: usize, const L: usize>(states: &[Vec<T>]) -> [[T; L]; N] {
     core::array::from_fn(|i| core::array::from_fn(|k| states[k][i]))
 }
 
 /// A platform's or closed loop's `_lanes` functions against its scalar ones, bit for bit, on
-/// 25 × 4 random regular states; every fifth round one lane has a NaN coordinate (its own
-/// `Err(Site::Input)`), and every fifth another lane is `far` (moved off the workspace or off
-/// the loops' closure: the scalar functions' `Err`, whatever it is, for that lane alone).
+/// 25 rounds of `LANES` random regular states; every fifth round one lane has a NaN coordinate
+/// (its own `Err(Site::Input)`), and every fifth another lane is `far` (moved off the workspace
+/// or off the loops' closure: the scalar functions' `Err`, whatever it is, for that lane
+/// alone). Every regular lane answers, in `f32` too (the `f64` states rounded).
 macro_rules! check_site_lanes {
     ($test:ident, $variant:ident, $m:ident, $seed:expr, $state:expr, $far:expr) => {
+        check_site_lanes!($test, $variant, $m, $seed, $state, $far, f64);
+    };
+    ($test:ident, $variant:ident, $m:ident, $seed:expr, $state:expr, $far:expr, $float:ty) => {
         #[test]
         fn $test() {
             use tests::variants::$variant::$m as g;
@@ -108,25 +115,26 @@ macro_rules! check_site_lanes {
             let mut state = $state(name);
             let far: fn(&mut [f64]) = $far;
             let mut far_errors = 0;
+            let float = |v: Vec<f64>| v.into_iter().map(|x| x as $float).collect::<Vec<$float>>();
             for round in 0..25 {
                 let mut xs = Vec::new();
                 let (mut us, mut uds) = (Vec::new(), Vec::new());
-                for _ in 0..L {
-                    let (x, u, ud) = state(&mut r);
-                    xs.push(x);
-                    us.push(u);
-                    uds.push(ud);
-                }
                 let nan = (round % 5 == 4).then(|| round % L);
                 let moved = (round % 5 == 2).then(|| (round + 1) % L);
+                for _ in 0..L {
+                    let (mut x, u, ud) = state(&mut r);
+                    if moved == Some(xs.len()) {
+                        far(&mut x);
+                    }
+                    xs.push(float(x));
+                    us.push(float(u));
+                    uds.push(float(ud));
+                }
                 if let Some(k) = nan {
-                    xs[k][0] = f64::NAN;
+                    xs[k][0] = <$float>::NAN;
                 }
-                if let Some(k) = moved {
-                    far(&mut xs[k]);
-                }
-                let x: [[f64; L]; NX] = columns(&xs);
-                let (u, ud): ([[f64; L]; N], [[f64; L]; N]) = (columns(&us), columns(&uds));
+                let x: [[$float; L]; NX] = columns(&xs);
+                let (u, ud): ([[$float; L]; N], [[$float; L]; N]) = (columns(&us), columns(&uds));
                 let (tau, id) = g::inverse_dynamics_lanes(&x, &u, &ud);
                 let (gr, grs) = g::gravity_lanes(&x);
                 let (c, cs) = g::coriolis_lanes(&x, &u);
@@ -134,7 +142,7 @@ macro_rules! check_site_lanes {
                 let (am, ams) = g::actuator_mass_matrix_lanes(&x);
                 let (fd, fds) = g::forward_dynamics_lanes(&x, &u, &tau);
                 for k in 0..L {
-                    let (xk, uk, udk, tauk): ([f64; NX], [f64; N], [f64; N], [f64; N]) =
+                    let (xk, uk, udk, tauk): ([$float; NX], [$float; N], [$float; N], [$float; N]) =
                         (lane(&x, k), lane(&u, k), lane(&ud, k), lane(&tau, k));
                     let pairs = [
                         (
@@ -354,6 +362,26 @@ check_site_lanes!(
     27,
     tests::closed::assembled,
     closed_open
+);
+
+// The 3-RRR and the four-bar in `f32` with 8 lanes.
+check_site_lanes!(
+    planar_3rrr_f32,
+    lanes_f32_sites,
+    planar_3rrr,
+    31,
+    tests::pkm::near_home,
+    platform_far,
+    f32
+);
+check_site_lanes!(
+    four_bar_f32,
+    lanes_f32_sites,
+    four_bar,
+    32,
+    tests::closed::assembled,
+    closed_open,
+    f32
 );
 
 /// A lane at a singularity of the actuation matrix among regular ones: the Gough–Stewart

@@ -1,7 +1,8 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
 //! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
-//! generated with `lanes`, `fma` and `vector_sin_cos`, and of a platform and a closed loop with
+//! generated with `lanes`, `fma` and `vector_sin_cos` (and the 3-RRR and the four-bar with
+//! `lanes`), and of a platform and a closed loop with
 //! frames read through the `Dynamics` trait (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
@@ -199,6 +200,47 @@ macro_rules! export_lanes {
 }
 
 export_lanes!(puma560_lanes: "f64", f64; puma560_lanes_f32: "f32", f32);
+
+macro_rules! export_site_lanes {
+    ($($m:ident: $dir:literal, $file:literal, $f:ty);* $(;)?) => {
+        $(
+            pub mod $m {
+                include!(concat!(env!("OUT_DIR"), "/", $dir, "/", $file, ".rs"));
+                /// Calls every `_lanes` function once; returns a checksum of the lanes that
+                /// answered.
+                #[unsafe(no_mangle)]
+                pub extern "C" fn $m(
+                    x: &[[$f; LANES]; NX],
+                    u: &[[$f; LANES]; DOF],
+                    ud: &[[$f; LANES]; DOF],
+                ) -> $f {
+                    let first = |v: $f, status: &[Result<(), Singular>; LANES]| {
+                        if status[0].is_ok() { v } else { 0.0 }
+                    };
+                    let (t, st) = inverse_dynamics_lanes(x, u, ud);
+                    let (g, sg) = gravity_lanes(x);
+                    let (c, sc) = coriolis_lanes(x, u);
+                    let (m, sm) = mass_matrix_lanes(x);
+                    let (a, sa) = actuator_mass_matrix_lanes(x);
+                    let (f, sf) = forward_dynamics_lanes(x, u, ud);
+                    first(t[0][0], &st)
+                        + first(g[0][0], &sg)
+                        + first(c[0][0], &sc)
+                        + first(m[0][0][0], &sm)
+                        + first(a[0][0][0], &sa)
+                        + first(f[0][0], &sf)
+                }
+            }
+        )*
+    };
+}
+
+export_site_lanes!(
+    planar_3rrr_lanes: "f64", "planar_3rrr", f64;
+    planar_3rrr_lanes_f32: "f32", "planar_3rrr", f32;
+    four_bar_lanes: "f64", "four_bar", f64;
+    four_bar_lanes_f32: "f32", "four_bar", f32;
+);
 
 /// A platform and a closed loop with a frame on the platform (`build.rs`), every frame read
 /// through the `Dynamics` trait.
