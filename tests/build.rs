@@ -345,6 +345,13 @@ fn figures(out: &Path) {
             .vector_sin_cos(true)
             .omit(&DYNAMICS_ONLY);
     });
+    // Three platforms with 8 lanes (dynamics only): the `lanes8/…` benches beside `lanes/…`.
+    generate(out, "lanes8_parallel", Path::new(GS), |b| {
+        b.spec("../mechanisms/specs/delta_rl5.toml")
+            .spec("../mechanisms/specs/agile_eye.toml")
+            .lanes(Some(8))
+            .omit(&DYNAMICS_ONLY);
+    });
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(IIWA).unwrap_or_else(|e| panic!("{IIWA}: {e}"));
     println!("cargo:rerun-if-changed={IIWA}");

@@ -13,7 +13,8 @@
 //!   once (`Config::vector_sin_cos`, `tests::variants::lanes_vector`; its `scalar` is the
 //!   same module's scalar function, std's `sin_cos`); `lanes_vector8/…` the same with 8 lanes
 //!   (`tests::variants::lanes_vector8`); `lanes/{platform or closed loop}/…` the same for
-//!   three platforms and two closed loops (`tests::variants::lanes_parallel`, `lanes_closed`).
+//!   three platforms and two closed loops (`tests::variants::lanes_parallel`, `lanes_closed`);
+//!   `lanes8/{platform}/…` three of them with 8 lanes (`tests::variants::lanes8_parallel`).
 //!
 //! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
 //! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
@@ -196,11 +197,14 @@ lanes_tree!(lanes_vector8_puma560, lanes_vector8, puma560);
 lanes_tree!(lanes_vector8_chain7, lanes_vector8, chain7);
 lanes_tree!(lanes_vector8_iiwa14, lanes_vector8, iiwa14);
 
-/// A platform's or closed loop's functions, `LANES` (4) regular states through the scalar
+/// A platform's or closed loop's functions, `LANES` (4, or 8 in the `lanes8/` group) regular states through the scalar
 /// function one after the other against one `_lanes` call (`tests::variants::lanes_parallel`,
 /// `lanes_closed`): inverse dynamics, the actuator-space mass matrix, forward dynamics.
 macro_rules! lanes_sites {
     ($fn_name:ident, $variant:ident, $m:ident, $states:path) => {
+        lanes_sites!($fn_name, $variant, $m, $states, "lanes/");
+    };
+    ($fn_name:ident, $variant:ident, $m:ident, $states:path, $group:literal) => {
         fn $fn_name(c: &mut Criterion) {
             use tests::variants::$variant::$m as g;
             const N: usize = g::DOF;
@@ -219,7 +223,7 @@ macro_rules! lanes_sites {
             let (taul, status) = g::inverse_dynamics_lanes(&xl, &ul, &udl);
             assert!(status.iter().all(Result::is_ok));
             let tau: [[f64; N]; L] = transpose(taul);
-            let name = concat!("lanes/", stringify!($m));
+            let name = concat!($group, stringify!($m));
             scalar_vs_lanes(
                 c,
                 format!("{name}/inverse_dynamics"),
@@ -270,6 +274,27 @@ lanes_sites!(
     lanes_parallel,
     agile_eye,
     tests::pkm::near_home
+);
+lanes_sites!(
+    lanes8_gough_stewart,
+    lanes8_parallel,
+    gough_stewart,
+    tests::pkm::near_home,
+    "lanes8/"
+);
+lanes_sites!(
+    lanes8_delta_rl5,
+    lanes8_parallel,
+    delta_rl5,
+    tests::pkm::near_home,
+    "lanes8/"
+);
+lanes_sites!(
+    lanes8_agile_eye,
+    lanes8_parallel,
+    agile_eye,
+    tests::pkm::near_home,
+    "lanes8/"
 );
 lanes_sites!(
     lanes_four_bar,
@@ -329,6 +354,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
 }
 criterion_main!(benches);

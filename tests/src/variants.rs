@@ -401,6 +401,32 @@ pub mod lanes_libm {
     }
 }
 
+/// Three platforms with 8 lanes, dynamics only, for the `lanes8/…` benches.
+#[cfg(feature = "figures")]
+pub mod lanes8_parallel {
+    /// `mechanisms/specs/gough_stewart.toml`.
+    pub mod gough_stewart {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_parallel/gough_stewart.rs"
+        ));
+    }
+    /// `mechanisms/specs/delta_rl5.toml`.
+    pub mod delta_rl5 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_parallel/delta_rl5.rs"
+        ));
+    }
+    /// `mechanisms/specs/agile_eye.toml`.
+    pub mod agile_eye {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_parallel/agile_eye.rs"
+        ));
+    }
+}
+
 /// The same three arms with 8 lanes (two 256-bit vectors per operation on AVX2, one 512-bit
 /// on AVX-512), for the `lanes_vector8` benches.
 #[cfg(feature = "figures")]
