@@ -2,8 +2,8 @@
 //! panic handler that exports a C entry point for every generated function of every bundled
 //! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
 //! generated with `lanes`, `fma` and `vector_sin_cos` (and the 3-RRR and the four-bar with
-//! `lanes`), and of a platform and a closed loop with
-//! frames read through the `Dynamics` trait (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
+//! `lanes`), and of a platform and a closed loop with frames read through the `Dynamics` trait
+//! (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
 //! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
