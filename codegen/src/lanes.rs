@@ -256,11 +256,21 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
         " One `f64` per state: the scalar of the `_lanes` functions (elementwise operators; the \
          math backend once per lane).",
     );
+    // Aligned to its size (a power of two): a vector load or store of whole `Lanes`, and
+    // LLVM's vectorizer no longer splits a long kernel into scalar code.
+    let size = l * if crate::scalar::single() { 4 } else { 8 };
+    let repr = if size.is_power_of_two() {
+        let a = Literal::usize_unsuffixed(size);
+        quote!(#[repr(C, align(#a))])
+    } else {
+        TokenStream::new()
+    };
     quote! {
         #[doc = #doc_lanes]
         pub const LANES: usize = #n;
         #[doc = #doc_type]
         #[derive(Clone, Copy, Debug, PartialEq)]
+        #repr
         pub struct Lanes(pub [#real; LANES]);
         #(#ops)*
         impl core::ops::Neg for Lanes {
