@@ -243,6 +243,29 @@ fn main() {
                 .omit(&DYNAMICS_ONLY);
         },
     );
+    // The lanes' arithmetic through the `wide` crate (`Config::wide`): three platforms, a
+    // closed loop and an arm with 4 lanes in `f64`, the 3-RRR with 8 in `f32` (dynamics only),
+    // against the scalar functions in `tests/tests/lanes.rs` and in the `lanes_wide` benches.
+    generate(&out, "lanes_wide", Path::new(GS), |b| {
+        b.spec("../mechanisms/specs/delta_rl5.toml")
+            .spec("../mechanisms/specs/agile_eye.toml")
+            .spec("../mechanisms/specs/four_bar.toml")
+            .spec(PUMA)
+            .lanes(Some(4))
+            .wide(Some("wide"))
+            .omit(&DYNAMICS_ONLY);
+    });
+    generate(
+        &out,
+        "lanes_wide_f32",
+        Path::new("../mechanisms/specs/planar_3rrr.toml"),
+        |b| {
+            b.lanes(Some(8))
+                .float(codegen::Float::F32)
+                .wide(Some("wide"))
+                .omit(&DYNAMICS_ONLY);
+        },
+    );
     // `sin` and `cos` over all lanes at once (`Config::vector_sin_cos`): three arms in `f64`,
     // the PUMA 560 also with 8 lanes in `f32`; dynamics only.
     generate(&out, "lanes_vector", Path::new(PUMA), |b| {
@@ -350,6 +373,14 @@ fn figures(out: &Path) {
         b.spec("../mechanisms/specs/delta_rl5.toml")
             .spec("../mechanisms/specs/agile_eye.toml")
             .lanes(Some(8))
+            .omit(&DYNAMICS_ONLY);
+    });
+    // The same three with 8 lanes through `wide`: the `lanes8_wide/…` benches.
+    generate(out, "lanes8_wide", Path::new(GS), |b| {
+        b.spec("../mechanisms/specs/delta_rl5.toml")
+            .spec("../mechanisms/specs/agile_eye.toml")
+            .lanes(Some(8))
+            .wide(Some("wide"))
             .omit(&DYNAMICS_ONLY);
     });
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.

@@ -175,6 +175,13 @@ impl Builder {
         self
     }
 
+    /// The lanes' arithmetic through the `wide` crate, named `path` by the including crate
+    /// (`Config::wide`; `None` by default).
+    pub fn wide(&mut self, path: Option<&str>) -> &mut Self {
+        self.config.wide = path.map(str::to_string);
+        self
+    }
+
     /// Also implement the runtime's `Dynamics` trait in every module (`Config::implement`):
     /// `runtime` is the path of the nocdyn runtime crate as the including crate names it (e.g.
     /// `"runtime"`). Each module then holds `pub struct Module` and

@@ -7,8 +7,11 @@
 //! instructions: one `vmulpd` of four lanes for one scalar `vmulsd`). Elementwise IEEE
 //! operations in the same order, so lane `k` of the result is bit for bit what the scalar
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
-//! backend once per lane. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
-//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's.
+//! backend once per lane. `Lanes` is aligned to its size when that is a power of two, so that
+//! it loads and stores whole. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
+//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's. With
+//! [`crate::Config::wide`], the operators and `sqrt` are the `wide` crate's vector operations
+//! (`lanes/wide.rs`), which do not depend on LLVM's vectorizer; still bit for bit.
 //!
 //! Arguments and results are structures of arrays, lane last: `q: &[[f64; LANES]; DOF]`, where
 //! `q[i][k]` is coordinate `i` of state `k`, and `[[f64; LANES]; DOF]` out (a matrix
@@ -39,6 +42,9 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 mod sin_cos;
+mod wide;
+
+pub(crate) use wide::{WIDTHS as WIDE_WIDTHS, vector_type as wide_type};
 
 use crate::Config;
 use crate::emit::{self, Function, Part, Shape};
@@ -187,7 +193,14 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
     let real = emit::real();
     let n = Literal::usize_unsuffixed(l);
     let idx: Vec<Literal> = (0..l).map(Literal::usize_unsuffixed).collect();
+    let wide = cfg
+        .wide
+        .as_deref()
+        .and_then(|k| Some((k, wide::vector_type(crate::scalar::single(), l)?)));
     let binop = |tr: &str, m: &str, op: TokenStream| {
+        if let Some((krate, ty)) = wide {
+            return wide::binop(krate, ty, tr, m, op);
+        }
         let (tr, m) = (format_ident!("{}", tr), format_ident!("{}", m));
         // Each lane bound first: a binary operation as an array element reads, to clippy's
         // `possible_missing_comma`, as a missing comma when the macro's tokens all carry the
@@ -224,6 +237,22 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
     let mul_add = idx
         .iter()
         .map(|i| emit::math_call(cfg, "mul_add", quote!(self.0[#i], b.0[#i], c.0[#i])));
+    let per_lane = quote!(Lanes([#(#mul_add),*]));
+    let mut neg = quote!(Lanes([#(#neg),*]));
+    let mut sqrt = quote!(Lanes([#(#sqrt),*]));
+    let mul_add = match wide {
+        Some((krate, ty)) => {
+            (neg, sqrt) = wide::unary(krate, ty);
+            wide::mul_add(krate, ty, per_lane)
+        }
+        None => quote! {
+            /// `self * b + c` per lane, one rounding.
+            #[inline(always)]
+            pub fn mul_add(self, b: Lanes, c: Lanes) -> Lanes {
+                #per_lane
+            }
+        },
+    };
     let pairs: Vec<Ident> = (0..l).map(|k| format_ident!("p{}", k)).collect();
     let per_lane: Vec<TokenStream> = idx
         .iter()
@@ -277,7 +306,7 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             type Output = Lanes;
             #[inline(always)]
             fn neg(self) -> Lanes {
-                Lanes([#(#neg),*])
+                #neg
             }
         }
         impl Lanes {
@@ -289,18 +318,14 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             /// Square root per lane.
             #[inline(always)]
             pub fn sqrt(self) -> Lanes {
-                Lanes([#(#sqrt),*])
+                #sqrt
             }
             /// `atan2(self, x)` per lane.
             #[inline(always)]
             pub fn atan2(self, x: Lanes) -> Lanes {
                 Lanes([#(#atan2),*])
             }
-            /// `self * b + c` per lane, one rounding.
-            #[inline(always)]
-            pub fn mul_add(self, b: Lanes, c: Lanes) -> Lanes {
-                Lanes([#(#mul_add),*])
-            }
+            #mul_add
             #[doc = #sin_cos_doc]
             #[inline(always)]
             pub fn sin_cos(self) -> (Lanes, Lanes) {

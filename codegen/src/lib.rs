@@ -138,6 +138,14 @@ pub struct Config {
     /// relative). A lane beyond `|x| = 2¹⁹·π/2` or not finite takes the backend for the
     /// whole call. Off by default; an error without `lanes`.
     pub vector_sin_cos: bool,
+    /// With `lanes`: `Some(path)` makes `Lanes`' arithmetic (`+ - * /`, negation, `sqrt`,
+    /// `mul_add`) go through the vector types of the `wide` crate (version 1), which the
+    /// including crate names `path` (e.g. `"wide"`) and must depend on (`no_std` with
+    /// `default-features = false`): explicit vector operations in safe code, chosen by the
+    /// target's features at compile time, instead of lane-by-lane operators left to LLVM's
+    /// vectorizer. Still bit for bit the scalar functions. For `lanes` of 2, 4 or 8 in `f64`
+    /// and 4, 8 or 16 in `f32`. `None` (default): no dependency.
+    pub wide: Option<String>,
 }
 
 impl Default for Config {
@@ -151,6 +159,7 @@ impl Default for Config {
             fma: false,
             lanes: None,
             vector_sin_cos: false,
+            wide: None,
         }
     }
 }
@@ -224,6 +233,20 @@ fn check_options(
     }
     if cfg.vector_sin_cos && cfg.lanes.is_none() {
         return Err("`vector_sin_cos` is for the `_lanes` functions: set `lanes` too".into());
+    }
+    if let Some(path) = &cfg.wide {
+        let Some(l) = cfg.lanes else {
+            return Err("`wide` is for the `_lanes` functions: set `lanes` too".into());
+        };
+        if lanes::wide_type(cfg.float == Float::F32, l).is_none() {
+            return Err(format!(
+                "`wide` has vector types for {} lanes, not {l}",
+                lanes::WIDE_WIDTHS
+            ));
+        }
+        if syn::parse_str::<syn::Path>(path).is_err() {
+            return Err(format!("`wide`: `{path}` is not a crate path"));
+        }
     }
     if let Some(l) = cfg.lanes {
         if !(2..=lanes::MAX).contains(&l) {

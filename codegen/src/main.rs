@@ -101,6 +101,10 @@ struct Cli {
     /// (within 2 ulp; no longer bit for bit the scalar functions).
     #[arg(long, requires = "lanes")]
     vector_sin_cos: bool,
+    /// With `--lanes`: the lanes' arithmetic through the `wide` crate's vector types (explicit
+    /// SIMD in safe code; the including crate depends on `wide` 1). Still bit for bit.
+    #[arg(long, requires = "lanes")]
+    wide: bool,
     /// Apply the joints' viscous and Coulomb friction (as `[scene] friction = true`; for a URDF,
     /// its `<dynamics damping friction>`).
     #[arg(long)]
@@ -304,6 +308,7 @@ fn main() -> ExitCode {
             fma: cli.fma,
             lanes: cli.lanes,
             vector_sin_cos: cli.vector_sin_cos,
+            wide: cli.wide.then(|| "wide".to_string()),
         },
     ) {
         Ok(o) => o,
@@ -384,6 +389,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
         fma: cli.fma,
         lanes: None,
         vector_sin_cos: false,
+        wide: None,
     }
 }
 

@@ -14,7 +14,10 @@
 //!   same module's scalar function, std's `sin_cos`); `lanes_vector8/…` the same with 8 lanes
 //!   (`tests::variants::lanes_vector8`); `lanes/{platform or closed loop}/…` the same for
 //!   three platforms and two closed loops (`tests::variants::lanes_parallel`, `lanes_closed`);
-//!   `lanes8/{platform}/…` three of them with 8 lanes (`tests::variants::lanes8_parallel`).
+//!   `lanes8/{platform}/…` three of them with 8 lanes (`tests::variants::lanes8_parallel`);
+//!   `lanes_wide/…` and `lanes8_wide/…` the same three and the four-bar with the lanes'
+//!   arithmetic through the `wide` crate (`Config::wide`, `tests::variants::lanes_wide`,
+//!   `lanes8_wide`).
 //!
 //! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
 //! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
@@ -308,6 +311,55 @@ lanes_sites!(
     andrews_squeezer,
     tests::closed::assembled
 );
+lanes_sites!(
+    lanes_wide_gough_stewart,
+    lanes_wide,
+    gough_stewart,
+    tests::pkm::near_home,
+    "lanes_wide/"
+);
+lanes_sites!(
+    lanes8_wide_gough_stewart,
+    lanes8_wide,
+    gough_stewart,
+    tests::pkm::near_home,
+    "lanes8_wide/"
+);
+lanes_sites!(
+    lanes_wide_delta_rl5,
+    lanes_wide,
+    delta_rl5,
+    tests::pkm::near_home,
+    "lanes_wide/"
+);
+lanes_sites!(
+    lanes8_wide_delta_rl5,
+    lanes8_wide,
+    delta_rl5,
+    tests::pkm::near_home,
+    "lanes8_wide/"
+);
+lanes_sites!(
+    lanes_wide_agile_eye,
+    lanes_wide,
+    agile_eye,
+    tests::pkm::near_home,
+    "lanes_wide/"
+);
+lanes_sites!(
+    lanes8_wide_agile_eye,
+    lanes8_wide,
+    agile_eye,
+    tests::pkm::near_home,
+    "lanes8_wide/"
+);
+lanes_sites!(
+    lanes_wide_four_bar,
+    lanes_wide,
+    four_bar,
+    tests::closed::assembled,
+    "lanes_wide/"
+);
 
 /// What a `_lanes` function pays per angle: four `sin_cos` calls of the math backend, std
 /// (the modules here: `runtime::math`) and the `libm` crate.
@@ -354,6 +406,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_wide_gough_stewart, lanes8_wide_gough_stewart, lanes_wide_delta_rl5, lanes8_wide_delta_rl5, lanes_wide_agile_eye, lanes8_wide_agile_eye, lanes_wide_four_bar, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
 }
 criterion_main!(benches);

@@ -2,7 +2,8 @@
 //! multiply–adds and the vector `sin_cos`: the options whose code the bundled `mechanisms`
 //! crate does not hold, linked here without std as well; and a platform and a closed loop with
 //! frames (the bundled specs have none) and the `Dynamics` impl, whose frames `lib.rs` reads
-//! through the trait; and the 3-RRR and the four-bar with the same lanes.
+//! through the trait; and the 3-RRR and the four-bar with the same lanes; and the PUMA 560
+//! (as above) and the 3-RRR with 4 lanes through the `wide` crate (`Config::wide`).
 
 fn main() {
     let spec = "../../mechanisms/specs/puma560.toml";
@@ -35,6 +36,26 @@ fn main() {
         b.math(codegen::MathBackend::Runtime("runtime".into()))
             .float(float)
             .lanes(Some(lanes))
+            .omit(&[
+                codegen::spec::Function::InverseDynamicsDerivatives,
+                codegen::spec::Function::ForwardDynamicsDerivatives,
+                codegen::spec::Function::Regressor,
+            ])
+            .out_dir(&dir)
+            .compile()
+            .unwrap_or_else(|e| panic!("\n{e}"));
+    }
+    let dir = out.join("wide");
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    for (spec, tree) in [("puma560", true), ("planar_3rrr", false)] {
+        let path = format!("../../mechanisms/specs/{spec}.toml");
+        let mut b = codegen::build_script::Builder::new();
+        b.spec(path)
+            .math(codegen::MathBackend::Runtime("runtime".into()))
+            .fma(tree)
+            .vector_sin_cos(tree)
+            .lanes(Some(4))
+            .wide(Some("wide"))
             .omit(&[
                 codegen::spec::Function::InverseDynamicsDerivatives,
                 codegen::spec::Function::ForwardDynamicsDerivatives,

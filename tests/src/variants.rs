@@ -388,6 +388,74 @@ pub mod lanes_f32_sites {
         ));
     }
 }
+/// Three platforms, a closed loop and an arm with 4 lanes whose arithmetic goes through the
+/// `wide` crate (`Config::wide`), dynamics only (`tests/tests/lanes.rs`).
+pub mod lanes_wide {
+    /// `mechanisms/specs/gough_stewart`.
+    pub mod gough_stewart {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_wide/gough_stewart.rs"
+        ));
+    }
+    /// `mechanisms/specs/delta_rl5`.
+    pub mod delta_rl5 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_wide/delta_rl5.rs"
+        ));
+    }
+    /// `mechanisms/specs/agile_eye`.
+    pub mod agile_eye {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_wide/agile_eye.rs"
+        ));
+    }
+    /// `mechanisms/specs/four_bar`.
+    pub mod four_bar {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_wide/four_bar.rs"));
+    }
+    /// `mechanisms/specs/puma560`.
+    pub mod puma560 {
+        include!(concat!(env!("OUT_DIR"), "/variants/lanes_wide/puma560.rs"));
+    }
+}
+/// The 3-RRR with 8 lanes in `f32` through `wide`, dynamics only.
+pub mod lanes_wide_f32 {
+    /// `mechanisms/specs/planar_3rrr`.
+    pub mod planar_3rrr {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_wide_f32/planar_3rrr.rs"
+        ));
+    }
+}
+/// `lanes_wide`'s three platforms with 8 lanes (the `lanes8_wide/…` benches).
+#[cfg(feature = "figures")]
+pub mod lanes8_wide {
+    /// `mechanisms/specs/gough_stewart`.
+    pub mod gough_stewart {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_wide/gough_stewart.rs"
+        ));
+    }
+    /// `mechanisms/specs/delta_rl5`.
+    pub mod delta_rl5 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_wide/delta_rl5.rs"
+        ));
+    }
+    /// `mechanisms/specs/agile_eye`.
+    pub mod agile_eye {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes8_wide/agile_eye.rs"
+        ));
+    }
+}
 /// The PUMA 560 and the 7-joint chain with 4 lanes and the `libm` math backend.
 #[cfg(feature = "figures")]
 pub mod lanes_libm {

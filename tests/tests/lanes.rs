@@ -29,9 +29,12 @@ fn lane_matrix<T: Copy, const N: usize, const L: usize>(
 
 macro_rules! check_lanes {
     ($test:ident, $m:ident, $seed:expr) => {
+        check_lanes!($test, lanes, $m, $seed);
+    };
+    ($test:ident, $variant:ident, $m:ident, $seed:expr) => {
         #[test]
         fn $test() {
-            use tests::variants::lanes::$m as g;
+            use tests::variants::$variant::$m as g;
             const N: usize = g::DOF;
             const L: usize = g::LANES;
             let name = stringify!($m);
@@ -384,6 +387,51 @@ check_site_lanes!(
     f32
 );
 
+// The same checks with the lanes' arithmetic through the `wide` crate (`Config::wide`):
+// explicit vector operations, still bit for bit the scalar functions.
+check_site_lanes!(
+    gough_stewart_wide,
+    lanes_wide,
+    gough_stewart,
+    41,
+    tests::pkm::near_home,
+    platform_zero
+);
+check_site_lanes!(
+    delta_rl5_wide,
+    lanes_wide,
+    delta_rl5,
+    42,
+    tests::pkm::near_home,
+    platform_far
+);
+check_site_lanes!(
+    agile_eye_wide,
+    lanes_wide,
+    agile_eye,
+    43,
+    tests::pkm::near_home,
+    platform_zero
+);
+check_site_lanes!(
+    four_bar_wide,
+    lanes_wide,
+    four_bar,
+    44,
+    tests::closed::assembled,
+    closed_open
+);
+check_site_lanes!(
+    planar_3rrr_wide_f32,
+    lanes_wide_f32,
+    planar_3rrr,
+    45,
+    tests::pkm::near_home,
+    platform_far,
+    f32
+);
+check_lanes!(puma560_wide, lanes_wide, puma560, 46);
+
 /// A lane at a singularity of the actuation matrix among regular ones: the Gough–Stewart
 /// platform at home turned 90° about the vertical (singular, `literal.rs` and
 /// `singularities.rs`). Its `A` is factorized over the lanes with the others' (the kernels are
@@ -681,4 +729,38 @@ fn vector_sin_cos_needs_lanes() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("set `lanes` too"), "{e}");
+}
+
+/// `wide` without `lanes`, or with a lane count `wide` has no vector type for, is refused.
+#[test]
+fn wide_needs_lanes_of_its_widths() {
+    let src = std::fs::read_to_string("../mechanisms/specs/planar_2r.toml").unwrap();
+    let refused = |lanes: Option<usize>, float: codegen::Float| {
+        let cfg = codegen::Config {
+            lanes,
+            float,
+            wide: Some("wide".into()),
+            ..Default::default()
+        };
+        codegen::compile("planar_2r.toml", &src, &cfg)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let e = refused(None, codegen::Float::F64).unwrap();
+    assert!(e.contains("set `lanes` too"), "{e}");
+    for (l, float) in [
+        (3, codegen::Float::F64),
+        (16, codegen::Float::F64),
+        (2, codegen::Float::F32),
+    ] {
+        let e = refused(Some(l), float).unwrap_or_else(|| panic!("{l} lanes accepted"));
+        assert!(e.contains("`wide` has vector types for"), "{e}");
+    }
+    for (l, float) in [
+        (2, codegen::Float::F64),
+        (8, codegen::Float::F64),
+        (16, codegen::Float::F32),
+    ] {
+        assert_eq!(refused(Some(l), float), None, "{l} lanes");
+    }
 }

@@ -94,3 +94,38 @@ fn lanes_modules() {
         insta::assert_snapshot!(format!("lanes_{spec}"), code);
     }
 }
+
+/// `Config::wide`: the planar 2R's two lanes with `wide`'s arithmetic. The module is the plain
+/// lanes module but for `Lanes`' operators, negation, `sqrt` and `mul_add`; the snapshot is the
+/// lines between the longest common head and tail of the two.
+#[test]
+fn lanes_wide_operators() {
+    let spec = "planar_2r.toml";
+    let src = bundled(spec);
+    let plain = Config {
+        lanes: Some(2),
+        ..Config::default()
+    };
+    let wide = Config {
+        wide: Some("wide".into()),
+        ..plain.clone()
+    };
+    let code = |cfg: &Config| {
+        compile(spec, &src, cfg)
+            .unwrap_or_else(|d| panic!("{d}"))
+            .code
+    };
+    let (plain, wide) = (code(&plain), code(&wide));
+    let (p, w): (Vec<&str>, Vec<&str>) = (plain.lines().collect(), wide.lines().collect());
+    let head = p.iter().zip(&w).take_while(|(a, b)| a == b).count();
+    let tail = p[head..]
+        .iter()
+        .rev()
+        .zip(w[head..].iter().rev())
+        .take_while(|(a, b)| a == b)
+        .count();
+    let middle = w[head..w.len() - tail].join("\n");
+    assert!(middle.contains("wide::f64x2::new"), "{middle}");
+    assert!(!middle.contains("fn sin_cos"), "sin_cos changed:\n{middle}");
+    insta::assert_snapshot!("lanes_wide_planar_2r", middle);
+}

@@ -18,7 +18,7 @@
 //! ```text
 //! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"]
 //!            [, implement = "P"] [, friction = true] [, rotor_inertia = true] [, snap = 1e-4]
-//!            [, fma = true] [, lanes = 4] [, vector_sin_cos = true])
+//!            [, fma = true] [, lanes = 4] [, vector_sin_cos = true] [, wide = "wide"])
 //! ```
 //!
 //! - The path is relative to the calling crate's `CARGO_MANIFEST_DIR` (its `Cargo.toml`
@@ -30,7 +30,9 @@
 //!   `--rotor-inertia` and `--snap TOL` (and `Builder`'s methods of the same names).
 //! - `fma`, `lanes` and `vector_sin_cos` are the CLI's `--fma` (fused multiply–adds), `--lanes N`
 //!   (`_lanes` functions of `N` states per call; trees) and `--vector-sin-cos` (with `lanes`:
-//!   `sin` and `cos` of all lanes at once), `Config`'s fields of the same names.
+//!   `sin` and `cos` of all lanes at once), `Config`'s fields of the same names; `wide` (with
+//!   `lanes`) is `Config::wide`: the lanes' arithmetic through the `wide` crate, which the
+//!   calling crate names as given and depends on.
 //!   - `"libm"`: the calling crate needs the `libm` crate as a dependency (`libm = "0.2"`); the
 //!     code is `no_std`.
 //!   - `"std"`: `f64::sin_cos` from std.
@@ -119,10 +121,11 @@ struct Args {
     fma: Option<LitBool>,
     lanes: Option<syn::LitInt>,
     vector_sin_cos: Option<LitBool>,
+    wide: Option<LitStr>,
 }
 
 /// The options and the kind of literal each takes.
-const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement` (strings), `friction`, `rotor_inertia`, `fma`, `vector_sin_cos` (`true` or `false`), `snap` (a number) or `lanes` (an integer)";
+const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement`, `wide` (strings), `friction`, `rotor_inertia`, `fma`, `vector_sin_cos` (`true` or `false`), `snap` (a number) or `lanes` (an integer)";
 
 impl Parse for Args {
     fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
@@ -139,6 +142,7 @@ impl Parse for Args {
             fma: None,
             lanes: None,
             vector_sin_cos: None,
+            wide: None,
         };
         while !input.is_empty() {
             input.parse::<Token![,]>()?;
@@ -151,18 +155,22 @@ impl Parse for Args {
             let twice = || Error::new(key.span(), format!("`{key}` is given twice"));
             let wrong = |what: &str| Error::new(value.span(), format!("`{key}` takes {what}"));
             match (key.to_string().as_str(), &value) {
-                (name @ ("math" | "runtime_path" | "float" | "implement"), Lit::Str(v)) => {
+                (
+                    name @ ("math" | "runtime_path" | "float" | "implement" | "wide"),
+                    Lit::Str(v),
+                ) => {
                     let slot = match name {
                         "math" => &mut args.math,
                         "runtime_path" => &mut args.runtime_path,
                         "float" => &mut args.float,
+                        "wide" => &mut args.wide,
                         _ => &mut args.implement,
                     };
                     if slot.replace(v.clone()).is_some() {
                         return Err(twice());
                     }
                 }
-                ("math" | "runtime_path" | "float" | "implement", _) => {
+                ("math" | "runtime_path" | "float" | "implement" | "wide", _) => {
                     return Err(wrong("a string"));
                 }
                 (
@@ -317,6 +325,7 @@ impl Args {
             fma: self.fma.as_ref().is_some_and(LitBool::value),
             lanes,
             vector_sin_cos,
+            wide: self.wide.as_ref().map(LitStr::value),
         })
     }
 }

@@ -2,9 +2,10 @@
 //! panic handler that exports a C entry point for every generated function of every bundled
 //! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
 //! generated with `lanes`, `fma` and `vector_sin_cos` (and the 3-RRR and the four-bar with
-//! `lanes`), and of a platform and a closed loop with frames read through the `Dynamics` trait
-//! (`build.rs`). Build with `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`;
-//! if anything pulls in std the build fails with a duplicate `panic_impl` lang item.
+//! `lanes`; the PUMA 560 and the 3-RRR also through the `wide` crate), and of a platform and a
+//! closed loop with frames read through the `Dynamics` trait (`build.rs`). Build with
+//! `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`; if anything pulls in std
+//! the build fails with a duplicate `panic_impl` lang item.
 #![no_std]
 
 #[panic_handler]
@@ -199,7 +200,11 @@ macro_rules! export_lanes {
     };
 }
 
-export_lanes!(puma560_lanes: "f64", f64; puma560_lanes_f32: "f32", f32);
+export_lanes!(
+    puma560_lanes: "f64", f64;
+    puma560_lanes_f32: "f32", f32;
+    puma560_lanes_wide: "wide", f64;
+);
 
 macro_rules! export_site_lanes {
     ($($m:ident: $dir:literal, $file:literal, $f:ty);* $(;)?) => {
@@ -240,6 +245,7 @@ export_site_lanes!(
     planar_3rrr_lanes_f32: "f32", "planar_3rrr", f32;
     four_bar_lanes: "f64", "four_bar", f64;
     four_bar_lanes_f32: "f32", "four_bar", f32;
+    planar_3rrr_lanes_wide: "wide", "planar_3rrr", f64;
 );
 
 /// A platform and a closed loop with a frame on the platform (`build.rs`), every frame read
