@@ -5,6 +5,13 @@
 //! through the trait; and the 3-RRR and the four-bar with the same lanes; and the PUMA 560
 //! (as above) and the 3-RRR with 4 lanes through the `wide` crate (`Config::wide`).
 
+/// What the lanes modules leave out: the functions with no `_lanes` version.
+const NOT_ON_LANES: [codegen::spec::Function; 3] = [
+    codegen::spec::Function::InverseDynamicsDerivatives,
+    codegen::spec::Function::ForwardDynamicsDerivatives,
+    codegen::spec::Function::Regressor,
+];
+
 fn main() {
     let spec = "../../mechanisms/specs/puma560.toml";
     println!("cargo:rerun-if-changed={spec}");
@@ -36,11 +43,7 @@ fn main() {
         b.math(codegen::MathBackend::Runtime("runtime".into()))
             .float(float)
             .lanes(Some(lanes))
-            .omit(&[
-                codegen::spec::Function::InverseDynamicsDerivatives,
-                codegen::spec::Function::ForwardDynamicsDerivatives,
-                codegen::spec::Function::Regressor,
-            ])
+            .omit(&NOT_ON_LANES)
             .out_dir(&dir)
             .compile()
             .unwrap_or_else(|e| panic!("\n{e}"));
@@ -56,11 +59,7 @@ fn main() {
             .vector_sin_cos(tree)
             .lanes(Some(4))
             .wide(Some("wide"))
-            .omit(&[
-                codegen::spec::Function::InverseDynamicsDerivatives,
-                codegen::spec::Function::ForwardDynamicsDerivatives,
-                codegen::spec::Function::Regressor,
-            ])
+            .omit(&NOT_ON_LANES)
             .out_dir(&dir)
             .compile()
             .unwrap_or_else(|e| panic!("\n{e}"));
