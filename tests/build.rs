@@ -368,21 +368,17 @@ fn figures(out: &Path) {
             .vector_sin_cos(true)
             .omit(&DYNAMICS_ONLY);
     });
-    // Three platforms with 8 lanes (dynamics only): the `lanes8/…` benches beside `lanes/…`.
-    generate(out, "lanes8_parallel", Path::new(GS), |b| {
-        b.spec("../mechanisms/specs/delta_rl5.toml")
-            .spec("../mechanisms/specs/agile_eye.toml")
-            .lanes(Some(8))
-            .omit(&DYNAMICS_ONLY);
-    });
-    // The same three with 8 lanes through `wide`: the `lanes8_wide/…` benches.
-    generate(out, "lanes8_wide", Path::new(GS), |b| {
-        b.spec("../mechanisms/specs/delta_rl5.toml")
-            .spec("../mechanisms/specs/agile_eye.toml")
-            .lanes(Some(8))
-            .wide(Some("wide"))
-            .omit(&DYNAMICS_ONLY);
-    });
+    // Three platforms with 8 lanes (dynamics only): the `lanes8/…` benches beside `lanes/…`,
+    // and the same through `wide`: the `lanes8_wide/…` benches.
+    for (variant, wide) in [("lanes8_parallel", None), ("lanes8_wide", Some("wide"))] {
+        generate(out, variant, Path::new(GS), |b| {
+            b.spec("../mechanisms/specs/delta_rl5.toml")
+                .spec("../mechanisms/specs/agile_eye.toml")
+                .lanes(Some(8))
+                .wide(wide)
+                .omit(&DYNAMICS_ONLY);
+        });
+    }
     // The iiwa 14 as published URDFs often write it: quarter and half turns to 5 digits.
     let src = std::fs::read_to_string(IIWA).unwrap_or_else(|e| panic!("{IIWA}: {e}"));
     println!("cargo:rerun-if-changed={IIWA}");

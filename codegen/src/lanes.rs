@@ -237,19 +237,19 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
     let mul_add = idx
         .iter()
         .map(|i| emit::math_call(cfg, "mul_add", quote!(self.0[#i], b.0[#i], c.0[#i])));
-    let per_lane = quote!(Lanes([#(#mul_add),*]));
+    let mul_add_per_lane = quote!(Lanes([#(#mul_add),*]));
     let mut neg = quote!(Lanes([#(#neg),*]));
     let mut sqrt = quote!(Lanes([#(#sqrt),*]));
     let mul_add = match wide {
         Some((krate, ty)) => {
             (neg, sqrt) = wide::unary(krate, ty);
-            wide::mul_add(krate, ty, per_lane)
+            wide::mul_add(krate, ty, mul_add_per_lane)
         }
         None => quote! {
             /// `self * b + c` per lane, one rounding.
             #[inline(always)]
             pub fn mul_add(self, b: Lanes, c: Lanes) -> Lanes {
-                #per_lane
+                #mul_add_per_lane
             }
         },
     };
@@ -285,8 +285,8 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
         " One `f64` per state: the scalar of the `_lanes` functions (elementwise operators; the \
          math backend once per lane).",
     );
-    // Aligned to its size (a power of two): a vector load or store of whole `Lanes`, and
-    // LLVM's vectorizer no longer splits a long kernel into scalar code.
+    // Aligned to its size (a power of two): a vector load or store of whole `Lanes`. (It does
+    // not keep LLVM's vectorizer from leaving a long kernel scalar; `Config::wide` does.)
     let size = l * if crate::scalar::single() { 4 } else { 8 };
     let repr = if size.is_power_of_two() {
         let a = Literal::usize_unsuffixed(size);

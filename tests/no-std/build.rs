@@ -52,6 +52,7 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     for (spec, tree) in [("puma560", true), ("planar_3rrr", false)] {
         let path = format!("../../mechanisms/specs/{spec}.toml");
+        println!("cargo:rerun-if-changed={path}");
         let mut b = codegen::build_script::Builder::new();
         b.spec(path)
             .math(codegen::MathBackend::Runtime("runtime".into()))
