@@ -277,14 +277,23 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
     } else {
         (" `(sin, cos)` per lane.", backend, TokenStream::new())
     };
-    let select = idx.iter().map(
-        |i| quote!(if #real::abs(self.0[#i]) > #real::abs(b.0[#i]) { x.0[#i] } else { y.0[#i] }),
-    );
+    let select = match wide {
+        Some((krate, ty)) => wide::select_abs_gt(krate, ty),
+        None => {
+            let each = idx.iter().map(|i| {
+                quote!(if #real::abs(self.0[#i]) > #real::abs(b.0[#i]) { x.0[#i] } else { y.0[#i] })
+            });
+            quote!(Lanes([#(#each),*]))
+        }
+    };
     let doc_lanes = format!(" States per call of the `_lanes` functions ({l}).");
-    let doc_type = emit::real_text(
+    let doc_type = emit::real_text(if wide.is_some() {
+        " One `f64` per state: the scalar of the `_lanes` functions (the `wide` crate's vector \
+         operators and selection; the math backend once per lane otherwise)."
+    } else {
         " One `f64` per state: the scalar of the `_lanes` functions (elementwise operators; the \
-         math backend once per lane).",
-    );
+         math backend once per lane)."
+    });
     // Aligned to its size (a power of two): a vector load or store of whole `Lanes`. (It does
     // not keep LLVM's vectorizer from leaving a long kernel scalar; `Config::wide` does.)
     let size = l * if crate::scalar::single() { 4 } else { 8 };
@@ -334,7 +343,7 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             /// Per lane: `x` where `|self| > |b|`, else `y`.
             #[inline(always)]
             pub fn select_abs_gt(self, b: Lanes, x: Lanes, y: Lanes) -> Lanes {
-                Lanes([#(#select),*])
+                #select
             }
         }
         #kernel

@@ -96,8 +96,8 @@ fn lanes_modules() {
 }
 
 /// `Config::wide`: the planar 2R's two lanes with `wide`'s arithmetic. The module is the plain
-/// lanes module but for `Lanes`' operators, negation, `sqrt` and `mul_add`; the snapshot is the
-/// lines between the longest common head and tail of the two.
+/// lanes module but for `Lanes`' doc line, operators, negation, `sqrt`, `mul_add` and
+/// `select_abs_gt`; the snapshot is the line diff of the two (one line of context).
 #[test]
 fn lanes_wide_operators() {
     let spec = "planar_2r.toml";
@@ -116,16 +116,24 @@ fn lanes_wide_operators() {
             .code
     };
     let (plain, wide) = (code(&plain), code(&wide));
-    let (p, w): (Vec<&str>, Vec<&str>) = (plain.lines().collect(), wide.lines().collect());
-    let head = p.iter().zip(&w).take_while(|(a, b)| a == b).count();
-    let tail = p[head..]
-        .iter()
-        .rev()
-        .zip(w[head..].iter().rev())
-        .take_while(|(a, b)| a == b)
-        .count();
-    let middle = w[head..w.len() - tail].join("\n");
-    assert!(middle.contains("wide::f64x2::new"), "{middle}");
-    assert!(!middle.contains("fn sin_cos"), "sin_cos changed:\n{middle}");
-    insta::assert_snapshot!("lanes_wide_planar_2r", middle);
+    let diff = similar::TextDiff::from_lines(&plain, &wide)
+        .unified_diff()
+        .context_radius(1)
+        .to_string();
+    let changed: Vec<&str> = diff
+        .lines()
+        .filter(|l| (l.starts_with('+') || l.starts_with('-')) && !l.starts_with("+++"))
+        .filter(|l| !l.starts_with("---"))
+        .collect();
+    assert!(
+        changed.iter().any(|l| l.contains("wide::f64x2::new")),
+        "{diff}"
+    );
+    for kept in ["sin_cos", "atan2", "fn inverse_dynamics", "splat"] {
+        assert!(
+            changed.iter().all(|l| !l.contains(kept)),
+            "{kept} changed:\n{diff}"
+        );
+    }
+    insta::assert_snapshot!("lanes_wide_planar_2r", diff);
 }

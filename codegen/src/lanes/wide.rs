@@ -7,7 +7,9 @@
 //! AVX-512, NEON, WASM SIMD, or a scalar fallback) in safe code, `no_std`.
 //!
 //! Bit for bit the plain operators: `+ - * /` and `sqrt` are IEEE operations, correctly
-//! rounded on every path `wide` takes, and its `neg` flips the sign bit as `-x` does.
+//! rounded on every path `wide` takes, and its `neg` flips the sign bit as `-x` does. The LU
+//! pivots' `select_abs_gt` is `wide`'s `abs` (the sign bit cleared, as `f64::abs`), its ordered
+//! `simd_gt` (false where a lane is NaN, as `>`) and its `select`.
 //! `mul_add` takes `wide`'s only where it is one fused operation on every width (x86 with FMA,
 //! AArch64), and the math backend per lane elsewhere.
 
@@ -59,6 +61,20 @@ pub(crate) fn unary(krate: &str, ty: &str) -> (TokenStream, TokenStream) {
         quote!(Lanes((-#w::new(self.0)).to_array())),
         quote!(Lanes(#w::new(self.0).sqrt().to_array())),
     )
+}
+
+/// The body of `select_abs_gt(self, b, x, y)`: `x` where `|self| > |b|`, else `y`, per lane.
+pub(crate) fn select_abs_gt(krate: &str, ty: &str) -> TokenStream {
+    let w = path(krate, ty);
+    quote! {
+        Lanes(
+            #w::new(self.0)
+                .abs()
+                .simd_gt(#w::new(b.0).abs())
+                .select(#w::new(x.0), #w::new(y.0))
+                .to_array(),
+        )
+    }
 }
 
 /// `mul_add`: `wide`'s fused one where every width fuses, `per_lane` (its body) elsewhere.
