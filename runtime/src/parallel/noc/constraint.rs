@@ -24,9 +24,14 @@
 //!   parallelogram of ball–ball rods also lets its distal side turn about the rod direction
 //!   (`a_parallelogram_allows_four_motions` in `codegen::spec::parallel::screws`).
 //!
-//! The test: the couples as unit rows, factorized by LU with partial pivoting (the pivoting
-//! chooses the three best of them when there are more); a pivot `|p| ≤ CONSTRAINT_TOLERANCE`
-//! is `Site::Constraint(i)`, the condition estimate `1/|p|`, as the closed loops' `Φ_d`.
+//! A Delta leg's couple is `a × d` of two unit vectors, not normalized: where the rods turn
+//! parallel to the crank axis the parallelogram folds flat and its couple vanishes with
+//! `|a × d|` (its own leg test fails there too, since `s = d·j ≤ |j| |a × d|`).
+//!
+//! The test: the couples as rows of length at most 1, factorized by LU with partial pivoting
+//! (the pivoting chooses the three best of them when there are more); a pivot
+//! `|p| ≤ CONSTRAINT_TOLERANCE` is `Site::Constraint(i)`, the condition estimate `1/|p|`, as
+//! the closed loops' `Φ_d`.
 
 use alloc::vec::Vec;
 
@@ -47,9 +52,9 @@ pub fn held_by_couples(plan: &Plan) -> bool {
     )
 }
 
-/// Each leg's constraint couple (base frame, unit), for the legs that impose one: a UPU leg's
-/// `e₀ × e₁`, a Delta leg's `a × d` (see the module's text). Empty unless
-/// [`held_by_couples`].
+/// Each leg's constraint couple (base frame), for the legs that impose one: a UPU leg's unit
+/// `e₀ × e₁`, a Delta leg's `a × d` of unit vectors, whose length is the sine between the rods
+/// and the crank axis (see the module's text). Empty unless [`held_by_couples`].
 pub fn constraint_couples<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<V<R>> {
     let mut out = Vec::new();
     if !held_by_couples(plan) {
@@ -61,12 +66,18 @@ pub fn constraint_couples<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<V<R>>
             // The closed-form UPS leg keeps the U's second axis e₁′ (base frame, unit, at right
             // angles to e₀): the couple is unit already.
             (LegKind::Ups, Some(uk), _) => Some(cross(mv(&lk.frame, cv(&lp.axes[0])), uk.e1)),
-            // The closed-form Delta leg keeps the rod direction d in L.
-            (LegKind::Rus, _, Some(dk)) => Some(unit(mv(&lk.frame, cross(cv(&lp.axes[0]), dk.d)))),
+            // The closed-form Delta leg keeps the rod direction d (unit) in L. `|a × d|` is the
+            // sine between the rods and the crank axis, and it vanishes with the couple where
+            // the parallelogram folds flat onto that axis: not normalized, so the test sees it
+            // (a singularity test never scales a quantity by itself alone).
+            (LegKind::Rus, _, Some(dk)) => Some(mv(&lk.frame, cross(cv(&lp.axes[0]), dk.d))),
+            // A U's two axes stay at their fixed angle: `|e₀ × e₁|` is a constant of the leg.
             (LegKind::Ups, None, _) => Some(unit(mv(&lk.frame, cross(lk.e[0], lk.e[1])))),
-            (LegKind::Rus, _, None) => {
-                Some(unit(mv(&lk.frame, cross(lk.e[0], sub(lk.end, lk.o[1])))))
-            }
+            // The generic Delta leg: the rod `P − E` over its (fixed) length, as above.
+            (LegKind::Rus, _, None) => Some(scale(
+                R::c(1.0 / lp.length),
+                mv(&lk.frame, cross(lk.e[0], sub(lk.end, lk.o[1]))),
+            )),
             // A UPU leg the closed form does not take (its U's axes do not meet, or its
             // prismatic axis is off the U centres' line).
             (LegKind::Generic, _, _)
@@ -87,7 +98,7 @@ pub fn constraint_couples<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Vec<V<R>>
 }
 
 /// The test of [`constraint_couples`]: with at least three couples, the LU with partial
-/// pivoting of their unit rows; a pivot `|p| ≤ CONSTRAINT_TOLERANCE` (or a couple of zero
+/// pivoting of their rows; a pivot `|p| ≤ CONSTRAINT_TOLERANCE` (or a couple of zero
 /// length) is `Site::Constraint(i)` with the condition estimate `1/|p|`.
 pub fn check_constraint<R: Real>(plan: &Plan, legs: &[LegKin<R>]) -> Result<(), Singular> {
     couple_lu(plan, legs, true).map(|_| ())
@@ -99,7 +110,7 @@ pub fn couple_pivots(plan: &Plan, legs: &[LegKin<f64>]) -> Vec<f64> {
     couple_lu(plan, legs, false).unwrap_or_default()
 }
 
-/// The LU of the unit couples as rows (partial pivoting as selects, rows swapped in the active
+/// The LU of the couples as rows (partial pivoting as selects, rows swapped in the active
 /// columns only), each pivot tested when `test`; the pivots.
 fn couple_lu<R: Real>(plan: &Plan, legs: &[LegKin<R>], test: bool) -> Result<Vec<R>, Singular> {
     let couples = constraint_couples(plan, legs);
