@@ -395,6 +395,22 @@ fn report(
     }
 }
 
+/// How far base parameters `a` that equal `b` in exact arithmetic but were computed along
+/// another route (a spec and the same spec written back as numbers) are from `b`:
+/// `max_k |a_k − b_k| / max(|b_k|, 1e-4 ‖b‖∞)`, to compare with `1e-9`. A parameter that is
+/// zero in exact arithmetic (a Delta's elbow-cross first moments, a pattern's turned mass
+/// centres) comes out as rounding noise of the terms grouped into it, about `1e-17 ‖b‖∞`,
+/// differently on each route: [`relative_mismatch`]'s floor of `1e-9 ‖b‖∞` would hold it to
+/// `1e-18 ‖b‖∞`, below one rounding of the largest, and refuse a spec whose numbers do read
+/// back exactly. The floor here allows `1e-13 ‖b‖∞` on such entries and keeps every parameter
+/// above it to `1e-9` relative.
+pub fn rounding_mismatch(a: &[f64], b: &[f64]) -> f64 {
+    let scale = 1e-4 * b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (0..b.len())
+        .map(|k| (a[k] - b[k]).abs() / b[k].abs().max(scale).max(f64::MIN_POSITIVE))
+        .fold(0.0, f64::max)
+}
+
 /// `max_k |a_k − b_k| / max(|b_k|, 1e-9 ‖b‖∞)` over the `keep` entries: relative, except for
 /// entries that are zero to the precision of the largest.
 pub fn relative_mismatch(a: &[f64], b: &[f64], keep: &[bool]) -> f64 {

@@ -512,7 +512,7 @@ pub fn update(
     let norm = apply(&doc, &unknowns, &z0)?;
     let pi0 = base_of(reg, file, &norm.to_string())?;
     let pi_spec = base_of(reg, file, source)?;
-    let drift = super::identify::relative_mismatch(&pi0, &pi_spec, &vec![true; pi0.len()]);
+    let drift = super::identify::rounding_mismatch(&pi0, &pi_spec);
     if drift > 1e-9 {
         return Err(format!(
             "error: {file}: its bodies written back as numbers change its base parameters ({drift:.2e} relative): --out cannot rewrite this spec (no file written)"

@@ -348,7 +348,7 @@ pub(super) fn update(
     let write = |z: &[f64]| apply(source, &tags, &links, &joints, scene.as_ref(), &unknowns, z);
     let pi0 = base(&write(&z0)?)?;
     let pi_spec = reg.base_of_spec(file, source, sidecar)?;
-    let drift = crate::cli::identify::relative_mismatch(&pi0, &pi_spec, &vec![true; pi0.len()]);
+    let drift = crate::cli::identify::rounding_mismatch(&pi0, &pi_spec);
     if drift > 1e-9 {
         return Err(format!(
             "error: {file}: its links written back as numbers change its base parameters ({drift:.2e} relative): --out cannot rewrite this URDF (no file written)"
