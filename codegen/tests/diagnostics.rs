@@ -382,3 +382,35 @@ fn an_open_loop_is_reported_at_its_joint_with_the_child_origin_that_closes_it() 
         );
     }
 }
+
+/// A frame that names no body and resembles none (here a URDF habit: the root link `world`)
+/// gets a hint that says what can be named, `"base"` among it: the hint listed only bodies, so
+/// a URDF user naming the root link (`base_link` of a Kinova Gen3) learnt no way to ask for the
+/// fixed world's frame.
+#[test]
+fn an_unknown_frame_hint_names_base() {
+    let source = r#"[mechanism]
+name = "arm"
+
+[[body]]
+name = "link1"
+mass = 1.0
+inertia = { ixx = 0.01, iyy = 0.01, izz = 0.01 }
+
+[[joint]]
+name = "j1"
+kind = "revolute"
+parent = "base"
+child = "link1"
+
+[scene]
+frames = ["world"]
+"#;
+    let diags = codegen::spec::load_tree("arm.toml", source).unwrap_err();
+    let text = diags.render();
+    assert!(text.contains("unknown frame \"world\""), "{text}");
+    assert!(text.contains("arm.toml:16:"), "{text}");
+    assert!(text.contains("or \"base\": the fixed world"), "{text}");
+    let ok = source.replace("[\"world\"]", "[\"base\", \"link1\"]");
+    codegen::spec::load_tree("arm.toml", &ok).unwrap_or_else(|d| panic!("{}", d.render()));
+}

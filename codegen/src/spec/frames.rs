@@ -109,7 +109,7 @@ pub(super) fn resolve(
                 .with_span(n.span.clone());
             d = d.with_hint(match suggest_hint(&n.name, &names) {
                 Some(h) => format!("{h} (a frame is a body's name)"),
-                None => "a frame is a body's name: one a joint moves, or one fixed to another by fixed joints".into(),
+                None => "a frame is a body's name (one a joint moves, or one fixed to another by fixed joints), or \"base\": the fixed world, which is also what a URDF's root link is".into(),
             });
             diags.push(d);
             continue;
