@@ -49,7 +49,8 @@ enum Math {
     version,
     about,
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    allow_negative_numbers = true
 )]
 struct Cli {
     /// Workspace tools (dynamic performance indices); without one, generate code.

@@ -462,3 +462,34 @@ fn isotropy_searches_a_named_design_number() {
     assert!((mm[1][1] - sigma).abs() < tol, "{mm:?} vs {sigma}");
     assert!(mm[0][1].abs() < tol, "{mm:?}");
 }
+
+/// A negative number is a value, refused by the option's own range check with its message:
+/// `reduce --tolerance -1` got clap's "unexpected argument '-1' found" instead, which names no
+/// bound (exit 2 either way).
+#[test]
+fn negative_numbers_get_the_range_message() {
+    let dir = scratch("negative");
+    let p = dir.join("x");
+    let p = p.to_str().unwrap();
+    let two_r = "../mechanisms/specs/planar_2r.toml";
+    for (args, says) in [
+        (
+            vec!["reduce", two_r, "--tolerance", "-1"],
+            "--tolerance must be positive",
+        ),
+        (
+            vec!["isotropy", FIVE, "--tolerance", "-0.5"],
+            "--tolerance non-negative",
+        ),
+        (vec!["map", FIVE, "--steps", "-4", "-o", p], "--steps"),
+        (vec!["excite", two_r, "--period", "-2"], "--period -2"),
+        (vec![two_r, "--snap", "-1"], "(0, 0.01]"),
+        (vec![two_r, "--lanes", "-4"], "from 2 to 16"),
+    ] {
+        let o = run(&args);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(!e.contains("unexpected argument"), "{args:?}: {e}");
+        assert!(e.contains(says), "{args:?}: {e}");
+    }
+}

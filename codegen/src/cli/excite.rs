@@ -31,6 +31,8 @@ use super::wls::condition;
 
 /// Arguments of `excite`.
 #[derive(Debug, Args)]
+// A negative number is a value (refused by the range checks with their message), not a flag.
+#[command(allow_negative_numbers = true)]
 pub struct ExciteArgs {
     /// Tree (`.toml` or `.urdf`), platform or closed-loop spec.
     pub spec: PathBuf,

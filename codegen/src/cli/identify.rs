@@ -25,6 +25,8 @@ pub enum Weights {
 
 /// Arguments of `identify`.
 #[derive(Debug, Args)]
+// A negative number is a value (refused by the range checks with their message), not a flag.
+#[command(allow_negative_numbers = true)]
 pub struct IdentifyArgs {
     /// Tree (`.toml` or `.urdf`), platform or closed-loop spec whose base parameters are
     /// identified.

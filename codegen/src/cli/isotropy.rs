@@ -44,6 +44,8 @@ pub enum NormArg {
 
 /// Arguments of `isotropy`.
 #[derive(Debug, Args)]
+// A negative number is a value (refused by the range checks with their message), not a flag.
+#[command(allow_negative_numbers = true)]
 pub struct IsotropyArgs {
     /// Mechanism spec (`.toml` or `.urdf`).
     pub spec: PathBuf,

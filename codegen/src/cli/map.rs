@@ -32,6 +32,8 @@ pub enum Scale {
 
 /// Arguments of `map`.
 #[derive(Debug, Args)]
+// A negative number is a value (refused by the range checks with their message), not a flag.
+#[command(allow_negative_numbers = true)]
 pub struct MapArgs {
     /// Mechanism spec (`.toml` or `.urdf`).
     pub spec: PathBuf,

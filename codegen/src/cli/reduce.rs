@@ -17,6 +17,8 @@ use super::Rng;
 
 /// Arguments of `reduce`.
 #[derive(Debug, clap::Args)]
+// A negative number is a value (refused by the range checks with their message), not a flag.
+#[command(allow_negative_numbers = true)]
 pub struct ReduceArgs {
     /// Mechanism spec (TOML, without a `[scene]` table).
     pub spec: PathBuf,
