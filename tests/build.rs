@@ -360,6 +360,16 @@ fn figures(out: &Path) {
             .lanes(Some(4))
             .math(codegen::MathBackend::Libm);
     });
+    // The three arms of `lanes_vector` with their lanes' arithmetic through the `wide` crate:
+    // the `lanes_vector_wide` benches.
+    generate(out, "lanes_vector_wide", Path::new(PUMA), |b| {
+        b.spec(CHAIN7)
+            .spec(IIWA)
+            .lanes(Some(4))
+            .vector_sin_cos(true)
+            .wide(Some("wide"))
+            .omit(&DYNAMICS_ONLY);
+    });
     // The three arms of `lanes_vector` with 8 lanes: the `lanes_vector8` benches.
     generate(out, "lanes_vector8", Path::new(PUMA), |b| {
         b.spec(CHAIN7)

@@ -17,7 +17,8 @@
 //!   `lanes8/{platform}/…` three of them with 8 lanes (`tests::variants::lanes8_parallel`);
 //!   `lanes_wide/…` and `lanes8_wide/…` the same three and the four-bar with the lanes'
 //!   arithmetic through the `wide` crate (`Config::wide`, `tests::variants::lanes_wide`,
-//!   `lanes8_wide`).
+//!   `lanes8_wide`); `lanes_vector_wide/…` the three arms of `lanes_vector` through `wide`
+//!   (`tests::variants::lanes_vector_wide`).
 //!
 //! `mul_add` is one instruction only with FMA enabled, and the lanes vectorize to 256-bit
 //! registers only with AVX, so run it for the host CPU (a target directory of its own keeps
@@ -196,6 +197,9 @@ lanes_tree!(lanes_libm_chain7, lanes_libm, chain7);
 lanes_tree!(lanes_vector_puma560, lanes_vector, puma560);
 lanes_tree!(lanes_vector_chain7, lanes_vector, chain7);
 lanes_tree!(lanes_vector_iiwa14, lanes_vector, iiwa14);
+lanes_tree!(lanes_vector_wide_puma560, lanes_vector_wide, puma560);
+lanes_tree!(lanes_vector_wide_chain7, lanes_vector_wide, chain7);
+lanes_tree!(lanes_vector_wide_iiwa14, lanes_vector_wide, iiwa14);
 lanes_tree!(lanes_vector8_puma560, lanes_vector8, puma560);
 lanes_tree!(lanes_vector8_chain7, lanes_vector8, chain7);
 lanes_tree!(lanes_vector8_iiwa14, lanes_vector8, iiwa14);
@@ -406,6 +410,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_wide_gough_stewart, lanes8_wide_gough_stewart, lanes_wide_delta_rl5, lanes8_wide_delta_rl5, lanes_wide_agile_eye, lanes8_wide_agile_eye, lanes_wide_four_bar, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector_wide_puma560, lanes_vector_wide_chain7, lanes_vector_wide_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_wide_gough_stewart, lanes8_wide_gough_stewart, lanes_wide_delta_rl5, lanes8_wide_delta_rl5, lanes_wide_agile_eye, lanes8_wide_agile_eye, lanes_wide_four_bar, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
 }
 criterion_main!(benches);

@@ -522,6 +522,33 @@ pub mod lanes_vector8 {
     }
 }
 
+/// The three arms of `lanes_vector`, their lanes' arithmetic through the `wide` crate
+/// (`Config::wide`), for the `lanes_vector_wide` benches.
+#[cfg(feature = "figures")]
+pub mod lanes_vector_wide {
+    /// `mechanisms/specs/puma560.toml`.
+    pub mod puma560 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector_wide/puma560.rs"
+        ));
+    }
+    /// `mechanisms/specs/chain7.toml`.
+    pub mod chain7 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector_wide/chain7.rs"
+        ));
+    }
+    /// `mechanisms/specs/iiwa14.urdf`.
+    pub mod iiwa14 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/lanes_vector_wide/iiwa14.rs"
+        ));
+    }
+}
+
 /// Three arms with 4 lanes whose `sin_cos` is one polynomial over all lanes
 /// (`Config::vector_sin_cos`), dynamics only.
 pub mod lanes_vector {
