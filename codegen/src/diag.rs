@@ -190,6 +190,48 @@ impl Diagnostics {
     pub fn sort_by_position(&mut self) {
         self.list
             .sort_by_key(|d| d.span.as_ref().map_or((1, 0, 0), |s| (0, s.start, s.end)));
+        self.merge_repeats();
+    }
+
+    /// The same problem at the same place reported once: a `[[pattern]]` entry's mistake
+    /// found after expansion (a negative mass) came once per copy, each naming its copy, all
+    /// pointing at one line. The first is kept, its key saying how many more there were.
+    /// Diagnostics with a [`Fix`] are left as they are (each fixes its own entry).
+    fn merge_repeats(&mut self) {
+        let same = |a: &Diagnostic, b: &Diagnostic| {
+            a.span.is_some()
+                && a.fix.is_none()
+                && b.fix.is_none()
+                && (a.severity, &a.message, &a.span, &a.hint)
+                    == (b.severity, &b.message, &b.span, &b.hint)
+        };
+        // Sorted by position, the repeats of one are among the diagnostics of its span, which
+        // are next to each other (but may alternate with other problems of the same entry).
+        let mut out: Vec<(Diagnostic, usize)> = Vec::with_capacity(self.list.len());
+        for d in std::mem::take(&mut self.list) {
+            let first = out
+                .iter_mut()
+                .rev()
+                .take_while(|(e, _)| e.span == d.span)
+                .find(|(e, _)| same(e, &d));
+            match first {
+                Some((_, n)) => *n += 1,
+                None => out.push((d, 0)),
+            }
+        }
+        self.list = out
+            .into_iter()
+            .map(|(mut d, n)| {
+                if n > 0 {
+                    let more = format!("and {n} more made from this text");
+                    d.key = Some(match d.key.take() {
+                        Some(k) => format!("{k}, {more}"),
+                        None => more,
+                    });
+                }
+                d
+            })
+            .collect();
     }
 
     /// Removes and returns the warnings, keeping the errors.

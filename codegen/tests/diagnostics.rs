@@ -414,3 +414,36 @@ frames = ["world"]
     let ok = source.replace("[\"world\"]", "[\"base\", \"link1\"]");
     codegen::spec::load_tree("arm.toml", &ok).unwrap_or_else(|d| panic!("{}", d.render()));
 }
+
+/// A `[[pattern]]` that cannot be expanded is the only error reported: with `copies = 65` the
+/// legs were missing, and the whole-mechanism counts (no joint actuated, no joint into the
+/// platform, the mobility) came first, ahead of it in the file. A mistake in a pattern's entry
+/// found after expansion (a negative mass) is reported once, not once per copy at the same line.
+#[test]
+fn a_pattern_s_mistake_is_reported_once() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/gough_stewart.toml");
+    let source = std::fs::read_to_string(&path).unwrap();
+    let load = |text: &str| match codegen::spec::load_mechanism("gs.toml", text) {
+        Ok(_) => panic!("accepted"),
+        Err(d) => d,
+    };
+    let copies = source.replacen("copies = 6", "copies = 65", 1);
+    assert_ne!(copies, source);
+    let d = load(&copies);
+    let messages: Vec<&str> = d.iter().map(|d| d.message.as_str()).collect();
+    assert_eq!(
+        messages,
+        ["copies must be a whole number from 1 to 64"],
+        "{}",
+        d.render()
+    );
+    let at = source.find("[[pattern.body]]").unwrap();
+    let mass = at + source[at..].find("mass = ").unwrap();
+    let end = mass + source[mass..].find('\n').unwrap();
+    let negative = format!("{}mass = -1.0{}", &source[..mass], &source[end..]);
+    let d = load(&negative);
+    assert_eq!(d.error_count(), 1, "{}", d.render());
+    let text = d.render();
+    assert!(text.contains("negative mass -1"), "{text}");
+    assert!(text.contains("and 5 more made from this text"), "{text}");
+}

@@ -73,6 +73,23 @@ impl Reader<'_> {
     }
 
     fn pattern(&mut self, k: usize, t: &DeTable<'_>, span: Range<usize>, out: &mut Copies) {
+        if !self.pattern_copies(k, t, span, out) {
+            // The pattern's copies are missing (the reason reported): the whole-mechanism
+            // checks (the actuator count, the mobility, joints into the platform, bodies left
+            // unattached) would only echo that error, ahead of it in the file.
+            self.joints_incomplete = true;
+        }
+    }
+
+    /// The copies of one pattern into `out`; `false` when none could be made (an error in
+    /// `copies`, `axis` or `angle`, or nothing to repeat).
+    fn pattern_copies(
+        &mut self,
+        k: usize,
+        t: &DeTable<'_>,
+        span: Range<usize>,
+        out: &mut Copies,
+    ) -> bool {
         let path = match get(t, "name").map(|v| v.get_ref()) {
             Some(DeValue::String(s)) => format!("pattern \"{s}\""),
             _ => format!("pattern[{k}]"),
@@ -89,7 +106,7 @@ impl Reader<'_> {
                     span.clone(),
                     "copies = N: how many times the pattern's entries are repeated",
                 );
-                return;
+                return false;
             }
             Some(v) => match v.get_ref() {
                 DeValue::Integer(n) => match i64::from_str_radix(n.as_str(), n.radix()) {
@@ -100,12 +117,12 @@ impl Reader<'_> {
                             &format!("{path}.copies"),
                             v.span(),
                         );
-                        return;
+                        return false;
                     }
                 },
                 _ => {
                     self.type_error("a whole number", v, &format!("{path}.copies"));
-                    return;
+                    return false;
                 }
             },
         };
@@ -130,7 +147,7 @@ impl Reader<'_> {
             Some(v) => self.angle(v, &format!("{path}.angle")),
         };
         let (Some(axis), Some(step)) = (axis, step) else {
-            return;
+            return false;
         };
         let params = match get(t, "parameters") {
             Some(v) => self.table(v, &format!("{path}.parameters")),
@@ -145,7 +162,7 @@ impl Reader<'_> {
             self.err("the pattern repeats nothing", &path, s).hint = Some(
                 "write its entries under [[pattern.body]], [[pattern.joint]], [[pattern.parallelogram]] or [[pattern.spring]] after the [[pattern]] header".into(),
             );
-            return;
+            return false;
         }
         for index in 1..=copies {
             let errors = self.diags.error_count();
@@ -199,11 +216,13 @@ impl Reader<'_> {
                 }
             }
             self.copy = None;
-            // An error in the pattern's text would repeat in every copy: report it once.
+            // An error in the pattern's text would repeat in every copy: report it once (the
+            // other copies are then missing too).
             if self.diags.error_count() > errors {
-                break;
+                return false;
             }
         }
+        true
     }
 
     /// A copy's joint with its placements on outside bodies turned.
