@@ -24,6 +24,19 @@ fn run(args: &[&str]) -> Output {
         .expect("the codegen binary runs")
 }
 
+/// `identify SPEC DATA --estimates EST --out OUT`.
+fn identify_out(spec: &Path, data: &Path, est: &Path, out: &Path) -> Output {
+    run(&[
+        "identify",
+        s(spec),
+        s(data),
+        "--estimates",
+        s(est),
+        "--out",
+        s(out),
+    ])
+}
+
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
@@ -241,15 +254,7 @@ fn end_to_end(test: &str, scene: &str, noise_seed: u64) {
     let data = measure(&dir, &rows, &truth, &[0.0; 6], 1);
     let est = dir.join("est0.csv");
     let out = dir.join("updated0.toml");
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
+    let o = identify_out(&spec, &data, &est, &out);
     ok(&o);
     let (e0, _) = estimates(&est);
     assert_eq!(e0.len(), true_base.len());
@@ -273,15 +278,7 @@ fn end_to_end(test: &str, scene: &str, noise_seed: u64) {
     let data = measure(&dir, &rows, &truth, &sigma, noise_seed);
     let est = dir.join("est.csv");
     let out = dir.join("updated.toml");
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
+    let o = identify_out(&spec, &data, &est, &out);
     ok(&o);
     let stdout = text(&o.stdout);
     assert!(stdout.contains("condition number of the weighted stacked regressor"));

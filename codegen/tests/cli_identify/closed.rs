@@ -13,7 +13,8 @@ use runtime::closed::noc;
 
 use super::platform::{bundled, listed, nudge, perturb_body};
 use super::{
-    Rng, csv_rows, estimates, generated_base_parameters, ok, rel, rel_floor, run, s, scratch, text,
+    Rng, csv_rows, estimates, generated_base_parameters, identify_out, ok, rel, rel_floor, run, s,
+    scratch, text,
 };
 
 const FOUR_BAR: &str = "../mechanisms/specs/four_bar.toml";
@@ -122,15 +123,7 @@ fn closed_end_to_end(test: &str, nominal: &str, q_max: &str, qd_max: &str, sigma
         measure_closed(&data, &states, &truth, noise, noise_seed);
         let est = dir.join(format!("{case}_est.csv"));
         let out = dir.join(format!("{case}_updated.toml"));
-        let o = run(&[
-            "identify",
-            s(&spec),
-            s(&data),
-            "--estimates",
-            s(&est),
-            "--out",
-            s(&out),
-        ]);
+        let o = identify_out(&spec, &data, &est, &out);
         ok(&o);
         eprintln!("{}", text(&o.stdout));
         let (e, sd) = estimates(&est);

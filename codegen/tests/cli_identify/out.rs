@@ -9,7 +9,9 @@ use super::platform::{
     DELTA, GS, TSAI, bundled, estimate_names, listed, measure_platform, perturbed_platform,
     platform, platform_trajectory,
 };
-use super::{Rng, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text};
+use super::{
+    Rng, estimates, generated_base_parameters, identify_out, ok, rel_floor, run, s, scratch, text,
+};
 
 /// Noise-free data of a perturbed Delta: the written spec's module has the estimates as its
 /// `BASE_PARAMETERS`, all 37, and its model the true model's inverse dynamics.
@@ -27,15 +29,7 @@ fn delta_out_writes_rods_and_reproduces_every_base_parameter() {
     let data = dir.join("exact.csv");
     measure_platform(&data, &states, &truth, 0.0, 1);
     let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
+    let o = identify_out(&spec, &data, &est, &out);
     ok(&o);
     let stderr = text(&o.stderr);
     assert!(
@@ -312,15 +306,7 @@ fn cross_out(
     let data = dir.join("exact.csv");
     measure_platform(&data, &states, &truth, 0.0, 1);
     let (est, out) = (dir.join("est.csv"), dir.join("updated.toml"));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
+    let o = identify_out(&spec, &data, &est, &out);
     ok(&o);
     let stderr = text(&o.stderr);
     assert!(
@@ -815,15 +801,7 @@ rod_inertia = { ixx = 1e-6, iyy = 0.004, izz = 0.004 }
         "-o",
         s(&data),
     ]));
-    let o = run(&[
-        "identify",
-        s(&spec),
-        s(&data),
-        "--estimates",
-        s(&est),
-        "--out",
-        s(&out),
-    ]);
+    let o = identify_out(&spec, &data, &est, &out);
     ok(&o);
     let (e, _) = estimates(&est);
     let written =

@@ -7,7 +7,8 @@
 use std::path::Path;
 
 use super::{
-    Rng, csv_rows, estimates, generated_base_parameters, ok, rel_floor, run, s, scratch, text,
+    Rng, csv_rows, estimates, generated_base_parameters, identify_out, ok, rel_floor, run, s,
+    scratch, text,
 };
 
 pub(super) const GS: &str = "../mechanisms/specs/gough_stewart.toml";
@@ -240,15 +241,7 @@ fn platform_end_to_end(
         measure_platform(&data, &states, &truth, noise, noise_seed);
         let est = dir.join(format!("{case}_est.csv"));
         let out = dir.join(format!("{case}_updated.toml"));
-        let o = run(&[
-            "identify",
-            s(&spec),
-            s(&data),
-            "--estimates",
-            s(&est),
-            "--out",
-            s(&out),
-        ]);
+        let o = identify_out(&spec, &data, &est, &out);
         ok(&o);
         eprintln!("{}", text(&o.stdout));
         let (e, sd) = estimates(&est);
