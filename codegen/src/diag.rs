@@ -186,7 +186,8 @@ impl Diagnostics {
         self.list.iter().filter(|d| d.is_error()).count()
     }
 
-    /// Stable sort by position in the source; diagnostics without a span go last.
+    /// Stable sort by position in the source, diagnostics without a span last; then the same
+    /// problem at the same place is kept once, its key counting the repeats.
     pub fn sort_by_position(&mut self) {
         self.list
             .sort_by_key(|d| d.span.as_ref().map_or((1, 0, 0), |s| (0, s.start, s.end)));

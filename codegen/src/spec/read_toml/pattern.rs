@@ -81,8 +81,9 @@ impl Reader<'_> {
         }
     }
 
-    /// The copies of one pattern into `out`; `false` when none could be made (an error in
-    /// `copies`, `axis` or `angle`, or nothing to repeat).
+    /// The copies of one pattern into `out`; `false` when some are missing: none could be made
+    /// (an error in `copies`, `axis` or `angle`, or nothing to repeat), or an error in an entry
+    /// stopped them after the first copy (reported once, not once per copy).
     fn pattern_copies(
         &mut self,
         k: usize,
