@@ -14,7 +14,8 @@
 //! The call is the math backend's: `libm::fma` (`fmaf`), `f64::mul_add` (std), or
 //! `<runtime>::math::mul_add` (`mul_add_f32`). `f64::mul_add` is one instruction only where the
 //! target has FMA (`-C target-cpu=native`, `-C target-feature=+fma`); elsewhere it is a call to
-//! the platform's `fma`, which is correct but slow.
+//! the platform's `fma`, which is correct but slow. The runtime's is the instruction there with
+//! or without std; `libm::fma` on x86 is a call through a pointer chosen at run time.
 
 use std::cell::Cell;
 use std::collections::HashMap;

@@ -117,7 +117,8 @@ pub struct Config {
     /// product is read by that sum alone ([`fma`]); the op-count table gains an `fma` column.
     /// Off by default: the output is then byte for byte the unfused one, and a `libm` build
     /// stays bit-identical across targets. Pays only on a target with FMA instructions
-    /// (`-C target-cpu=native` or `-C target-feature=+fma`); elsewhere `mul_add` is a
+    /// (`-C target-cpu=native` or `-C target-feature=+fma`) and through the `Runtime` or `Std`
+    /// backend (`libm::fma` on x86 is a call chosen at run time); elsewhere `mul_add` is a
     /// library call. Results differ from the unfused ones by rounding (tests: ≤ 1e-12
     /// relative).
     pub fma: bool,

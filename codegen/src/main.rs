@@ -365,7 +365,7 @@ fn main() -> ExitCode {
 
 /// What `--fma` with the default `libm` backend costs on x86 (docs/performance.md, "Fused
 /// multiply–add"): the module is right, but `libm::fma` is no instruction there.
-const FMA_LIBM_NOTE: &str = "note: with `--math libm` (the default) each fused multiply-add is a call of `libm::fma`, which on x86 chooses the FMA instruction or a software fallback at run time through a function pointer, even with `-C target-cpu=native`: there the fused module is about twice as slow as the unfused one (PUMA 560: inverse dynamics 2.2x, mass matrix 1.8x). On a host, take `--math std` (or `--math runtime` with the runtime's `std` feature), where `mul_add` is one instruction; see docs/performance.md, \"Fused multiply-add\".";
+const FMA_LIBM_NOTE: &str = "note: with `--math libm` (the default) each fused multiply-add is a call of `libm::fma`, which on x86 chooses the FMA instruction or a software fallback at run time through a function pointer, even with `-C target-cpu=native`: there the fused module is about twice as slow as the unfused one (PUMA 560: inverse dynamics 2.2x, mass matrix 1.8x). Take `--math runtime` (with or without the runtime's `std` feature) or, on a host, `--math std`, where `mul_add` is one instruction; see docs/performance.md, \"Fused multiply-add\".";
 
 /// The tolerance `snap_note` tries: four or five digits, as published files round π/2.
 const SUGGESTED_SNAP: f64 = 1e-4;

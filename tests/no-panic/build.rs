@@ -1,8 +1,11 @@
 //! The PUMA 560 with `_lanes` functions (4 states per call) and the vector `sin_cos`: options
-//! whose code the bundled `mechanisms` crate does not hold, proved here too. Not `fma`: with
-//! the `libm` crate (no std) its `fma` on x86 picks the instruction or a fallback at run time
-//! through a function pointer, an indirect call the proof cannot see through (it reports a
-//! possible panic); docs/performance.md, "Fused multiply–add".
+//! whose code the bundled `mechanisms` crate does not hold, proved here too.
+//!
+//! The PUMA 560 with fused multiply–adds (`fma`), every function, through its `Dynamics` impl.
+//! On x86 the proof is built with the target's FMA (`-C target-feature=+fma`; `.ci/run`): the
+//! runtime's `mul_add` is then the instruction, where the `libm` crate's `fma` picks the
+//! instruction or a fallback at run time through a function pointer, an indirect call the proof
+//! cannot see through (docs/performance.md, "Fused multiply–add").
 
 //!
 //! Also a platform (the planar 3-RRR) and a closed loop (the four-bar) with `_lanes` functions,
@@ -18,6 +21,16 @@ fn main() {
         .lanes(Some(4))
         .vector_sin_cos(true)
         .out_dir(&out)
+        .compile()
+        .unwrap_or_else(|e| panic!("\n{e}"));
+    let fma = out.join("fma");
+    std::fs::create_dir_all(&fma).unwrap_or_else(|e| panic!("{}: {e}", fma.display()));
+    codegen::build_script::Builder::new()
+        .spec(spec)
+        .math(codegen::MathBackend::Runtime("runtime".into()))
+        .fma(true)
+        .implement("runtime")
+        .out_dir(&fma)
         .compile()
         .unwrap_or_else(|e| panic!("\n{e}"));
     let (platform, closed) = (

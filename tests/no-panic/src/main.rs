@@ -223,8 +223,10 @@ fn run<M: Module<NX, N>, const NX: usize, const N: usize>(m: &M, seed: &mut u64)
 macro_rules! mechanisms {
     ($($m:ident),* $(,)?) => {
         /// Every mechanism's `run`, with its name.
-        pub const MECHANISMS: &[(&str, fn(&mut u64) -> F)] =
-            &[$((stringify!($m), |seed| run(&root::$m::Module, seed))),*];
+        pub const MECHANISMS: &[(&str, fn(&mut u64) -> F)] = &[
+            $((stringify!($m), |seed| run(&root::$m::Module, seed)),)*
+            ("puma560_fma", |seed| run(&puma560_fma::Module, seed)),
+        ];
     };
 }
 
@@ -266,6 +268,24 @@ frames!(
     chain7_iiwa_link_7: chain7::{iiwa_link_7_pose, iiwa_link_7_jacobian, iiwa_link_7_jacobian_dot_qd},
     iiwa14_iiwa_link_ee: iiwa14::{iiwa_link_ee_pose, iiwa_link_ee_jacobian, iiwa_link_ee_jacobian_dot_qd},
     iiwa14_tool: iiwa14::{tool_pose, tool_jacobian, tool_jacobian_dot_qd},
+);
+
+/// The PUMA 560 generated with `fma` and the `Dynamics` impl (`build.rs`): every function
+/// through the generic wrappers above, as a mechanism of its own (`MECHANISMS`).
+#[allow(dead_code)]
+mod puma560_fma {
+    include!(concat!(env!("OUT_DIR"), "/fma/puma560.rs"));
+}
+
+// Without the target's FMA, the runtime's `mul_add` on x86 is the `libm` crate's, whose call
+// through a pointer the proof cannot see through.
+#[cfg(all(
+    feature = "prove",
+    any(target_arch = "x86", target_arch = "x86_64"),
+    not(target_feature = "fma")
+))]
+compile_error!(
+    "on x86 the proof needs the target's FMA for its `fma` module: build it as .ci/run does, with `-C target-feature=+fma` for the target (`--target <host>` and `CARGO_TARGET_<HOST>_RUSTFLAGS`)"
 );
 
 /// The PUMA 560 generated with `lanes = 4` and `vector_sin_cos` (`build.rs`).
