@@ -11,7 +11,10 @@
 //!    `__kernel_cos` (degree 13 and 14; Sun Microsystems' freely distributable fdlibm 5.3,
 //!    the coefficients of its `k_sin.c` and `k_cos.c`), `cos` with fdlibm's correction of
 //!    `1 − r²/2`;
-//! 3. the quadrant `n mod 4` swaps and negates the pair by selects, not branches.
+//! 3. the quadrant `n mod 4` swaps and negates the pair by selects, not branches. It is read
+//!    from the bits of `t = x·2/π + 1.5·2⁵²`, whose mantissa is `n + 2⁵¹` (unit last place),
+//!    so its two low bits are `n mod 4`: integer operations that vectorize, where `n as i32`
+//!    is a saturating conversion per lane (six scalar instructions each on x86).
 //!
 //! A call whose lanes are not all finite and within `|x| ≤ 2¹⁹·π/2` (about 8.2e5 rad) takes the
 //! backend's `sin_cos` for every lane instead: the reduction above would no longer be exact.
@@ -78,7 +81,8 @@ pub(super) fn body_and_kernel(idx: &[Literal], backend: TokenStream) -> (TokenSt
             const C4: f64 = -2.75573143513906633035e-07;
             const C5: f64 = 2.08757232129817482790e-09;
             const C6: f64 = -1.13596475577881948265e-11;
-            let n = (x * core::f64::consts::FRAC_2_PI + SHIFT) - SHIFT;
+            let t = x * core::f64::consts::FRAC_2_PI + SHIFT;
+            let n = t - SHIFT;
             let r = ((x - n * P1) - n * P2) - n * P3;
             let z = r * r;
             let sin = r + z * r * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
@@ -87,7 +91,7 @@ pub(super) fn body_and_kernel(idx: &[Literal], backend: TokenStream) -> (TokenSt
             let hz = 0.5 * z;
             let one_minus = 1.0 - hz;
             let cos = one_minus + (((1.0 - one_minus) - hz) + z * q);
-            let quadrant = (n as i32) & 3;
+            let quadrant = t.to_bits() & 3;
             let (a, b) = if quadrant & 1 != 0 { (cos, sin) } else { (sin, cos) };
             let a = if quadrant & 2 != 0 { -a } else { a };
             let b = if (quadrant + 1) & 2 != 0 { -b } else { b };
