@@ -167,3 +167,43 @@ fn a_mistake_in_a_pattern_is_reported_once() {
     let e = errors(&PATTERN.replace("name = \"arm{i}\"", "name = \"arm\""));
     assert!(e.contains("arm"), "{e}");
 }
+
+/// A long chain of parameters, each written before the one it refers to (the order that
+/// needs the most passes), is read in about linear time: the pass-by-pass evaluation took
+/// cubic time (2,000 parameters 2.3 s, 6,000 parameters 78 s in release, a "hang" for a
+/// 100 kB spec). The values, the cycle diagnostics and the evaluation order are unchanged.
+#[test]
+fn a_long_chain_of_parameters_is_read_quickly() {
+    let n = 4_000;
+    let mut src = String::from("[parameters]\n");
+    for k in 0..n {
+        src += &format!("p{k} = \"p{} + 1\"\n", k + 1);
+    }
+    src += &format!("p{n} = 0.5\nl1 = 1\nm1 = \"p0 / {n}\"\nyaw = 0\nh = 1\n");
+    src += ARM;
+    let started = std::time::Instant::now();
+    let (m, _) = load_mechanism("t.toml", &src).unwrap_or_else(|d| panic!("{d}"));
+    let took = started.elapsed();
+    assert!(
+        took.as_secs_f64() < 10.0,
+        "{n} chained parameters took {took:?}"
+    );
+    // m1 = (n + 0.5) / n
+    let text = format!("{m:?}");
+    let want = format!("{:?}", (n as f64 + 0.5) / n as f64);
+    assert!(text.contains(&want), "mass {want} not in the model");
+
+    // A cycle below a long chain is still reported at each parameter that waits on it.
+    let e = errors(&format!(
+        "[parameters]\nl1 = \"a\"\na = \"b\"\nb = \"c + a\"\nc = 1\nm1 = 1\nyaw = 0\nh = 1\n{ARM}"
+    ));
+    assert_eq!(e.matches("depends on itself").count(), 3, "{e}");
+    assert!(
+        e.contains("parameter `b` depends on itself through a"),
+        "{e}"
+    );
+    assert!(
+        e.contains("parameter `l1` depends on itself through a"),
+        "{e}"
+    );
+}

@@ -141,41 +141,52 @@ impl Reader<'_> {
             });
         }
         let mut done: Vec<(String, Value)> = Vec::new();
-        // Each pass evaluates every parameter that refers to no parameter still waiting; a pass
-        // that makes no progress leaves a cycle. Unknown names are reported at evaluation.
-        while !pending.is_empty() {
-            let waiting: Vec<String> = pending.iter().map(|p| p.name.clone()).collect();
-            let (now, later): (Vec<_>, Vec<_>) = pending
-                .into_iter()
-                .partition(|p| !p.refers.iter().any(|r| waiting.contains(r)));
-            if now.is_empty() {
-                for p in &later {
-                    let waits: Vec<&str> = p
-                        .refers
-                        .iter()
-                        .filter(|r| waiting.contains(r))
-                        .map(String::as_str)
-                        .collect();
-                    let span = key_span(t, &p.name).unwrap_or(p.value.span());
-                    self.err(
-                        format!(
-                            "parameter `{}` depends on itself through {}",
-                            p.name,
-                            waits.join(", ")
-                        ),
-                        &p.key,
-                        span,
-                    )
-                    .hint = Some("parameters may refer to each other, but not in a cycle".into());
-                }
-                break;
+        // The parameters are evaluated in passes: each pass evaluates, in table order, every
+        // parameter that refers to no parameter still waiting, and a pass that makes no
+        // progress leaves a cycle (unknown names are reported at evaluation). That order is a
+        // parameter's depth (the longest chain of references below it) and then its place in
+        // the table; computed here in one walk of the references rather than pass by pass,
+        // which took cubic time in the length of a chain (6,000 chained parameters: 78 s).
+        let depth = reference_depths(&pending);
+        let mut order: Vec<usize> = (0..pending.len()).filter(|&k| depth[k].is_some()).collect();
+        order.sort_by_key(|&k| depth[k]);
+        for &k in &order {
+            let p = &pending[k];
+            if let Some(v) = self.parameter_value(p.value, &p.key) {
+                self.push_parameter(&p.name, v, &mut done);
             }
-            for p in now {
-                if let Some(v) = self.parameter_value(p.value, &p.key) {
-                    self.push_parameter(&p.name, v, &mut done);
-                }
-            }
-            pending = later;
+        }
+        // What is left waits on a cycle: reported at each such parameter, with the names it
+        // still waits on, as the passes left them.
+        let waiting: std::collections::HashSet<&str> = pending
+            .iter()
+            .zip(&depth)
+            .filter(|(_, d)| d.is_none())
+            .map(|(p, _)| p.name.as_str())
+            .collect();
+        for p in pending
+            .iter()
+            .zip(&depth)
+            .filter(|(_, d)| d.is_none())
+            .map(|(p, _)| p)
+        {
+            let waits: Vec<&str> = p
+                .refers
+                .iter()
+                .filter(|r| waiting.contains(r.as_str()))
+                .map(String::as_str)
+                .collect();
+            let span = key_span(t, &p.name).unwrap_or(p.value.span());
+            self.err(
+                format!(
+                    "parameter `{}` depends on itself through {}",
+                    p.name,
+                    waits.join(", ")
+                ),
+                &p.key,
+                span,
+            )
+            .hint = Some("parameters may refer to each other, but not in a cycle".into());
         }
         done
     }
@@ -209,4 +220,76 @@ impl Reader<'_> {
             _ => self.number(v, key).map(Value::Scalar),
         }
     }
+}
+
+/// Each pending parameter's depth: 0 when it refers to no other pending parameter, else one
+/// more than the deepest it refers to; `None` when it refers, directly or through others, to a
+/// cycle. Iterative (a chain of a million parameters must not overflow the stack) and linear
+/// in the number of references.
+fn reference_depths(pending: &[Pending<'_, '_>]) -> Vec<Option<usize>> {
+    #[derive(Clone, Copy)]
+    enum State {
+        New,
+        Open,
+        Done(Option<usize>),
+    }
+    let index: std::collections::HashMap<&str, usize> = pending
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (p.name.as_str(), k))
+        .collect();
+    let deps: Vec<Vec<usize>> = pending
+        .iter()
+        .map(|p| {
+            p.refers
+                .iter()
+                .filter_map(|r| index.get(r.as_str()).copied())
+                .collect()
+        })
+        .collect();
+    let mut state = vec![State::New; pending.len()];
+    for root in 0..pending.len() {
+        if !matches!(state[root], State::New) {
+            continue;
+        }
+        // (parameter, next reference to look at, depth so far: None once a cycle is met)
+        let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(root, 0, Some(0))];
+        state[root] = State::Open;
+        while let Some(top) = stack.last_mut() {
+            let (k, next, depth) = *top;
+            if next < deps[k].len() {
+                top.1 += 1;
+                let d = deps[k][next];
+                match state[d] {
+                    State::New => {
+                        state[d] = State::Open;
+                        stack.push((d, 0, Some(0)));
+                    }
+                    State::Open => top.2 = None,
+                    State::Done(dd) => {
+                        top.2 = match (depth, dd) {
+                            (Some(a), Some(b)) => Some(a.max(b + 1)),
+                            _ => None,
+                        }
+                    }
+                }
+            } else {
+                stack.pop();
+                state[k] = State::Done(depth);
+                if let Some(parent) = stack.last_mut() {
+                    parent.2 = match (parent.2, depth) {
+                        (Some(a), Some(b)) => Some(a.max(b + 1)),
+                        _ => None,
+                    };
+                }
+            }
+        }
+    }
+    state
+        .into_iter()
+        .map(|s| match s {
+            State::Done(d) => d,
+            _ => None,
+        })
+        .collect()
 }
