@@ -447,3 +447,77 @@ fn a_pattern_s_mistake_is_reported_once() {
     assert!(text.contains("negative mass -1"), "{text}");
     assert!(text.contains("and 5 more made from this text"), "{text}");
 }
+
+/// A joint's `<limit>`, `<safety_controller>` and `<calibration>` are read as docs/spec.md
+/// ("URDF input") says: a `<limit>` that gives no usable range is no limit, and the other two
+/// are ignored, however they are written. urdf-rs used to reject a `<limit>` without
+/// `velocity` (valid in `<limit lower upper effort>` as many hand-written URDFs have it), a
+/// `<safety_controller>` without `k_velocity` or a word in `effort` or `rising`, at the
+/// `<robot>` tag as "URDF: custom: missing field `velocity`". A `<mimic>`'s numbers are still
+/// checked, at their attribute.
+#[cfg(feature = "urdf")]
+#[test]
+fn urdf_limit_safety_controller_and_calibration_never_fail_the_file() {
+    let urdf = |extra: &str| {
+        format!(
+            r#"<?xml version="1.0"?>
+<robot name="r">
+<link name="a"/>
+<link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="c"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+  <limit lower="-1" upper="1" effort="1" velocity="2"/><safety_controller soft_lower_limit="-1" soft_upper_limit="1"/></joint>
+<joint name="k" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 1 0"/>
+  {extra}
+</joint>
+</robot>
+"#
+        )
+    };
+    let overrides = codegen::spec::SceneOverrides::default();
+    for (extra, k_limit) in [
+        (
+            r#"<limit lower="-1" upper="1" effort="10"/>"#,
+            Some((-1.0, 1.0, None)),
+        ),
+        (
+            r#"<limit lower="-2" upper="2" effort="x" velocity="1"/>"#,
+            Some((-2.0, 2.0, Some(1.0))),
+        ),
+        (r#"<limit lower="nan" upper="inf" velocity="-1"/>"#, None),
+        (r#"<limit lower="abc" upper="1" velocity="1"/>"#, None),
+        (r#"<calibration rising="x"/>"#, None),
+        (r#"<safety_controller k_position="fast"/>"#, None),
+    ] {
+        let loaded = codegen::spec::load("r.urdf", &urdf(extra), &overrides)
+            .unwrap_or_else(|d| panic!("{extra}: {}", d.render()));
+        let limit = |name: &str| {
+            loaded
+                .limits
+                .iter()
+                .find(|l| l.joint == name)
+                .map(|l| (l.lower, l.upper, l.velocity))
+        };
+        assert_eq!(limit("j"), Some((-1.0, 1.0, Some(2.0))), "{extra}");
+        assert_eq!(limit("k"), k_limit, "{extra}");
+    }
+    for (extra, key) in [
+        (
+            r#"<mimic joint="j" multiplier="two"/>"#,
+            r#"joint "k".mimic.multiplier"#,
+        ),
+        (
+            r#"<mimic joint="j" offset="nan"/>"#,
+            r#"joint "k".mimic.offset"#,
+        ),
+        (r#"<mimic multiplier="2"/>"#, r#"joint "k".mimic"#),
+    ] {
+        let e = codegen::spec::load("r.urdf", &urdf(extra), &overrides)
+            .err()
+            .unwrap_or_else(|| panic!("{extra}: loaded"))
+            .render();
+        assert!(e.contains("r.urdf:9:"), "{extra}: {e}");
+        assert!(e.contains(key), "{extra}: {e}");
+        assert!(!e.contains("custom"), "{extra}: {e}");
+    }
+}

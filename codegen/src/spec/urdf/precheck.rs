@@ -146,6 +146,21 @@ fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
     check_joint_type(doc, j, name, &jk, diags);
     if let Some(m) = doc.child(j, "mimic") {
         let of = doc.tags[m].attr("joint").map_or("?", |a| a.value);
+        // urdf-rs reads the `<mimic>` (for `codegen convert`'s comment): its numbers and its
+        // `joint` are checked here, at their place, rather than by urdf-rs at `<robot>`.
+        if doc.tags[m].attr("joint").is_none() {
+            diags.push(
+                Diagnostic::error("<mimic> without joint")
+                    .with_key(format!("{jk}.mimic"))
+                    .with_span(doc.tags[m].span.clone())
+                    .with_hint("name the joint it follows: <mimic joint=\"…\"/>"),
+            );
+        }
+        for a in ["multiplier", "offset"] {
+            if let Some(at) = doc.tags[m].attr(a) {
+                check_number(at, &format!("{jk}.mimic.{a}"), diags);
+            }
+        }
         // Read as an independent joint, as Pinocchio's URDF parser does by default (so the
         // coordinates match), with a warning: the coupling is not modelled.
         diags.push(

@@ -22,8 +22,17 @@ pub(super) fn strip_ignored(source: &str, doc: &Doc<'_>) -> String {
     let mut out = source.as_bytes().to_vec();
     for t in &doc.tags {
         let top = t.parent == Some(doc.robot);
+        // A top-level joint's `<limit>`, `<safety_controller>` and `<calibration>`: the limit
+        // is read from the scanned tag (a range only when well formed, else none), the others
+        // not at all; urdf-rs would reject a `<limit>` without `velocity`, a
+        // `<safety_controller>` without `k_velocity` or a word in any of them, at the `<robot>`
+        // tag and in its own words.
+        let in_joint = t
+            .parent
+            .is_some_and(|p| doc.tags[p].name == "joint" && doc.tags[p].parent == Some(doc.robot));
         let ignored = matches!(t.name, "visual" | "collision")
-            || (top && matches!(t.name, "material" | "gazebo" | "transmission"));
+            || (top && matches!(t.name, "material" | "gazebo" | "transmission"))
+            || (in_joint && matches!(t.name, "limit" | "safety_controller" | "calibration"));
         if !ignored {
             continue;
         }
