@@ -521,3 +521,49 @@ fn urdf_limit_safety_controller_and_calibration_never_fail_the_file() {
         assert!(!e.contains("custom"), "{extra}: {e}");
     }
 }
+
+/// Two of an element a `<joint>`, `<link>` or `<inertial>` holds once, and an `<axis>` without
+/// `xyz`, are errors at that element with its key; urdf-rs reported them at the `<robot>`
+/// tag as "URDF: custom: duplicate field `axis`" or "missing field `xyz`".
+#[cfg(feature = "urdf")]
+#[test]
+fn urdf_duplicate_elements_and_an_axis_without_xyz_are_located() {
+    let urdf = |link_extra: &str, joint_extra: &str| {
+        format!(
+            r#"<?xml version="1.0"?>
+<robot name="r">
+<link name="a"/>
+<link name="b"><inertial><mass value="1"/>{link_extra}<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="k" type="continuous"><parent link="a"/><child link="b"/>
+  {joint_extra}
+</joint>
+</robot>
+"#
+        )
+    };
+    for (link_extra, joint_extra, line, key) in [
+        ("", r#"<axis/>"#, 6, r#"joint "k".axis"#),
+        (
+            "",
+            r#"<axis xyz="0 0 1"/><axis xyz="1 0 0"/>"#,
+            6,
+            r#"joint "k".axis"#,
+        ),
+        ("", r#"<parent link="a"/>"#, 6, r#"joint "k".parent"#),
+        (
+            "",
+            r#"<origin xyz="0 0 1"/><origin xyz="0 0 2"/>"#,
+            6,
+            r#"joint "k".origin"#,
+        ),
+        (r#"<mass value="2"/>"#, "", 4, r#"link "b".inertial.mass"#),
+    ] {
+        let e = codegen::spec::load_tree("r.urdf", &urdf(link_extra, joint_extra))
+            .err()
+            .unwrap_or_else(|| panic!("{link_extra}{joint_extra}: loaded"))
+            .render();
+        assert!(e.contains(&format!("r.urdf:{line}:")), "{joint_extra}: {e}");
+        assert!(e.contains(key), "{joint_extra}: {e}");
+        assert!(!e.contains("custom"), "{joint_extra}: {e}");
+    }
+}

@@ -14,9 +14,19 @@ pub(super) fn precheck(doc: &Doc<'_>, diags: &mut Diagnostics) -> (Vec<usize>, V
     check_names(doc, &links, &joints, diags);
     for &l in &links {
         check_link(doc, l, diags);
+        check_once(doc, l, &["inertial"], diags);
+        if let Some(inl) = doc.child(l, "inertial") {
+            check_once(doc, inl, &["origin", "mass", "inertia"], diags);
+        }
     }
     for &j in &joints {
         check_joint(doc, j, diags);
+        check_once(
+            doc,
+            j,
+            &["parent", "child", "origin", "axis", "dynamics", "mimic"],
+            diags,
+        );
     }
     check_ends(doc, &links, &joints, diags);
     (links, joints)
@@ -172,6 +182,16 @@ fn check_joint(doc: &Doc<'_>, j: usize, diags: &mut Diagnostics) {
             .with_hint(
                 "the coupling q = multiplier·q_other + offset is not modelled: the joint has its own coordinate (as in Pinocchio's default reading); lock it with [scene] locked in a TOML spec, or drive it yourself",
             ),
+        );
+    }
+    if let Some(a) = doc.child(j, "axis")
+        && doc.tags[a].attr("xyz").is_none()
+    {
+        diags.push(
+            Diagnostic::error("<axis> without xyz")
+                .with_key(format!("{jk}.axis"))
+                .with_span(doc.tags[a].span.clone())
+                .with_hint("write the axis as <axis xyz=\"x y z\"/>, or leave <axis> out for the default 1 0 0"),
         );
     }
     for (tag, attrs) in [("origin", &["xyz", "rpy"][..]), ("axis", &["xyz"][..])] {
@@ -336,5 +356,32 @@ fn check_number(attr: &Attr<'_>, key: &str, diags: &mut Diagnostics) {
                     "write a plain number such as 1.5 (decimal point, no units or expressions)",
                 ),
         ),
+    }
+}
+
+/// The elements urdf-rs reads at most once under tag `t` (a `<link>`, its `<inertial>`, a
+/// `<joint>`): a second one is an error at it (urdf-rs reported "duplicate field" at `<robot>`).
+fn check_once(doc: &Doc<'_>, t: usize, names: &[&str], diags: &mut Diagnostics) {
+    let tag = &doc.tags[t];
+    let owner = match tag.name {
+        "inertial" => {
+            let link = tag.parent.map(|p| &doc.tags[p]);
+            let name = link.and_then(|l| l.attr("name")).map_or("", |a| a.value);
+            format!("link \"{name}\".inertial")
+        }
+        kind => format!("{kind} \"{}\"", tag.attr("name").map_or("", |a| a.value)),
+    };
+    for name in names {
+        for dup in doc.children(t, name).skip(1) {
+            diags.push(
+                Diagnostic::error(format!("a second <{name}> in <{}>", tag.name))
+                    .with_key(format!("{owner}.{name}"))
+                    .with_span(doc.tags[dup].span.clone())
+                    .with_hint(format!(
+                        "a <{}> has one <{name}>: remove or merge this one",
+                        tag.name
+                    )),
+            );
+        }
     }
 }
