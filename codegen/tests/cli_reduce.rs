@@ -97,3 +97,43 @@ fn time_column() {
     let ns: f64 = reference.split('|').nth(3).unwrap().trim().parse().unwrap();
     assert!(ns > 0.0 && ns < 1e6, "{reference}");
 }
+
+/// A spec that has a `[scene]` of its own is refused with exit 2 and a diagnostic at the
+/// header, file:line:column and key, however the header is spaced: it was an unlocated
+/// "error: NAME: `reduce` writes the [scene] table itself" for `[scene]`, and `[ scene ]`
+/// (the same table in TOML) got past that check to fail as "the full model cannot be
+/// generated".
+#[test]
+fn a_spec_with_its_own_scene_is_refused_at_the_header() {
+    let dir = std::env::temp_dir().join(format!("nocdyn_reduce_scene_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/planar_2r.toml"),
+    )
+    .unwrap();
+    let lines = spec.lines().count();
+    for header in ["[scene]", "[ scene ]", "[scene]   # the scene"] {
+        let path = dir.join("with_scene.toml");
+        std::fs::write(
+            &path,
+            format!("{spec}\n{header}\nfunctions = [\"inverse_dynamics\"]\n"),
+        )
+        .unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_codegen"))
+            .args(["reduce", path.to_str().unwrap(), "--samples", "5"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{header}: {err}");
+        assert!(
+            err.contains("writes the [scene] table itself"),
+            "{header}: {err}"
+        );
+        assert!(
+            err.contains(&format!("with_scene.toml:{}:", lines + 2)),
+            "{header}: {err}"
+        );
+        assert!(err.contains("^^^^^ scene"), "{header}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

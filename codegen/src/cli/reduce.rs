@@ -264,11 +264,19 @@ const MAX_SAMPLES: usize = 100_000;
 /// positive tolerance, at least one sample.
 fn read_checked(args: &ReduceArgs) -> Result<(String, String), ExitCode> {
     let (name, source) = super::read_spec(&args.spec)?;
-    if source
-        .lines()
-        .any(|l| l.trim_start().starts_with("[scene]"))
-    {
-        eprintln!("error: {name}: `reduce` writes the [scene] table itself; remove the spec's own");
+    if let Some(span) = scene_table(&source) {
+        let mut d = codegen::diag::Diagnostics::new(&name, &source);
+        d.push(
+            codegen::diag::Diagnostic::error(
+                "`reduce` writes the [scene] table itself; remove the spec's own",
+            )
+            .with_key("scene")
+            .with_span(span)
+            .with_hint(
+                "reduce chooses the point_mass and massless lists and writes them in the output's [scene]; run it on the spec without its [scene], then add the other scene keys (frames, payload, …) to its output",
+            ),
+        );
+        eprint!("{}", d.render());
         return Err(ExitCode::from(2));
     }
     if args.tolerance.is_nan() || args.tolerance <= 0.0 || args.samples == 0 {
@@ -280,6 +288,15 @@ fn read_checked(args: &ReduceArgs) -> Result<(String, String), ExitCode> {
         return Err(ExitCode::from(2));
     }
     Ok((name, source))
+}
+
+/// The span of the spec's `scene` key (a `[scene]` header however spaced, `[scene.…]`, or an
+/// inline `scene = { … }`), if it has one; a spec that does not parse has none here (its
+/// syntax error is reported when it is loaded).
+fn scene_table(source: &str) -> Option<std::ops::Range<usize>> {
+    let root = toml::de::DeTable::parse(source).ok()?;
+    let (key, _) = root.get_ref().get_key_value("scene")?;
+    Some(key.span())
 }
 
 /// The full model and the spec's body names (a TOML spec).
