@@ -280,6 +280,22 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     }
+    // `-o` onto the spec or its scene file would replace the input with the module (exit 2,
+    // before any work, as every tool's outputs; docs/usage.md). `--emit c`'s `-o` is a
+    // directory, created new.
+    if cli.emit == EmitArg::Rust {
+        let scene = cli
+            .scene
+            .clone()
+            .or_else(|| codegen::build_script::scene_beside(spec));
+        let mut inputs: Vec<(&str, &std::path::Path)> = vec![("the spec", spec)];
+        if let Some(s) = &scene {
+            inputs.push(("the scene file", s));
+        }
+        if let Err(code) = cli::distinct_outputs(&inputs, &[("-o", cli.output.as_deref())]) {
+            return code;
+        }
+    }
     let math = match cli.math {
         Math::Libm => MathBackend::Libm,
         Math::Std => MathBackend::Std,

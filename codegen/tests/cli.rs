@@ -733,3 +733,70 @@ fn fma_with_libm_gets_a_note() {
         );
     }
 }
+
+/// `-o` naming the input (the spec, a URDF, its scene file), under any spelling of the path,
+/// is refused with exit 2 and the input left as it was, by generation, `draw`, `convert` and
+/// `reduce` as by `excite`, `identify` and `map` (docs/usage.md, "Output files"): each used to
+/// replace the spec with the module, the SVG or the TOML, exit 0.
+#[test]
+fn output_onto_the_input_is_refused_and_the_input_kept() {
+    let dir = scratch("output_onto_the_input");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs");
+    let spec = dir.join("arm.toml");
+    let urdf = dir.join("puma.urdf");
+    let scene = dir.join("puma.scene.toml");
+    let spec_text = std::fs::read_to_string(root.join("planar_2r.toml")).unwrap();
+    let urdf_text = std::fs::read_to_string(root.join("puma560.urdf")).unwrap();
+    let scene_text = "[scene]\nfunctions = [\"inverse_dynamics\"]\n";
+    std::fs::write(&spec, &spec_text).unwrap();
+    std::fs::write(&urdf, &urdf_text).unwrap();
+    std::fs::write(&scene, scene_text).unwrap();
+    let (s, u, c) = (path_str(&spec), path_str(&urdf), path_str(&scene));
+    let other_spelling = format!(
+        "{}/../{}/arm.toml",
+        path_str(&dir),
+        dir.file_name().unwrap().to_str().unwrap()
+    );
+    for args in [
+        vec![s, "-o", s],
+        vec![s, "-o", &other_spelling],
+        vec!["draw", s, "-o", s],
+        vec!["reduce", s, "--samples", "3", "-o", s],
+        vec!["convert", u, "-o", u],
+        vec![u, "-o", u],
+        vec![u, "-o", c],
+        vec![u, "--scene", c, "-o", c],
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("which it would overwrite"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+        assert_eq!(
+            std::fs::read_to_string(&spec).unwrap(),
+            spec_text,
+            "{args:?}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&urdf).unwrap(),
+            urdf_text,
+            "{args:?}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&scene).unwrap(),
+            scene_text,
+            "{args:?}"
+        );
+    }
+    // Another file is still written.
+    let out = dir.join("arm.rs");
+    let o = run(&[s, "-o", path_str(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .contains("pub fn inverse_dynamics")
+    );
+}

@@ -21,6 +21,12 @@ pub fn run(args: &ConvertArgs) -> ExitCode {
         Ok(r) => r,
         Err(code) => return code,
     };
+    if let Err(code) = super::distinct_outputs(
+        &[("the URDF", &args.urdf)],
+        &[("-o", args.output.as_deref())],
+    ) {
+        return code;
+    }
     let (text, warnings) = match codegen::spec::urdf_to_toml(&name, &source) {
         Ok(r) => r,
         Err(d) => {

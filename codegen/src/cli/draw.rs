@@ -22,6 +22,12 @@ pub fn run(args: &DrawArgs) -> ExitCode {
         Ok(r) => r,
         Err(code) => return code,
     };
+    if let Err(code) = super::distinct_outputs(
+        &[("the spec", &args.spec)],
+        &[("-o", args.output.as_deref())],
+    ) {
+        return code;
+    }
     let (drawing, diags) = match codegen::draw::draw(&name, &source) {
         Ok(r) => r,
         Err(d) => {

@@ -264,6 +264,10 @@ const MAX_SAMPLES: usize = 100_000;
 /// positive tolerance, at least one sample.
 fn read_checked(args: &ReduceArgs) -> Result<(String, String), ExitCode> {
     let (name, source) = super::read_spec(&args.spec)?;
+    super::distinct_outputs(
+        &[("the spec", &args.spec)],
+        &[("-o", args.output.as_deref())],
+    )?;
     if let Some(span) = scene_table(&source) {
         let mut d = codegen::diag::Diagnostics::new(&name, &source);
         d.push(
