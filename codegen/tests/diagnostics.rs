@@ -567,3 +567,47 @@ fn urdf_duplicate_elements_and_an_axis_without_xyz_are_located() {
         assert!(!e.contains("custom"), "{joint_extra}: {e}");
     }
 }
+
+/// A `[scene]` payload's inertia that no rigid body has is a warning at the payload's
+/// `inertia`, with the payload's own principal moments; the body it rides on is judged by its
+/// own tensor. The check saw only the sum, and blamed the body's own (physical) `inertia`,
+/// with the sum's moments. A negative payload mass is an error at the `mass`, not at `body`.
+#[test]
+fn a_payload_is_judged_at_its_own_place() {
+    let spec = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/specs/planar_2r.toml"),
+    )
+    .unwrap();
+    let lines = spec.lines().count();
+    let with = |payload: &str| format!("{spec}\n[scene]\npayload = {payload}\n");
+    let overrides = codegen::spec::SceneOverrides::default();
+    let src =
+        with(r#"{ body = "link2", mass = 1.0, inertia = { ixx = -1.0, iyy = 1.0, izz = 1.0 } }"#);
+    let loaded = codegen::spec::load("arm.toml", &src, &overrides)
+        .unwrap_or_else(|d| panic!("{}", d.render()));
+    let w = loaded.warnings.render();
+    assert_eq!(w.matches("warning:").count(), 1, "{w}");
+    assert!(
+        w.contains("payload inertia is not positive semi-definite"),
+        "{w}"
+    );
+    assert!(w.contains("scene.payload.inertia"), "{w}");
+    assert!(w.contains(&format!("arm.toml:{}:", lines + 3)), "{w}");
+    assert!(w.contains("principal moments -1, 1, 1"), "{w}");
+    assert!(!w.contains("body \"link2\".inertia"), "{w}");
+
+    let src = with(r#"{ body = "link2", mass = -1.0 }"#);
+    let e = codegen::spec::load("arm.toml", &src, &overrides)
+        .err()
+        .unwrap()
+        .render();
+    assert!(e.contains("payload mass -1"), "{e}");
+    let col = src.lines().nth(lines + 2).unwrap().find("-1.0").unwrap() + 1;
+    assert!(e.contains(&format!("arm.toml:{}:{col}", lines + 3)), "{e}");
+
+    // A physical payload on a physical body: no warning.
+    let src =
+        with(r#"{ body = "link2", mass = 1.0, inertia = { ixx = 0.01, iyy = 0.01, izz = 0.01 } }"#);
+    let loaded = codegen::spec::load("arm.toml", &src, &overrides).unwrap();
+    assert!(loaded.warnings.is_empty(), "{}", loaded.warnings.render());
+}

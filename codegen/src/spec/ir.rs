@@ -132,6 +132,8 @@ impl SceneSpec {
         self.massless.iter_mut().for_each(n);
         if let Some(p) = &mut self.payload {
             n(&mut p.body);
+            s(&mut p.mass_span);
+            s(&mut p.inertia_span);
         }
         self.locked.iter_mut().for_each(|(named, _)| n(named));
         self.armature.iter_mut().for_each(|(named, _)| n(named));
@@ -237,6 +239,9 @@ pub(crate) struct Payload {
     pub mass: f64,
     pub com: Vec3,
     pub inertia: Mat3,
+    /// Where `mass` and `inertia` are written (the body's name when absent).
+    pub mass_span: Span,
+    pub inertia_span: Span,
 }
 
 /// How a parallel mechanism's platform moves (`platform.coordinates`).
@@ -295,6 +300,10 @@ pub(crate) struct BodySpec {
     /// Inertia about the mass centre in `F`'s axes (kg·m²), symmetric.
     pub inertia: Mat3,
     pub inertia_span: Span,
+    /// The body's own inertia about its own mass centre, in `F`'s axes, when a `[scene]`
+    /// payload has been added to `inertia` (which then holds the sum); the physical checks
+    /// judge the body by this and the payload by its own tensor, each at its own place.
+    pub own_inertia: Option<Mat3>,
     /// The pose of the body's own frame (the one the spec writes it in, the frame
     /// `[scene] frames` names) in `F`: the identity, except after a child-side joint frame
     /// (`child_origin` on a tree joint) has re-expressed the body in its joint frame

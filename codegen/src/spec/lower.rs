@@ -262,7 +262,9 @@ fn check_body(b: &BodySpec, diags: &mut Diagnostics) {
                 .with_key(format!("{}.inertia", b.key))
                 .with_span(b.inertia_span.clone()),
         );
-    } else if let Err((msg, hint)) = geom::check_inertia(&b.inertia) {
+    } else if let Err((msg, hint)) =
+        geom::check_inertia(b.own_inertia.as_ref().unwrap_or(&b.inertia))
+    {
         // A warning: published URDFs carry such tensors (Allegro hand, ANYmal, HyQ, PR2,
         // TIAGo), and Pinocchio and RBDL take them as given; so does nocdyn.
         diags.push(

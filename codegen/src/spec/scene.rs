@@ -141,9 +141,23 @@ pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
                     p.mass
                 ))
                 .with_key("scene.payload.mass")
-                .with_span(p.body.span.clone()),
+                .with_span(p.mass_span.clone()),
             );
-        } else if !runtime {
+        } else {
+            // The payload's tensor is judged on its own, at its place (it was only seen summed
+            // into the body's, and the warning blamed the body's own, physical, tensor).
+            if let Err((msg, hint)) = geom::check_inertia(&p.inertia) {
+                diags.push(
+                    Diagnostic::warning(format!("payload {msg}"))
+                        .with_key("scene.payload.inertia")
+                        .with_span(p.inertia_span.clone())
+                        .with_hint(format!(
+                            "{hint}; the tensor is used as given, but no rigid body has it, and forward dynamics fails where the mass matrix is not positive definite"
+                        )),
+                );
+            }
+        }
+        if p.mass.is_finite() && p.mass >= 0.0 && !runtime {
             // Run-time parameters keep the payload apart (`scene_params`).
             let b = &mut spec.bodies[i];
             let c = geom::MassProps::combine(&[
@@ -158,6 +172,7 @@ pub(super) fn apply_scene(spec: &mut ir::Spec, diags: &mut Diagnostics) {
                     inertia: p.inertia,
                 },
             ]);
+            b.own_inertia.get_or_insert(b.inertia);
             b.mass = c.mass;
             b.com = c.com;
             b.inertia = c.inertia;

@@ -444,6 +444,7 @@ fn bodies(r: &urdf_rs::Robot, names: &Names, links: &Spans<'_, '_>) -> Vec<BodyS
                 inertia_span: links
                     .tag(i, &["inertial", "inertia"])
                     .or_else(|| links.name(i)),
+                own_inertia: None,
                 own_frame: Transform::IDENTITY,
             }
         })

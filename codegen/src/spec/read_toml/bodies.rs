@@ -93,6 +93,7 @@ impl Reader<'_> {
             com: com.unwrap_or([0.0; 3]),
             inertia: inertia.unwrap_or([[0.0; 3]; 3]),
             inertia_span: Some(inertia_span),
+            own_inertia: None,
             own_frame: Transform::IDENTITY,
         }
     }

@@ -406,6 +406,7 @@ impl Reader<'_> {
             com: [pg.rod_com * d[0], pg.rod_com * d[1], pg.rod_com * d[2]],
             inertia,
             inertia_span: Some(pg.rod_inertia_span.clone()),
+            own_inertia: None,
             own_frame: Transform::IDENTITY,
         };
         let at = |t: Vec3| Transform {

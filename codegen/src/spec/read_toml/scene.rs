@@ -271,6 +271,8 @@ impl Reader<'_> {
             mass,
             com,
             inertia,
+            mass_span: Some(get(t, "mass").unwrap_or(b).span()),
+            inertia_span: Some(get(t, "inertia").unwrap_or(b).span()),
         })
     }
 }
