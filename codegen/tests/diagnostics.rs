@@ -101,26 +101,40 @@ fn warning_specs() {
 
 /// A serial chain of `n` revolute joints, as TOML.
 fn chain_toml(n: usize) -> String {
+    tree_toml(1, n)
+}
+
+/// `branches` serial chains of `n` revolute joints each from the base, as TOML.
+fn tree_toml(branches: usize, n: usize) -> String {
     let mut s = String::from("[mechanism]\nname = \"huge\"\n");
-    for i in 0..n {
-        let parent = if i == 0 {
-            "base".to_owned()
+    for b in 0..branches {
+        // The first branch's names are a chain's: `l{i}`, `j{i}`.
+        let tag = if b == 0 {
+            String::new()
         } else {
-            format!("l{}", i - 1)
+            format!("b{b}_")
         };
-        s += &format!(
-            "[[body]]\nname = \"l{i}\"\nmass = 1.0\ncom = [0.1, 0.0, 0.0]\n[[joint]]\nname = \"j{i}\"\nkind = \"R\"\nparent = \"{parent}\"\nchild = \"l{i}\"\norigin = {{ xyz = [0.2, 0.0, 0.0] }}\naxis = [0.0, 1.0, 0.0]\n"
-        );
+        for i in 0..n {
+            let parent = if i == 0 {
+                "base".to_owned()
+            } else {
+                format!("{tag}l{}", i - 1)
+            };
+            s += &format!(
+                "[[body]]\nname = \"{tag}l{i}\"\nmass = 1.0\ncom = [0.1, 0.0, 0.0]\n[[joint]]\nname = \"{tag}j{i}\"\nkind = \"R\"\nparent = \"{parent}\"\nchild = \"{tag}l{i}\"\norigin = {{ xyz = [0.2, 0.0, 0.0] }}\naxis = [0.0, 1.0, 0.0]\n"
+            );
+        }
     }
     s
 }
 
 /// Specs too large to generate are refused before lowering, quickly and with a clear message:
-/// too many coordinates, too many entries (TOML and URDF) and too many bytes. `compile` on them
-/// returns the same diagnostics (it never starts generating).
+/// too many coordinates, too many on one path from the base, too many entries (TOML and URDF)
+/// and too many bytes. `compile` on them returns the same diagnostics (it never starts
+/// generating).
 #[test]
 fn specs_too_large_are_refused_up_front() {
-    use codegen::spec::{MAX_DOF, MAX_ENTRIES, MAX_SOURCE_BYTES};
+    use codegen::spec::{MAX_DOF, MAX_ENTRIES, MAX_PATH_DOF, MAX_SOURCE_BYTES};
     let start = std::time::Instant::now();
     let check = |name: &str, src: &str, expect: &str| -> String {
         let e = codegen::spec::load_mechanism(name, src).unwrap_err();
@@ -130,8 +144,25 @@ fn specs_too_large_are_refused_up_front() {
         assert_eq!(c.render(), r);
         r
     };
-    // Exactly at the limit is fine (only loaded here: generating 64 joints takes a while).
-    codegen::spec::load_tree("at_limit.toml", &chain_toml(MAX_DOF)).unwrap();
+    // Exactly at the limits is fine (only loaded here: generating takes a while): branches of
+    // `MAX_PATH_DOF` joints up to `MAX_DOF` in all.
+    assert_eq!(MAX_DOF % MAX_PATH_DOF, 0);
+    codegen::spec::load_tree(
+        "at_limit.toml",
+        &tree_toml(MAX_DOF / MAX_PATH_DOF, MAX_PATH_DOF),
+    )
+    .unwrap();
+    // One joint more on one path: a 33-joint chain (7 s, 1.1 GB and 24 MB of code in release at
+    // 32 joints; 64 joints took 55 s and 5.9 GB), refused at its last joint.
+    let path = check(
+        "long_path.toml",
+        &tree_toml(2, MAX_PATH_DOF + 1),
+        &format!(
+            "the path from the base to joint \"j{MAX_PATH_DOF}\" has {} joint coordinates (the limit is {MAX_PATH_DOF})",
+            MAX_PATH_DOF + 1
+        ),
+    );
+    assert!(path.contains("long_path.toml:"), "{path}");
     let dof = check(
         "too_many_dof.toml",
         &chain_toml(MAX_DOF + 1),

@@ -16,8 +16,18 @@ pub const MAX_ENTRIES: usize = 1024;
 /// of the DOF (the dense `LᵀDL` of a chain's mass matrix) and generation time faster still
 /// (a generic 16-joint chain takes 3 s, 32 joints 17 s, 64 joints about 3 min in the test
 /// profile; branched trees are much cheaper: the 55-joint Romeo and the 101-joint TIAGo dual
-/// URDFs take 2.5 s and 4.2 s in release), so larger specs are refused up front.
+/// URDFs take 2.5 s and 4.2 s in release), so larger specs are refused up front; one path
+/// from the base is held to [`MAX_PATH_DOF`].
 pub const MAX_DOF: usize = 128;
+
+/// The most joint coordinates on one path from the base (`"base"`) to a body, counted as for
+/// [`MAX_DOF`], along each body's first joint in (a closed loop's or parallel mechanism's
+/// spanning tree). A chain's mass matrix is dense, and the code of its `LᵀDL` and of the
+/// functions built on it grows with the cube of the path: a generic 32-joint chain is 24 MB
+/// of Rust (7 s and 1.1 GB to generate in release), 64 joints 126 MB (55 s, 5.9 GB). Published
+/// robots stay far below it (the longest path of the example-robot-data URDFs is 15: TIAGo), and
+/// branched ones are cheap up to [`MAX_DOF`] (the 101-joint TIAGo dual: 4.2 s).
+pub const MAX_PATH_DOF: usize = 32;
 
 /// The longest name (of a mechanism, body, joint or spring; URDF: robot, link or joint), in
 /// characters. Names become Rust identifiers and strings in the generated code.
@@ -138,12 +148,7 @@ pub(super) fn check_size(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
     }
     let mut dof = 0;
     for j in &spec.joints {
-        dof += match j.kind {
-            ir::Kind::Revolute | ir::Kind::Prismatic => 1,
-            ir::Kind::Universal => 2,
-            ir::Kind::Spherical => 3,
-            ir::Kind::Fixed => 0,
-        };
+        dof += coordinates(&j.kind);
         if dof > MAX_DOF {
             diags.push(
                 Diagnostic::error(format!(
@@ -153,6 +158,69 @@ pub(super) fn check_size(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
                 .with_key(j.key.clone())
                 .with_span(j.span.clone().unwrap_or(anchor))
                 .with_hint(format!("the generated code grows with the cube of the number of coordinates; nocdyn generates at most {MAX_DOF} (revolute and prismatic joints count 1, universal 2, spherical 3, fixed 0; for a parallel mechanism every leg joint counts)")),
+            );
+            return false;
+        }
+    }
+    check_path(spec, diags)
+}
+
+/// Joint coordinates of a joint of kind `kind`.
+fn coordinates(kind: &ir::Kind) -> usize {
+    match kind {
+        ir::Kind::Revolute | ir::Kind::Prismatic => 1,
+        ir::Kind::Universal => 2,
+        ir::Kind::Spherical => 3,
+        ir::Kind::Fixed => 0,
+    }
+}
+
+/// [`MAX_PATH_DOF`]: the first joint (in the spec's order) whose path from the base has more
+/// coordinates is an error. Each body is reached through the first joint naming it as child;
+/// a walk stops at the base, at an unknown parent, or where it meets itself (a cycle, which the
+/// topology checks report).
+fn check_path(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
+    let mut into: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for (k, j) in spec.joints.iter().enumerate() {
+        into.entry(j.child.as_str()).or_insert(k);
+    }
+    // Coordinates from the base to each joint's child, memoized; `None` while unknown.
+    let mut depth: Vec<Option<usize>> = vec![None; spec.joints.len()];
+    // The walk that last went through each joint.
+    let mut walked: Vec<usize> = vec![usize::MAX; spec.joints.len()];
+    for k in 0..spec.joints.len() {
+        let mut path = vec![k];
+        walked[k] = k;
+        let mut at = k;
+        while let Some(&up) = into.get(spec.joints[at].parent.as_str()) {
+            if depth[up].is_some() || walked[up] == k {
+                break;
+            }
+            walked[up] = k;
+            path.push(up);
+            at = up;
+        }
+        let mut d = into
+            .get(spec.joints[at].parent.as_str())
+            .and_then(|&up| depth[up])
+            .unwrap_or(0);
+        for &j in path.iter().rev() {
+            d += coordinates(&spec.joints[j].kind);
+            if depth[j].is_none() {
+                depth[j] = Some(d);
+            }
+        }
+        let j = &spec.joints[k];
+        let n = depth[k].unwrap_or(0);
+        if n > MAX_PATH_DOF {
+            diags.push(
+                Diagnostic::error(format!(
+                    "the path from the base to joint \"{}\" has {n} joint coordinates (the limit is {MAX_PATH_DOF})",
+                    j.name
+                ))
+                .with_key(j.key.clone())
+                .with_span(j.span.clone().unwrap_or(spec.anchor.clone().unwrap_or(0..0)))
+                .with_hint(format!("a chain's mass matrix is dense and its code grows with the cube of the path; nocdyn generates paths of at most {MAX_PATH_DOF} coordinates (revolute and prismatic joints count 1, universal 2, spherical 3, fixed 0). Published robots have at most about 15 on one path")),
             );
             return false;
         }

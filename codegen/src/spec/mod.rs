@@ -48,7 +48,7 @@ pub(crate) use frames::frame_ident;
 pub use function::{Function, FunctionSet, Kind};
 pub use home::{HomeJoint, HomePose, JointKind, Part, Segment};
 pub use input::{
-    MAX_DOF, MAX_ENTRIES, MAX_MAGNITUDE, MAX_NAME_LEN, MAX_SNAP, MAX_SOURCE_BYTES,
+    MAX_DOF, MAX_ENTRIES, MAX_MAGNITUDE, MAX_NAME_LEN, MAX_PATH_DOF, MAX_SNAP, MAX_SOURCE_BYTES,
     is_snap_tolerance, source_text,
 };
 pub(crate) use input::{SNAP_HINT, in_range, name_too_long};
