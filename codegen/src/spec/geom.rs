@@ -230,6 +230,9 @@ pub(crate) fn check_inertia(i: &Mat3) -> Result<(), (String, String)> {
     let [a, b, c] = principal_moments(i);
     let scale = a.abs().max(b.abs()).max(c.abs());
     let tol = 1e-12 * scale;
+    // A moment within the tolerance is rounding noise of the eigenvalues: written as 0 (not as
+    // `-0.00000000000000000000000222045`).
+    let num = |x: f64| num(if x.abs() <= tol { 0.0 } else { x });
     let moments = format!("principal moments {}, {}, {} kg·m²", num(a), num(b), num(c));
     if a < -tol {
         return Err((
@@ -297,4 +300,28 @@ pub(crate) fn toml_num(v: f64) -> String {
     let v = if v.abs() < 1e-15 { 0.0 } else { v };
     let s = format!("{v:.12e}").parse::<f64>().unwrap_or(v);
     format!("{s:?}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Moments 0, 0 and 1 kg·m² (0 + 0 < 1 breaks the triangle inequality), turned about many
+    /// axes: the eigenvalues' rounding noise is written as 0, never as a long decimal.
+    #[test]
+    fn an_inertia_s_noise_moments_are_written_as_zero() {
+        let diag = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        for k in 0..200 {
+            let t = f64::from(k);
+            let axis = [t.sin(), (1.3 * t).cos(), 0.5 + (0.7 * t).sin()];
+            let n = norm(&axis);
+            let r = rotation(&[axis[0] / n, axis[1] / n, axis[2] / n], 0.1 + 0.05 * t);
+            let (msg, hint) = check_inertia(&rotate_inertia(&r, &diag)).unwrap_err();
+            assert!(msg.contains("triangle inequality"), "{msg}");
+            assert!(
+                hint.starts_with("principal moments 0, 0, 1 kg·m²"),
+                "{k}: {hint}"
+            );
+        }
+    }
 }
