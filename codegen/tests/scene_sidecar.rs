@@ -94,6 +94,17 @@ fn mistakes_are_reported_in_the_scene_file() {
     assert!(e.contains("has its own [scene] table"), "{e}");
 }
 
+/// A warning from the scene file (a payload whose inertia breaks the triangle inequality, on
+/// line 4) names the scene file's line and column; it has no place in the URDF's text.
+#[test]
+fn warnings_of_the_scene_file_name_its_line() {
+    let odd = SCENE.replace("izz = 0.005", "izz = 0.05");
+    let g = compile("puma560.urdf", &urdf(), &with_scene(&odd)).unwrap_or_else(|d| panic!("{d}"));
+    let w = g.warnings.render();
+    assert!(w.contains("puma560.scene.toml:4:"), "{w}");
+    assert!(w.contains("triangle inequality"), "{w}");
+}
+
 #[test]
 fn the_cli_and_the_builder_find_the_scene_beside_the_urdf() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scene_sidecar");

@@ -356,10 +356,22 @@ fn load_any(
                 side.sort_by_position();
                 (None, side, platform)
             } else {
-                // Its warnings, without a place in the spec's text.
+                // Its warnings, with no place in the spec's text: the scene file's line and
+                // column go into the message.
                 for mut m in side.take_if(|_| true) {
-                    m.message = format!("{}: {}", side.file_name(), m.message);
-                    m.span = None;
+                    let place = m.span.take().map_or(String::new(), |s| {
+                        let before = side.source().get(..s.start).unwrap_or_default();
+                        let line = before.matches('\n').count() + 1;
+                        let column = before
+                            .rsplit('\n')
+                            .next()
+                            .unwrap_or_default()
+                            .chars()
+                            .count()
+                            + 1;
+                        format!(":{line}:{column}")
+                    });
+                    m.message = format!("{}{place}: {}", side.file_name(), m.message);
                     diags.push(m);
                 }
                 (mechanism, diags, platform)
