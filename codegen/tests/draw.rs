@@ -313,10 +313,11 @@ fn no_input_panics() {
     assert!(seen > 20, "{seen}");
 }
 
-/// A long chain written leaf first: every joint placed, each link 0.1 m along x.
+/// A long chain written leaf first (as long as one path may be): every joint placed, each link
+/// 0.1 m along x.
 #[test]
 fn a_chain_written_backwards_draws() {
-    let n = 100;
+    let n = codegen::spec::MAX_PATH_DOF;
     let mut text = String::from("[mechanism]\nname = \"chain\"\n");
     for i in (0..n).rev() {
         let parent = if i == 0 {
