@@ -636,6 +636,22 @@ fn a_payload_is_judged_at_its_own_place() {
     let col = src.lines().nth(lines + 2).unwrap().find("-1.0").unwrap() + 1;
     assert!(e.contains(&format!("arm.toml:{}:{col}", lines + 3)), "{e}");
 
+    // Each of its mistakes is reported, not only the first one met.
+    let src = with(r#"{ mass = "heavy", com = [0.1, 0.2], inertia = { ixx = "x" } }"#);
+    let e = codegen::spec::load("arm.toml", &src, &overrides)
+        .err()
+        .unwrap()
+        .render();
+    for key in [
+        "scene.payload.body",
+        "scene.payload.mass",
+        "scene.payload.com",
+        "scene.payload.inertia.iyy",
+        "scene.payload.inertia.ixx",
+    ] {
+        assert!(e.contains(&format!("^ {key}\n")), "{key}:\n{e}");
+    }
+
     // A physical payload on a physical body: no warning.
     let src =
         with(r#"{ body = "link2", mass = 1.0, inertia = { ixx = 0.01, iyy = 0.01, izz = 0.01 } }"#);

@@ -240,28 +240,33 @@ impl Reader<'_> {
         let path = "scene.payload";
         let t = self.table(v, path)?;
         self.unknown_keys(t, PAYLOAD_KEYS, path);
-        let Some(b) = get(t, "body") else {
-            self.missing(
-                "body",
-                path,
-                v.span(),
-                "the body that carries the payload: body = \"<its name>\"",
-            );
-            return None;
+        // Every entry is read before any is given up on, so that each mistake is reported.
+        let b = get(t, "body");
+        let name = match b {
+            Some(b) => self.string(b, "scene.payload.body"),
+            None => {
+                self.missing(
+                    "body",
+                    path,
+                    v.span(),
+                    "the body that carries the payload: body = \"<its name>\"",
+                );
+                None
+            }
         };
-        let name = self.string(b, "scene.payload.body")?;
         let mass = match get(t, "mass") {
-            Some(m) => self.number(m, "scene.payload.mass")?,
-            None => 0.0,
+            Some(m) => self.number(m, "scene.payload.mass"),
+            None => Some(0.0),
         };
         let com = match get(t, "com") {
-            Some(c) => self.triple(c, "scene.payload.com", false)?,
-            None => [0.0; 3],
+            Some(c) => self.triple(c, "scene.payload.com", false),
+            None => Some([0.0; 3]),
         };
         let inertia = match get(t, "inertia") {
-            Some(i) => self.inertia(i, "scene.payload.inertia")?,
-            None => [[0.0; 3]; 3],
+            Some(i) => self.inertia(i, "scene.payload.inertia"),
+            None => Some([[0.0; 3]; 3]),
         };
+        let (b, name, mass, com, inertia) = (b?, name?, mass?, com?, inertia?);
         Some(Payload {
             body: Named {
                 name,
