@@ -1084,6 +1084,79 @@ mod parallel_specs {
             "{e}"
         );
     }
+
+    /// A 3-RUU (a crank, then a rod between two universal joints: not supported) is told so,
+    /// once per leg, and nothing else: the 3-UPU's own checks (its base U's axes meet) are not
+    /// applied to a leg that is not U-P.
+    #[test]
+    fn an_unsupported_leg_into_a_universal_joint_is_only_unsupported() {
+        let e = errors("ruu3.toml", RUU3);
+        for k in 1..=3 {
+            assert!(
+                e.contains(&format!(
+                    "leg \"ub{k}\" is R-U-U, which is not a supported leg type"
+                )),
+                "{e}"
+            );
+        }
+        assert_eq!(e.matches("error:").count(), 3, "{e}");
+    }
+
+    const RUU3: &str = r#"[mechanism]
+name = "ruu3"
+
+[platform]
+body = "plate"
+coordinates = "translation"
+home = { xyz = [0.0, 0.0, -0.5] }
+
+[[body]]
+name = "plate"
+mass = 0.8
+inertia = { ixx = 0.003, iyy = 0.003, izz = 0.005 }
+
+[[pattern]]
+name = "leg"
+copies = 3
+
+[[pattern.body]]
+name = "crank{i}"
+mass = 0.6
+com = [0.1, 0.0, 0.0]
+inertia = { ixx = 0.0001, iyy = 0.002, izz = 0.002 }
+
+[[pattern.body]]
+name = "rod{i}"
+mass = 0.3
+com = [0.0, 0.0, -0.25]
+inertia = { ixx = 0.005, iyy = 0.005, izz = 0.0001 }
+
+[[pattern.joint]]
+name = "m{i}"
+kind = "R"
+parent = "base"
+child = "crank{i}"
+origin = { xyz = [0.3, 0.0, 0.0] }
+axis = [0.0, 1.0, 0.0]
+actuated = true
+
+[[pattern.joint]]
+name = "ua{i}"
+kind = "U"
+parent = "crank{i}"
+child = "rod{i}"
+origin = { xyz = [0.2, 0.0, 0.0] }
+axes = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+
+[[pattern.joint]]
+name = "ub{i}"
+kind = "U"
+parent = "rod{i}"
+child = "plate"
+origin = { xyz = [0.0, 0.0, -0.5] }
+axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+child_origin = { xyz = [0.5, 0.0, 0.0] }
+"#;
 }
 
 mod springs {

@@ -64,8 +64,10 @@ pub(super) fn check_orientation_axes(tree: &Tree<'_>, pm: &ParallelModel, diags:
     }
 }
 
-/// The legs that end in a universal joint into a translational platform (Tsai's 3-UPU), their
-/// closing joint and the U's two axes at home (base frame, unit; the cross's first axis first).
+/// The legs that end in a universal joint into a translational platform and are U-P below it
+/// (Tsai's 3-UPU: two revolutes, then a prismatic joint), their closing joint and the U's two
+/// axes at home (base frame, unit; the cross's first axis first). Other legs into a U (an
+/// R-U-U) are the leg-type check's to report, not these checks'.
 fn upu_legs<'a>(
     tree: &'a Tree<'_>,
     axes: &'a Axes,
@@ -77,6 +79,11 @@ fn upu_legs<'a>(
         .filter(move |(_, c)| {
             matches!(pm.motion, PlatformMotion::Translation { .. })
                 && tree.spec.joints[**c].kind == Kind::Universal
+        })
+        .filter(|(leg, _)| {
+            use runtime::model::JointKind::{Prismatic, Revolute};
+            let kinds: Vec<_> = leg.joints.iter().map(|j| j.kind).collect();
+            kinds == [Revolute, Revolute, Prismatic]
         })
         .map(move |(leg, &c)| {
             let tip = runtime::parallel::leg_home_poses(leg)
