@@ -406,6 +406,15 @@ impl<'a> Files<'a> for Excerpt<'a> {
     }
 }
 
+/// The line and column (both from 1; the column in characters) of byte offset `at` in
+/// `source`, for a place written into a message's text.
+pub(crate) fn line_column(source: &str, at: usize) -> (usize, usize) {
+    let before = source.get(..at).unwrap_or(source);
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
 /// Clamps `span` into `source` and onto char boundaries (codespan-reporting rejects others).
 fn clamp_span(source: &str, span: Range<usize>) -> Range<usize> {
     let fix = |mut i: usize| {

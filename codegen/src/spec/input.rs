@@ -148,7 +148,7 @@ pub(super) fn check_size(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
     }
     let mut dof = 0;
     for j in &spec.joints {
-        dof += coordinates(&j.kind);
+        dof += j.kind.coordinates();
         if dof > MAX_DOF {
             diags.push(
                 Diagnostic::error(format!(
@@ -162,24 +162,14 @@ pub(super) fn check_size(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
             return false;
         }
     }
-    check_path(spec, diags)
-}
-
-/// Joint coordinates of a joint of kind `kind`.
-fn coordinates(kind: &ir::Kind) -> usize {
-    match kind {
-        ir::Kind::Revolute | ir::Kind::Prismatic => 1,
-        ir::Kind::Universal => 2,
-        ir::Kind::Spherical => 3,
-        ir::Kind::Fixed => 0,
-    }
+    check_path(spec, anchor, diags)
 }
 
 /// [`MAX_PATH_DOF`]: the first joint (in the spec's order) whose path from the base has more
 /// coordinates is an error. Each body is reached through the first joint naming it as child;
 /// a walk stops at the base, at an unknown parent, or where it meets itself (a cycle, which the
 /// topology checks report).
-fn check_path(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
+fn check_path(spec: &ir::Spec, anchor: std::ops::Range<usize>, diags: &mut Diagnostics) -> bool {
     let mut into: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
     for (k, j) in spec.joints.iter().enumerate() {
         into.entry(j.child.as_str()).or_insert(k);
@@ -205,7 +195,7 @@ fn check_path(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
             .and_then(|&up| depth[up])
             .unwrap_or(0);
         for &j in path.iter().rev() {
-            d += coordinates(&spec.joints[j].kind);
+            d += spec.joints[j].kind.coordinates();
             if depth[j].is_none() {
                 depth[j] = Some(d);
             }
@@ -219,7 +209,7 @@ fn check_path(spec: &ir::Spec, diags: &mut Diagnostics) -> bool {
                     j.name
                 ))
                 .with_key(j.key.clone())
-                .with_span(j.span.clone().unwrap_or(spec.anchor.clone().unwrap_or(0..0)))
+                .with_span(j.span.clone().unwrap_or(anchor))
                 .with_hint(format!("a chain's mass matrix is dense and its code grows with the cube of the path; nocdyn generates paths of at most {MAX_PATH_DOF} coordinates (revolute and prismatic joints count 1, universal 2, spherical 3, fixed 0). Published robots have at most about 15 on one path")),
             );
             return false;

@@ -322,6 +322,17 @@ pub(crate) enum Kind {
 }
 
 impl Kind {
+    /// The joint coordinates a joint of this kind adds: 1 for revolute and prismatic, 2 for
+    /// universal, 3 for spherical, 0 for fixed.
+    pub fn coordinates(self) -> usize {
+        match self {
+            Kind::Revolute | Kind::Prismatic => 1,
+            Kind::Universal => 2,
+            Kind::Spherical => 3,
+            Kind::Fixed => 0,
+        }
+    }
+
     pub fn word(self) -> &'static str {
         match self {
             Kind::Revolute => "revolute",

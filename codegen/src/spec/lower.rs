@@ -686,9 +686,7 @@ fn topological_order(
 pub(super) fn position(source: &str, span: &Span) -> String {
     match span {
         Some(s) => {
-            let before = &source[..s.start.min(source.len())];
-            let line = before.matches('\n').count() + 1;
-            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            let (line, col) = crate::diag::line_column(source, s.start.min(source.len()));
             format!("at line {line}, column {col}")
         }
         None => "earlier".into(),

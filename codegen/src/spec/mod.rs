@@ -360,15 +360,7 @@ fn load_any(
                 // column go into the message.
                 for mut m in side.take_if(|_| true) {
                     let place = m.span.take().map_or(String::new(), |s| {
-                        let before = side.source().get(..s.start).unwrap_or_default();
-                        let line = before.matches('\n').count() + 1;
-                        let column = before
-                            .rsplit('\n')
-                            .next()
-                            .unwrap_or_default()
-                            .chars()
-                            .count()
-                            + 1;
+                        let (line, column) = crate::diag::line_column(side.source(), s.start);
                         format!(":{line}:{column}")
                     });
                     m.message = format!("{}{place}: {}", side.file_name(), m.message);

@@ -7,7 +7,7 @@ use runtime::parallel::GEOMETRY_TOLERANCE;
 use super::platform::scale;
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::spec::geom;
-use crate::spec::ir::{Coordinates, JointSpec, Kind, PlatformSpec, Spec};
+use crate::spec::ir::{Coordinates, JointSpec, PlatformSpec, Spec};
 
 /// Mobility by Grübler–Kutzbach, `M = λ(n − j − 1) + Σf` over the spec's bodies (plus the base)
 /// and joints (minus the idle spin of a planar point platform), against the platform's DOF; and
@@ -34,12 +34,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
     let f: i64 = spec
         .joints
         .iter()
-        .map(|j| match j.kind {
-            Kind::Revolute | Kind::Prismatic => 1,
-            Kind::Universal => 2,
-            Kind::Spherical => 3,
-            Kind::Fixed => 0,
-        })
+        .map(|j| j.kind.coordinates() as i64)
         .sum::<i64>()
         + 7 * pgs;
     // A planar point platform's spin about the plane normal is idle (the point has no

@@ -82,8 +82,10 @@ fn upu_legs<'a>(
         })
         .filter(|(leg, _)| {
             use runtime::model::JointKind::{Prismatic, Revolute};
-            let kinds: Vec<_> = leg.joints.iter().map(|j| j.kind).collect();
-            kinds == [Revolute, Revolute, Prismatic]
+            leg.joints
+                .iter()
+                .map(|j| j.kind)
+                .eq([Revolute, Revolute, Prismatic])
         })
         .map(move |(leg, &c)| {
             let tip = runtime::parallel::leg_home_poses(leg)
@@ -129,9 +131,6 @@ pub(super) fn check_upu_legs(
     for (leg, c, _) in upu_legs(tree, axes, &before) {
         let j = &tree.spec.joints[c];
         let poses = runtime::parallel::leg_home_poses(leg);
-        if leg.joints.len() != 3 || poses.len() != 3 {
-            continue; // reported by the leg-type check
-        }
         let ax: Vec<(Vec3, Vec3)> = poses
             .iter()
             .zip(&leg.joints)
@@ -244,7 +243,7 @@ pub(super) fn check_upu_axes(
     for (leg, c, e) in upu_legs(tree, axes, pm) {
         let j = &tree.spec.joints[c];
         let poses = runtime::parallel::leg_home_poses(leg);
-        if leg.joints.len() != 3 || e.len() != 2 {
+        if e.len() != 2 {
             continue;
         }
         let base: Vec<Vec3> = poses

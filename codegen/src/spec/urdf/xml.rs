@@ -343,9 +343,7 @@ fn read_start_tag(src: &str, lt: usize) -> StartTag<'_> {
 
 /// `line L, column C` of a byte offset.
 fn line_col(src: &str, at: usize) -> String {
-    let before = src.get(..at).unwrap_or(src);
-    let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    let (line, col) = crate::diag::line_column(src, at);
     format!("at line {line}, column {col}")
 }
 
