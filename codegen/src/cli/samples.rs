@@ -6,6 +6,8 @@
 //! and blank lines are skipped; other columns are ignored. Every problem is an error at its
 //! file, line and column.
 
+use codegen::spec::MAX_MAGNITUDE;
+
 use super::filter::{differentiate, filtfilt};
 
 /// Cutoff periods of samples dropped at each end of positions-only data (the filter's
@@ -219,6 +221,10 @@ pub fn read(
     for c in cols.iter().flatten().flatten().chain(t_col.as_ref()) {
         used[*c] = true;
     }
+    let mut position = vec![false; header.len()];
+    for c in cols[0].iter().flatten() {
+        position[*c] = true;
+    }
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut line_of = Vec::new();
     for (ln, line) in lines {
@@ -251,6 +257,18 @@ pub fn read(
                     ln + 1,
                     c + 1,
                     header[c],
+                ));
+            }
+            // A position past the spec's own bound on numbers is no measurement: an angle of
+            // 1e308 rad fitted without complaint, and beyond 2⁵³ a double cannot even tell
+            // one turn from the next.
+            if position[c] && v.abs() > MAX_MAGNITUDE {
+                return Err(format!(
+                    "error: {file}:{}:{}: column `{}`: `{cell}` is beyond {:e} (a position in rad or m; check the column's unit)",
+                    ln + 1,
+                    c + 1,
+                    header[c],
+                    MAX_MAGNITUDE,
                 ));
             }
             row[c] = v;
@@ -420,6 +438,18 @@ mod tests {
         assert!(e(&format!("{h}0,1,2,3,4,5,6,7\n")).contains("d.csv:2:9: 8 fields"));
         assert!(e(&format!("{h}0,1,2,3,x,5,6,7,8\n")).contains("d.csv:2:5: column `qd2`"));
         assert!(e(&format!("{h}# c\n0,1,2,3,4,NaN,6,7,8\n")).contains("d.csv:3:6"));
+        // Positions past the spec's bound on numbers (1e9); speeds and efforts are judged by
+        // the regressor's reach instead.
+        assert!(e(&format!("{h}0,1,1e308,3,4,5,6,7,8\n")).contains("d.csv:2:3: column `q2`"));
+        assert!(e(&format!("{h}0,-2e9,2,3,4,5,6,7,8\n")).contains("is beyond 1e9"));
+        let speed = read(
+            "d.csv",
+            &format!("{h}0,1e9,2,2e9,4,5,6,7,8\n"),
+            &Columns::joints(&joints()),
+            1,
+            F,
+        );
+        assert_eq!(speed.unwrap().qd, vec![vec![2e9, 4.0]]);
         assert!(e(h).contains("too few"));
         assert!(e("t,q1,q1\n").contains("twice"));
         assert!(e("q1,q2,tau1,tau2\n1,2,3,4\n").contains("`t` column is needed"));

@@ -156,15 +156,30 @@ fn a_cutoff_far_below_the_sample_rate_is_an_error_not_a_panic() {
 }
 
 /// States of 1e300 made the regressor overflow and the SVD never return (a hang); efforts of
-/// 1e308 printed NaN estimates with exit 0. Now exit 2 at the row.
+/// 1e308 printed NaN estimates with exit 0. Now exit 2 at the row. Angles of 1e308 rad were
+/// fitted (their sines are finite) with exit 0: now exit 2 at the cell.
 #[test]
 fn huge_values_are_located_errors_not_hangs_or_nan() {
     let dir = scratch("abuse_huge");
     let (h, rows) = two_r_data(&dir);
     let cols: Vec<&str> = h.split(',').collect();
+    let q1 = cols.iter().position(|c| *c == "q1").unwrap();
+    let data = write(
+        &dir,
+        "angles.csv",
+        &h,
+        &with_column(&rows, q1, |_, _| "1e308".into()),
+    );
+    rejected(
+        &["identify", TWO_R, &data],
+        &format!(
+            "angles.csv:2:{}: column `q1`: `1e308` is beyond 1e9",
+            q1 + 1
+        ),
+    );
     let mut big = rows.clone();
     for (c, name) in cols.iter().enumerate() {
-        if name.starts_with('q') {
+        if name.starts_with("qd") {
             big = with_column(&big, c, |_, _| "1e300".into());
         }
     }
