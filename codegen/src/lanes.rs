@@ -188,6 +188,7 @@ fn closed_actuator_mass_matrix(functions: &[Function<'_>]) -> TokenStream {
         /// `actuator_mass_matrix` of `LANES` states at once: `mass_matrix_lanes` (the actuated
         /// joints are the independent coordinates).
         #[inline(always)]
+        #[allow(clippy::type_complexity)]
         pub fn actuator_mass_matrix_lanes(
             x: &[[#real; LANES]; NX] #p_arg
         ) -> ([[[#real; LANES]; DOF]; DOF], [Result<(), Singular>; LANES]) {
