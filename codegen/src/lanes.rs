@@ -541,10 +541,13 @@ fn checked_on_entry(g: &Graph, s: &Schedule, arg: ExprId) -> bool {
 }
 
 /// With the vector `sin_cos`, the entry checks of `f`'s angle inputs (`sin_cos_reach(&q[1])`,
-/// before the inputs are transposed into `Lanes`): when one fails, every lane is evaluated by
-/// the scalar function, so the polynomials need no fallback, whose calls to the backend made
-/// the whole function keep its values on the stack (docs/performance.md, "`sin` and `cos` over
-/// the lanes").
+/// before the inputs are transposed into `Lanes`): when one fails, every lane is evaluated
+/// again by the scalar function at the end, so the polynomials need no fallback, whose calls
+/// to the backend made the whole function keep its values on the stack (docs/performance.md,
+/// "`sin` and `cos` over the lanes"). The polynomial of an angle out of reach gives a wrong
+/// but harmless value (IEEE arithmetic only), which the scalar function's replaces; acting at
+/// the end rather than returning on entry keeps the function one straight line (a return on
+/// entry cost a fifth to a half of a forward dynamics' time, measured).
 fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
     let s = &f.schedule;
     let mut seen = Vec::new();
@@ -566,12 +569,13 @@ fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
 
 /// `<name>_lanes_each`, which evaluates an infallible function's lanes one by one by the
 /// scalar function (out of line and cold: it runs only when an angle is out of the vector
-/// `sin_cos`'s reach), and the entry statement that calls it.
+/// `sin_cos`'s reach), the entry statements that check the angles and keep the inputs, and
+/// the statement before the result that calls it when a check failed.
 fn each_lane(
     f: &Function<'_>,
     args: &[TokenStream],
     checks: &[TokenStream],
-) -> (TokenStream, TokenStream) {
+) -> (TokenStream, TokenStream, TokenStream) {
     let real = emit::real();
     let scalar = Ident::new(f.name, Span::call_site());
     let each = format_ident!("{}_lanes_each", f.name);
@@ -621,12 +625,17 @@ fn each_lane(
             out
         }
     };
+    let kept = (0..names.len()).map(syn::Index::from);
     let entry = quote! {
-        if !(#(#checks)&&*) {
-            return #each(#(#names),*);
+        let reach = #(#checks)&&*;
+        let inputs = (#(#names,)*);
+    };
+    let late = quote! {
+        if !reach {
+            return #each(#(inputs.#kept),*);
         }
     };
-    (item, entry)
+    (item, entry, late)
 }
 
 /// Whether `f`'s `_lanes` version returns each lane's status.
@@ -705,24 +714,19 @@ fn settle(
         " `{name}`'s values over the lanes, and the lanes it must evaluate again by `{}`.",
         f.name
     );
-    // An angle beyond the vector `sin_cos`'s reach: every lane by the scalar function.
-    let reach = if checks.is_empty() {
-        TokenStream::new()
+    // An angle beyond the vector `sin_cos`'s reach: every lane marked, so evaluated again by
+    // the scalar function.
+    let (reach, late) = if checks.is_empty() {
+        (TokenStream::new(), TokenStream::new())
     } else {
-        let zeros = parts.iter().map(|p| match p {
-            Part::Matrix => quote!([[[0.0; LANES]; DOF]; DOF]),
-            _ => quote!([[0.0; LANES]; DOF]),
-        });
-        let zero = if one {
-            quote!(#(#zeros)*)
-        } else {
-            quote!((#(#zeros),*))
-        };
-        quote! {
-            if !(#(#checks)&&*) {
-                return (#zero, [true; LANES]);
-            }
-        }
+        (
+            quote!(let reach = #(#checks)&&*;),
+            quote! {
+                if !reach {
+                    bad = [true; LANES];
+                }
+            },
+        )
     };
     quote! {
         #[doc = #doc]
@@ -733,6 +737,7 @@ fn settle(
             #body
             let mut out = #values;
             #(#flags)*
+            #late
             (out, bad)
         }
         #[allow(clippy::type_complexity)]
@@ -783,8 +788,8 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
                 quote!([[#lane; DOF]; DOF])
             };
             let ret = emit::return_tokens(f, &outs);
-            let (each, reach) = if checks.is_empty() {
-                (TokenStream::new(), TokenStream::new())
+            let (each, reach, late) = if checks.is_empty() {
+                (TokenStream::new(), TokenStream::new(), TokenStream::new())
             } else {
                 each_lane(f, &args, &checks)
             };
@@ -797,6 +802,7 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
                     #reach
                     #(#entry)*
                     #(#stmts)*
+                    #late
                     #ret
                 }
             };
