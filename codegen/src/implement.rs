@@ -215,14 +215,26 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
             fn gravity(&self, x: &[#real; #nx]) -> Option<Result<[#real; DOF], Singular>>
         },
     );
-    let friction = fallible(
-        "friction",
-        quote!(x, u),
-        quote! {
-            fn friction(&self, x: &[#real; #nx], u: &[#real; DOF])
-                -> Option<Result<[#real; DOF], Singular>>
-        },
-    );
+    // A tree's `friction` takes the speeds only (`friction(qd)`).
+    let friction = if tree {
+        fallible(
+            "friction",
+            quote!(u),
+            quote! {
+                fn friction(&self, _: &[#real; #nx], u: &[#real; DOF])
+                    -> Option<Result<[#real; DOF], Singular>>
+            },
+        )
+    } else {
+        fallible(
+            "friction",
+            quote!(x, u),
+            quote! {
+                fn friction(&self, x: &[#real; #nx], u: &[#real; DOF])
+                    -> Option<Result<[#real; DOF], Singular>>
+            },
+        )
+    };
     let id_derivatives = fallible(
         "inverse_dynamics_derivatives",
         quote!(x, u, ud),
@@ -536,5 +548,47 @@ axis = [0.0, 1.0, 0.0]
             "\"forward_dynamics\", \"actuator_rates\"]",
         );
         assert!(crate::compile("f.toml", &src, &cfg).is_ok());
+    }
+
+    /// Each call in the impl passes the free function as many arguments as it takes: a tree's
+    /// `friction(qd)` was called as `friction(x, u)`, so a tree with friction and `implement`
+    /// did not compile (found by building the docs' `mechanism!(…, implement = "runtime",
+    /// friction = true)`).
+    #[test]
+    fn the_impl_calls_a_trees_friction_with_its_arguments() {
+        for scene in [
+            "[scene]\nfriction = true\n",
+            "[scene]\nfriction = true\nparameters = \"runtime\"\n",
+        ] {
+            let code = compile(&format!("damping = 0.1\n{scene}")).unwrap();
+            let file: syn::File = syn::parse_str(&code).unwrap();
+            let arity = |name: &str| {
+                file.items.iter().find_map(|i| match i {
+                    syn::Item::Fn(f) if f.sig.ident == name => Some(f.sig.inputs.len()),
+                    _ => None,
+                })
+            };
+            let mut calls = 0;
+            for item in &file.items {
+                let syn::Item::Impl(imp) = item else { continue };
+                for it in &imp.items {
+                    let syn::ImplItem::Fn(m) = it else { continue };
+                    let text = quote::quote!(#m).to_string();
+                    let name = m.sig.ident.to_string();
+                    let Some(n) = arity(&name) else { continue };
+                    // The call `name (a , b)` in the method's body.
+                    let call = format!("{name} (");
+                    let Some(at) = text.rfind(&call) else {
+                        continue;
+                    };
+                    let args = &text[at + call.len()..];
+                    let args = &args[..args.find(')').unwrap()];
+                    assert_eq!(args.split(',').count(), n, "{scene}: {text}");
+                    calls += 1;
+                }
+            }
+            assert!(calls >= 8, "{scene}: {calls} calls checked");
+            assert!(code.contains("fn friction"), "{scene}");
+        }
     }
 }
