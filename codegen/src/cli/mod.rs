@@ -349,9 +349,20 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
         .parse()
         .map_err(|_| format!("`{b}` is not a number"))?;
     // The width too: `-1e308:1e308` spans infinity, and the grid and the heat map's axis
-    // became NaN (a panic in the plotting library).
-    if !(lo.is_finite() && hi.is_finite() && lo < hi && (hi - lo).is_finite()) {
-        return Err(format!("`{s}`: need finite LO < HI, HI - LO finite"));
+    // became NaN (a panic in the plotting library). And the heat map's cells reach half a
+    // cell, at most half the width, beyond each end: `8e307:1.6e308` put its edge at infinity
+    // and the plotting library's axis ticks looped forever.
+    let w = hi - lo;
+    if !(lo.is_finite()
+        && hi.is_finite()
+        && lo < hi
+        && w.is_finite()
+        && (lo - w).is_finite()
+        && (hi + w).is_finite())
+    {
+        return Err(format!(
+            "`{s}`: need finite LO < HI, with HI - LO, LO - (HI - LO) and HI + (HI - LO) finite"
+        ));
     }
     Ok((lo, hi))
 }
@@ -446,6 +457,10 @@ mod tests {
         assert!(parse_range("a:1").is_err());
         assert!(parse_range("nan:1").is_err());
         assert!(parse_range("-1e308:1e308").is_err());
+        // A heat map's cell edge at infinity: `map` hung in the plotting library (QA).
+        assert!(parse_range("8e307:1.6e308").is_err());
+        assert!(parse_range("-1.6e308:-8e307").is_err());
+        assert!(parse_range("1e308:1.1e308").is_ok());
     }
 
     #[test]
