@@ -664,6 +664,22 @@ fn emit_c_writes_a_crate() {
     let o = run(&[PUMA, "--emit", "c"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("-o DIR"), "{}", stderr(&o));
+    // A directory holding a crate of one's own: its `Cargo.toml` was replaced, exit 0 (QA).
+    let mine = dir.join("mine");
+    std::fs::create_dir_all(mine.join("src")).unwrap();
+    std::fs::write(mine.join("Cargo.toml"), "[package]\nname = \"mine\"\n").unwrap();
+    let o = run(&[PUMA, "--emit", "c", "-o", mine.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not a file codegen wrote"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("Cargo.toml")).unwrap(),
+        "[package]\nname = \"mine\"\n"
+    );
+    assert!(!mine.join("src/lib.rs").exists(), "nothing written");
     let o = run(&[
         PUMA,
         "--emit",
