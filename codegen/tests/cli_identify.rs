@@ -426,6 +426,8 @@ fn bad_input_is_exit_code_2_without_a_panic() {
             "--out",
             "y.toml", // the update of a URDF is a URDF
         ],
+        // And a TOML spec's is TOML (it was written as `y.urdf`, exit 0).
+        vec!["identify", PUMA, "x.csv", "--out", "y.urdf"],
         vec!["identify", PUMA, "x.csv", "--weights", "heavy"],
     ] {
         let o = run(&args);

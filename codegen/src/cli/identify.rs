@@ -91,6 +91,20 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    // And a TOML spec's update is TOML: named `….urdf`, it was written with exit 0 and then
+    // read as XML by every tool (QA).
+    if let Some(out) = &args.out
+        && !super::spec_update::is_urdf(&name, &source)
+        && out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
+    {
+        eprintln!(
+            "error: --out {}: the update of a TOML spec is a TOML spec: do not name it `….urdf` (the tools tell a spec's format by its name)",
+            out.display()
+        );
+        return ExitCode::from(2);
+    }
     // A URDF's `--out` takes its scene file beside it.
     let scene_out = args
         .out
