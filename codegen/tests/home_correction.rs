@@ -173,4 +173,23 @@ fn fix_home_rewrites_the_spec_once() {
         String::from_utf8_lossy(&second.stderr).contains("nothing to fix"),
         "{second:?}"
     );
+    // With nothing to fix, `-o` still gets the spec: `-o -` printed nothing, and `-o OUT`
+    // wrote no file (QA).
+    let fixed = std::fs::read_to_string(&file).unwrap();
+    let to = |out: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_codegen"))
+            .arg("fix-home")
+            .arg(&file)
+            .arg("-o")
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let stdout = to(std::path::Path::new("-"));
+    assert!(stdout.status.success(), "{stdout:?}");
+    assert_eq!(String::from_utf8_lossy(&stdout.stdout), fixed);
+    let copy = dir.join("copy.toml");
+    let written = to(&copy);
+    assert!(written.status.success(), "{written:?}");
+    assert_eq!(std::fs::read_to_string(&copy).unwrap(), fixed);
 }

@@ -35,6 +35,16 @@ pub fn run(args: &FixHomeArgs) -> ExitCode {
     };
     let (text, applied) = codegen::spec::apply_fixes(&source, &warnings);
     if applied == 0 {
+        // With `-o`, the output is still the spec (unchanged): `-o -` printed nothing and
+        // `-o OUT.toml` wrote no file, so `fix-home SPEC -o - > OUT.toml` emptied OUT (QA).
+        if let Some(out) = &args.output {
+            if out.as_os_str() == "-" {
+                out!("{text}");
+            } else if let Err(e) = super::write_output(out, &text) {
+                eprintln!("error: {e}");
+                return ExitCode::from(1);
+            }
+        }
         eprintln!("{name}: nothing to fix");
         return ExitCode::SUCCESS;
     }
