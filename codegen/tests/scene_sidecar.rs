@@ -156,3 +156,42 @@ fn the_cli_and_the_builder_find_the_scene_beside_the_urdf() {
         expected
     );
 }
+
+/// The scene file beside a URDF is an input of `excite` and `identify` as of generation: an
+/// output onto it is refused (exit 2, the file untouched). `excite -o arm.scene.toml` and
+/// `identify --estimates`/`--plot arm.scene.toml` replaced it with exit 0 (QA).
+#[test]
+fn the_tools_do_not_write_over_the_scene_beside_the_urdf() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scene_sidecar_outputs");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("arm.urdf"), urdf()).unwrap();
+    let scene = dir.join("arm.scene.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let data = dir.join("data.csv");
+    std::fs::write(&data, "t\n0\n").unwrap();
+    let runs: [Vec<&std::ffi::OsStr>; 3] = [
+        vec!["excite".as_ref(), "-o".as_ref(), scene.as_os_str()],
+        vec![
+            "identify".as_ref(),
+            data.as_os_str(),
+            "--estimates".as_ref(),
+            scene.as_os_str(),
+        ],
+        vec![
+            "identify".as_ref(),
+            data.as_os_str(),
+            "--plot".as_ref(),
+            scene.as_os_str(),
+        ],
+    ];
+    for args in runs {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_codegen"));
+        cmd.arg(args[0]).arg(dir.join("arm.urdf")).args(&args[1..]);
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("that is the scene file"), "{args:?}: {err}");
+        assert_eq!(std::fs::read_to_string(&scene).unwrap(), SCENE, "{args:?}");
+    }
+}

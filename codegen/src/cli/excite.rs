@@ -417,10 +417,13 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     if !warnings.is_empty() {
         eprint!("{warnings}");
     }
-    if let Err(c) = super::distinct_outputs(
-        &[("the spec", &args.spec)],
-        &[("-o", args.output.as_deref())],
-    ) {
+    // The scene file read beside a URDF is an input too: `-o` onto it replaced it (QA).
+    let scene_in = codegen::build_script::scene_beside(&args.spec);
+    let mut inputs = vec![("the spec", args.spec.as_path())];
+    if let Some(s) = &scene_in {
+        inputs.push(("the scene file", s));
+    }
+    if let Err(c) = super::distinct_outputs(&inputs, &[("-o", args.output.as_deref())]) {
         return c;
     }
     let bounds = match check(args, &reg, &limits) {

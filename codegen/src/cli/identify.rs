@@ -111,8 +111,18 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         .as_ref()
         .filter(|_| codegen::build_script::scene_beside(&args.spec).is_some())
         .map(|o| o.with_extension("scene.toml"));
+    // The scene file read beside a URDF is an input too: `--estimates` or `--plot` onto it
+    // replaced it, exit 0 (QA).
+    let scene_in = codegen::build_script::scene_beside(&args.spec);
+    let mut inputs = vec![
+        ("the spec", args.spec.as_path()),
+        ("the data file", &args.data),
+    ];
+    if let Some(s) = &scene_in {
+        inputs.push(("the scene file", s));
+    }
     if let Err(c) = super::distinct_outputs(
-        &[("the spec", &args.spec), ("the data file", &args.data)],
+        &inputs,
         &[
             ("--out", args.out.as_deref()),
             ("--out's scene file", scene_out.as_deref()),
