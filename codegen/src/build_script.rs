@@ -162,7 +162,7 @@ impl Builder {
         self
     }
 
-    /// Also emit `_lanes` functions of `lanes` states per call (`Config::lanes`; trees only).
+    /// Also emit `_lanes` functions of `lanes` states per call (`Config::lanes`; every kind).
     pub fn lanes(&mut self, lanes: Option<usize>) -> &mut Self {
         self.config.lanes = lanes;
         self
