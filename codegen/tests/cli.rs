@@ -420,6 +420,17 @@ fn malformed_xml_is_refused() {
             ":1:22",
             "outside the root",
         ),
+        // An attribute written twice, also in a <limit> (read by nocdyn itself, not urdf-rs):
+        // it was taken with its first value, exit 0 (QA).
+        (
+            "twice.urdf",
+            ROBOT.replace(
+                "<axis xyz=\"0 0 1\"/>",
+                "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" velocity=\"1\" velocity=\"0\"/>",
+            ),
+            ":6:145",
+            "`velocity` written twice",
+        ),
     ] {
         let f = spec_file(&dir, name, text);
         assert_located(&run(&["--check", path_str(&f)]), &f, at, what);

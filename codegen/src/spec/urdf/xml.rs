@@ -233,6 +233,24 @@ impl<'s> Scanner<'s> {
             );
             return Err(Stop);
         };
+        // An attribute written twice is not XML. urdf-rs refused it at the <robot> tag, but not
+        // in the elements blanked out for it: `<limit velocity="1" velocity="0"/>` was read
+        // with its first value, exit 0 (QA).
+        if let Some((_, a)) = attrs
+            .iter()
+            .enumerate()
+            .find(|(k, a)| attrs[..*k].iter().any(|b| b.name == a.name))
+        {
+            diags.push(
+                Diagnostic::error(format!(
+                    "XML: attribute `{}` written twice in <{name}>",
+                    a.name
+                ))
+                .with_span(a.span.clone())
+                .with_hint("an XML attribute may appear once per element"),
+            );
+            return Err(Stop);
+        }
         if self.stack.is_empty() && std::mem::replace(&mut self.root_seen, true) {
             diags.push(
                 Diagnostic::error(format!("XML: a second root element <{name}>"))
