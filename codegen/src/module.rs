@@ -129,6 +129,30 @@ pub(crate) fn error_types(site: &str, value: &str, residual: &str) -> TokenStrea
             /// branch): give a guess on the intended assembly.
             Branch,
         }
+
+        impl core::fmt::Display for Singular {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(
+                    f,
+                    "singular at {:?}: value {:e}, condition estimate {:e}",
+                    self.site, self.value, self.condition_estimate
+                )
+            }
+        }
+
+        impl core::error::Error for Singular {}
+
+        impl core::fmt::Display for NoConvergence {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(
+                    f,
+                    "forward kinematics did not converge ({:?}) after {} iterations, residual {:e}",
+                    self.stop, self.iterations, self.residual
+                )
+            }
+        }
+
+        impl core::error::Error for NoConvergence {}
     }
 }
 

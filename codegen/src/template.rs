@@ -67,7 +67,8 @@ impl<'a> Specialize<'a> {
         self
     }
 
-    /// The items of `source` named in `names`, specialized, in the order of `names`.
+    /// The items of `source` named in `names`, specialized, in the order of `names`; a type's
+    /// `impl` blocks in `source` follow it.
     pub(crate) fn items(&self, source: &str, names: &[&str]) -> TokenStream {
         // The templates are this crate's own files, parsed by a test for every one of them: a
         // failure here is a generator bug.
@@ -79,15 +80,20 @@ impl<'a> Specialize<'a> {
             Ok(f) => f,
             Err(e) => panic!("internal error: a specialized template does not parse: {e}"),
         };
-        let items = names.iter().map(|name| {
-            match file
+        let items = names.iter().flat_map(|name| {
+            let item = match file
                 .items
                 .iter()
                 .find(|item| item_name(item).as_deref() == Some(*name))
             {
                 Some(item) => item,
                 None => panic!("internal error: no item `{name}` in the template"),
-            }
+            };
+            let impls = file
+                .items
+                .iter()
+                .filter(|i| impl_of(i).as_deref() == Some(*name));
+            std::iter::once(item).chain(impls)
         });
         quote!(#(#items)*)
     }
@@ -213,6 +219,17 @@ fn strip_params(inner: TokenStream) -> TokenStream {
         t.truncate(n - 2);
     }
     t.into_iter().collect()
+}
+
+/// The type an `impl` block is for (`impl Display for IndexError`: `IndexError`).
+fn impl_of(item: &syn::Item) -> Option<String> {
+    match item {
+        syn::Item::Impl(i) => match &*i.self_ty {
+            syn::Type::Path(p) => p.path.get_ident().map(Ident::to_string),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 fn item_name(item: &syn::Item) -> Option<String> {

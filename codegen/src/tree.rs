@@ -628,6 +628,22 @@ fn items(
                 /// Lower bound of the mass matrix's 2-norm condition number.
                 pub condition_estimate: #real,
             }
+
+            impl core::fmt::Display for Singular {
+                fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                    if self.pivot == DOF {
+                        write!(f, "non-finite input or result ({:e})", self.value)
+                    } else {
+                        write!(
+                            f,
+                            "singular mass matrix: pivot {} is {:e}, condition number at least {:e}",
+                            self.pivot, self.value, self.condition_estimate
+                        )
+                    }
+                }
+            }
+
+            impl core::error::Error for Singular {}
         }
     });
     let frames = (!frame_names.is_empty()).then(|| {

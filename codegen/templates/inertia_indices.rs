@@ -76,6 +76,24 @@ pub enum IndexError {
     Overflow,
 }
 
+impl core::fmt::Display for IndexError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            IndexError::NotFinite { row, col } => write!(f, "entry ({row}, {col}) is not finite"),
+            IndexError::NotSymmetric { row, col } => {
+                write!(f, "entries ({row}, {col}) and ({col}, {row}) differ")
+            }
+            IndexError::NotPositiveDefinite { pivot, value } => {
+                write!(f, "not positive definite: pivot {pivot} is {value:e}")
+            }
+            IndexError::NoConvergence => write!(f, "the eigenvalue iteration did not converge"),
+            IndexError::Overflow => write!(f, "an index overflows"),
+        }
+    }
+}
+
+impl core::error::Error for IndexError {}
+
 /// Asada's generalized inertia ellipsoid (eigenvalues, axes, `λ_min/λ_max`), the
 /// condition number, Ma & Angeles' dynamic conditioning index in both normalizations
 /// (Frobenius weights), Yoshikawa's dynamic manipulability and Khatib & Burdick's

@@ -274,6 +274,35 @@ fn nan_and_infinity_propagate_as_documented() {
     }
 }
 
+/// The generated error types are `core::error::Error`s with a message, so the README's
+/// `forward_dynamics(&q, &qd, &tau)?` compiles in a function returning `Box<dyn Error>` (QA:
+/// it did not, the types had neither `Display` nor `Error`).
+#[test]
+fn generated_errors_are_errors_with_a_message() {
+    use std::error::Error;
+    fn tree(q: [f64; 2]) -> Result<[f64; 2], Box<dyn Error>> {
+        Ok(mechanisms::planar_2r::forward_dynamics(
+            &q, &[0.0; 2], &[1.0; 2],
+        )?)
+    }
+    assert!(tree([0.1, 0.2]).is_ok());
+    let e = tree([f64::NAN, 0.2]).unwrap_err().to_string();
+    assert!(e.starts_with("non-finite input or result"), "{e}");
+    let e = mechanisms::planar_2r::inertia_indices(&[[f64::NAN; 2]; 2]).unwrap_err();
+    assert_eq!(e.to_string(), "entry (0, 0) is not finite");
+    use mechanisms::gough_stewart as gs;
+    fn platform(x: &[f64; gs::NX]) -> Result<[f64; gs::DOF], Box<dyn Error>> {
+        Ok(gs::inverse_dynamics(x, &[0.0; gs::DOF], &[0.0; gs::DOF])?)
+    }
+    assert!(platform(&gs::HOME).is_ok());
+    let e = platform(&[f64::NAN; gs::NX]).unwrap_err().to_string();
+    assert!(e.starts_with("singular at Input"), "{e}");
+    let e = gs::forward_kinematics(&[f64::NAN; gs::DOF], &gs::HOME).unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("did not converge (Input)"), "{text}");
+    let _: &dyn Error = &e;
+}
+
 /// Issue 18, 4c: finite inputs whose result overflows. The PUMA 560 with a base rate of 1e155
 /// rad/s (its square overflows) gave `Ok` holding NaN; the `f32` module did so from 1e20.
 /// Both, and the runtime, now return `Err` with `pivot == DOF`; at an ordinary rate they still
