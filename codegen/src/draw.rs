@@ -102,6 +102,12 @@ pub struct Drawing {
 /// [`crate::spec::home_pose`]).
 pub fn draw(file_name: &str, source: &str) -> Result<(Drawing, Diagnostics), Diagnostics> {
     let (home, diags) = crate::spec::home_pose(file_name, source)?;
+    // A spec with errors and nothing to draw (no `[mechanism]`, no joint, no body) cannot be
+    // read as a mechanism: nothing is written (docs/draw.md, "Exit codes").
+    let empty = home.joints.is_empty() && home.segments.is_empty() && home.mass_centres.is_empty();
+    if empty && diags.has_errors() {
+        return Err(diags);
+    }
     Ok((svg(&home), diags))
 }
 

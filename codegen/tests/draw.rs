@@ -280,6 +280,15 @@ fn cli_writes_the_drawing_and_refuses_bad_input() {
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty());
     assert!(String::from_utf8_lossy(&o.stderr).contains("nowhere"));
+    // An empty spec (no `[mechanism]`) is no mechanism: exit 2 and no file (QA: it wrote an
+    // empty picture of `unnamed` with exit 2).
+    let empty = dir.join("empty.toml");
+    std::fs::write(&empty, "").unwrap();
+    let svg = dir.join("empty.svg");
+    let o = run(&["draw", empty.to_str().unwrap(), "-o", svg.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing [mechanism]"));
+    assert!(!svg.exists(), "nothing written");
     let o = run(&["draw", "no/such/file.toml"]);
     assert_eq!(o.status.code(), Some(1));
 }
