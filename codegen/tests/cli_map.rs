@@ -261,6 +261,19 @@ fn map_outputs_never_replace_the_spec_or_half_write() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
 }
 
+/// A search where no start can be evaluated (every one out of reach) is an error, not an empty
+/// table with exit 0 (QA: `isotropy gough_stewart.toml --samples 2 --range 1e308`).
+#[test]
+fn an_isotropy_search_with_nothing_evaluated_is_an_error() {
+    let o = run(&["isotropy", FIVE, "--samples", "2", "--range", "1e308"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stdout));
+    assert!(
+        text(&o.stderr).contains("none of the 2 random starts could be evaluated"),
+        "{}",
+        text(&o.stderr)
+    );
+}
+
 /// Counts no run can meet are refused at once, before any work: `isotropy --samples
 /// 18446744073709551615` panicked (capacity overflow, exit 101) and 4,294,967,296 aborted
 /// out of memory (134); `reduce --samples 4294967296` and `map --threads 100000` never ended.

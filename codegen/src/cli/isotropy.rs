@@ -262,6 +262,16 @@ pub fn run(args: &IsotropyArgs) -> ExitCode {
     let elapsed = t0.elapsed();
 
     let minima = merge(found, &half, args.tolerance);
+    // Every start singular or out of reach: an empty table with exit 0 said nothing.
+    if minima.is_empty() {
+        eprintln!(
+            "error: none of the {} random starts could be evaluated (each singular or out of reach within --range {} / --angle-range {}): narrow the ranges or take more --samples",
+            args.samples,
+            fmt_g(args.range),
+            fmt_g(args.angle_range)
+        );
+        return ExitCode::from(2);
+    }
     let isotropic: Vec<&Minimum> = minima
         .iter()
         .filter(|m| m.psi_dimensionless <= args.tolerance)
