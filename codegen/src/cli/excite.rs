@@ -477,6 +477,14 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // A regressor singular at every state excites nothing (`--q-max 1e-300`: every entry
+    // underflows): no file to identify from.
+    if !cond.is_finite() {
+        eprintln!(
+            "error: the best trajectory found excites no base parameter set (the stacked base regressor is singular, condition number {cond:e}): widen --q-max, --qd-max, --reach or --turn"
+        );
+        return ExitCode::from(2);
+    }
     let mut from: Option<Vec<f64>> = None;
     for k in 0..args.samples {
         let t = args.period * k as f64 / args.samples as f64;

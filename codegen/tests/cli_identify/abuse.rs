@@ -312,6 +312,13 @@ fn excite_rejects_periods_and_noise_that_leave_the_numbers() {
         a.extend(quick);
         rejected(&a, flag);
     }
+    // Bounds so small that the regressor underflows to zero: a trajectory that excites
+    // nothing (condition number inf) was written with exit 0 (QA pass 3).
+    for (flag, v) in [("--q-max", "1e-300"), ("--qd-max", "1e-300")] {
+        let mut a = vec!["excite", TWO_R, flag, v];
+        a.extend(quick);
+        rejected(&a, "excites no base parameter set");
+    }
     assert!(!out.exists());
     // Up to the new bound, the condition number is taken over at most 20,000 states.
     let mut a = vec!["excite", TWO_R, "--samples", "30000"];
