@@ -192,4 +192,13 @@ fn fix_home_rewrites_the_spec_once() {
     let written = to(&copy);
     assert!(written.status.success(), "{written:?}");
     assert_eq!(std::fs::read_to_string(&copy).unwrap(), fixed);
+    // Into a missing directory: exit 1 naming `-o`, not a temporary file (QA).
+    let missing = to(&dir.join("no_such_dir").join("x.toml"));
+    assert_eq!(missing.status.code(), Some(1), "{missing:?}");
+    let err = String::from_utf8_lossy(&missing.stderr);
+    assert!(
+        err.contains("-o ") && err.contains("its directory does not exist"),
+        "{err}"
+    );
+    assert!(!err.contains(".tmp"), "{err}");
 }

@@ -26,6 +26,13 @@ pub fn run(args: &FixHomeArgs) -> ExitCode {
         eprintln!("error: fix-home rewrites TOML specs; {name} is a URDF");
         return ExitCode::from(2);
     }
+    // `-o` onto a directory or into a missing one: exit 1 before any work, with the flag
+    // named (it failed at the write, naming a temporary file). Onto the spec is allowed: that
+    // is the default, in place.
+    let output = args.output.as_deref().filter(|o| o.as_os_str() != "-");
+    if let Err(code) = super::distinct_outputs(&[], &[("-o", output)]) {
+        return code;
+    }
     let warnings = match codegen::spec::load_mechanism(&name, &source) {
         Ok((_, w)) => w,
         Err(d) => {
