@@ -350,6 +350,15 @@ fn main() -> ExitCode {
         eprintln!("{}", out.stats_table().join("\n"));
     }
     if let (Some(c), Some(dir)) = (&out.c_crate, &cli.output) {
+        // `-o` naming a file, not a directory: said so (it failed at `FILE/Cargo.toml: File
+        // exists`, QA).
+        if dir.exists() && !dir.is_dir() {
+            eprintln!(
+                "error: -o {}: --emit c writes a crate into a directory, and this is a file: give a directory (nothing written)",
+                dir.display()
+            );
+            return ExitCode::from(1);
+        }
         // Into an existing directory, only over files codegen wrote: `-o .` in a crate of
         // one's own replaced its `Cargo.toml` and `src/lib.rs`, exit 0 (QA).
         for (rel, _) in &c.files {

@@ -691,6 +691,13 @@ fn emit_c_writes_a_crate() {
         "[package]\nname = \"mine\"\n"
     );
     assert!(!mine.join("src/lib.rs").exists(), "nothing written");
+    // `-o` naming a file: said so (it was `FILE/Cargo.toml: File exists`, QA), the file kept.
+    let file = dir.join("a_file");
+    std::fs::write(&file, "mine").unwrap();
+    let o = run(&[PUMA, "--emit", "c", "-o", file.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("this is a file"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
     let o = run(&[
         PUMA,
         "--emit",
