@@ -11,7 +11,7 @@
 //! it loads and stores whole. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
 //! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's; a
 //! function then checks its angle inputs on entry, and a call with one out of the
-//! polynomial's reach goes lane by lane through the scalar function (`reach_checks`). With
+//! polynomial's reach goes lane by lane through the scalar function ([`reach_checks`]). With
 //! [`crate::Config::wide`], the operators and `sqrt` are the `wide` crate's vector operations
 //! (`lanes/wide.rs`), which do not depend on LLVM's vectorizer; still bit for bit.
 //!
