@@ -567,29 +567,6 @@ fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
         .collect()
 }
 
-/// The names of `f`'s arguments, and the arguments of its scalar call on lane `k` (`&lane_of(q,
-/// k)`; the parameters `p` as they are).
-fn lane_call(f: &Function<'_>) -> (Vec<Ident>, Vec<TokenStream>) {
-    let names: Vec<Ident> = f
-        .args
-        .iter()
-        .map(|a| Ident::new(if *a == Arg::P { "p" } else { a.name() }, Span::call_site()))
-        .collect();
-    let lane_args = f
-        .args
-        .iter()
-        .zip(&names)
-        .map(|(a, id)| {
-            if *a == Arg::P {
-                quote!(#id)
-            } else {
-                quote!(&lane_of(#id, k))
-            }
-        })
-        .collect();
-    (names, lane_args)
-}
-
 /// `<name>_lanes_each`, which evaluates an infallible function's lanes one by one by the
 /// scalar function (out of line and cold: it runs only when an angle is out of the vector
 /// `sin_cos`'s reach), the entry statements that check the angles and keep the inputs, and
@@ -602,7 +579,18 @@ fn each_lane(
     let real = emit::real();
     let scalar = Ident::new(f.name, Span::call_site());
     let each = format_ident!("{}_lanes_each", f.name);
-    let (names, lane_args) = lane_call(f);
+    let names: Vec<Ident> = f
+        .args
+        .iter()
+        .map(|a| Ident::new(if *a == Arg::P { "p" } else { a.name() }, Span::call_site()))
+        .collect();
+    let lane_args = f.args.iter().zip(&names).map(|(a, id)| {
+        if *a == Arg::P {
+            quote!(#id)
+        } else {
+            quote!(&lane_of(#id, k))
+        }
+    });
     let (ty, zero, put) = if matches!(f.shape, Shape::Matrix) {
         (
             quote!([[[#real; LANES]; DOF]; DOF]),
@@ -710,7 +698,18 @@ fn settle(
             _ => quote!(put_lane(&mut #o, k, #v);),
         }
     });
-    let (names, lane_args) = lane_call(f);
+    let names: Vec<Ident> = f
+        .args
+        .iter()
+        .map(|a| Ident::new(if *a == Arg::P { "p" } else { a.name() }, Span::call_site()))
+        .collect();
+    let lane_args = f.args.iter().zip(&names).map(|(a, id)| {
+        if *a == Arg::P {
+            quote!(#id)
+        } else {
+            quote!(&lane_of(#id, k))
+        }
+    });
     let doc = format!(
         " `{name}`'s values over the lanes, and the lanes it must evaluate again by `{}`.",
         f.name
