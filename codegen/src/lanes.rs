@@ -541,13 +541,10 @@ fn checked_on_entry(g: &Graph, s: &Schedule, arg: ExprId) -> bool {
 }
 
 /// With the vector `sin_cos`, the entry checks of `f`'s angle inputs (`sin_cos_reach(&q[1])`,
-/// before the inputs are transposed into `Lanes`): when one fails, every lane is evaluated
-/// again by the scalar function at the end, so the polynomials need no fallback, whose calls
-/// to the backend made the whole function keep its values on the stack (docs/performance.md,
-/// "`sin` and `cos` over the lanes"). The polynomial of an angle out of reach gives a wrong
-/// but harmless value (IEEE arithmetic only), which the scalar function's replaces; acting at
-/// the end rather than returning on entry keeps the function one straight line (a return on
-/// entry cost a fifth to a half of a forward dynamics' time, measured).
+/// before the inputs are transposed into `Lanes`): when one fails, every lane is evaluated by
+/// the scalar function, so the polynomials need no fallback, whose calls to the backend made
+/// the whole function keep its values on the stack (docs/performance.md, "`sin` and `cos` over
+/// the lanes").
 fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
     let s = &f.schedule;
     let mut seen = Vec::new();
@@ -569,13 +566,12 @@ fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
 
 /// `<name>_lanes_each`, which evaluates an infallible function's lanes one by one by the
 /// scalar function (out of line and cold: it runs only when an angle is out of the vector
-/// `sin_cos`'s reach), the entry statements that check the angles and keep the inputs, and
-/// the statement before the result that calls it when a check failed.
+/// `sin_cos`'s reach), and the entry statement that calls it.
 fn each_lane(
     f: &Function<'_>,
     args: &[TokenStream],
     checks: &[TokenStream],
-) -> (TokenStream, TokenStream, TokenStream) {
+) -> (TokenStream, TokenStream) {
     let real = emit::real();
     let scalar = Ident::new(f.name, Span::call_site());
     let each = format_ident!("{}_lanes_each", f.name);
@@ -625,17 +621,12 @@ fn each_lane(
             out
         }
     };
-    let kept = (0..names.len()).map(syn::Index::from);
     let entry = quote! {
-        let reach = #(#checks)&&*;
-        let inputs = (#(#names,)*);
-    };
-    let late = quote! {
-        if !reach {
-            return #each(#(inputs.#kept),*);
+        if !(#(#checks)&&*) {
+            return #each(#(#names),*);
         }
     };
-    (item, entry, late)
+    (item, entry)
 }
 
 /// Whether `f`'s `_lanes` version returns each lane's status.
@@ -714,19 +705,24 @@ fn settle(
         " `{name}`'s values over the lanes, and the lanes it must evaluate again by `{}`.",
         f.name
     );
-    // An angle beyond the vector `sin_cos`'s reach: every lane marked, so evaluated again by
-    // the scalar function.
-    let (reach, late) = if checks.is_empty() {
-        (TokenStream::new(), TokenStream::new())
+    // An angle beyond the vector `sin_cos`'s reach: every lane by the scalar function.
+    let reach = if checks.is_empty() {
+        TokenStream::new()
     } else {
-        (
-            quote!(let reach = #(#checks)&&*;),
-            quote! {
-                if !reach {
-                    bad = [true; LANES];
-                }
-            },
-        )
+        let zeros = parts.iter().map(|p| match p {
+            Part::Matrix => quote!([[[0.0; LANES]; DOF]; DOF]),
+            _ => quote!([[0.0; LANES]; DOF]),
+        });
+        let zero = if one {
+            quote!(#(#zeros)*)
+        } else {
+            quote!((#(#zeros),*))
+        };
+        quote! {
+            if !(#(#checks)&&*) {
+                return (#zero, [true; LANES]);
+            }
+        }
     };
     quote! {
         #[doc = #doc]
@@ -737,7 +733,6 @@ fn settle(
             #body
             let mut out = #values;
             #(#flags)*
-            #late
             (out, bad)
         }
         #[allow(clippy::type_complexity)]
@@ -788,8 +783,8 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
                 quote!([[#lane; DOF]; DOF])
             };
             let ret = emit::return_tokens(f, &outs);
-            let (each, reach, late) = if checks.is_empty() {
-                (TokenStream::new(), TokenStream::new(), TokenStream::new())
+            let (each, reach) = if checks.is_empty() {
+                (TokenStream::new(), TokenStream::new())
             } else {
                 each_lane(f, &args, &checks)
             };
@@ -802,7 +797,6 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
                     #reach
                     #(#entry)*
                     #(#stmts)*
-                    #late
                     #ret
                 }
             };
