@@ -9,9 +9,7 @@
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
 //! backend once per lane. `Lanes` is aligned to its size when that is a power of two, so that
 //! it loads and stores whole. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
-//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's; a
-//! function then checks its angle inputs on entry, and a call with one out of the
-//! polynomial's reach goes lane by lane through the scalar function ([`reach_checks`]). With
+//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's. With
 //! [`crate::Config::wide`], the operators and `sqrt` are the `wide` crate's vector operations
 //! (`lanes/wide.rs`), which do not depend on LLVM's vectorizer; still bit for bit.
 //!
@@ -131,9 +129,8 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
         return TokenStream::new();
     }
     let ty = lanes_type(cfg, l);
-    let vector = cfg.vector_sin_cos;
-    let fns = chosen.iter().map(|f| function(g, f, l, vector));
-    let kernel_fns = kernels.iter().map(|f| kernel(g, f, l, vector));
+    let fns = chosen.iter().map(|f| function(g, f, l));
+    let kernel_fns = kernels.iter().map(|f| kernel(g, f, l));
     let wrappers: Vec<&str> = KERNELS
         .iter()
         .filter(|(k, _)| kernels.iter().any(|f| f.name == *k))
@@ -143,13 +140,8 @@ pub(crate) fn items(g: &Graph, cfg: &Config, functions: &[Function<'_>], l: usiz
     if wrappers.iter().any(|w| *w != "actuator_mass_matrix") {
         items.push("solve_t_lanes".into());
     }
-    // The per-lane helpers of the functions that can fail ([`settle`]) or go lane by lane
-    // when an angle is out of the vector `sin_cos`'s reach ([`each_lane`]).
-    if chosen
-        .iter()
-        .any(|f| fallible(f) || (vector && !reach_checks(g, f).is_empty()))
-        || !kernels.is_empty()
-    {
+    // The per-lane helpers of the functions that can fail ([`settle`]).
+    if chosen.iter().any(|f| fallible(f)) || !kernels.is_empty() {
         items.extend(["lane_of", "put_lane", "flag_non_finite"].map(String::from));
     }
     let items: Vec<&str> = items.iter().map(String::as_str).collect();
@@ -275,22 +267,16 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
         #(#per_lane)*
         (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
     };
-    let (sin_cos_doc, sin_cos, in_reach, kernel) = if cfg.vector_sin_cos {
-        let (body, in_reach, kernel) = sin_cos::body_and_kernel(&idx, backend);
+    let (sin_cos_doc, sin_cos, kernel) = if cfg.vector_sin_cos {
+        let (body, kernel) = sin_cos::body_and_kernel(&idx, backend);
         (
             " `(sin, cos)` of every lane at once (a polynomial; the backend per lane beyond \
              |x| = 2¹⁹·π/2 or for a non-finite lane).",
             body,
-            in_reach,
             kernel,
         )
     } else {
-        (
-            " `(sin, cos)` per lane.",
-            backend,
-            TokenStream::new(),
-            TokenStream::new(),
-        )
+        (" `(sin, cos)` per lane.", backend, TokenStream::new())
     };
     let select = match wide {
         Some((krate, ty)) => wide::select_abs_gt(krate, ty),
@@ -355,7 +341,6 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
             pub fn sin_cos(self) -> (Lanes, Lanes) {
                 #sin_cos
             }
-            #in_reach
             /// Per lane: `x` where `|self| > |b|`, else `y`.
             #[inline(always)]
             pub fn select_abs_gt(self, b: Lanes, x: Lanes, y: Lanes) -> Lanes {
@@ -391,16 +376,12 @@ fn lane_scalar(g: &Graph, s: &Schedule, id: ExprId, k: usize) -> TokenStream {
 }
 
 /// One step over lanes.
-fn step(g: &Graph, s: &Schedule, st: &Step, l: usize, vector: bool) -> TokenStream {
+fn step(g: &Graph, s: &Schedule, st: &Step, l: usize) -> TokenStream {
     let op = |id| lane_operand(g, s, id);
     match *st {
         Step::SinCos { sin, cos, arg } => {
             let (a, b, x) = (emit::var(sin), emit::var(cos), op(arg));
-            if vector && checked_on_entry(g, s, arg) {
-                quote!(let (#a, #b) = Lanes::sin_cos_in_reach(#x);)
-            } else {
-                quote!(let (#a, #b) = Lanes::sin_cos(#x);)
-            }
+            quote!(let (#a, #b) = Lanes::sin_cos(#x);)
         }
         Step::Check { node } => (0..l).map(|k| check(g, s, node, k)).collect(),
         Step::MulAdd { name, node, mul } => {
@@ -523,110 +504,9 @@ fn prologue(g: &Graph, f: &Function<'_>) -> (Vec<TokenStream>, Vec<TokenStream>,
 }
 
 /// The scheduled statements over the lanes.
-fn statements(
-    g: &Graph,
-    f: &Function<'_>,
-    s: &Schedule,
-    l: usize,
-    vector: bool,
-) -> Vec<TokenStream> {
-    let stmts: Vec<TokenStream> = s.steps.iter().map(|st| step(g, s, st, l, vector)).collect();
+fn statements(g: &Graph, f: &Function<'_>, s: &Schedule, l: usize) -> Vec<TokenStream> {
+    let stmts: Vec<TokenStream> = s.steps.iter().map(|st| step(g, s, st, l)).collect();
     emit::chunked(g, s, &f.outputs, stmts)
-}
-
-/// Whether a `sin_cos` of `arg` is an angle the function reads as an input, which (with the
-/// vector `sin_cos`) it checks once on entry ([`reach_checks`]).
-fn checked_on_entry(g: &Graph, s: &Schedule, arg: ExprId) -> bool {
-    matches!(s.operand(g, arg), Operand::Input(a, _) if a != Arg::P)
-}
-
-/// With the vector `sin_cos`, the entry checks of `f`'s angle inputs (`sin_cos_reach(&q[1])`,
-/// before the inputs are transposed into `Lanes`): when one fails, every lane is evaluated by
-/// the scalar function, so the polynomials need no fallback, whose calls to the backend made
-/// the whole function keep its values on the stack (docs/performance.md, "`sin` and `cos` over
-/// the lanes").
-fn reach_checks(g: &Graph, f: &Function<'_>) -> Vec<TokenStream> {
-    let s = &f.schedule;
-    let mut seen = Vec::new();
-    for st in &s.steps {
-        if let Step::SinCos { arg, .. } = *st
-            && checked_on_entry(g, s, arg)
-            && !seen.contains(&arg)
-        {
-            seen.push(arg);
-        }
-    }
-    seen.into_iter()
-        .map(|arg| {
-            let x = emit::operand(g, s, arg);
-            quote!(sin_cos_reach(&#x))
-        })
-        .collect()
-}
-
-/// `<name>_lanes_each`, which evaluates an infallible function's lanes one by one by the
-/// scalar function (out of line and cold: it runs only when an angle is out of the vector
-/// `sin_cos`'s reach), and the entry statement that calls it.
-fn each_lane(
-    f: &Function<'_>,
-    args: &[TokenStream],
-    checks: &[TokenStream],
-) -> (TokenStream, TokenStream) {
-    let real = emit::real();
-    let scalar = Ident::new(f.name, Span::call_site());
-    let each = format_ident!("{}_lanes_each", f.name);
-    let names: Vec<Ident> = f
-        .args
-        .iter()
-        .map(|a| Ident::new(if *a == Arg::P { "p" } else { a.name() }, Span::call_site()))
-        .collect();
-    let lane_args = f.args.iter().zip(&names).map(|(a, id)| {
-        if *a == Arg::P {
-            quote!(#id)
-        } else {
-            quote!(&lane_of(#id, k))
-        }
-    });
-    let (ty, zero, put) = if matches!(f.shape, Shape::Matrix) {
-        (
-            quote!([[[#real; LANES]; DOF]; DOF]),
-            quote!([[[0.0; LANES]; DOF]; DOF]),
-            quote! {
-                for (o, r) in out.iter_mut().zip(v) {
-                    put_lane(o, k, r);
-                }
-            },
-        )
-    } else {
-        (
-            quote!([[#real; LANES]; DOF]),
-            quote!([[0.0; LANES]; DOF]),
-            quote!(put_lane(&mut out, k, v);),
-        )
-    };
-    let doc = format!(
-        " `{}_lanes` lane by lane, by `{}`: when an angle is beyond the vector `sin_cos`'s reach.",
-        f.name, f.name
-    );
-    let item = quote! {
-        #[doc = #doc]
-        #[cold]
-        #[inline(never)]
-        fn #each(#(#args),*) -> #ty {
-            let mut out = #zero;
-            for k in 0..LANES {
-                let v = #scalar(#(#lane_args),*);
-                #put
-            }
-            out
-        }
-    };
-    let entry = quote! {
-        if !(#(#checks)&&*) {
-            return #each(#(#names),*);
-        }
-    };
-    (item, entry)
 }
 
 /// Whether `f`'s `_lanes` version returns each lane's status.
@@ -653,7 +533,6 @@ fn settle(
     values_ty: TokenStream,
     ret_ty: TokenStream,
     parts: &[Part],
-    checks: &[TokenStream],
 ) -> TokenStream {
     let scalar = Ident::new(f.name, Span::call_site());
     let name = format_ident!("{}_lanes", f.name);
@@ -705,31 +584,11 @@ fn settle(
         " `{name}`'s values over the lanes, and the lanes it must evaluate again by `{}`.",
         f.name
     );
-    // An angle beyond the vector `sin_cos`'s reach: every lane by the scalar function.
-    let reach = if checks.is_empty() {
-        TokenStream::new()
-    } else {
-        let zeros = parts.iter().map(|p| match p {
-            Part::Matrix => quote!([[[0.0; LANES]; DOF]; DOF]),
-            _ => quote!([[0.0; LANES]; DOF]),
-        });
-        let zero = if one {
-            quote!(#(#zeros)*)
-        } else {
-            quote!((#(#zeros),*))
-        };
-        quote! {
-            if !(#(#checks)&&*) {
-                return (#zero, [true; LANES]);
-            }
-        }
-    };
     quote! {
         #[doc = #doc]
         #[inline(always)]
         #[allow(unused_variables, unused_mut, clippy::all)]
         fn #marked(#(#args),*) -> (#values_ty, [bool; LANES]) {
-            #reach
             #body
             let mut out = #values;
             #(#flags)*
@@ -757,17 +616,12 @@ fn settle(
 
 /// The `_lanes` version of `f` (see [`flat`]): the values lane last, and for a function that
 /// can fail each lane's status.
-fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream {
+fn function(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
     let name = format_ident!("{}_lanes", f.name);
     let (args, entry, s) = prologue(g, f);
     let s = &s;
-    let stmts = statements(g, f, s, l, vector);
-    let checks = if vector {
-        reach_checks(g, f)
-    } else {
-        Vec::new()
-    };
+    let stmts = statements(g, f, s, l);
     let outs: Vec<TokenStream> = f.outputs.iter().map(|&o| lane_array(g, s, o)).collect();
     let lane = quote!([#real; LANES]);
     let doc = format!(
@@ -783,18 +637,11 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
                 quote!([[#lane; DOF]; DOF])
             };
             let ret = emit::return_tokens(f, &outs);
-            let (each, reach) = if checks.is_empty() {
-                (TokenStream::new(), TokenStream::new())
-            } else {
-                each_lane(f, &args, &checks)
-            };
             return quote! {
-                #each
                 #[doc = #doc]
                 #[inline]
                 #[allow(unused_variables, unused_mut, clippy::all)]
                 pub fn #name(#(#args),*) -> #ret_ty {
-                    #reach
                     #(#entry)*
                     #(#stmts)*
                     #ret
@@ -834,7 +681,6 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
         values_ty.clone(),
         quote!((#values_ty, [Result<(), Singular>; LANES])),
         parts,
-        &checks,
     )
 }
 
@@ -843,16 +689,11 @@ fn function(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream 
 /// Lane `k` is bit for bit what the scalar kernel returns for state `k`. (Results handed
 /// out per lane instead, as the scalar kernel's `Result`s, kept LLVM from vectorizing the
 /// kernel at all.)
-fn kernel(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream {
+fn kernel(g: &Graph, f: &Function<'_>, l: usize) -> TokenStream {
     let real = emit::real();
     let (args, entry, s) = prologue(g, f);
     let s = &s;
-    let stmts = statements(g, f, s, l, vector);
-    let checks = if vector {
-        reach_checks(g, f)
-    } else {
-        Vec::new()
-    };
+    let stmts = statements(g, f, s, l);
     let Shape::Fallible(parts) = &f.shape else {
         panic!("internal error: kernel `{}` cannot fail", f.name)
     };
@@ -889,6 +730,5 @@ fn kernel(g: &Graph, f: &Function<'_>, l: usize, vector: bool) -> TokenStream {
         quote!((#(#types),*)),
         quote!(((#(#types),*), [Result<(), Singular>; LANES])),
         parts,
-        &checks,
     )
 }

@@ -136,10 +136,8 @@ pub struct Config {
     /// kernels), instead of the math backend once per lane, which is most of their time.
     /// Within 2 ulp of the correctly rounded values away from their zeros, so lanes agree
     /// with the scalar functions to rounding, no longer bit for bit (tests: ≤ 1e-13
-    /// relative). A call with an input angle beyond `|x| = 2¹⁹·π/2` or not finite in any lane
-    /// is evaluated lane by lane by the scalar function (each lane then its bits); an angle
-    /// computed inside a function takes the backend for the whole `sin_cos` then. Off by
-    /// default; an error without `lanes`.
+    /// relative). A lane beyond `|x| = 2¹⁹·π/2` or not finite takes the backend for the
+    /// whole call. Off by default; an error without `lanes`.
     pub vector_sin_cos: bool,
     /// With `lanes`: `Some(path)` makes `Lanes`' arithmetic (`+ - * /`, negation, `sqrt`,
     /// `mul_add`) go through the vector types of the `wide` crate (version 1), which the

@@ -16,13 +16,8 @@
 //!    so its two low bits are `n mod 4`: integer operations that vectorize, where `n as i32`
 //!    is a saturating conversion per lane (six scalar instructions each on x86).
 //!
-//! The reduction is exact only for finite lanes within `|x| ≤ 2¹⁹·π/2` (about 8.2e5 rad).
-//! A `_lanes` function checks the angles it reads as inputs once on entry (`sin_cos_reach`)
-//! and, if a lane of one is out of that range or not finite, evaluates every lane by the
-//! scalar function instead (`crate::lanes`); their polynomials (`Lanes::sin_cos_in_reach`)
-//! then have no fallback in them, whose calls made the whole function spill its vector
-//! registers. `Lanes::sin_cos` (an angle computed inside a function) checks its own lanes and
-//! takes the backend's `sin_cos` for every lane when one is out.
+//! A call whose lanes are not all finite and within `|x| ≤ 2¹⁹·π/2` (about 8.2e5 rad) takes the
+//! backend's `sin_cos` for every lane instead: the reduction above would no longer be exact.
 //! Accuracy (tests/tests/lanes.rs, against values correctly rounded by mpmath): within 2 ulp
 //! where `|sin|` or `|cos| ≥ 2⁻²⁰`; near their zeros the reduction's error dominates, absolute
 //! (within 2⁻⁵³), not relative. Not bit for bit the backend's: an option of its own.
@@ -36,13 +31,9 @@ use crate::emit;
 const RANGE: f64 = 823_549.0;
 
 /// The body of `Lanes::sin_cos` (`self` is the `Lanes`; `backend` the body that calls the math
-/// backend per lane, for lanes out of range), the method `Lanes::sin_cos_in_reach` (the
-/// polynomial alone, for lanes checked by `sin_cos_reach`) and, as module items, the per-lane
-/// kernel `lane_sin_cos(x: f64) -> (f64, f64)` and the check `sin_cos_reach`.
-pub(super) fn body_and_kernel(
-    idx: &[Literal],
-    backend: TokenStream,
-) -> (TokenStream, TokenStream, TokenStream) {
+/// backend per lane, for lanes out of range) and, after it, the per-lane kernel
+/// `lane_sin_cos(x: f64) -> (f64, f64)` as a module item.
+pub(super) fn body_and_kernel(idx: &[Literal], backend: TokenStream) -> (TokenStream, TokenStream) {
     let real = emit::real();
     // An `f32` lane is widened to `f64` and rounded back; an `f64` one needs no cast.
     let (widen, narrow) = if crate::scalar::single() {
@@ -57,17 +48,6 @@ pub(super) fn body_and_kernel(
     let body = quote! {
         // `!(|x| <= RANGE)` is also true of NaN.
         if #(#in_range)&&* {
-            self.sin_cos_in_reach()
-        } else {
-            #backend
-        }
-    };
-    let in_reach = quote! {
-        /// `(sin, cos)` of every lane by the polynomial alone: each lane must be finite and
-        /// within `|x| ≤ 2¹⁹·π/2` (`sin_cos_reach`).
-        #[inline(always)]
-        #[allow(dead_code)]
-        fn sin_cos_in_reach(self) -> (Lanes, Lanes) {
             let (mut s, mut c) = (self.0, self.0);
             for ((s, c), x) in s.iter_mut().zip(c.iter_mut()).zip(self.0) {
                 let (a, b) = lane_sin_cos(x #widen);
@@ -75,17 +55,11 @@ pub(super) fn body_and_kernel(
                 *c = b #narrow;
             }
             (Lanes(s), Lanes(c))
+        } else {
+            #backend
         }
     };
     let kernel = quote! {
-        /// Whether every lane of `x` is finite and within `|x| ≤ 2¹⁹·π/2`, where
-        /// `Lanes::sin_cos_in_reach` holds. (Unused where no function reads an angle as an
-        /// input.)
-        #[inline(always)]
-        #[allow(dead_code)]
-        fn sin_cos_reach(x: &[#real; LANES]) -> bool {
-            x.iter().all(|v| #real::abs(*v) #widen <= #range)
-        }
         /// `(sin x, cos x)` for `|x| ≤ 2¹⁹·π/2`: Cody–Waite reduction by π/2 and fdlibm's
         /// kernels, branch-free (the `_lanes` functions' vector `sin_cos`).
         #[inline(always)]
@@ -124,5 +98,5 @@ pub(super) fn body_and_kernel(
             (a, b)
         }
     };
-    (body, in_reach, kernel)
+    (body, kernel)
 }
