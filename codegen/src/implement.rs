@@ -216,25 +216,19 @@ pub(crate) fn items(module: &TokenStream, runtime_path: &str, name: &str) -> Tok
         },
     );
     // A tree's `friction` takes the speeds only (`friction(qd)`).
-    let friction = if tree {
-        fallible(
-            "friction",
-            quote!(u),
-            quote! {
-                fn friction(&self, _: &[#real; #nx], u: &[#real; DOF])
-                    -> Option<Result<[#real; DOF], Singular>>
-            },
-        )
+    let (friction_args, friction_x) = if tree {
+        (quote!(u), quote!(_))
     } else {
-        fallible(
-            "friction",
-            quote!(x, u),
-            quote! {
-                fn friction(&self, x: &[#real; #nx], u: &[#real; DOF])
-                    -> Option<Result<[#real; DOF], Singular>>
-            },
-        )
+        (quote!(x, u), quote!(x))
     };
+    let friction = fallible(
+        "friction",
+        friction_args,
+        quote! {
+            fn friction(&self, #friction_x: &[#real; #nx], u: &[#real; DOF])
+                -> Option<Result<[#real; DOF], Singular>>
+        },
+    );
     let id_derivatives = fallible(
         "inverse_dynamics_derivatives",
         quote!(x, u, ud),

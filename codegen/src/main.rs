@@ -288,10 +288,7 @@ fn main() -> ExitCode {
             .scene
             .clone()
             .or_else(|| codegen::build_script::scene_beside(spec));
-        let mut inputs: Vec<(&str, &std::path::Path)> = vec![("the spec", spec)];
-        if let Some(s) = &scene {
-            inputs.push(("the scene file", s));
-        }
+        let inputs = cli::spec_inputs(spec, scene.as_deref());
         if let Err(code) = cli::distinct_outputs(&inputs, &[("-o", cli.output.as_deref())]) {
             return code;
         }

@@ -419,10 +419,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     }
     // The scene file read beside a URDF is an input too: `-o` onto it replaced it (QA).
     let scene_in = codegen::build_script::scene_beside(&args.spec);
-    let mut inputs = vec![("the spec", args.spec.as_path())];
-    if let Some(s) = &scene_in {
-        inputs.push(("the scene file", s));
-    }
+    let inputs = super::spec_inputs(&args.spec, scene_in.as_deref());
     if let Err(c) = super::distinct_outputs(&inputs, &[("-o", args.output.as_deref())]) {
         return c;
     }

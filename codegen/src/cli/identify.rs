@@ -105,22 +105,16 @@ pub fn run(args: &IdentifyArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    // A URDF's `--out` takes its scene file beside it.
+    // The scene file read beside a URDF is an input too: `--estimates` or `--plot` onto it
+    // replaced it, exit 0 (QA). A URDF's `--out` takes its scene file beside it.
+    let scene_in = codegen::build_script::scene_beside(&args.spec);
     let scene_out = args
         .out
         .as_ref()
-        .filter(|_| codegen::build_script::scene_beside(&args.spec).is_some())
+        .filter(|_| scene_in.is_some())
         .map(|o| o.with_extension("scene.toml"));
-    // The scene file read beside a URDF is an input too: `--estimates` or `--plot` onto it
-    // replaced it, exit 0 (QA).
-    let scene_in = codegen::build_script::scene_beside(&args.spec);
-    let mut inputs = vec![
-        ("the spec", args.spec.as_path()),
-        ("the data file", &args.data),
-    ];
-    if let Some(s) = &scene_in {
-        inputs.push(("the scene file", s));
-    }
+    let mut inputs = super::spec_inputs(&args.spec, scene_in.as_deref());
+    inputs.push(("the data file", &args.data));
     if let Err(c) = super::distinct_outputs(
         &inputs,
         &[

@@ -391,6 +391,18 @@ fn file_identity(p: &std::path::Path) -> std::path::PathBuf {
     }
 }
 
+/// The inputs of a tool that reads `spec` and its scene file `scene` (the one `--scene` names,
+/// or `ROBOT.scene.toml` beside a URDF), for [`distinct_outputs`]: an output onto either
+/// replaced what had just been read.
+pub fn spec_inputs<'a>(
+    spec: &'a std::path::Path,
+    scene: Option<&'a std::path::Path>,
+) -> Vec<(&'static str, &'a std::path::Path)> {
+    let mut inputs = vec![("the spec", spec)];
+    inputs.extend(scene.map(|s| ("the scene file", s)));
+    inputs
+}
+
 /// Refuse output files that would overwrite an input or another output (`(flag, path)` each,
 /// the inputs' flag being what names them in the message, e.g. `"the spec"`): exit code 2
 /// before any work, so that a slip of the shell never replaces the measurements with a plot;
