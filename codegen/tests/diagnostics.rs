@@ -441,7 +441,7 @@ frames = ["world"]
     let text = diags.render();
     assert!(text.contains("unknown frame \"world\""), "{text}");
     assert!(text.contains("arm.toml:16:"), "{text}");
-    assert!(text.contains("or \"base\": the fixed world"), "{text}");
+    assert!(text.contains("or the fixed world: \"base\""), "{text}");
     let ok = source.replace("[\"world\"]", "[\"base\", \"link1\"]");
     codegen::spec::load_tree("arm.toml", &ok).unwrap_or_else(|d| panic!("{}", d.render()));
 }

@@ -195,3 +195,64 @@ fn the_tools_do_not_write_over_the_scene_beside_the_urdf() {
         assert_eq!(std::fs::read_to_string(&scene).unwrap(), SCENE, "{args:?}");
     }
 }
+
+/// A ROS-Industrial URDF's own link "base" (read under another name, as nocdyn's "base" is the
+/// fixed world) is what a scene's "base" names; the root link names the fixed world. Before,
+/// `frames = ["base"]` gave the fixed world's pose with no error. Reference: the URDF's fixed
+/// joint, `rpy = "0 0 π"` at the origin, so R = diag(−1, −1, 1).
+#[test]
+fn a_urdf_link_named_base_is_the_scenes_base() {
+    let path = root().join("codegen/tests/data/warn/base_link_named_base.urdf");
+    let urdf = std::fs::read_to_string(path).unwrap();
+    let scene = |text: &str| SceneOverrides {
+        sidecar: Some(SceneFile {
+            name: "arm.scene.toml".into(),
+            text: text.into(),
+        }),
+        ..Default::default()
+    };
+    let l = codegen::spec::load(
+        "arm.urdf",
+        &urdf,
+        &scene("[scene]\nframes = [\"base\", \"base_link\", \"upper\"]\n"),
+    )
+    .unwrap_or_else(|d| panic!("{d}"));
+    let f = &l.scene.frames;
+    let names: Vec<(&str, &str)> = f
+        .iter()
+        .map(|f| (f.name.as_str(), f.ident.as_str()))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            ("base", "base"),
+            ("base_link", "base_link"),
+            ("upper", "upper")
+        ]
+    );
+    let r = f[0].placement.rotation;
+    let want = [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]];
+    for i in 0..3 {
+        for j in 0..3 {
+            assert!((r[i][j] - want[i][j]).abs() < 1e-15, "{r:?}");
+        }
+    }
+    assert_eq!(f[0].body, None);
+    assert_eq!(
+        f[1].placement.rotation,
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    // The hint of the warning says so.
+    assert!(
+        l.warnings.render().contains("in a scene, \"base\""),
+        "{}",
+        l.warnings.render()
+    );
+    // A body the scene names "base" is that link too: a point mass on it is accepted.
+    codegen::spec::load(
+        "arm.urdf",
+        &urdf,
+        &scene("[scene]\nmassless = [\"base\"]\n"),
+    )
+    .unwrap_or_else(|d| panic!("{d}"));
+}

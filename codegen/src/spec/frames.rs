@@ -101,7 +101,9 @@ pub(super) fn resolve(
         };
         let found = match names.iter().position(|b| *b == n.name) {
             Some(b) => attach.get(b).copied().flatten(),
-            None => (n.name == ir::BASE).then_some(base),
+            None => {
+                (n.name == ir::BASE || spec.root_link.as_ref() == Some(&n.name)).then_some(base)
+            }
         };
         let Some(at) = found else {
             let mut d = Diagnostic::error(format!("unknown frame {:?}", n.name))
@@ -109,7 +111,7 @@ pub(super) fn resolve(
                 .with_span(n.span.clone());
             d = d.with_hint(match suggest_hint(&n.name, &names) {
                 Some(h) => format!("{h} (a frame is a body's name)"),
-                None => "a frame is a body's name (one a joint moves, or one fixed to another by fixed joints), or \"base\": the fixed world, which is also what a URDF's root link is".into(),
+                None => "a frame is a body's name (one a joint moves, or one fixed to another by fixed joints), or the fixed world: \"base\", or a URDF's root link by its name".into(),
             });
             diags.push(d);
             continue;
@@ -150,7 +152,11 @@ pub(super) fn resolve(
             None => at.pose,
         };
         frames.push(Frame {
-            name: n.name.clone(),
+            // A URDF's own link "base" keeps its name (read under another).
+            name: match &spec.base_link {
+                Some(a) if *a == n.name => ir::BASE.to_owned(),
+                _ => n.name.clone(),
+            },
             ident,
             body: at.target,
             placement,

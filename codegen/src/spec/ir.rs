@@ -35,6 +35,11 @@ pub(crate) struct Spec {
     /// Each `[[parallelogram]]`'s short-side width (m), in the order of `parallelograms`: the
     /// declared-motion check places its two rods.
     pub parallelogram_widths: Vec<f64>,
+    /// A URDF link named `"base"` that is not the root, under the name the spec reads it by
+    /// (`"base"` names the fixed world): the body a scene's `"base"` means (URDF only).
+    pub base_link: Option<String>,
+    /// A URDF's root link: the fixed world, which a scene's frame may name (URDF only).
+    pub root_link: Option<String>,
 }
 
 /// A `[[spring]]` entry: a linear spring-damper between a point of `body_a` and one of
@@ -151,6 +156,27 @@ impl SceneSpec {
             s(span);
         }
         s(&mut self.written);
+    }
+
+    /// Every body this scene names `from` (point masses, massless bodies, the payload's body,
+    /// run-time inertia, frames) renamed `to`.
+    pub fn rename_body(&mut self, from: &str, to: &str) {
+        let n = |named: &mut Named| {
+            if named.name == from {
+                named.name = to.to_owned();
+            }
+        };
+        if let Some((f, _)) = &mut self.frames {
+            f.iter_mut().for_each(n);
+        }
+        self.point_mass.iter_mut().for_each(n);
+        self.massless.iter_mut().for_each(n);
+        if let Some(p) = &mut self.payload {
+            n(&mut p.body);
+        }
+        if let Some((RuntimeInertia::Bodies(b), _)) = &mut self.runtime_inertia {
+            b.iter_mut().for_each(n);
+        }
     }
 }
 

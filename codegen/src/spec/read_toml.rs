@@ -186,6 +186,8 @@ impl Reader<'_> {
             springs,
             parallelograms: Vec::new(),
             parallelogram_widths: Vec::new(),
+            base_link: None,
+            root_link: None,
         };
         self.expand_parallelograms(&mut spec, parallelograms);
         spec

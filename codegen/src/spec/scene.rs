@@ -98,6 +98,10 @@ pub(super) fn prepare(spec: &mut ir::Spec, overrides: &SceneOverrides, diags: &m
             );
         }
     }
+    // A URDF's own link "base" (read under another name): what the scene's "base" means.
+    if let Some(alias) = spec.base_link.clone() {
+        spec.scene.rename_body(ir::BASE, &alias);
+    }
     snap::snap(spec, diags);
     apply_scene(spec, diags);
 }

@@ -223,6 +223,8 @@ fn read_robot(source: &str, diags: &mut Diagnostics) -> Option<(urdf_rs::Robot, 
         springs: Vec::new(),
         parallelograms: Vec::new(),
         parallelogram_widths: Vec::new(),
+        base_link: names.alias.clone(),
+        root_link: names.root.clone(),
     };
     Some((r, names, spec))
 }
@@ -391,7 +393,11 @@ impl Names {
                         root.as_deref().unwrap_or("?")
                     ))
                     .with_key(format!("link \"{BASE}\""))
-                    .with_span(links.name(i)),
+                    .with_span(links.name(i))
+                    .with_hint(format!(
+                        "in a scene, \"{BASE}\" (a frame, a payload's body, …) is this link, and \"{}\" the fixed world",
+                        root.as_deref().unwrap_or("?")
+                    )),
                 );
             }
             a
