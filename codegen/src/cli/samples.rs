@@ -8,7 +8,7 @@
 
 use codegen::spec::MAX_MAGNITUDE;
 
-use super::filter::{differentiate, filtfilt};
+use super::filter::{differentiate, filtfilt, settling};
 
 /// Cutoff periods of samples dropped at each end of positions-only data (the filter's
 /// transient; see [`read`]).
@@ -296,10 +296,10 @@ pub fn read(
         // `exp(−2π/√2) = 1.2e-2` of it after one cutoff period, `1.6e-6` after three, the
         // in-band error's level (docs/identification.md, "The CSV format"). Compared as a
         // float first: a cutoff far below the sample rate makes it larger than any file.
-        let edge = (EDGE_PERIODS * fs / filtering.cutoff).ceil().max(2.0);
+        let edge = settling(filtering.cutoff, fs, EDGE_PERIODS).ceil().max(2.0);
         if 2.0 * edge + min_rows as f64 > rows.len() as f64 {
             return Err(format!(
-                "error: {file}: {}: too few to filter and differentiate at --cutoff {:?} Hz (need {min_rows} samples after dropping {} at each end: three cutoff periods of samples)",
+                "error: {file}: {}: too few to filter and differentiate at --cutoff {:?} Hz (need {min_rows} samples after dropping {} at each end: the filter's settling, three cutoff periods or more near half the sample rate)",
                 count(rows.len(), "row"),
                 filtering.cutoff,
                 if edge < 1e12 {

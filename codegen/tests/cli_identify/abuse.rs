@@ -155,6 +155,38 @@ fn a_cutoff_far_below_the_sample_rate_is_an_error_not_a_panic() {
     rejected(&["identify", TWO_R, &data], "back.csv:13:1: column `t`");
 }
 
+/// A `--cutoff` within rounding of half the sample rate (the rate is the file's mean step,
+/// exact to its digits): the filter's poles sit at `z = −1`, its transient never decays, and
+/// before, `identify` dropped three cutoff periods (6 samples) and fitted the ringing with
+/// exit 0 (a QA finding). Near half the rate more is dropped (`0.45 fs`: 61 samples, not 7).
+#[test]
+fn a_cutoff_at_half_the_sample_rate_is_an_error() {
+    let dir = scratch("abuse_nyquist");
+    let (h, rows) = two_r_data(&dir);
+    let (ph, prow) = positions_only(&h, &rows, 0.05);
+    let data = write(&dir, "pos.csv", &ph, &prow);
+    let t: Vec<f64> = prow
+        .iter()
+        .map(|r| r.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let fs = (t.len() - 1) as f64 / (t[t.len() - 1] - t[0]);
+    let nyquist = format!("{:?}", 0.5 * fs * (1.0 - 1e-12));
+    rejected(
+        &["identify", TWO_R, &data, "--cutoff", &nyquist],
+        "too few to filter",
+    );
+    let o = run(&[
+        "identify",
+        TWO_R,
+        &data,
+        "--cutoff",
+        &format!("{:?}", 0.45 * fs),
+    ]);
+    ok(&o);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("; 61 samples dropped at each end"), "{out}");
+}
+
 /// States of 1e300 made the regressor overflow and the SVD never return (a hang); efforts of
 /// 1e308 printed NaN estimates with exit 0. Now exit 2 at the row. Angles of 1e308 rad were
 /// fitted (their sines are finite) with exit 0: now exit 2 at the cell.
