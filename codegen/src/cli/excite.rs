@@ -443,7 +443,7 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     if !bounds.line.is_empty() {
         eprintln!("{}", bounds.line);
     }
-    let best = search(&reg, args, &bounds);
+    let (best_cost, best) = search(&reg, args, &bounds);
     let n = reg.dof();
     let columns = reg.columns();
     let mut csv = String::from("t");
@@ -468,9 +468,21 @@ pub fn run(args: &ExciteArgs) -> ExitCode {
     ) {
         Ok(w) => condition(&w),
         Err(t) => {
-            eprintln!(
-                "error: the best trajectory found leaves the workspace or meets a singularity at t = {t} s (between the search's samples): reduce --reach or --turn, or raise --search-samples"
-            );
+            // The bounds that shrink the motion: a platform's are --reach and --turn, a tree's
+            // and a closed loop's (its independent coordinates) --q-max and --qd-max.
+            let bounds = match reg {
+                Regressor::Platform(_) => "reduce --reach or --turn",
+                _ => "reduce --q-max or --qd-max",
+            };
+            if best_cost == f64::MAX {
+                eprintln!(
+                    "error: no trajectory the search tried stays in the workspace (each leaves it or meets a singularity; the best at t = {t} s): {bounds}"
+                );
+            } else {
+                eprintln!(
+                    "error: the best trajectory found leaves the workspace or meets a singularity at t = {t} s (between the search's samples): {bounds}, or raise --search-samples"
+                );
+            }
             return ExitCode::from(2);
         }
     };
@@ -568,7 +580,9 @@ fn fmt_list(v: &[f64]) -> String {
 }
 
 /// The random starts and coordinate search; progress on standard error.
-fn search(reg: &Regressor, args: &ExciteArgs, bounds: &Bounds) -> Fourier {
+/// The best trajectory and its cost (`f64::MAX` when no candidate had a regressor at every
+/// search sample).
+fn search(reg: &Regressor, args: &ExciteArgs, bounds: &Bounds) -> (f64, Fourier) {
     let (q_max, qd_max, offset) = (&bounds.q, &bounds.qd, &bounds.centre);
     const GRID: usize = 400;
     let n = reg.dof();
@@ -642,14 +656,17 @@ fn search(reg: &Regressor, args: &ExciteArgs, bounds: &Bounds) -> Fourier {
         }
     }
     match best {
-        Some((_, f)) => f,
-        None => Fourier {
-            c: vec![0.0; n * 2 * l],
-            n,
-            l,
-            w,
-            offset: offset.clone(),
-        },
+        Some(b) => b,
+        None => (
+            f64::MAX,
+            Fourier {
+                c: vec![0.0; n * 2 * l],
+                n,
+                l,
+                w,
+                offset: offset.clone(),
+            },
+        ),
     }
 }
 

@@ -274,6 +274,45 @@ fn closed_loop_bad_input_is_exit_code_2_without_a_panic() {
     }
 }
 
+/// `excite` on a closed loop whose default bound (`--q-max 1`) leaves its workspace (the
+/// five-bar's distal links reach only about ±0.26 rad of its motors' home angles): exit 2,
+/// and the error names the closed loop's bounds, `--q-max`/`--qd-max`, not a platform's
+/// `--reach`/`--turn` (which a closed loop does not take), and says that no candidate stayed
+/// in the workspace rather than blaming the gaps between the search's samples.
+#[test]
+fn closed_loop_out_of_its_workspace_names_its_own_bounds() {
+    let o = run(&[
+        "excite",
+        "../mechanisms/specs/five_bar_joints.toml",
+        "--restarts",
+        "1",
+        "--evaluations",
+        "5",
+    ]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or("");
+    assert!(last.contains("reduce --q-max or --qd-max"), "{last}");
+    assert!(!last.contains("--reach"), "{last}");
+    assert!(last.contains("no trajectory the search tried"), "{last}");
+    // With a bound inside the workspace it writes a trajectory.
+    let dir = scratch("closed_reach");
+    let traj = dir.join("traj.csv");
+    let o = run(&[
+        "excite",
+        "../mechanisms/specs/five_bar_joints.toml",
+        "--restarts",
+        "1",
+        "--evaluations",
+        "5",
+        "--q-max",
+        "0.1",
+        "-o",
+        s(&traj),
+    ]);
+    ok(&o);
+}
+
 /// The same samples given as all tree coordinates `x1..xNX` (assembled here by the runtime)
 /// give the estimates of the independent coordinates' file, and `excite` writes the same bytes
 /// for a seed.
