@@ -169,15 +169,16 @@ pub(super) fn check_runtime_bodies(
     }
 }
 
-/// `actuated` and `child_origin` belong to parallel mechanisms only.
+/// `actuated` belongs to parallel mechanisms and closed loops (never to a tree), and so does a
+/// `child_origin` that closes a loop.
 fn check_no_parallel_keys(spec: &Spec, diags: &mut Diagnostics) {
     for j in &spec.joints {
         if j.actuated {
             diags.push(
-                Diagnostic::error("`actuated` is only for parallel mechanisms")
+                Diagnostic::error("`actuated` is only for parallel mechanisms and closed loops")
                     .with_key(format!("{}.actuated", j.key))
                     .with_span(j.actuated_span.clone().or(j.span.clone()))
-                    .with_hint("this spec has no [platform] table, so it is a tree, in which every joint is actuated; remove `actuated` (or add a [platform] table)"),
+                    .with_hint("this spec has no [platform] table and no loop-closing joint (one with `child_origin` whose child another joint also reaches), so it is a tree, in which every joint is actuated; remove `actuated`, or close the loop (docs/spec.md, \"Closed loops in joint coordinates\") or add a [platform] table"),
             );
         }
         if j.child_origin.is_some() {
