@@ -423,11 +423,23 @@ fn check_plan(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) -> Opt
             }
             None => "the mechanism is assembled at home with every tree joint at zero: check the joint origins, `child_origin` and which joints are actuated (one per degree of freedom)".to_string(),
         };
+        // The loops close but the actuated set does not fit them (more or fewer actuated
+        // joints than degrees of freedom, or ones that do not determine the others: every
+        // such message of `Plan::new` names the actuated joints): point at the last
+        // `actuated`, the key to change, not at a loop that is fine.
+        let actuated = match open {
+            None if e.contains("actuated") => spec.joints.iter().rev().find(|j| j.actuated),
+            _ => None,
+        };
         let at = open
             .map(|(j, _)| j)
             .or_else(|| spec.joints.iter().find(|j| j.child_origin.is_some()));
         let mut d = Diagnostic::error(e).with_hint(hint);
-        if let Some(j) = at {
+        if let Some(j) = actuated {
+            d = d
+                .with_key(format!("{}.actuated", j.key))
+                .with_span(j.actuated_span.clone().or(j.span.clone()));
+        } else if let Some(j) = at {
             d = d
                 .with_key(format!("{}.child_origin", j.key))
                 .with_span(j.child_origin_span.clone().or(j.span.clone()));
