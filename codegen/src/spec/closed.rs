@@ -70,6 +70,9 @@ pub(crate) fn lower_closed_attached(
             home
         },
     };
+    if check_locked_at_home(spec, &closed, diags) {
+        return None;
+    }
     close_at_home(spec, &mut closed, diags);
     check_spring_lengths(spec, &closed, diags);
     if diags.has_errors() {
@@ -399,6 +402,37 @@ fn close_at_home(spec: &Spec, closed: &mut ClosedModel, diags: &mut Diagnostics)
         let c = &mut closed.cuts[k];
         c.frame_child = c.frame_child.compose(&fix);
     }
+}
+
+/// `[scene] locked` joints held away from their home value move the loops off the home pose
+/// the spec closes: the gap is theirs, not a cut's (whose `child_origin` the closure check
+/// would otherwise blame, or silently move when the gap is small). When a loop is open at
+/// home and some locked joint's value is not its home, each such lock is an error at its key;
+/// true when one was reported.
+fn check_locked_at_home(spec: &Spec, closed: &ClosedModel, diags: &mut Diagnostics) -> bool {
+    if closed.open_cut().is_none() {
+        return false;
+    }
+    let mut reported = false;
+    for (n, value) in &spec.scene.locked {
+        let Some(j) = spec.joints.iter().find(|j| j.name == n.name) else {
+            continue;
+        };
+        if *value == j.home {
+            continue;
+        }
+        diags.push(
+            Diagnostic::error(format!(
+                "joint \"{}\" is locked at {value}, but the spec closes its loops with it at {} (its home): held there, it opens them",
+                j.name, j.home
+            ))
+            .with_key(n.key.clone())
+            .with_span(n.span.clone())
+            .with_hint("in a closed loop a joint can be locked only at its home value; to hold it elsewhere, write the home pose with the joint there (the loops' other joints placed so that every loop closes), or leave it free"),
+        );
+        reported = true;
+    }
+    reported
 }
 
 /// The loop analysis ([`Plan::new`]); `None` when it fails (reported).
