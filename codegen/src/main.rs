@@ -229,21 +229,23 @@ fn main() -> ExitCode {
                 if !warnings.is_empty() {
                     eprint!("{}", warnings.render());
                 }
+                let count =
+                    |n: usize, noun: &str| format!("{n} {noun}{}", if n == 1 { "" } else { "s" });
                 match mechanism {
                     codegen::spec::Mechanism::Tree(model) => {
-                        eprintln!("{}: ok ({} joints)", name, model.dof())
+                        eprintln!("{}: ok ({})", name, count(model.dof(), "joint"))
                     }
                     codegen::spec::Mechanism::Parallel(model) => eprintln!(
-                        "{}: ok (parallel, {} legs, {} DOF)",
+                        "{}: ok (parallel, {}, {} DOF)",
                         name,
-                        model.legs.len(),
+                        count(model.legs.len(), "leg"),
                         model.dof()
                     ),
                     codegen::spec::Mechanism::Closed(model) => eprintln!(
-                        "{}: ok (closed loops, {} joint coordinates, {} cut joints, {} DOF)",
+                        "{}: ok (closed loops, {}, {}, {} DOF)",
                         name,
-                        model.nx(),
-                        model.cuts.len(),
+                        count(model.nx(), "joint coordinate"),
+                        count(model.cuts.len(), "cut joint"),
                         model.dof()
                     ),
                 }

@@ -88,6 +88,13 @@ fn check_validates_without_generating() {
     assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
     assert!(o.stdout.is_empty(), "--check printed: {}", stdout(&o));
     assert!(stderr(&o).contains("ok (2 joints)"), "{}", stderr(&o));
+    // One of a kind is singular ("1 cut joints" before).
+    let o = run(&["--check", "../mechanisms/specs/four_bar.toml"]);
+    assert!(
+        stderr(&o).contains("ok (closed loops, 3 joint coordinates, 1 cut joint, 1 DOF)"),
+        "{}",
+        stderr(&o)
+    );
 
     // --check with -o writes nothing either.
     let dir = scratch("check");
