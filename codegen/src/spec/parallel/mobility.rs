@@ -61,7 +61,7 @@ pub(super) fn check_mobility(spec: &Spec, ps: &PlatformSpec, diags: &mut Diagnos
             .with_hint(format!(
                 "M = λ(n − j − 1) + Σf with n = {n} bodies (with the base), j = {j} joints and Σf = {f} joint freedoms (U counts 2, S 3, fixed 0); check the legs' joints{}",
                 match coords {
-                    Coordinates::Pose => ": each leg of a 6-DOF platform has six joint freedoms (UPS, PUS, RUS)",
+                    Coordinates::Pose => ": each leg of a 6-DOF platform has six joint freedoms (UPS, PUS, RUS; an R-S-S or P-S-S leg has seven, its rod spinning idly about its own line: write its first S as a U, R-U-S)",
                     Coordinates::Orientation => ": each leg of a spherical mechanism is R-R-R",
                     Coordinates::Planar => ": each leg of a planar five-bar is R-R, joined at the point by a revolute",
                     Coordinates::Translation => ": each leg of a Delta is a revolute crank carrying a [[parallelogram]] (two ball–ball rods, their idle spins not counted)",
