@@ -20,6 +20,6 @@ for f in $(find "$D" -name '*.urdf' | sort); do
     cp -p "$f" "urdf/$m.urdf"
     printf '[scene]\nfunctions = ["inverse_dynamics", "mass_matrix", "forward_dynamics"]\nframes = []\n' >"urdf/$m.scene.toml"
 done
-python3 gen.py
+python3 ../gen.py 30 --values-only
 # Unoptimized: the modules of 30–55 DOF build in about a minute (the build script optimized).
 cargo run | tee results.txt

@@ -1,7 +1,7 @@
 //! Every URDF of example-robot-data against Pinocchio (`run.sh`; ../README.md, "Every URDF of
 //! example-robot-data"): per robot the worst relative error (∞-norm over the vector or matrix)
 //! of the generated `inverse_dynamics`, `mass_matrix` and `forward_dynamics` against `rnea`,
-//! `crba` and `aba` at the states of `data/NAME.txt` (gen.py), joints matched by name, and how
+//! `crba` and `aba` at the states of `data/NAME.txt` (`../gen.py`), joints matched by name, and how
 //! many states forward dynamics refused (`Err(Singular)`).
 mod robots {
     include!(concat!(env!("OUT_DIR"), "/all.rs"));
