@@ -10,7 +10,8 @@
 //! The factorization is Gaussian elimination with partial pivoting:
 //! - at step `k` each lower row `i` is swapped into row `k` by selects when `|m_ik| > |m_kk|`,
 //!   so row `k` ends with the largest entry of the column (the pivot a search would choose, the
-//!   first one on ties) without a data-dependent branch;
+//!   first one on ties) without a data-dependent branch; the scalar solves keep the running
+//!   `|m_kk|` apart (`top`, a `max`), so that the comparisons do not wait on the swaps;
 //! - the tolerance test is that of the matrix with each column scaled by its unit group's
 //!   reference ([`runtime::parallel::noc::ColumnUnits`]: the group's largest 2-norm, or
 //!   another group's times the platform's radius `L` between rotation speeds (rad/s) and
@@ -158,10 +159,6 @@ fn transposed_solve(n: usize, lanes: bool, st: &mut Vec<TokenStream>) {
             st.push(cond_swap(lanes, &sw, &u, &v));
         }
     }
-}
-
-fn abs(v: &Ident) -> TokenStream {
-    quote!((if #v < 0.0 { -#v } else { #v }))
 }
 
 /// The emitted function.
@@ -351,8 +348,18 @@ fn pivot_swaps(n: usize, k: usize, k_rhs: usize, tr: bool, lanes: bool, st: &mut
             let ((sa, sb), ik) = (flag_operands(&sw), m(i, k));
             st.push(quote!(let (#sa, #sb) = (#ik, #kk);));
         } else {
-            let (a_ik, a_kk) = (abs(&m(i, k)), abs(&kk));
-            st.push(quote!(let #sw = #a_ik > #a_kk;));
+            // `top` is `|m_kk|` after the swaps so far (the same value: a swap moves it, the
+            // absolute value is exact), kept apart so that each comparison waits on one
+            // `max` rather than on the row swap before it.
+            if i == k + 1 {
+                st.push(quote!(let top = if #kk < 0.0 { -#kk } else { #kk };));
+            }
+            let ik = m(i, k);
+            st.push(quote!(let cand = if #ik < 0.0 { -#ik } else { #ik };));
+            st.push(quote!(let #sw = cand > top;));
+            if i + 1 < n {
+                st.push(quote!(let top = if #sw { cand } else { top };));
+            }
         }
         for j in k..n {
             st.push(cond_swap(lanes, &sw, &m(k, j), &m(i, j)));
