@@ -66,7 +66,8 @@ pub use tree::{Symbolic, symbolic, symbolic_with, symbolic_with_frames};
 pub enum MathBackend {
     /// The `libm` crate (`libm::sincos`): works in `no_std`, bit-identical on every target.
     Libm,
-    /// `f64::sin_cos` from std (fastest on hosts; not `no_std`).
+    /// `f64::sin_cos` from std (not `no_std`): two calls of the platform's libm, where the
+    /// `libm` crate's `sincos` is one (twice as fast on glibc x86-64: docs/performance.md).
     Std,
     /// `<path>::math::sin_cos` of the nocdyn runtime crate at `path` (e.g. `"runtime"`), which
     /// picks std or libm by its features.
