@@ -50,13 +50,9 @@ fn states(home: &[f64; 7], seed: u64) -> Vec<State> {
         .collect()
 }
 
-fn rel(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-        / scale
-}
+#[path = "../../src/rel.rs"]
+mod rel;
+use rel::rel;
 
 #[repr(C)]
 struct Timespec {

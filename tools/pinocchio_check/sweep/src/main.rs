@@ -6,13 +6,9 @@
 mod robots {
     include!(concat!(env!("OUT_DIR"), "/all.rs"));
 }
-fn rel(a: &[f64], b: &[f64]) -> f64 {
-    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-        / scale
-}
+#[path = "../../src/rel.rs"]
+mod rel;
+use rel::rel;
 macro_rules! check {
     ($m:ident) => {{
         use robots::$m as g;
