@@ -187,6 +187,14 @@ fn main() {
             b.fma(true).implement("runtime");
         });
     }
+    // `sin` and `cos` of a function's input angles in one call (`tests/tests/batch_sin_cos.rs`):
+    // two trees of 7 joints and a closed loop in joint coordinates, each with
+    // `Config::batch_sin_cos`.
+    for spec in [CHAIN7, IIWA, "../mechanisms/specs/spherical_five_bar.toml"] {
+        generate(&out, "batch_sin_cos", Path::new(spec), |b| {
+            b.batch_sin_cos(true).implement("runtime");
+        });
+    }
     // Many states per call (`tests/tests/lanes.rs`, the `lanes` bench group): every bundled
     // tree with `Config::lanes` (4 in `f64`), the PUMA 560 also with 8 lanes in `f32`.
     let trees = [

@@ -175,6 +175,13 @@ impl Builder {
         self
     }
 
+    /// `sin` and `cos` of a scalar function's joint angles in one call
+    /// (`Config::batch_sin_cos`; off by default).
+    pub fn batch_sin_cos(&mut self, on: bool) -> &mut Self {
+        self.config.batch_sin_cos = on;
+        self
+    }
+
     /// The lanes' arithmetic through the `wide` crate, named `path` by the including crate
     /// (`Config::wide`; `None` by default).
     pub fn wide(&mut self, path: Option<&str>) -> &mut Self {

@@ -193,10 +193,16 @@ pub(crate) fn math_call(cfg: &Config, f: &str, x: TokenStream) -> TokenStream {
 }
 
 fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
-    let s = &f.schedule;
+    let batched;
+    let s = if cfg.batch_sin_cos {
+        batched = crate::sin_cos::batched(g, &f.schedule);
+        &batched
+    } else {
+        &f.schedule
+    };
     let mut stmts = Vec::with_capacity(s.steps.len());
     for step in &s.steps {
-        stmts.push(step_tokens(g, cfg, f, step));
+        stmts.push(step_tokens(g, cfg, f, s, step));
     }
     let stmts = chunked(g, s, &f.outputs, stmts);
     let checks = input_checks(f);
@@ -215,14 +221,20 @@ fn body(g: &Graph, cfg: &Config, f: &Function<'_>) -> TokenStream {
 
 /// The statement of one step (empty for a `Check` of a node that is no guard, or a `Let` of a
 /// node that is no operation).
-fn step_tokens(g: &Graph, cfg: &Config, f: &Function<'_>, step: &Step) -> TokenStream {
-    let s = &f.schedule;
+fn step_tokens(
+    g: &Graph,
+    cfg: &Config,
+    f: &Function<'_>,
+    s: &Schedule,
+    step: &Step,
+) -> TokenStream {
     match *step {
         Step::SinCos { sin, cos, arg } => {
             let (a, b) = (var(sin), var(cos));
             let call = math_call(cfg, "sin_cos", operand(g, s, arg));
             quote!(let (#a, #b) = #call;)
         }
+        Step::SinCosBatch => crate::sin_cos::batch_statement(g, s),
         Step::Check { node } => check_tokens(g, f, node),
         Step::Let { name, node } => let_tokens(g, cfg, s, name, node),
         Step::MulAdd { name, node, mul } => {
@@ -452,13 +464,20 @@ fn matrix_tokens(outs: &[TokenStream], n: usize) -> TokenStream {
 const CHUNK: usize = 512;
 
 /// Variables a step defines and uses.
-fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
+pub(crate) fn step_vars(g: &Graph, s: &Schedule, step: &Step) -> (Vec<usize>, Vec<usize>) {
     let var_of = |id: ExprId| match s.operand(g, id) {
         Operand::Var(n) => Some(n),
         _ => None,
     };
     match *step {
         Step::SinCos { sin, cos, arg } => (vec![sin, cos], var_of(arg).into_iter().collect()),
+        Step::SinCosBatch => (
+            s.batch
+                .iter()
+                .flat_map(|&(sin, cos, _)| [sin, cos])
+                .collect(),
+            s.batch.iter().filter_map(|&(_, _, a)| var_of(a)).collect(),
+        ),
         Step::Check { node } => (vec![], g.operands(node).filter_map(var_of).collect()),
         Step::Let { name, node } => (vec![name], g.operands(node).filter_map(var_of).collect()),
         Step::MulAdd { name, node, mul } => (vec![name], crate::fma::reads(g, s, node, mul)),

@@ -60,6 +60,7 @@ pub(crate) fn fuse(g: &Graph, k: &Kernel, s: &mut Schedule) {
         let read: Vec<ExprId> = match *step {
             Step::Let { node, .. } | Step::Check { node } => g.operands(node).collect(),
             Step::SinCos { arg, .. } => vec![arg],
+            Step::SinCosBatch => s.batch.iter().map(|&(_, _, arg)| arg).collect(),
             Step::MulAdd { .. } => Vec::new(),
         };
         for id in read {

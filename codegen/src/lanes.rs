@@ -9,7 +9,7 @@
 //! function returns for state `k`; `sin_cos`, `sqrt`, `atan2` and `mul_add` call the math
 //! backend once per lane. `Lanes` is aligned to its size when that is a power of two, so that
 //! it loads and stores whole. With [`crate::Config::vector_sin_cos`], `sin_cos` is instead one
-//! polynomial over all lanes (`lanes/sin_cos.rs`), no longer bit for bit the backend's. With
+//! polynomial over all lanes (`sin_cos.rs`), no longer bit for bit the backend's. With
 //! [`crate::Config::wide`], the operators and `sqrt` are the `wide` crate's vector operations
 //! (`lanes/wide.rs`), which do not depend on LLVM's vectorizer; still bit for bit.
 //!
@@ -41,7 +41,6 @@
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
-mod sin_cos;
 mod wide;
 
 pub(crate) use wide::{WIDTHS as WIDE_WIDTHS, vector_type as wide_type};
@@ -268,7 +267,10 @@ fn lanes_type(cfg: &Config, l: usize) -> TokenStream {
         (Lanes([#(#pairs.0),*]), Lanes([#(#pairs.1),*]))
     };
     let (sin_cos_doc, sin_cos, kernel) = if cfg.vector_sin_cos {
-        let (body, kernel) = sin_cos::body_and_kernel(&idx, backend);
+        let (body, kernel) = (
+            crate::sin_cos::lanes_body(&idx, backend),
+            crate::sin_cos::kernel(),
+        );
         (
             " `(sin, cos)` of every lane at once (a polynomial; the backend per lane beyond \
              |x| = 2¹⁹·π/2 or for a non-finite lane).",
@@ -383,6 +385,15 @@ fn step(g: &Graph, s: &Schedule, st: &Step, l: usize) -> TokenStream {
             let (a, b, x) = (emit::var(sin), emit::var(cos), op(arg));
             quote!(let (#a, #b) = Lanes::sin_cos(#x);)
         }
+        // Not made for the lanes (`emit` batches the scalar functions only): one call each.
+        Step::SinCosBatch => s
+            .batch
+            .iter()
+            .map(|&(sin, cos, arg)| {
+                let (a, b, x) = (emit::var(sin), emit::var(cos), op(arg));
+                quote!(let (#a, #b) = Lanes::sin_cos(#x);)
+            })
+            .collect(),
         Step::Check { node } => (0..l).map(|k| check(g, s, node, k)).collect(),
         Step::MulAdd { name, node, mul } => {
             let x = emit::var(name);

@@ -50,6 +50,7 @@ pub mod parallel;
 pub mod params;
 pub mod scalar;
 pub mod schedule;
+mod sin_cos;
 pub mod spec;
 pub mod sym;
 mod tangent;
@@ -140,6 +141,14 @@ pub struct Config {
     /// relative). A lane beyond `|x| = 2¹⁹·π/2` or not finite takes the backend for the
     /// whole call. Off by default; an error without `lanes`.
     pub vector_sin_cos: bool,
+    /// The scalar functions take the `sin` and `cos` of all their angles computed from the
+    /// inputs alone (a tree's joint angles) in one call, by the polynomial of
+    /// `vector_sin_cos` over them as one array, which vectorizes, instead of the math backend
+    /// once per angle, which is much of a tree's inverse dynamics and mass matrix on a host.
+    /// Results differ from the backend's by rounding (within 2 ulp of `sin` and `cos`); an
+    /// angle beyond `|x| = 2¹⁹·π/2` or not finite takes the backend for the whole call. Off by
+    /// default (the output is then byte for byte what it was); independent of `lanes`.
+    pub batch_sin_cos: bool,
     /// With `lanes`: `Some(path)` makes `Lanes`' arithmetic (`+ - * /`, negation, `sqrt`,
     /// `mul_add`) go through the vector types of the `wide` crate (version 1), which the
     /// including crate names `path` (e.g. `"wide"`) and must depend on (`no_std` with
@@ -161,6 +170,7 @@ impl Default for Config {
             fma: false,
             lanes: None,
             vector_sin_cos: false,
+            batch_sin_cos: false,
             wide: None,
         }
     }

@@ -102,6 +102,11 @@ struct Cli {
     /// (within 2 ulp; no longer bit for bit the scalar functions).
     #[arg(long, requires = "lanes")]
     vector_sin_cos: bool,
+    /// The scalar functions take `sin` and `cos` of their joint angles in one call, by the
+    /// same polynomial over them as one array (within 2 ulp of the backend's; faster on a
+    /// host: build with `-C target-cpu=native`).
+    #[arg(long)]
+    batch_sin_cos: bool,
     /// With `--lanes`: the lanes' arithmetic through the `wide` crate's vector types (explicit
     /// SIMD in safe code; the including crate depends on `wide` 1). Still bit for bit.
     #[arg(long, requires = "lanes")]
@@ -324,6 +329,7 @@ fn main() -> ExitCode {
             fma: cli.fma,
             lanes: cli.lanes,
             vector_sin_cos: cli.vector_sin_cos,
+            batch_sin_cos: cli.batch_sin_cos,
             wide: cli.wide.then(|| "wide".to_string()),
         },
     ) {
@@ -431,6 +437,7 @@ fn cfg_for_snap(cli: &Cli, sidecar: Option<codegen::spec::SceneFile>) -> Config 
         fma: cli.fma,
         lanes: None,
         vector_sin_cos: false,
+        batch_sin_cos: cli.batch_sin_cos,
         wide: None,
     }
 }

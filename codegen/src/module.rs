@@ -49,6 +49,10 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
     if let Some(l) = cfg.lanes {
         module.extend(crate::lanes::items(plan.graph, cfg, &plan.functions, l));
     }
+    let batches = crate::sin_cos::batches(cfg, plan.graph, &plan.functions);
+    if batches {
+        module.extend(crate::sin_cos::batch_items(cfg));
+    }
     let mut header = plan.header.clone();
     // The options are named right after the math backend (the table follows), each inserted
     // there, so the last one inserted comes first.
@@ -64,6 +68,13 @@ pub(crate) fn render(plan: &ModulePlan<'_>, cfg: &Config) -> String {
             "Lanes: {l} states per call in the `_lanes` functions ({}).",
             crate::lanes::names(&plan.functions).join(", ")
         ));
+    }
+    if batches {
+        after_math_backend(
+            "Batched `sin_cos`: on (a function's input angles in one polynomial call, \
+             `sin_cos_batch`)."
+                .into(),
+        );
     }
     if cfg.fma {
         after_math_backend(

@@ -75,6 +75,9 @@ pub enum Step {
     Let { name: usize, node: ExprId },
     /// `let (x{sin}, x{cos}) = sin_cos(<arg>);`
     SinCos { sin: usize, cos: usize, arg: ExprId },
+    /// The `sin_cos` of every pair in [`Schedule::batch`] in one call
+    /// ([`crate::Config::batch_sin_cos`]).
+    SinCosBatch,
     /// Pivot check of a `Guard` node: return `Err` unless the value exceeds the tolerance.
     Check { node: ExprId },
     /// `let x{name} = mul_add(…);`: the `Add` or `Sub` `node` with its operand `mul` (a `Mul`
@@ -105,6 +108,8 @@ pub struct Schedule {
     pub(crate) names: HashMap<ExprId, usize>,
     /// Operation count.
     pub ops: OpCount,
+    /// The `(sin, cos, arg)` of the [`Step::SinCosBatch`] (empty without one).
+    pub batch: Vec<(usize, usize, ExprId)>,
 }
 
 impl Schedule {

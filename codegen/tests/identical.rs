@@ -78,6 +78,7 @@ fn macro_text(spec: &str, math: &MathBackend, float: Float) -> Vec<u8> {
         fma: false,
         lanes: None,
         vector_sin_cos: false,
+        batch_sin_cos: false,
         wide: None,
     };
     macro_support::expand(manifest_dir(), spec, &cfg)

@@ -29,6 +29,10 @@
 //!     cargo bench -p tests --features figures --bench speed
 //! ```
 //!
+//! `batch_sin_cos/{mechanism}/{function}/{plain,batched}`: the 7-joint chain and the iiwa 14
+//! with every function's joint angles in one call (`Config::batch_sin_cos`,
+//! `tests::variants::batch_sin_cos`) against the bundled modules.
+//!
 //! `sin_cos/four_angles` times what one angle costs a `_lanes` function (a call per lane).
 //!
 //! The `#[inline(never)]` wrappers below are the functions whose instructions
@@ -124,6 +128,42 @@ fn fma_gough_stewart(c: &mut Criterion) {
     });
     g.finish();
 }
+
+/// `batch_sin_cos/{mechanism}/{function}/{plain,batched}`: the bundled module against the same
+/// spec with every function's joint angles in one `sin_cos_batch` call (`Config::batch_sin_cos`,
+/// `tests::variants::batch_sin_cos`), both through `runtime::math` with std (std's `sin_cos`:
+/// two libm calls per angle), inverse dynamics and mass matrix.
+macro_rules! batch_tree {
+    ($fn_name:ident, $m:ident) => {
+        fn $fn_name(c: &mut Criterion) {
+            use mechanisms::$m as plain;
+            use tests::variants::batch_sin_cos::$m as batched;
+            const N: usize = plain::DOF;
+            let [q, qd, qdd] = states::<N, 1>(11).map(|s| s[0]);
+            let mut g = c.benchmark_group(concat!(
+                "batch_sin_cos/",
+                stringify!($m),
+                "/inverse_dynamics"
+            ));
+            g.bench_function("plain", |b| {
+                b.iter(|| plain::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd)))
+            });
+            g.bench_function("batched", |b| {
+                b.iter(|| batched::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qdd)))
+            });
+            g.finish();
+            let mut g =
+                c.benchmark_group(concat!("batch_sin_cos/", stringify!($m), "/mass_matrix"));
+            g.bench_function("plain", |b| b.iter(|| plain::mass_matrix(black_box(&q))));
+            g.bench_function("batched", |b| {
+                b.iter(|| batched::mass_matrix(black_box(&q)))
+            });
+            g.finish();
+        }
+    };
+}
+batch_tree!(batch_chain7, chain7);
+batch_tree!(batch_iiwa14, iiwa14);
 
 /// A group `name` of `scalar` (`l` states through the scalar function, one after the other)
 /// against `lanes` (one `_lanes` call of the same states); criterion's throughput is per state.
@@ -410,6 +450,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = fma_puma560, fma_chain7, fma_gough_stewart, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector_wide_puma560, lanes_vector_wide_chain7, lanes_vector_wide_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_wide_gough_stewart, lanes8_wide_gough_stewart, lanes_wide_delta_rl5, lanes8_wide_delta_rl5, lanes_wide_agile_eye, lanes8_wide_agile_eye, lanes_wide_four_bar, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
+    targets = fma_puma560, fma_chain7, fma_gough_stewart, batch_chain7, batch_iiwa14, lanes_puma560, lanes_chain7, lanes_iiwa14, lanes_libm_puma560, lanes_libm_chain7, lanes_vector_puma560, lanes_vector_chain7, lanes_vector_iiwa14, lanes_vector_wide_puma560, lanes_vector_wide_chain7, lanes_vector_wide_iiwa14, lanes_vector8_puma560, lanes_vector8_chain7, lanes_vector8_iiwa14, lanes_gough_stewart, lanes_delta_rl5, lanes_agile_eye, lanes8_gough_stewart, lanes8_delta_rl5, lanes8_agile_eye, lanes_wide_gough_stewart, lanes8_wide_gough_stewart, lanes_wide_delta_rl5, lanes8_wide_delta_rl5, lanes_wide_agile_eye, lanes8_wide_agile_eye, lanes_wide_four_bar, lanes_four_bar, lanes_andrews_squeezer, sin_cos, wrappers
 }
 criterion_main!(benches);

@@ -1,7 +1,8 @@
 //! The PUMA 560 with `_lanes` functions (4 states per call) and the vector `sin_cos`: options
 //! whose code the bundled `mechanisms` crate does not hold, proved here too.
 //!
-//! The PUMA 560 with fused multiply–adds (`fma`), every function, through its `Dynamics` impl.
+//! The PUMA 560 with fused multiply–adds (`fma`) and its joint angles' `sin_cos` in one call
+//! (`batch_sin_cos`), every function, through its `Dynamics` impl.
 //! On x86 the proof is built with the target's FMA (`-C target-feature=+fma`; `.ci/run`): the
 //! runtime's `mul_add` is then the instruction, where the `libm` crate's `fma` picks the
 //! instruction or a fallback at run time through a function pointer, an indirect call the proof
@@ -29,6 +30,7 @@ fn main() {
         .spec(spec)
         .math(codegen::MathBackend::Runtime("runtime".into()))
         .fma(true)
+        .batch_sin_cos(true)
         .implement("runtime")
         .out_dir(&fma)
         .compile()

@@ -29,6 +29,7 @@ fn main() {
             .fma(true)
             .lanes(Some(lanes))
             .vector_sin_cos(true)
+            .batch_sin_cos(true)
             .out_dir(&dir)
             .compile()
             .unwrap_or_else(|e| panic!("\n{e}"));

@@ -1,6 +1,7 @@
 //! Shared helpers for nocdyn's integration tests: random models and states, error norms.
 #![allow(clippy::needless_range_loop)]
 
+pub mod agree;
 pub mod base_parameters;
 mod bundled;
 pub mod closed;

@@ -208,6 +208,32 @@ pub mod fma {
     }
 }
 
+/// The 7-joint chain, the iiwa 14 and the spherical five-bar with the `sin` and `cos` of a
+/// function's input angles in one call (`Config::batch_sin_cos`; `tests/tests/batch_sin_cos.rs`).
+pub mod batch_sin_cos {
+    /// The 7-joint chain, batched.
+    pub mod chain7 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/batch_sin_cos/chain7.rs"
+        ));
+    }
+    /// The iiwa 14 (its URDF), batched.
+    pub mod iiwa14 {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/batch_sin_cos/iiwa14.rs"
+        ));
+    }
+    /// The spherical five-bar, batched.
+    pub mod spherical_five_bar {
+        include!(concat!(
+            env!("OUT_DIR"),
+            "/variants/batch_sin_cos/spherical_five_bar.rs"
+        ));
+    }
+}
+
 /// Every bundled tree with `_lanes` functions of 4 states per call (`Config::lanes`;
 /// `tests/tests/lanes.rs`).
 pub mod lanes {

@@ -136,3 +136,32 @@ fn lanes_wide_operators() {
     }
     insta::assert_snapshot!("lanes_wide_planar_2r", diff);
 }
+
+/// `Config::batch_sin_cos`: the planar 2R with every function's joint angles in one
+/// `sin_cos_batch` call. The module is the plain one but for the header line, each function's
+/// `sin_cos` statements (one batched call after the statements its angles need) and the items
+/// appended; the snapshot is the line diff of the two (no context). Batching moves statements
+/// and adds none (`batch_sin_cos.rs` compares the op counts): the only backend call left is in
+/// `sin_cos_backend`, for angles beyond the polynomial's range.
+#[test]
+fn batch_sin_cos_statements() {
+    let spec = "planar_2r.toml";
+    let src = bundled(spec);
+    let code = |cfg: &Config| {
+        compile(spec, &src, cfg)
+            .unwrap_or_else(|d| panic!("{d}"))
+            .code
+    };
+    let plain = code(&Config::default());
+    let batched = code(&Config {
+        batch_sin_cos: true,
+        ..Config::default()
+    });
+    assert!(plain.matches("libm::sincos(").count() > 1);
+    assert_eq!(batched.matches("libm::sincos(").count(), 1);
+    let diff = similar::TextDiff::from_lines(&plain, &batched)
+        .unified_diff()
+        .context_radius(0)
+        .to_string();
+    insta::assert_snapshot!("batch_sin_cos_planar_2r", diff);
+}

@@ -1,6 +1,7 @@
 /// The arms (<= 9 DOF) that are also generated with fused multiply-adds (`Config::fma`), for the
 /// comparison with Pinocchio's CppADCodeGen code (README.md, "Against Pinocchio's code
-/// generation"). Their modules are `robots::fma::NAME`.
+/// generation"). Their modules are `robots::fma::NAME`, and with `Config::batch_sin_cos` too
+/// `robots::batch::NAME`.
 const FMA_ARMS: [&str; 8] = ["ur5", "ur10", "panda", "z1", "kinova", "xarm7", "iiwa14", "talos_left_arm"];
 
 fn main() {
@@ -25,6 +26,21 @@ fn main() {
     list.push_str("pub mod fma {\n");
     for m in f.module_names() {
         list.push_str(&format!("    pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/fma/{m}.rs\")); }}\n"));
+    }
+    list.push_str("}\n");
+    // The same again with every function's joint angles in one `sin_cos_batch` call
+    // (`Config::batch_sin_cos`): `robots::batch::NAME`.
+    let batch_dir = out.join("batch");
+    std::fs::create_dir_all(&batch_dir).unwrap();
+    let mut b = codegen::build_script::Builder::new();
+    b.math(codegen::MathBackend::Runtime("runtime".into())).fma(true).batch_sin_cos(true).out_dir(&batch_dir);
+    for a in FMA_ARMS {
+        b.spec(format!("urdf/{a}.urdf"));
+    }
+    b.compile().unwrap_or_else(|e| panic!("{e}"));
+    list.push_str("pub mod batch {\n");
+    for m in b.module_names() {
+        list.push_str(&format!("    pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/batch/{m}.rs\")); }}\n"));
     }
     list.push_str("}\n");
     std::fs::write(out.join("all.rs"), list).unwrap();

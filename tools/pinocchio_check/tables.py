@@ -1,7 +1,8 @@
 """The README's tables "Against Pinocchio's code generation" from one run of run.sh.
 
 Usage: python3 tables.py out/rust.txt out/cg.txt
-rust.txt: the `fma NAME ...` lines of src/main.rs (generated code without and with FMA);
+rust.txt: the `fma NAME ...` lines of src/main.rs (generated code without and with FMA, and with
+FMA and the joint angles' `sin_cos` in one call, `batch`);
 cg.txt: the `cg NAME ...` lines of bench_cg.cpp (plain Pinocchio, its CppADCodeGen code through
 the CodeGen classes' evalFunction, and the generated library called alone).
 """
@@ -20,11 +21,13 @@ def parse_rust(path):
         f = fields(line)
         name, dof = f[1], int(f[3])
         err = {"ID": float(f[7]), "M": float(f[9]), "dID": float(f[11])}
-        i = f.index("plain/fma:")
+        berr = {"ID": float(f[15]), "M": float(f[17]), "dID": float(f[19])}
+        i = f.index("plain/fma/batch:")
         ns = {}
         for k in range(4):
-            key, a, b = f[i + 1 + 3 * k], f[i + 2 + 3 * k], f[i + 3 + 3 * k]
-            ns[key] = (float(a), float(b))
+            key, a, b, c = f[i + 1 + 4 * k:i + 5 + 4 * k]
+            ns[key] = (float(a), float(b), float(c))
+        err = (err, berr)
         out[name] = (dof, err, ns)
     return out
 
@@ -61,17 +64,17 @@ def main():
     ]
     for k, (title, key, pname, cname, target) in enumerate(funcs):
         print(f"**{title}**, ns per call (Pinocchio {pname}, CppADCodeGen {cname})\n")
-        print("| robot | DOF | generated | generated FMA | Pinocchio | CppADCodeGen | CppADCodeGen raw "
-              "| CG ÷ generated | CG ÷ generated FMA | raw ÷ generated FMA |")
-        print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+        print("| robot | DOF | generated | generated FMA | FMA + batched `sin_cos` | Pinocchio | CppADCodeGen "
+              "| CppADCodeGen raw | CG ÷ generated | CG ÷ generated FMA | CG ÷ batched | raw ÷ batched |")
+        print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
         worst = None
         for n in names:
             dof, _, ns = rust[n]
-            g, gf = ns[key]
+            g, gf, gb = ns[key]
             _, _, plain, c, raw = cg[n]
-            best = min(g, gf)
-            print(f"| {n} | {dof} | {g:.0f} | {gf:.0f} | {plain[k]:.0f} | {c[k]:.0f} | {raw[k]:.0f} "
-                  f"| {c[k] / g:.1f} | {c[k] / gf:.1f} | {raw[k] / gf:.1f} |")
+            best = min(g, gf, gb)
+            print(f"| {n} | {dof} | {g:.0f} | {gf:.0f} | {gb:.0f} | {plain[k]:.0f} | {c[k]:.0f} | {raw[k]:.0f} "
+                  f"| {c[k] / g:.1f} | {c[k] / gf:.1f} | {c[k] / gb:.1f} | {raw[k] / gb:.1f} |")
             r = c[k] / best
             if worst is None or r < worst[1]:
                 worst = (n, r)
@@ -80,15 +83,17 @@ def main():
         print(f"\n{goal} (CppADCodeGen ÷ the faster generated variant): met on "
               f"{len(met)} of {len(names)} ({', '.join(met) or 'none'}); lowest ratio "
               f"{worst[1]:.2f} ({worst[0]}).\n")
-    print("Checks (worst relative error at 5 states, CppADCodeGen vs plain Pinocchio; FMA variant vs "
-          "Pinocchio over 200 states) and CppADCodeGen build time (taping + C generation + gcc, s):\n")
-    print("| robot | CG ID | CG M | CG ∂RNEA | CG ∂ABA | FMA ID | FMA M | FMA ∂ID | build s (ID, M, ∂ID, ∂FD) |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    print("Checks (worst relative error at 5 states, CppADCodeGen vs plain Pinocchio; FMA and batched "
+          "variants vs Pinocchio over 200 states) and CppADCodeGen build time (taping + C generation + gcc, s):\n")
+    print("| robot | CG ID | CG M | CG ∂RNEA | CG ∂ABA | FMA ID | FMA M | FMA ∂ID | batched ID | batched M "
+          "| batched ∂ID | build s (ID, M, ∂ID, ∂FD) |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for n in names:
         check, build, *_ = cg[n]
-        _, err, _ = rust[n]
+        _, (err, berr), _ = rust[n]
         print(f"| {n} | {check['ID']:.1e} | {check['M']:.1e} | {check['dRNEA']:.1e} | {check['dABA']:.1e} "
-              f"| {err['ID']:.1e} | {err['M']:.1e} | {err['dID']:.1e} | "
+              f"| {err['ID']:.1e} | {err['M']:.1e} | {err['dID']:.1e} "
+              f"| {berr['ID']:.1e} | {berr['M']:.1e} | {berr['dID']:.1e} | "
               + ", ".join(f"{b:.1f}" for b in build) + " |")
 
 

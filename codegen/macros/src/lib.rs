@@ -18,7 +18,8 @@
 //! ```text
 //! mechanism!("SPEC.toml" | "SPEC.urdf" [, math = "libm" | "std" | "runtime"] [, runtime_path = "P"] [, float = "f64" | "f32"]
 //!            [, implement = "P"] [, friction = true] [, rotor_inertia = true] [, snap = 1e-4]
-//!            [, fma = true] [, lanes = 4] [, vector_sin_cos = true] [, wide = "wide"])
+//!            [, fma = true] [, lanes = 4] [, vector_sin_cos = true] [, batch_sin_cos = true]
+//!            [, wide = "wide"])
 //! ```
 //!
 //! - The path is relative to the calling crate's `CARGO_MANIFEST_DIR` (its `Cargo.toml`
@@ -30,7 +31,8 @@
 //!   `--rotor-inertia` and `--snap TOL` (and `Builder`'s methods of the same names).
 //! - `fma`, `lanes` and `vector_sin_cos` are the CLI's `--fma` (fused multiply–adds), `--lanes N`
 //!   (`_lanes` functions of `N` states per call; trees) and `--vector-sin-cos` (with `lanes`:
-//!   `sin` and `cos` of all lanes at once), `Config`'s fields of the same names; `wide` (with
+//!   `sin` and `cos` of all lanes at once), and `batch_sin_cos` the CLI's `--batch-sin-cos` (a
+//!   scalar function's joint angles in one call), `Config`'s fields of the same names; `wide` (with
 //!   `lanes`) is `Config::wide`: the lanes' arithmetic through the `wide` crate, which the
 //!   calling crate names as given and depends on.
 //!   - `"libm"`: the calling crate needs the `libm` crate as a dependency (`libm = "0.2"`); the
@@ -121,11 +123,12 @@ struct Args {
     fma: Option<LitBool>,
     lanes: Option<syn::LitInt>,
     vector_sin_cos: Option<LitBool>,
+    batch_sin_cos: Option<LitBool>,
     wide: Option<LitStr>,
 }
 
 /// The options and the kind of literal each takes.
-const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement`, `wide` (strings), `friction`, `rotor_inertia`, `fma`, `vector_sin_cos` (`true` or `false`), `snap` (a number) or `lanes` (an integer)";
+const OPTIONS: &str = "`math`, `runtime_path`, `float`, `implement`, `wide` (strings), `friction`, `rotor_inertia`, `fma`, `vector_sin_cos`, `batch_sin_cos` (`true` or `false`), `snap` (a number) or `lanes` (an integer)";
 
 impl Parse for Args {
     fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
@@ -142,6 +145,7 @@ impl Parse for Args {
             fma: None,
             lanes: None,
             vector_sin_cos: None,
+            batch_sin_cos: None,
             wide: None,
         };
         while !input.is_empty() {
@@ -174,20 +178,22 @@ impl Parse for Args {
                     return Err(wrong("a string"));
                 }
                 (
-                    name @ ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos"),
+                    name @ ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos"
+                    | "batch_sin_cos"),
                     Lit::Bool(v),
                 ) => {
                     let slot = match name {
                         "friction" => &mut args.friction,
                         "rotor_inertia" => &mut args.rotor_inertia,
                         "fma" => &mut args.fma,
+                        "batch_sin_cos" => &mut args.batch_sin_cos,
                         _ => &mut args.vector_sin_cos,
                     };
                     if slot.replace(v.clone()).is_some() {
                         return Err(twice());
                     }
                 }
-                ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos", _) => {
+                ("friction" | "rotor_inertia" | "fma" | "vector_sin_cos" | "batch_sin_cos", _) => {
                     return Err(wrong("`true` or `false`"));
                 }
                 ("lanes", Lit::Int(v)) => {
@@ -325,6 +331,7 @@ impl Args {
             fma: self.fma.as_ref().is_some_and(LitBool::value),
             lanes,
             vector_sin_cos,
+            batch_sin_cos: self.batch_sin_cos.as_ref().is_some_and(LitBool::value),
             wide: self.wide.as_ref().map(LitStr::value),
         })
     }

@@ -16,13 +16,15 @@ mod planar_runtime {
     );
 }
 
-/// The same spec with fused multiply–adds and 4 states per call, `sin` and `cos` over the lanes.
+/// The same spec with fused multiply–adds and 4 states per call, `sin` and `cos` over the lanes
+/// and over each scalar function's angles.
 mod planar_lanes {
     nocdyn_macros::mechanism!(
         "../../mechanisms/specs/planar_2r.toml",
         fma = true,
         lanes = 4,
         vector_sin_cos = true,
+        batch_sin_cos = true,
     );
 }
 
@@ -105,8 +107,9 @@ fn gough_stewart_inverse_dynamics_at_home() {
     assert!(q.iter().all(|qi| qi.abs() <= 1e-12), "{q:?}");
 }
 
-/// The options `fma`, `lanes` and `vector_sin_cos` reach the generator: four states per call,
-/// each within rounding of the plain expansion's scalar inverse dynamics.
+/// The options `fma`, `lanes`, `vector_sin_cos` and `batch_sin_cos` reach the generator: four
+/// states per call, each within rounding of the plain expansion's scalar inverse dynamics, and
+/// the scalar function too.
 #[test]
 fn fma_and_lanes_options() {
     assert_eq!(planar_lanes::LANES, 4);
@@ -124,6 +127,11 @@ fn fma_and_lanes_options() {
         assert!(
             rel_err(&got, &want) <= 1e-13,
             "state {k}: {got:?} vs {want:?}"
+        );
+        let scalar = planar_lanes::inverse_dynamics(&s[0], &s[1], &s[2]);
+        assert!(
+            rel_err(&scalar, &want) <= 1e-13,
+            "state {k}: {scalar:?} vs {want:?}"
         );
     }
 }

@@ -270,8 +270,8 @@ frames!(
     iiwa14_tool: iiwa14::{tool_pose, tool_jacobian, tool_jacobian_dot_qd},
 );
 
-/// The PUMA 560 generated with `fma` and the `Dynamics` impl (`build.rs`): every function
-/// through the generic wrappers above, as a mechanism of its own (`MECHANISMS`).
+/// The PUMA 560 generated with `fma`, `batch_sin_cos` and the `Dynamics` impl (`build.rs`):
+/// every function through the generic wrappers above, as a mechanism of its own (`MECHANISMS`).
 #[allow(dead_code)]
 mod puma560_fma {
     include!(concat!(env!("OUT_DIR"), "/fma/puma560.rs"));

@@ -1,7 +1,7 @@
 //! Proof that the generated mechanisms link without std: a `#![no_std]` staticlib with its own
 //! panic handler that exports a C entry point for every generated function of every bundled
 //! mechanism (trees, parallel mechanisms and closed loops; a few in `f32`), and of the PUMA 560
-//! generated with `lanes`, `fma` and `vector_sin_cos` (and the 3-RRR and the four-bar with
+//! generated with `lanes`, `fma`, `vector_sin_cos` and `batch_sin_cos` (and the 3-RRR and the four-bar with
 //! `lanes`; the PUMA 560 and the 3-RRR also through the `wide` crate), and of a platform and a
 //! closed loop with frames read through the `Dynamics` trait (`build.rs`). Build with
 //! `cargo build -p tests-no-std --config 'profile.dev.panic="abort"'`; if anything pulls in std

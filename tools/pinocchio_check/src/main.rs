@@ -141,9 +141,11 @@ macro_rules! check_deriv {
     }};
 }
 
-/// Generated code without and with fused multiply-adds (`robots::NAME`, `robots::fma::NAME`) on
-/// the arms, for the table beside Pinocchio's CppADCodeGen code (`bench_cg.cpp`): the FMA
-/// variant's worst relative error against Pinocchio (ID, M, ∂ID), then ns per call of
+/// Generated code without and with fused multiply-adds (`robots::NAME`, `robots::fma::NAME`), and
+/// with both fused multiply-adds and the joint angles' `sin_cos` in one call
+/// (`robots::batch::NAME`), on the arms, for the table beside Pinocchio's CppADCodeGen code
+/// (`bench_cg.cpp`): the FMA and batched variants' worst relative errors against Pinocchio (ID,
+/// M, ∂ID), then ns per call of
 /// inverse_dynamics, mass_matrix, inverse_dynamics_derivatives and forward_dynamics_derivatives
 /// of each (median of 31 batches over the 200 states of `data/NAME.deriv.txt`, the whole result
 /// through `black_box`).
@@ -151,6 +153,7 @@ macro_rules! compare_fma {
     ($m:ident) => {{
         use robots::$m as g;
         use robots::fma::$m as f;
+        use robots::batch::$m as b;
         const N: usize = g::DOF;
         assert_eq!(g::JOINT_NAMES, f::JOINT_NAMES);
         let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".txt")).unwrap();
@@ -158,6 +161,7 @@ macro_rules! compare_fma {
         let pin_names: Vec<&str> = lines.next().unwrap().split(' ').collect();
         let perm: Vec<usize> = pin_names.iter().map(|n| g::JOINT_NAMES.iter().position(|m| m == n).expect("name")).collect();
         let (mut eid, mut emm) = (0.0f64, 0.0f64);
+        let (mut bid, mut bmm) = (0.0f64, 0.0f64);
         for line in lines {
             let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
             let take = |k: usize| -> [f64; N] {
@@ -170,10 +174,12 @@ macro_rules! compare_fma {
             for i in 0..N { for j in 0..N { mp[perm[i]][perm[j]] = v[4 * N + i * N + j]; } }
             eid = eid.max(rel(&f::inverse_dynamics(&q, &qd, &qdd), &tau));
             emm = emm.max(rel(f::mass_matrix(&q).as_flattened(), mp.as_flattened()));
+            bid = bid.max(rel(&b::inverse_dynamics(&q, &qd, &qdd), &tau));
+            bmm = bmm.max(rel(b::mass_matrix(&q).as_flattened(), mp.as_flattened()));
         }
         let text = std::fs::read_to_string(concat!("data/", stringify!($m), ".deriv.txt")).unwrap();
         let mut states: Vec<([f64; N], [f64; N], [f64; N], [f64; N])> = Vec::new();
-        let mut edid = 0.0f64;
+        let (mut edid, mut bdid) = (0.0f64, 0.0f64);
         for line in text.lines().skip(1) {
             let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
             let take = |k: usize| -> [f64; N] {
@@ -190,6 +196,8 @@ macro_rules! compare_fma {
             let (q, qd, qdd, t2) = (take(0), take(1), take(2), take(3));
             let (dq, dv) = f::inverse_dynamics_derivatives(&q, &qd, &qdd);
             edid = edid.max(rel(dq.as_flattened(), mat(0).as_flattened())).max(rel(dv.as_flattened(), mat(1).as_flattened()));
+            let (dq, dv) = b::inverse_dynamics_derivatives(&q, &qd, &qdd);
+            bdid = bdid.max(rel(dq.as_flattened(), mat(0).as_flattened())).max(rel(dv.as_flattened(), mat(1).as_flattened()));
             states.push((q, qd, qdd, t2));
         }
         let time = |h: &dyn Fn(&([f64; N], [f64; N], [f64; N], [f64; N])) -> f64| {
@@ -208,16 +216,20 @@ macro_rules! compare_fma {
         let ns = [
             time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics(q, qd, qdd))[0]),
             time(&|(q, qd, qdd, _)| std::hint::black_box(f::inverse_dynamics(q, qd, qdd))[0]),
+            time(&|(q, qd, qdd, _)| std::hint::black_box(b::inverse_dynamics(q, qd, qdd))[0]),
             time(&|(q, _, _, _)| std::hint::black_box(g::mass_matrix(q))[0][0]),
             time(&|(q, _, _, _)| std::hint::black_box(f::mass_matrix(q))[0][0]),
+            time(&|(q, _, _, _)| std::hint::black_box(b::mass_matrix(q))[0][0]),
             time(&|(q, qd, qdd, _)| std::hint::black_box(g::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]),
             time(&|(q, qd, qdd, _)| std::hint::black_box(f::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]),
+            time(&|(q, qd, qdd, _)| std::hint::black_box(b::inverse_dynamics_derivatives(q, qd, qdd)).0[0][0]),
             time(&|(q, qd, _, t2)| std::hint::black_box(g::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)),
             time(&|(q, qd, _, t2)| std::hint::black_box(f::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)),
+            time(&|(q, qd, _, t2)| std::hint::black_box(b::forward_dynamics_derivatives(q, qd, t2)).map(|(a, _, _)| a[0][0]).unwrap_or(0.0)),
         ];
         println!(
-            "fma {:16} dof {:2}  FMA errors: ID {:.1e} M {:.1e} dID {:.1e}  ns plain/fma: ID {:.0} {:.0}  M {:.0} {:.0}  IDD {:.0} {:.0}  FDD {:.0} {:.0}",
-            stringify!($m), N, eid, emm, edid, ns[0], ns[1], ns[2], ns[3], ns[4], ns[5], ns[6], ns[7]
+            "fma {:16} dof {:2}  FMA errors: ID {:.1e} M {:.1e} dID {:.1e}  batch errors: ID {:.1e} M {:.1e} dID {:.1e}  ns plain/fma/batch: ID {:.0} {:.0} {:.0}  M {:.0} {:.0} {:.0}  IDD {:.0} {:.0} {:.0}  FDD {:.0} {:.0} {:.0}",
+            stringify!($m), N, eid, emm, edid, bid, bmm, bdid, ns[0], ns[1], ns[2], ns[3], ns[4], ns[5], ns[6], ns[7], ns[8], ns[9], ns[10], ns[11]
         );
     }};
 }
