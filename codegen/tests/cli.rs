@@ -775,6 +775,20 @@ fn fma_with_libm_gets_a_note() {
     }
 }
 
+/// `--batch-sin-cos`: the module calls `sin_cos_batch` for its joint angles and says so in its
+/// header; the op-count table (stderr, `--stats`) is the one without the flag.
+#[test]
+fn batch_sin_cos_flag() {
+    let o = run(&[PUMA, "--batch-sin-cos", "--stats"]);
+    assert_eq!(o.status.code(), Some(0), "stderr: {}", stderr(&o));
+    let code = stdout(&o);
+    assert!(code.contains("= sin_cos_batch(["), "not batched");
+    assert!(code.contains("// Batched `sin_cos`: on"), "no header line");
+    let plain = run(&[PUMA, "--stats"]);
+    assert_eq!(stderr(&o), stderr(&plain), "op counts moved");
+    assert!(!stdout(&plain).contains("sin_cos_batch"));
+}
+
 /// `-o` naming the input (the spec, a URDF, its scene file), under any spelling of the path,
 /// is refused with exit 2 and the input left as it was, by generation, `draw`, `convert` and
 /// `reduce` as by `excite`, `identify` and `map` (docs/usage.md, "Output files"): each used to

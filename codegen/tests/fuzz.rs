@@ -987,6 +987,9 @@ mod binary {
             push("--fma");
         }
         if rng.chance(10) {
+            push("--batch-sin-cos");
+        }
+        if rng.chance(10) {
             // 2 to 16 states per call, for every kind of mechanism; other counts are refused,
             // naming the flag.
             let (n, ok) = *rng.pick(&[
