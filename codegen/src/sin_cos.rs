@@ -39,17 +39,22 @@ use crate::sym::{ExprId, Graph, Node};
 /// The largest `|x|` the reduction takes: `2¹⁹·π/2` rounded down.
 const RANGE: f64 = 823_549.0;
 
-/// The body of `Lanes::sin_cos` (`self` is the `Lanes`, of lanes `idx`; `backend` the body
-/// that calls the math backend per lane, for lanes out of range).
-pub(crate) fn lanes_body(idx: &[Literal], backend: TokenStream) -> TokenStream {
-    let real = emit::real();
-    // An `f32` lane is widened to `f64` and rounded back; an `f64` one needs no cast.
+/// The casts around the `f64` kernel (an `f32` argument is widened to `f64` and its values
+/// rounded back; an `f64` one needs none) and the literal of [`RANGE`].
+fn casts() -> (TokenStream, TokenStream, Literal) {
     let (widen, narrow) = if crate::scalar::single() {
         (quote!(as f64), quote!(as f32))
     } else {
         (TokenStream::new(), TokenStream::new())
     };
-    let range = Literal::f64_suffixed(RANGE);
+    (widen, narrow, Literal::f64_suffixed(RANGE))
+}
+
+/// The body of `Lanes::sin_cos` (`self` is the `Lanes`, of lanes `idx`; `backend` the body
+/// that calls the math backend per lane, for lanes out of range).
+pub(crate) fn lanes_body(idx: &[Literal], backend: TokenStream) -> TokenStream {
+    let real = emit::real();
+    let (widen, narrow, range) = casts();
     let in_range = idx
         .iter()
         .map(|i| quote!(#real::abs(self.0[#i]) #widen <= #range));
@@ -132,12 +137,7 @@ pub(crate) fn batches(cfg: &Config, g: &Graph, functions: &[emit::Function<'_>])
 /// `Lanes::sin_cos` brings it ([`crate::Config::vector_sin_cos`]).
 pub(crate) fn batch_items(cfg: &Config) -> TokenStream {
     let real = emit::real();
-    let (widen, narrow) = if crate::scalar::single() {
-        (quote!(as f64), quote!(as f32))
-    } else {
-        (TokenStream::new(), TokenStream::new())
-    };
-    let range = Literal::f64_suffixed(RANGE);
+    let (widen, narrow, range) = casts();
     let backend = emit::math_call(cfg, "sin_cos", quote!(x));
     let kernel = if cfg.vector_sin_cos && cfg.lanes.is_some() {
         TokenStream::new()

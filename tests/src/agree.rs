@@ -5,16 +5,7 @@
 use mechanisms::Dynamics;
 use rand::Rng;
 
-/// `‖a − b‖∞ / ‖b‖∞` (0 when both are 0).
-pub fn rel(a: &[f64], b: &[f64]) -> f64 {
-    let num = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
-    let den = b.iter().map(|y| y.abs()).fold(0.0, f64::max);
-    if num == 0.0 { 0.0 } else { num / den }
-}
+use crate::pkm::rel;
 
 /// A matrix's entries, row by row.
 pub fn flat<const N: usize>(m: &[[f64; N]; N]) -> Vec<f64> {

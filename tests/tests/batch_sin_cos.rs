@@ -78,7 +78,7 @@ fn far_and_non_finite_angles_take_the_backend() {
             _ => [f64::NAN; p::DOF],
         };
         let bound = |what: &str, a: &[f64], c: &[f64]| {
-            let e = tests::agree::rel(a, c);
+            let e = tests::pkm::rel(a, c);
             assert!(e <= BOUND, "{what} at {q:?}: {e:e}");
         };
         let same = |what: &str, a: String, c: String| assert_eq!(a, c, "{what} at {q:?}");

@@ -14,34 +14,33 @@ fn main() {
         list.push_str(&format!("pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/{m}.rs\")); }}\n"));
     }
     // The same arms with `mul_add` (one instruction where the target has FMA: run.sh builds with
-    // RUSTFLAGS="-C target-cpu=native").
-    let fma_dir = out.join("fma");
-    std::fs::create_dir_all(&fma_dir).unwrap();
-    let mut f = codegen::build_script::Builder::new();
-    f.math(codegen::MathBackend::Runtime("runtime".into())).fma(true).out_dir(&fma_dir);
-    for a in FMA_ARMS {
-        f.spec(format!("urdf/{a}.urdf"));
-    }
-    f.compile().unwrap_or_else(|e| panic!("{e}"));
-    list.push_str("pub mod fma {\n");
-    for m in f.module_names() {
-        list.push_str(&format!("    pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/fma/{m}.rs\")); }}\n"));
-    }
-    list.push_str("}\n");
-    // The same again with every function's joint angles in one `sin_cos_batch` call
-    // (`Config::batch_sin_cos`): `robots::batch::NAME`.
-    let batch_dir = out.join("batch");
-    std::fs::create_dir_all(&batch_dir).unwrap();
+    // RUSTFLAGS="-C target-cpu=native"), and again with every function's joint angles in one
+    // `sin_cos_batch` call (`Config::batch_sin_cos`).
+    list.push_str(&arms(&out, "fma", |b| {
+        b.fma(true);
+    }));
+    list.push_str(&arms(&out, "batch", |b| {
+        b.fma(true).batch_sin_cos(true);
+    }));
+    std::fs::write(out.join("all.rs"), list).unwrap();
+}
+
+/// The arms generated with the options `setup` sets into `$OUT_DIR/NAME`, and the text that
+/// declares them as `robots::NAME::ARM`.
+fn arms(out: &std::path::Path, name: &str, setup: impl FnOnce(&mut codegen::build_script::Builder)) -> String {
+    let dir = out.join(name);
+    std::fs::create_dir_all(&dir).unwrap();
     let mut b = codegen::build_script::Builder::new();
-    b.math(codegen::MathBackend::Runtime("runtime".into())).fma(true).batch_sin_cos(true).out_dir(&batch_dir);
+    b.math(codegen::MathBackend::Runtime("runtime".into())).out_dir(&dir);
+    setup(&mut b);
     for a in FMA_ARMS {
         b.spec(format!("urdf/{a}.urdf"));
     }
     b.compile().unwrap_or_else(|e| panic!("{e}"));
-    list.push_str("pub mod batch {\n");
+    let mut list = format!("pub mod {name} {{\n");
     for m in b.module_names() {
-        list.push_str(&format!("    pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/batch/{m}.rs\")); }}\n"));
+        list.push_str(&format!("    pub mod {m} {{ include!(concat!(env!(\"OUT_DIR\"), \"/{name}/{m}.rs\")); }}\n"));
     }
     list.push_str("}\n");
-    std::fs::write(out.join("all.rs"), list).unwrap();
+    list
 }
