@@ -123,13 +123,22 @@ pub(crate) fn kernel() -> TokenStream {
 /// without the option, byte for byte).
 pub(crate) fn batches(cfg: &Config, g: &Graph, functions: &[emit::Function<'_>]) -> bool {
     cfg.batch_sin_cos
-        && functions.iter().any(|f| {
-            let mut memo = HashMap::new();
-            f.schedule
-                .steps
-                .iter()
-                .any(|st| matches!(*st, Step::SinCos { arg, .. } if of_inputs(g, arg, &mut memo)))
+        && functions
+            .iter()
+            .any(|f| !members(g, &f.schedule).is_empty())
+}
+
+/// The `(sin, cos, arg)` of every `sin_cos` of `s` whose argument depends on the inputs alone,
+/// in schedule order: what [`batched`] puts in one call.
+fn members(g: &Graph, s: &Schedule) -> Vec<(usize, usize, ExprId)> {
+    let mut memo = HashMap::new();
+    s.steps
+        .iter()
+        .filter_map(|st| match *st {
+            Step::SinCos { sin, cos, arg } if of_inputs(g, arg, &mut memo) => Some((sin, cos, arg)),
+            _ => None,
         })
+        .collect()
 }
 
 /// The module items of [`crate::Config::batch_sin_cos`] (when it [`batches`]):
@@ -185,15 +194,7 @@ pub(crate) fn batch_items(cfg: &Config) -> TokenStream {
 /// their order) and before all others (a pure function: the order is free, and the guards keep
 /// theirs). `s` itself when there is none.
 pub(crate) fn batched(g: &Graph, s: &Schedule) -> Schedule {
-    let mut memo = HashMap::new();
-    let batch: Vec<(usize, usize, ExprId)> = s
-        .steps
-        .iter()
-        .filter_map(|st| match *st {
-            Step::SinCos { sin, cos, arg } if of_inputs(g, arg, &mut memo) => Some((sin, cos, arg)),
-            _ => None,
-        })
-        .collect();
+    let batch = members(g, s);
     if batch.is_empty() {
         return s.clone();
     }
@@ -272,8 +273,7 @@ pub(crate) fn batch_statement(g: &Graph, s: &Schedule) -> TokenStream {
     let sins = s.batch.iter().map(|&(sin, _, _)| emit::var(sin));
     let coss = s.batch.iter().map(|&(_, cos, _)| emit::var(cos));
     let args = s.batch.iter().map(|&(_, _, a)| emit::operand(g, s, a));
-    let holes = (0..pad).map(|_| quote!(_));
-    let holes2 = (0..pad).map(|_| quote!(_));
-    let zeros = (0..pad).map(|_| quote!(0.0));
-    quote!(let ([#(#sins,)* #(#holes),*], [#(#coss,)* #(#holes2),*]) = sin_cos_batch([#(#args,)* #(#zeros),*]);)
+    let holes = vec![quote!(_); pad];
+    let zeros = vec![quote!(0.0); pad];
+    quote!(let ([#(#sins,)* #(#holes),*], [#(#coss,)* #(#holes),*]) = sin_cos_batch([#(#args,)* #(#zeros),*]);)
 }
