@@ -4,8 +4,10 @@
 //! the full model and, step by step, takes the body (for parallel mechanisms: the group of
 //! corresponding bodies of every leg) whose reduction saves the most inverse-dynamics flops
 //! while the actuator efforts stay within the tolerance of the full model's — the largest
-//! relative error (∞-norm per state) over random regular states, evaluated by the runtime. It
-//! prints the table of every level tried and writes the cheapest spec that meets the tolerance.
+//! relative error (∞-norm per state) over random regular states, evaluated by the runtime. Each
+//! step also tries every group's point masses at once (bodies that turn together cost less only
+//! together). It prints the table of every level tried and writes the cheapest spec that meets
+//! the tolerance.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -383,8 +385,9 @@ impl Search<'_> {
         );
     }
 
-    /// One greedy step from `current` (at `cost` flops): tries reducing each group further,
-    /// prints a row per try, and returns the cheapest accepted level and its flops.
+    /// One greedy step from `current` (at `cost` flops): tries reducing each group further, and
+    /// every group to point masses at once ([`together`]), prints a row per try, and returns
+    /// the cheapest accepted level and its flops.
     fn step(
         &self,
         current: &Level,
@@ -393,25 +396,28 @@ impl Search<'_> {
         pb: &indicatif::ProgressBar,
     ) -> Option<(Level, usize)> {
         let mut best: Option<(Level, usize, f64, f64)> = None;
-        for g in groups {
-            if g.iter().any(|b| current.massless.contains(b)) {
+        let open: Vec<&Vec<String>> = groups
+            .iter()
+            .filter(|g| !g.iter().any(|b| current.massless.contains(b)))
+            .collect();
+        for l in open
+            .iter()
+            .flat_map(|g| tries(current, g))
+            .chain(together(current, &open))
+        {
+            pb.inc(1);
+            let Some((f, worst, rms)) = self.evaluate(&l) else {
                 continue;
-            }
-            for l in tries(current, g) {
-                pb.inc(1);
-                let Some((f, worst, rms)) = self.evaluate(&l) else {
-                    continue;
-                };
-                let ok = worst <= self.args.tolerance && f < cost;
-                outln!(
-                    "| {} | {f} |{} {worst:.2e} | {rms:.2e} | {} |",
-                    l.describe(),
-                    self.ns(&l),
-                    if ok { "yes" } else { "no" }
-                );
-                if ok && best.as_ref().is_none_or(|b| f < b.1) {
-                    best = Some((l, f, worst, rms));
-                }
+            };
+            let ok = worst <= self.args.tolerance && f < cost;
+            outln!(
+                "| {} | {f} |{} {worst:.2e} | {rms:.2e} | {} |",
+                l.describe(),
+                self.ns(&l),
+                if ok { "yes" } else { "no" }
+            );
+            if ok && best.as_ref().is_none_or(|b| f < b.1) {
+                best = Some((l, f, worst, rms));
             }
         }
         best.map(|(l, f, _, _)| (l, f))
@@ -437,6 +443,26 @@ fn tries(current: &Level, g: &[String]) -> Vec<Level> {
     l.massless.extend(g.iter().cloned());
     tries.push(l);
     tries
+}
+
+/// Every group of `open` that is not yet all point masses made point masses at once, when that
+/// is more than one group: bodies that turn together (a UPS leg's cylinder and piston) are one
+/// rotational inertia in the generated code, which costs fewer flops only once all of them
+/// lose theirs.
+fn together(current: &Level, open: &[&Vec<String>]) -> Option<Level> {
+    let mut l = current.clone();
+    let mut groups = 0;
+    for g in open {
+        if !g.iter().all(|b| l.point_mass.contains(b)) {
+            groups += 1;
+            for b in g.iter() {
+                if !l.point_mass.contains(b) {
+                    l.point_mass.push(b.clone());
+                }
+            }
+        }
+    }
+    (groups > 1).then_some(l)
 }
 
 /// Writes the spec at `level` to `-o` or standard output.

@@ -118,7 +118,7 @@ pub use parasitic::{
 pub use plan::{LegPlan, Plan};
 pub use pose::{Platform, platform};
 pub use shaft::{SHAFT_TOLERANCE, ShaftPlan};
-pub use ups::{UpsBody, UpsKin, UpsPlan};
+pub use ups::{UpsKin, UpsPlan};
 
 #[cfg(doc)]
 use crate::scalar::Real;

@@ -4,26 +4,10 @@
 //! at its S centre (`ups_force`, in place of steps 3–5) and its end-point inertia
 //! (`ups_inertia`).
 
-use alloc::vec::Vec;
-
 use super::plan::{LegPlan, cross3, dot3, sub3};
-use crate::algebra::{M, V, add, cm, cross, cv, dot, mv, scale, sub, zero3};
+use crate::algebra::{M, V, add, cross, dot, mv, scale, sub};
 use crate::model::{Mat3, Vec3, mat_vec};
 use crate::scalar::Real;
-
-/// One body of a closed-form UPS leg, resolved in the leg frame `(t, e₁′, s)` (see
-/// [`UpsPlan`]).
-#[derive(Clone, Debug)]
-pub struct UpsBody {
-    /// Mass.
-    pub mass: f64,
-    /// Mass centre relative to the U centre at home length (leg frame).
-    pub com: Vec3,
-    /// Inertia about the mass centre (leg frame, constant).
-    pub inertia: Mat3,
-    /// The body rides on the prismatic joint (its mass centre moves by `ρ − ρ_home` along `s`).
-    pub slides: bool,
-}
 
 /// The constants of the closed-form UPS leg (Khalil & Guegan, IEEE T-RO 20(4), 2004, §III;
 /// derivation at `ups_force`). It applies when the U's two axes are perpendicular, its second
@@ -38,8 +22,17 @@ pub struct UpsBody {
 pub struct UpsPlan {
     /// The U's first axis `e₀` (base frame, unit).
     pub e0: Vec3,
-    /// The leg's massive bodies after the U's cross (cylinder, piston, …).
-    pub bodies: Vec<UpsBody>,
+    /// The inertia of the leg's bodies after the U's cross (cylinder, piston, …) about the U
+    /// centre at home length, `J₀ = Σ I_b + m_b (|c_b|² 1 − c_b c_bᵀ)` (leg frame; `c_b` a
+    /// body's mass centre from the U centre, `I_b` its inertia about it).
+    pub inertia: Mat3,
+    /// Their first moment about the U centre at home length, `h₀ = Σ m_b c_b` (leg frame).
+    pub moment: Vec3,
+    /// The mass of the bodies that ride on the prismatic joint (their mass centres move by
+    /// `δ = ρ − ρ_home` along `s`).
+    pub sliding_mass: f64,
+    /// Their first moment at home length, `Σ m_b c_b` over them (leg frame).
+    pub sliding_moment: Vec3,
     /// The home leg length (the sliding bodies' mass centres are given there).
     pub length: f64,
 }
@@ -87,39 +80,51 @@ pub(super) fn ups_plan(lp: &LegPlan) -> Option<UpsPlan> {
     // Leg-frame coordinates of an L vector: Bᵀ x with B = [t e₁′ s].
     let bt = snap([t, y, sh]);
     let to_leg = |x: &Vec3| mat_vec(&bt, x);
-    let bodies = (1..lp.bodies.len())
-        .filter(|&k| !massless(k))
-        .map(|k| {
-            let (mass, com, inertia) = lp.bodies[k];
-            let h = &lp.homes[k];
-            let q = snap(crate::model::mat_mul(&bt, &h.rotation));
-            let isotropic = inertia[0][0] == inertia[1][1]
-                && inertia[1][1] == inertia[2][2]
-                && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
-                && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3];
-            let inertia = if isotropic {
-                inertia
-            } else {
-                snap(crate::model::mat_mul(
-                    &crate::model::mat_mul(&q, &inertia),
-                    &crate::model::transpose(&q),
-                ))
-            };
-            let rel = sub3(&h.apply(&com), &lp.u_centre);
-            UpsBody {
-                mass,
-                com: snap([to_leg(&rel), [0.0; 3], [0.0; 3]])[0],
-                inertia,
-                slides: k >= 2,
-            }
-        })
-        .collect();
-    let f = &lp.frame;
-    Some(UpsPlan {
-        e0: snap([mat_vec(&f.rotation, &e0), [0.0; 3], [0.0; 3]])[0],
-        bodies,
+    // The bodies after the U's cross, merged about the U centre (`ups_force_leg`).
+    let mut plan = UpsPlan {
+        e0: [0.0; 3],
+        inertia: [[0.0; 3]; 3],
+        moment: [0.0; 3],
+        sliding_mass: 0.0,
+        sliding_moment: [0.0; 3],
         length: lp.length,
-    })
+    };
+    for k in (1..lp.bodies.len()).filter(|&k| !massless(k)) {
+        let (mass, com, inertia) = lp.bodies[k];
+        let h = &lp.homes[k];
+        let q = snap(crate::model::mat_mul(&bt, &h.rotation));
+        let isotropic = inertia[0][0] == inertia[1][1]
+            && inertia[1][1] == inertia[2][2]
+            && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
+            && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3];
+        let inertia = if isotropic {
+            inertia
+        } else {
+            snap(crate::model::mat_mul(
+                &crate::model::mat_mul(&q, &inertia),
+                &crate::model::transpose(&q),
+            ))
+        };
+        let rel = sub3(&h.apply(&com), &lp.u_centre);
+        let c = snap([to_leg(&rel), [0.0; 3], [0.0; 3]])[0];
+        // The parallel-axis theorem: I_b + m_b (|c|² 1 − c cᵀ).
+        let c2 = dot3(&c, &c);
+        for i in 0..3 {
+            for j in 0..3 {
+                let diagonal = if i == j { c2 } else { 0.0 };
+                plan.inertia[i][j] += inertia[i][j] + mass * (diagonal - c[i] * c[j]);
+            }
+            plan.moment[i] += mass * c[i];
+        }
+        if k >= 2 {
+            plan.sliding_mass += mass;
+            for i in 0..3 {
+                plan.sliding_moment[i] += mass * c[i];
+            }
+        }
+    }
+    plan.e0 = snap([mat_vec(&lp.frame.rotation, &e0), [0.0; 3], [0.0; 3]])[0];
+    Some(plan)
 }
 
 /// The configuration of a closed-form UPS leg (base frame; see [`UpsPlan`]).
@@ -162,7 +167,11 @@ pub struct UpsKin<R> {
 /// 3. One Newton–Euler wrench per body (`f_b = m_b (a_b − g)`, `n_b = I_b α + ω × I_b ω`, `I_b`
 ///    constant in the leg frame), `a_b = α × r_b + ω × (ω × r_b)` plus, for the bodies on the
 ///    prismatic joint, `ρ̈ ẑ + 2ρ̇ ω × ẑ`; `N = Σ n_b + r_b × f_b` (about the U centre) and
-///    `F_z = Σ_{sliding} f_b·ẑ`.
+///    `F_z = Σ_{sliding} f_b·ẑ`. The bodies turn together, so the sums are taken once, by the
+///    leg's inertia `J` about the U centre and its first moments (the parallel-axis theorem;
+///    [`UpsPlan`]): `N = J α + ω × J ω − h × g + h_s × (ρ̈ ẑ + 2ρ̇ ω × ẑ)`,
+///    `F_z = (α × h_s + ω × (ω × h_s))_z + m_s (ρ̈ − g_z)`, with `J`, `h` and `h_s` polynomials in
+///    `δ = ρ − ρ_home` of constant coefficients.
 /// 4. Joint efforts `τ₀ = e₀·N = d N_x + c N_z`, `τ₁ = e₁′·N = N_y`, `τ_P = ±F_z`; the leg
 ///    Jacobian's columns are `∂v/∂θ̇₀ = ρ e₀ × ẑ = −ρ d ŷ`, `∂v/∂θ̇₁ = ρ x̂`, `∂v/∂q̇_P = ±ẑ`, so
 ///    `y = J⁻ᵀ τ = (N_y/ρ, −(N_x + (c/d) N_z)/ρ, F_z)`, then `y_x t + y_y e₁′ + y_z s`.
@@ -189,26 +198,35 @@ fn ups_force_leg<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, vl: V<R>, al: V<R>, gl: 
     let ay = (al[0] - rd2 * w[1]) * ip - w[0] * w[2];
     let alpha = [ax, ay, uk.cot * ax + w[0] * w[1] * (uk.inv_d * uk.inv_d)];
     let rdd = al[2] + uk.rho * (w[0] * w[0] + w[1] * w[1]);
-    // 3. Body wrenches, the moment about the U centre and the prismatic joint's force.
-    let mut nsum = zero3::<R>();
-    let mut fz = R::c(0.0);
-    for b in &up.bodies {
-        let mut r = cv::<R>(&b.com);
-        if b.slides {
-            r[2] = r[2] + (uk.rho - R::c(up.length));
-        }
-        let mut acc = add(cross(alpha, r), cross(w, cross(w, r)));
-        if b.slides {
-            // ρ̈ ẑ + 2ρ̇ ω × ẑ, ω × ẑ = (ω_y, −ω_x, 0).
-            acc = add(acc, [rd2 * w[1], -(rd2 * w[0]), rdd]);
-        }
-        let fb = scale(R::c(b.mass), sub(acc, gl));
-        let nb = euler_const(&b.inertia, w, alpha);
-        nsum = add(nsum, add(nb, cross(r, fb)));
-        if b.slides {
-            fz = fz + fb[2];
-        }
-    }
+    // 3. The bodies merged about the U centre, `δ = ρ − ρ_home` along ẑ for the sliding ones:
+    //    J(δ) = J₀ + δ J₁ + δ² m_s (1 − ẑẑᵀ), J₁ = 2 h_{s,z} 1 − (h_s ẑᵀ + ẑ h_sᵀ) (at home);
+    //    h = h₀ + m_s δ ẑ and h_s = h_{s,0} + m_s δ ẑ the first moments (all, sliding).
+    let delta = uk.rho - R::c(up.length);
+    let (ms, hs0) = (up.sliding_mass, up.sliding_moment);
+    let j1 = [
+        [2.0 * hs0[2], 0.0, -hs0[0]],
+        [0.0, 2.0 * hs0[2], -hs0[1]],
+        [-hs0[0], -hs0[1], 0.0],
+    ];
+    let j2 = [ms, ms, 0.0];
+    let jm: M<R> = core::array::from_fn(|i| {
+        core::array::from_fn(|k| {
+            let quadratic = if i == k { j2[i] } else { 0.0 };
+            R::c(up.inertia[i][k]) + delta * (R::c(j1[i][k]) + delta * R::c(quadratic))
+        })
+    });
+    let along = |h: &Vec3| [R::c(h[0]), R::c(h[1]), R::c(h[2]) + R::c(ms) * delta];
+    let (h, hs) = (along(&up.moment), along(&hs0));
+    // ρ̈ ẑ + 2ρ̇ ω × ẑ (ω × ẑ = (ω_y, −ω_x, 0)): the sliding bodies' acceleration beyond the
+    // cylinder's.
+    let slide = [rd2 * w[1], -(rd2 * w[0]), rdd];
+    // N = Σ I_b α + ω × I_b ω + r_b × m_b (a_b − g) = J α + ω × J ω − h × g + h_s × slide.
+    let nsum = add(
+        add(mv(&jm, alpha), cross(w, mv(&jm, w))),
+        sub(cross(hs, slide), cross(h, gl)),
+    );
+    // F_z = Σ_sliding m_b (a_b − g)·ẑ = (α × h_s + ω × (ω × h_s))_z + m_s (ρ̈ − g_z).
+    let fz = (cross(alpha, hs)[2] + cross(w, cross(w, hs))[2]) + R::c(ms) * (rdd - gl[2]);
     // 4. y = J⁻ᵀ τ (leg frame).
     let yx = nsum[1] * ip;
     let yy = -((nsum[0] + uk.cot * nsum[2]) * ip);
@@ -244,18 +262,4 @@ pub(super) fn ups_inertia<R: Real>(up: &UpsPlan, uk: &UpsKin<R>) -> M<R> {
         }
     }
     lam
-}
-
-/// Euler's equation `I ω̇ + ω × I ω` for a constant inertia `inertia` (in the frame of `w`,
-/// `wd`); `c ω̇` for an isotropic one.
-fn euler_const<R: Real>(inertia: &Mat3, w: V<R>, wd: V<R>) -> V<R> {
-    let c = inertia[0][0];
-    if [inertia[1][1], inertia[2][2]] == [c; 2]
-        && [inertia[0][1], inertia[0][2], inertia[1][2]] == [0.0; 3]
-        && [inertia[1][0], inertia[2][0], inertia[2][1]] == [0.0; 3]
-    {
-        return scale(R::c(c), wd);
-    }
-    let i = cm::<R>(inertia);
-    add(mv(&i, wd), cross(w, mv(&i, w)))
 }
