@@ -147,7 +147,9 @@ pub struct Config {
     /// once per angle, which is much of a tree's inverse dynamics and mass matrix on a host.
     /// Results differ from the backend's by rounding (within 2 ulp of `sin` and `cos`); an
     /// angle beyond `|x| = 2¹⁹·π/2` or not finite takes the backend for the whole call. Off by
-    /// default (the output is then byte for byte what it was); independent of `lanes`.
+    /// default (the output is then byte for byte what it was); independent of `lanes`. It
+    /// pays where vectors hold four `f64` or more (AVX2, AVX-512: `-C target-cpu`); built for
+    /// x86-64's baseline it is mostly slower (docs/performance.md).
     pub batch_sin_cos: bool,
     /// With `lanes`: `Some(path)` makes `Lanes`' arithmetic (`+ - * /`, negation, `sqrt`,
     /// `mul_add`) go through the vector types of the `wide` crate (version 1), which the

@@ -103,8 +103,8 @@ struct Cli {
     #[arg(long, requires = "lanes")]
     vector_sin_cos: bool,
     /// The scalar functions take `sin` and `cos` of their joint angles in one call, by the
-    /// same polynomial over them as one array (within 2 ulp of the backend's; faster on a
-    /// host: build with `-C target-cpu=native`).
+    /// same polynomial over them as one array (within 2 ulp of the backend's). Pays with AVX2
+    /// or wider (`-C target-cpu=native`); slower than the backend's calls on x86-64's baseline.
     #[arg(long)]
     batch_sin_cos: bool,
     /// With `--lanes`: the lanes' arithmetic through the `wide` crate's vector types (explicit
