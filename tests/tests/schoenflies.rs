@@ -272,3 +272,56 @@ fn schoenflies_with_drives_matches_joint_coordinates() {
         assert!(w <= 1e-12, "{worst:?}");
     }
 }
+
+/// The tool turned by whole turns is the same machine: at `θ + 2πk` (`k = ±1, ±2, ±3`, tool
+/// angles out to about 22 rad) the generated inverse dynamics, `A⁻ᵀ I A⁻¹` and forward dynamics
+/// equal those at `θ`, and `inverse_kinematics` the same motor angles modulo 2π (each revolute
+/// actuator's angle is returned in `(−π, π]`). With the checks above against independent routes,
+/// which draw `θ` within ±3 rad, this covers every tool angle.
+#[test]
+fn schoenflies_is_periodic_in_the_tool_angle() {
+    use mechanisms::delta4_rl5 as g;
+    use std::f64::consts::PI;
+    let m = model("delta4_rl5");
+    let plan = Plan::new(&m).unwrap();
+    let home = m.home_x();
+    let mut rng = tests::rng(0x2f1);
+    let wrapped = |d: f64| d - 2.0 * PI * (d / (2.0 * PI)).round();
+    let mut worst = [0.0f64; 4];
+    for _ in 0..200 {
+        let (x, u, ud) = random_state(&plan, &home, &mut rng, 3.0, 0.2 * m.size());
+        let x: [f64; 4] = x.try_into().unwrap();
+        let u: [f64; 4] = u.try_into().unwrap();
+        let ud: [f64; 4] = ud.try_into().unwrap();
+        let tau = g::inverse_dynamics(&x, &u, &ud).unwrap();
+        let mass = g::actuator_mass_matrix(&x).unwrap();
+        let acc = g::forward_dynamics(&x, &u, &tau).unwrap();
+        let q = g::inverse_kinematics(&x).unwrap();
+        for k in [-3.0, -2.0, -1.0, 1.0, 2.0, 3.0] {
+            let mut xk = x;
+            xk[3] += 2.0 * PI * k;
+            let qk = g::inverse_kinematics(&xk).unwrap();
+            let e = [
+                rel(&g::inverse_dynamics(&xk, &u, &ud).unwrap(), &tau),
+                rel(
+                    &g::actuator_mass_matrix(&xk).unwrap().concat(),
+                    &mass.concat(),
+                ),
+                rel(&g::forward_dynamics(&xk, &u, &tau).unwrap(), &acc),
+                (0..4)
+                    .map(|i| wrapped(qk[i] - q[i]).abs())
+                    .fold(0.0, f64::max),
+            ];
+            for (w, e) in worst.iter_mut().zip(e) {
+                *w = w.max(e);
+            }
+        }
+    }
+    println!(
+        "delta4_rl5: θ + 2πk against θ, worst relative error (∞-norm): ID {:.1e}, A⁻ᵀIA⁻¹ {:.1e}, FD {:.1e}; motor angles {:.1e} rad",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    for w in worst {
+        assert!(w <= 1e-12, "{worst:?}");
+    }
+}
