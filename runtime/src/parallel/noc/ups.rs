@@ -222,7 +222,7 @@ fn ups_force_leg<R: Real>(up: &UpsPlan, uk: &UpsKin<R>, vl: V<R>, al: V<R>, gl: 
     let slide = [rd2 * w[1], -(rd2 * w[0]), rdd];
     // N = Σ I_b α + ω × I_b ω + r_b × m_b (a_b − g) = J α + ω × J ω − h × g + h_s × slide.
     let nsum = add(
-        add(mv(&jm, alpha), cross(w, mv(&jm, w))),
+        euler(&jm, up.diagonal(), w, alpha),
         sub(cross(hs, slide), cross(h, gl)),
     );
     // F_z = Σ_sliding m_b (a_b − g)·ẑ = (α × h_s + ω × (ω × h_s))_z + m_s (ρ̈ − g_z).
@@ -262,4 +262,31 @@ pub(super) fn ups_inertia<R: Real>(up: &UpsPlan, uk: &UpsKin<R>) -> M<R> {
         }
     }
     lam
+}
+
+impl UpsPlan {
+    /// Whether the leg's inertia `J(δ)` about the U centre is diagonal in the leg frame at
+    /// every extension (its bodies' principal axes along the leg frame, the sliding ones'
+    /// mass centres on the leg axis).
+    fn diagonal(&self) -> bool {
+        let j = &self.inertia;
+        [j[0][1], j[0][2], j[1][2], j[1][0], j[2][0], j[2][1]] == [0.0; 6]
+            && self.sliding_moment[0] == 0.0
+            && self.sliding_moment[1] == 0.0
+    }
+}
+
+/// Euler's equation `J α + ω × J ω`; for a diagonal `J` in the principal form
+/// `J_x α_x + (J_z − J_y) ω_y ω_z`, … (so that a `J` symmetric about the leg axis, `J_x = J_y`,
+/// leaves no `z` term of `ω × J ω` in generated code).
+fn euler<R: Real>(j: &M<R>, diagonal: bool, w: V<R>, alpha: V<R>) -> V<R> {
+    if !diagonal {
+        return add(mv(j, alpha), cross(w, mv(j, w)));
+    }
+    let (jx, jy, jz) = (j[0][0], j[1][1], j[2][2]);
+    [
+        jx * alpha[0] + (jz - jy) * (w[1] * w[2]),
+        jy * alpha[1] - (jz - jx) * (w[2] * w[0]),
+        jz * alpha[2] + (jy - jx) * (w[0] * w[1]),
+    ]
 }
