@@ -159,7 +159,8 @@ pub(super) fn delta_kin<R: Real>(
 ///    `q̈ = (d·a − q̇² d·(e₀ × j) + |ṙ|²/L) / s`; `r̈ = a − Ë`.
 /// 3. The rod's wrench: `f = m (Ë + κ r̈ − g)` (`κ L` its mass centre from `E`),
 ///    `n = I⊥ ω̇ = I⊥ d × r̈ / L` (`ω` and `ω̇` are across `d`, so `ω × I ω = 0`).
-/// 4. Its power on `ċ = Ė + κ ṙ`, `ω = d × ṙ / L`: `f·Ė + F·ṙ` with `F = κ f + n × d / L`, so
+/// 4. Its power on `ċ = Ė + κ ṙ`, `ω = d × ṙ / L`: `f·Ė + F·ṙ` with `F = κ f + n × d / L`
+///    (`n × d = I⊥ (r̈ − (d·r̈) d) / L`, `d` a unit vector), so
 ///    `F` on `v` and `j·(f − F)` on the crank; the crank's own effort `J q̈ − e₀·(m r × g)`.
 /// 5. `y = F + (d/s) τ₀`, `τ₀` the crank's total effort (`q̇ = (d/s)·v`).
 pub(super) fn delta_force<R: Real>(
@@ -184,8 +185,12 @@ fn delta_force_leg<R: Real>(dp: &DeltaPlan, dk: &DeltaKin<R>, v: V<R>, a: V<R>, 
     let rdd = sub(a, ee);
     let kappa = R::c(dp.rod_com);
     let f = scale(R::c(dp.rod_mass), sub(add(ee, scale(kappa, rdd)), g));
-    let n = scale(R::c(dp.rod_inertia) * il, cross(dk.d, rdd));
-    let big_f = add(scale(kappa, f), scale(il, cross(n, dk.d)));
+    // n × d / L with n = I⊥ d × r̈ / L and |d| = 1: (d × r̈) × d = r̈ − (d·r̈) d.
+    let across = sub(rdd, scale(dot(dk.d, rdd), dk.d));
+    let big_f = add(
+        scale(kappa, f),
+        scale(R::c(dp.rod_inertia) * il * il, across),
+    );
     let crank = R::c(dp.crank_inertia) * qdd - dot(cv(&dp.e0), cross(dk.moment, g));
     let tau = crank + dot(dk.j, sub(f, big_f));
     add(big_f, scale(tau * dk.inv_s, dk.d))
