@@ -33,7 +33,7 @@ use quote::quote;
 
 use crate::Config;
 use crate::emit;
-use crate::schedule::{Operand, Schedule, Step};
+use crate::schedule::{Schedule, Step};
 use crate::sym::{ExprId, Graph, Node};
 
 /// The largest `|x|` the reduction takes: `2¹⁹·π/2` rounded down.
@@ -198,30 +198,28 @@ pub(crate) fn batched(g: &Graph, s: &Schedule) -> Schedule {
     if batch.is_empty() {
         return s.clone();
     }
+    let members: HashSet<usize> = batch.iter().map(|&(sin, _, _)| sin).collect();
+    let is_member = |st: &Step| matches!(*st, Step::SinCos { sin, .. } if members.contains(&sin));
     // The statements the arguments read, transitively (of the inputs alone, like them).
-    let var_of = |id: ExprId| match s.operand(g, id) {
-        Operand::Var(n) => Some(n),
-        _ => None,
-    };
     let defined: HashMap<usize, usize> = s
         .steps
         .iter()
         .enumerate()
-        .filter_map(|(i, st)| match *st {
-            Step::Let { name, .. } | Step::MulAdd { name, .. } => Some((name, i)),
-            _ => None,
-        })
+        .flat_map(|(i, st)| emit::step_vars(g, s, st).0.into_iter().map(move |v| (v, i)))
         .collect();
     let mut needed = HashSet::new();
-    let mut stack: Vec<usize> = batch.iter().filter_map(|&(_, _, a)| var_of(a)).collect();
+    let mut stack: Vec<usize> = s
+        .steps
+        .iter()
+        .filter(|st| is_member(st))
+        .flat_map(|st| emit::step_vars(g, s, st).1)
+        .collect();
     while let Some(v) = stack.pop() {
         let Some(&i) = defined.get(&v) else { continue };
         if needed.insert(i) {
             stack.extend(emit::step_vars(g, s, &s.steps[i]).1);
         }
     }
-    let members: HashSet<usize> = batch.iter().map(|&(sin, _, _)| sin).collect();
-    let is_member = |st: &Step| matches!(*st, Step::SinCos { sin, .. } if members.contains(&sin));
     let mut steps: Vec<Step> = (0..s.steps.len())
         .filter(|i| needed.contains(i))
         .map(|i| s.steps[i])
@@ -250,8 +248,7 @@ fn of_inputs(g: &Graph, id: ExprId, memo: &mut HashMap<ExprId, bool>) -> bool {
     let b = match g.node(id) {
         Node::Input(..) | Node::Const(_) => true,
         Node::Add(..) | Node::Sub(..) | Node::Mul(..) | Node::Neg(..) => {
-            let ops: Vec<ExprId> = g.operands(id).collect();
-            ops.into_iter().all(|o| of_inputs(g, o, memo))
+            g.operands(id).all(|o| of_inputs(g, o, memo))
         }
         _ => false,
     };

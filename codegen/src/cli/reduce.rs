@@ -428,14 +428,8 @@ impl Search<'_> {
 /// massless.
 fn tries(current: &Level, g: &[String]) -> Vec<Level> {
     let mut tries = Vec::new();
-    if !g.iter().all(|b| current.point_mass.contains(b)) {
-        let mut l = current.clone();
-        let add: Vec<String> = g
-            .iter()
-            .filter(|b| !l.point_mass.contains(b))
-            .cloned()
-            .collect();
-        l.point_mass.extend(add);
+    let mut l = current.clone();
+    if point_masses(&mut l, g) {
         tries.push(l);
     }
     let mut l = current.clone();
@@ -453,16 +447,21 @@ fn together(current: &Level, open: &[&Vec<String>]) -> Option<Level> {
     let mut l = current.clone();
     let mut groups = 0;
     for g in open {
-        if !g.iter().all(|b| l.point_mass.contains(b)) {
-            groups += 1;
-            for b in g.iter() {
-                if !l.point_mass.contains(b) {
-                    l.point_mass.push(b.clone());
-                }
-            }
-        }
+        groups += usize::from(point_masses(&mut l, g));
     }
     (groups > 1).then_some(l)
+}
+
+/// Makes the bodies of `g` point masses in `l`; whether any was not one already.
+fn point_masses(l: &mut Level, g: &[String]) -> bool {
+    let add: Vec<String> = g
+        .iter()
+        .filter(|b| !l.point_mass.contains(b))
+        .cloned()
+        .collect();
+    let any = !add.is_empty();
+    l.point_mass.extend(add);
+    any
 }
 
 /// Writes the spec at `level` to `-o` or standard output.
